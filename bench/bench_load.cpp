@@ -1,0 +1,101 @@
+// bench_load.cpp — ossa-bench-load: how much faster is opening a cooked file than importing its
+// source with Assimp, the thesis's loader and its stated future-work bottleneck?
+//
+//   ossa-bench-load [--min-seconds S] ASSET...
+//
+// Each ASSET (a source file) is cooked in-process with default options into a temporary directory.
+// Then, in this one process and one after the other, it times (a) Assimp::Importer::ReadFile with
+// the cooker's import flags and settings, and (b) ossa::Asset::open = mmap + FlatBuffers verify +
+// semantic checks (+ unmap). Each is repeated for at least --min-seconds (and at least 5 / 200
+// times); the median is reported. Output: a tab-separated table with a header, one row per asset:
+//   asset source_bytes cooked_bytes assimp_import_ms ossa_open_ms speedup
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <unistd.h>
+
+#include <assimp/Importer.hpp>
+#include <assimp/config.h>
+#include <assimp/scene.h>
+
+#include "cooker/cook.h"
+#include "cooker/import_scene.h"
+#include "runtime/asset.h"
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+template <class F>
+double median_ms(double min_seconds, int min_runs, F&& run) {
+  std::vector<double> samples;
+  const auto start = Clock::now();
+  while (static_cast<int>(samples.size()) < min_runs ||
+         std::chrono::duration<double>(Clock::now() - start).count() < min_seconds) {
+    const auto t0 = Clock::now();
+    if (!run()) return -1.0;
+    samples.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
+    if (samples.size() >= 100000) break;
+  }
+  std::sort(samples.begin(), samples.end());
+  return samples[samples.size() / 2];
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  double min_seconds = 1.0;
+  std::vector<fs::path> assets;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--min-seconds" && i + 1 < argc) min_seconds = std::atof(argv[++i]);
+    else if (a == "-h" || a == "--help") {
+      std::printf("usage: ossa-bench-load [--min-seconds S] ASSET...\n");
+      return 0;
+    } else assets.emplace_back(a);
+  }
+  if (assets.empty()) {
+    std::fprintf(stderr, "usage: ossa-bench-load [--min-seconds S] ASSET...\n");
+    return 2;
+  }
+  const fs::path tmp = fs::temp_directory_path() / ("ossa-bench-load-" + std::to_string(::getpid()));
+  int status = 0;
+  std::printf("asset\tsource_bytes\tcooked_bytes\tassimp_import_ms\tossa_open_ms\tspeedup\n");
+  for (size_t i = 0; i < assets.size(); ++i) {
+    const fs::path& src = assets[i];
+    const fs::path cooked = tmp / (std::to_string(i) + "-" + src.stem().string() + ".ossa");
+    const ossa::cook::CookRecord rec = ossa::cook::cook_file(src, cooked, {});
+    if (!rec.ok) {
+      std::fprintf(stderr, "ossa-bench-load: %s\n", rec.error.c_str());
+      status = 1;
+      continue;
+    }
+    Assimp::Importer importer;
+    importer.SetPropertyBool(AI_CONFIG_IMPORT_FBX_PRESERVE_PIVOTS, false);
+    const unsigned flags = ossa::cook::assimp_import_flags();
+    const double assimp_ms = median_ms(min_seconds, 5, [&] {
+      const bool ok = importer.ReadFile(src.string(), flags) != nullptr;
+      importer.FreeScene();
+      return ok;
+    });
+    const double ossa_ms = median_ms(min_seconds, 200, [&] { return ossa::Asset::open(cooked.string()).ok(); });
+    if (assimp_ms < 0 || ossa_ms < 0) {
+      std::fprintf(stderr, "ossa-bench-load: %s: load failed during timing\n", src.string().c_str());
+      status = 1;
+      continue;
+    }
+    std::printf("%s\t%llu\t%llu\t%.3f\t%.4f\t%.0f\n", src.filename().string().c_str(),
+                static_cast<unsigned long long>(rec.source_bytes), static_cast<unsigned long long>(rec.cooked_bytes),
+                assimp_ms, ossa_ms, assimp_ms / ossa_ms);
+    std::fflush(stdout);
+  }
+  std::error_code ec;
+  fs::remove_all(tmp, ec);
+  return status;
+}

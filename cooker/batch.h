@@ -1,0 +1,47 @@
+// batch.h — many inputs to many outputs: plan the output paths, cook in parallel, report.
+//
+// Planning happens before any cooking so that a batch with two inputs mapping to one output is
+// refused whole (nothing is written), while a batch whose inputs merely fail goes on to the end:
+// each failure is a record, the others are cooked. Records come back in input order whatever the
+// number of threads, so reports are stable and outputs are identical for any --jobs.
+#pragma once
+#include <cstddef>
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "cooker/cook.h"
+#include "format/result.h"
+
+namespace ossa::cook {
+
+struct BatchItem {
+  std::filesystem::path input;
+  std::filesystem::path output;
+};
+
+/// File extensions ossa-cook picks up when an input is a directory (lower case, with the dot).
+bool is_source_extension(const std::filesystem::path& path);
+
+/// Expands directory inputs (recursively, sorted, source extensions only) and maps each input to
+/// OUTDIR/<stem>.ossa, or with `root` to OUTDIR/<path relative to root>/<stem>.ossa. Errors: an
+/// input outside `root`, or two inputs mapping to one output (both named). Missing inputs are not
+/// errors here: they fail at cook time as their own record. O(inputs log inputs).
+Result<std::vector<BatchItem>> plan_batch(const std::vector<std::filesystem::path>& inputs,
+                                          const std::filesystem::path& out_dir,
+                                          const std::filesystem::path& root);
+
+/// Called after each item finishes, from the worker thread, serialized by the batch.
+using BatchProgress = std::function<void(size_t done, size_t total, const CookRecord& record)>;
+
+/// Cooks every item on `jobs` threads (>= 1). Returns one record per item, in item order.
+std::vector<CookRecord> run_batch(const std::vector<BatchItem>& items, const CookOptions& options,
+                                  unsigned jobs, const BatchProgress& progress);
+
+/// The --report document: cooker version, options, totals and one record per input.
+nlohmann::ordered_json report_json(const std::vector<CookRecord>& records, const CookOptions& options);
+
+}  // namespace ossa::cook

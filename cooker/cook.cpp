@@ -1,0 +1,190 @@
+// cook.cpp — one source file to one .ossa file (see cook.h): import, build meshes, write, rename.
+#include "cooker/cook.h"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+
+#include "cooker/import_scene.h"
+#include "cooker/mesh_build.h"
+#include "cooker/write_ossa.h"
+#include "format/hash.h"
+#include "runtime/asset.h"
+
+namespace ossa::cook {
+namespace fs = std::filesystem;
+
+std::string CookOptions::canonical() const {
+  std::string s = float_vertices ? "vertices=float32" : "vertices=quantized";
+  if (reference != nullptr) s += ";skeleton=" + reference_name;
+  return s;
+}
+
+namespace {
+
+Result<std::vector<uint8_t>> read_bytes(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return Error{path.string() + ": cannot open: " + std::strerror(errno)};
+  std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (in.bad()) return Error{path.string() + ": read error"};
+  return bytes;
+}
+
+void cook_into(CookRecord& record, const fs::path& input, const fs::path& output, const CookOptions& options) {
+  std::error_code ec;
+  if (fs::is_directory(input, ec)) {
+    record.error = input.string() + ": is a directory, not a source file";
+    return;
+  }
+  auto source = read_bytes(input);
+  if (!source) {
+    record.error = source.error().message;
+    return;
+  }
+  record.source_bytes = source->size();
+
+  ImportOptions import_options;
+  import_options.reference = options.reference;
+  auto scene = import_scene(input.string(), import_options);
+  if (!scene) {
+    record.error = scene.error().message;
+    return;
+  }
+  record.warnings = scene->warnings;
+
+  MeshOptions mesh_options;
+  mesh_options.float_vertices = options.float_vertices;
+  MeshBuildStats stats;
+  auto meshes = build_meshes(*scene, mesh_options, &stats, &record.warnings);
+  if (!meshes) {
+    record.error = input.string() + ": " + meshes.error().message;
+    return;
+  }
+
+  WriteProvenance provenance;
+  provenance.source_name = input.filename().string();
+  provenance.source_hash = hash_bytes(source->data(), source->size());
+  provenance.options = options.canonical();
+  // A clip-only file binds to its rig by hash and carries no skeleton; a file with meshes always
+  // carries the rig its joint palettes index (with --skeleton, the reference's, hash-identical).
+  WriteOptions write_options;
+  write_options.include_skeleton = options.reference == nullptr || !meshes->empty();
+  const std::vector<uint8_t> bytes = write_ossa(*scene, *meshes, provenance, write_options);
+
+  // The writer's output must pass the same checks every reader makes; a cooker bug is caught here
+  // rather than in a game.
+  if (Status st = verify_buffer(bytes, output.filename().string()); !st) {
+    record.error = input.string() + ": internal error, cooked bytes fail verification: " + st.message();
+    return;
+  }
+  if (Status st = write_file_atomic(output, bytes); !st) {
+    record.error = st.message();
+    return;
+  }
+
+  record.ok = true;
+  record.cooked_bytes = bytes.size();
+  record.joints = static_cast<uint32_t>(write_options.include_skeleton ? scene->skeleton.joints.size() : 0);
+  record.meshes = static_cast<uint32_t>(meshes->size());
+  for (const CookedMesh& m : *meshes) record.submeshes += static_cast<uint32_t>(m.submeshes.size());
+  record.vertices = stats.cooked_vertices;
+  record.triangles = stats.triangles;
+  record.clips = static_cast<uint32_t>(scene->clips.size());
+  record.materials = static_cast<uint32_t>(scene->materials.size());
+  for (const SourceMaterial& m : scene->materials) record.textures += static_cast<uint32_t>(m.textures.size());
+  record.vertices_over_4_influences = scene->vertices_over_4_influences;
+}
+
+}  // namespace
+
+CookRecord cook_file(const fs::path& input, const fs::path& output, const CookOptions& options) {
+  CookRecord record;
+  record.input = input.string();
+  record.output = output.string();
+  const auto start = std::chrono::steady_clock::now();
+  try {
+    cook_into(record, input, output, options);
+  } catch (const std::exception& e) {
+    record.ok = false;
+    record.error = input.string() + ": unexpected failure: " + e.what();
+  } catch (...) {
+    record.ok = false;
+    record.error = input.string() + ": unexpected failure";
+  }
+  record.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return record;
+}
+
+Result<SourceSkeleton> load_reference_skeleton(const fs::path& ossa_file) {
+  auto asset = Asset::open(ossa_file.string());
+  if (!asset) return asset.error();
+  const SkeletonView sk = asset->skeleton();
+  if (sk.empty() || sk.joint_count() == 0) return Error{ossa_file.string() + ": holds no skeleton to cook against"};
+  SourceSkeleton out;
+  out.joints.resize(sk.joint_count());
+  for (size_t i = 0; i < sk.joint_count(); ++i) {
+    SourceJoint& j = out.joints[i];
+    j.name = std::string(sk.joint_name(i));
+    j.parent = sk.parents()[i];
+    const fb::Vec3& t = sk.bind_translations()[i];
+    const fb::Quat& r = sk.bind_rotations()[i];
+    const fb::Vec3& s = sk.bind_scales()[i];
+    j.translation = {t.x(), t.y(), t.z()};
+    j.rotation = glm::quat(r.w(), r.x(), r.y(), r.z());
+    j.scale = {s.x(), s.y(), s.z()};
+    const auto* m = sk.inverse_bind()[i].m();
+    for (int c = 0; c < 4; ++c)
+      for (int r4 = 0; r4 < 4; ++r4) j.inverse_bind[c][r4] = m->Get(static_cast<flatbuffers::uoffset_t>(c * 4 + r4));
+  }
+  return out;
+}
+
+Status write_file_atomic(const fs::path& path, const std::vector<uint8_t>& bytes) {
+  static std::atomic<unsigned> counter{0};
+  std::error_code ec;
+  const fs::path dir = path.parent_path().empty() ? fs::path(".") : path.parent_path();
+  fs::create_directories(dir, ec);
+  if (ec) return Error{path.string() + ": cannot create directory " + dir.string() + ": " + ec.message()};
+  const fs::path tmp = dir / ("." + path.filename().string() + ".tmp-" + std::to_string(::getpid()) + "-" +
+                              std::to_string(counter.fetch_add(1)));
+  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+  if (fd < 0) return Error{path.string() + ": cannot create " + tmp.string() + ": " + std::strerror(errno)};
+  size_t done = 0;
+  bool ok = true;
+  std::string why;
+  while (done < bytes.size()) {
+    const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      ok = false;
+      why = std::strerror(errno);
+      break;
+    }
+    done += static_cast<size_t>(n);
+  }
+  if (ok && ::fsync(fd) != 0) {
+    ok = false;
+    why = std::strerror(errno);
+  }
+  if (::close(fd) != 0 && ok) {
+    ok = false;
+    why = std::strerror(errno);
+  }
+  if (ok && std::rename(tmp.c_str(), path.c_str()) != 0) {
+    ok = false;
+    why = std::strerror(errno);
+  }
+  if (!ok) {
+    ::unlink(tmp.c_str());
+    return Error{path.string() + ": write failed: " + why};
+  }
+  return {};
+}
+
+}  // namespace ossa::cook

@@ -1,0 +1,52 @@
+// cook.h — cook one source file into one .ossa file: import, build meshes, write, atomically.
+//
+// The batch driver (main.cpp) calls cook_file once per input, possibly from several threads; a
+// call touches nothing shared, so the bytes written do not depend on --jobs. The output is written
+// to a temporary file beside the target and renamed over it only when complete: a failed input
+// leaves no output file, and a reader never sees a half-written one.
+#pragma once
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "cooker/source_scene.h"
+#include "format/result.h"
+
+namespace ossa::cook {
+
+struct CookOptions {
+  bool float_vertices = false;
+  /// Clip-only cooking against this rig (loaded from --skeleton REF.ossa); null otherwise.
+  const SourceSkeleton* reference = nullptr;
+  std::string reference_name;  // REF.ossa's file name, recorded in the options string
+  /// Canonical text of the options that change output bytes, recorded in provenance.
+  std::string canonical() const;
+};
+
+/// One line of the --report file.
+struct CookRecord {
+  std::string input;
+  std::string output;
+  bool ok = false;
+  std::string error;                  // when !ok: "<input>: what is wrong"
+  std::vector<std::string> warnings;
+  uint32_t joints = 0, meshes = 0, submeshes = 0, vertices = 0, triangles = 0, clips = 0,
+           materials = 0, textures = 0;
+  uint32_t vertices_over_4_influences = 0;
+  uint64_t source_bytes = 0, cooked_bytes = 0;
+  double seconds = 0.0;
+};
+
+/// Cooks `input` to `output` (parent directories are created). Never throws.
+CookRecord cook_file(const std::filesystem::path& input, const std::filesystem::path& output,
+                     const CookOptions& options);
+
+/// Loads the skeleton of a cooked file (for --skeleton). Errors name the file.
+Result<SourceSkeleton> load_reference_skeleton(const std::filesystem::path& ossa_file);
+
+/// Writes bytes to a temporary file in path's directory, flushes, then renames it onto path.
+/// On any failure the temporary is removed and path is untouched.
+Status write_file_atomic(const std::filesystem::path& path, const std::vector<uint8_t>& bytes);
+
+}  // namespace ossa::cook

@@ -1,0 +1,35 @@
+// write_ossa.h — serialize a cooked scene into .ossa bytes (FlatBuffers), deterministically.
+//
+// Tables are created in a fixed order from ordered containers, vertex/index/texture byte vectors are
+// aligned to 16 with ForceVectorAlignment (flatc 2.0.8 parses force_align on vectors but does not
+// generate it), and nothing time- or address-dependent is written. The result verifies with
+// ossa::verify_buffer.
+#pragma once
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "cooker/mesh_build.h"
+#include "cooker/source_scene.h"
+
+namespace ossa::cook {
+
+struct WriteProvenance {
+  std::string source_name;   // file name only
+  uint64_t source_hash = 0;  // hash_bytes of the source file
+  std::string options;       // canonical option string
+};
+
+struct WriteOptions {
+  bool include_skeleton = true;  // false for clip-only files cooked against --skeleton
+};
+
+/// The skeleton hash of a SourceSkeleton (format/hash.h's skeleton_hash over its names/parents).
+uint64_t skeleton_hash_of(const SourceSkeleton& skeleton);
+
+/// Serializes. Clips are tagged with the hash of scene.skeleton. O(output size).
+std::vector<uint8_t> write_ossa(const SourceScene& scene, std::span<const CookedMesh> meshes,
+                                const WriteProvenance& provenance, const WriteOptions& options);
+
+}  // namespace ossa::cook

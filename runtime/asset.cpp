@@ -1,0 +1,313 @@
+// asset.cpp — Asset (mmap or aligned copy, then verify) and the typed views over it (asset.h).
+//
+// Loading order is cheapest-rejection first: size, alignment and identifier cost nothing and give
+// the clearest messages for the common mistakes (wrong file, truncated file); the FlatBuffers
+// verifier then proves every offset lies inside the buffer, and only then may validate_file and
+// the views dereference anything. The views are thin: each accessor is a pointer cast or a span
+// over a vector's bytes, because validation already proved what they could otherwise check.
+//
+// POSIX mmap is used directly rather than through a portability library: ossa targets Linux, and
+// the three calls are all there is. A mapped file that another process truncates while it is
+// mapped raises SIGBUS on access; like every mmap-based loader we accept that (cooked assets are
+// not rewritten in place: the cooker writes a new file and renames it).
+//
+// Cost: open is O(file size) (the verifier visits every table; the semantic checks scan indices
+// and joint slots); from_bytes adds one copy; every view accessor is O(1) except find_joint
+// (O(joints)) and ClipView::key_count (O(tracks)).
+#include "runtime/asset.h"
+
+#include <fcntl.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cassert>
+#include <cerrno>
+#include <cstring>
+#include <new>
+#include <utility>
+
+#include "format/version.h"
+#include "runtime/message.h"
+#include "runtime/validate.h"
+
+namespace ossa {
+namespace {
+
+constexpr size_t kAlignment = 16;
+// A FlatBuffer with an identifier is at least a root offset and the identifier.
+constexpr size_t kMinSize = 8;
+
+template <class V>
+size_t count_of(const V* v) {
+  return v ? v->size() : 0;
+}
+
+/// Span over a vector of FlatBuffers structs. The structs are laid out exactly as the generated
+/// C++ types (that is what FlatBuffers structs are), so the vector's bytes are an array of them.
+template <class T>
+std::span<const T> struct_span(const flatbuffers::Vector<const T*>* v) {
+  if (!v) return {};
+  return {reinterpret_cast<const T*>(v->Data()), v->size()};
+}
+
+template <class T>
+std::span<const T> scalar_span(const flatbuffers::Vector<T>* v) {
+  if (!v) return {};
+  return {v->data(), v->size()};
+}
+
+std::string_view view_of(const flatbuffers::String* s) {
+  return s ? std::string_view(s->c_str(), s->size()) : std::string_view();
+}
+
+Error error(std::string_view name, const std::string& what) { return Error{std::string(name) + ": " + what}; }
+
+std::string os_error(const char* what, int err) { return std::string(what) + ": " + std::strerror(err); }
+
+}  // namespace
+
+// ---- verification ------------------------------------------------------------------------------
+
+Status verify_buffer(std::span<const uint8_t> bytes, std::string_view name) {
+  if (bytes.size() < kMinSize)
+    return error(name, detail::format("too small to be an .ossa file (%zu bytes)", bytes.size()));
+  // FlatBuffers offsets are 32-bit signed: the verifier requires size < 2^31 - 1.
+  if (bytes.size() >= FLATBUFFERS_MAX_BUFFER_SIZE)
+    return error(name, detail::format("too large for a FlatBuffer (%zu bytes, the limit is 2 GiB)", bytes.size()));
+  if (reinterpret_cast<uintptr_t>(bytes.data()) % kAlignment != 0)
+    return error(name, "buffer is not 16-byte aligned in memory (copy it, or use Asset::from_bytes)");
+  if (!fb::FileBufferHasIdentifier(bytes.data())) {
+    const std::string_view id(reinterpret_cast<const char*>(bytes.data()) + 4, 4);
+    return error(name, "not an .ossa file (identifier '" + detail::printable(id) + "')");
+  }
+
+  flatbuffers::Verifier::Options options;
+  options.check_alignment = true;
+  // Every table costs at least 8 bytes (its vtable offset and the offset that reaches it), so
+  // size / 8 admits any real file, while still bounding the work on tables shared many times.
+  const size_t table_limit = bytes.size() / 8;
+  if (table_limit > options.max_tables) options.max_tables = static_cast<flatbuffers::uoffset_t>(table_limit);
+  flatbuffers::Verifier verifier(bytes.data(), bytes.size(), options);
+  if (!fb::VerifyFileBuffer(verifier))
+    return error(name, "corrupt: the FlatBuffers verifier rejected it (an offset, size or alignment is "
+                       "outside the buffer, or a required field is missing)");
+
+  const fb::File* file = fb::GetFile(bytes.data());
+  if (file->version() != kFormatVersion)
+    return error(name, detail::format("format version %u, this build reads %u (re-cook the asset)",
+                                      file->version(), kFormatVersion));
+  return validate_file(*file, name, bytes.size());
+}
+
+Status check_clip_binding(const ClipView& clip, const SkeletonView& skeleton, std::string_view name) {
+  const std::string label = "clip '" + detail::printable(clip.name()) + "'";
+  if (skeleton.empty()) return error(name, label + " needs a skeleton to play on, and none was given");
+  if (clip.skeleton_hash() != skeleton.hash())
+    return error(name, detail::format("%s was cooked for skeleton %016llx, not this one (%016llx)", label.c_str(),
+                                      static_cast<unsigned long long>(clip.skeleton_hash()),
+                                      static_cast<unsigned long long>(skeleton.hash())));
+  // Equal hashes mean equal rigs for honest files; a crafted clip could still claim more joints
+  // than the rig has, and its track indices are only checked against its own joint count.
+  if (clip.fb->joint_count() != skeleton.joint_count())
+    return error(name, detail::format("%s addresses %u joints, the skeleton has %zu", label.c_str(),
+                                      static_cast<unsigned>(clip.fb->joint_count()), skeleton.joint_count()));
+  return {};
+}
+
+// ---- Asset -------------------------------------------------------------------------------------
+
+Result<Asset> Asset::open(const std::string& path) {
+  // O_NONBLOCK: opening a FIFO (or a device) for reading must not wait for a writer before
+  // fstat can say it is not a regular file; it changes nothing for regular files or mmap.
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK | O_NOCTTY);
+  if (fd < 0) return error(path, os_error("cannot open", errno));
+  struct stat st;
+  if (::fstat(fd, &st) != 0) {
+    const int err = errno;
+    ::close(fd);
+    return error(path, os_error("cannot stat", err));
+  }
+  if (!S_ISREG(st.st_mode)) {
+    ::close(fd);
+    return error(path, "not a regular file");
+  }
+  const auto size = static_cast<uint64_t>(st.st_size);
+  if (size == 0) {
+    ::close(fd);
+    return error(path, "empty file");
+  }
+  if (size < kMinSize || size >= FLATBUFFERS_MAX_BUFFER_SIZE) {
+    ::close(fd);
+    return error(path, size < kMinSize
+                           ? detail::format("too small to be an .ossa file (%llu bytes)", static_cast<unsigned long long>(size))
+                           : detail::format("too large for a FlatBuffer (%llu bytes, the limit is 2 GiB)",
+                                            static_cast<unsigned long long>(size)));
+  }
+  void* mapping = ::mmap(nullptr, static_cast<size_t>(size), PROT_READ, MAP_PRIVATE, fd, 0);
+  const int map_errno = errno;
+  ::close(fd);  // the mapping keeps the file alive; the descriptor is no longer needed
+  if (mapping == MAP_FAILED) return error(path, os_error("cannot map", map_errno));
+
+  const std::span<const uint8_t> bytes(static_cast<const uint8_t*>(mapping), static_cast<size_t>(size));
+  if (Status s = verify_buffer(bytes, path); !s) {
+    ::munmap(mapping, static_cast<size_t>(size));
+    return s.error();
+  }
+  Asset asset;
+  asset.name_ = path;
+  asset.data_ = bytes.data();
+  asset.size_ = bytes.size();
+  asset.mapping_ = mapping;
+  asset.file_ = fb::GetFile(bytes.data());
+  return asset;
+}
+
+Result<Asset> Asset::from_bytes(std::span<const uint8_t> bytes, std::string name) {
+  // Reject what verify_buffer would reject before allocating for it.
+  if (bytes.size() < kMinSize || bytes.size() >= FLATBUFFERS_MAX_BUFFER_SIZE) {
+    if (Status s = verify_buffer(bytes, name); !s) return s.error();
+  }
+  void* heap = ::operator new(bytes.size(), std::align_val_t{kAlignment}, std::nothrow);
+  if (!heap) return error(name, detail::format("out of memory copying %zu bytes", bytes.size()));
+  std::memcpy(heap, bytes.data(), bytes.size());
+  const std::span<const uint8_t> copy(static_cast<const uint8_t*>(heap), bytes.size());
+  if (Status s = verify_buffer(copy, name); !s) {
+    ::operator delete(heap, std::align_val_t{kAlignment});
+    return s.error();
+  }
+  Asset asset;
+  asset.name_ = std::move(name);
+  asset.data_ = copy.data();
+  asset.size_ = copy.size();
+  asset.heap_ = heap;
+  asset.file_ = fb::GetFile(copy.data());
+  return asset;
+}
+
+Asset::Asset(Asset&& other) noexcept
+    : name_(std::move(other.name_)),
+      data_(std::exchange(other.data_, nullptr)),
+      size_(std::exchange(other.size_, 0)),
+      mapping_(std::exchange(other.mapping_, nullptr)),
+      heap_(std::exchange(other.heap_, nullptr)),
+      file_(std::exchange(other.file_, nullptr)) {}
+
+Asset& Asset::operator=(Asset&& other) noexcept {
+  if (this != &other) {
+    release();
+    name_ = std::move(other.name_);
+    data_ = std::exchange(other.data_, nullptr);
+    size_ = std::exchange(other.size_, 0);
+    mapping_ = std::exchange(other.mapping_, nullptr);
+    heap_ = std::exchange(other.heap_, nullptr);
+    file_ = std::exchange(other.file_, nullptr);
+  }
+  return *this;
+}
+
+Asset::~Asset() { release(); }
+
+void Asset::release() {
+  if (mapping_) ::munmap(mapping_, size_);
+  if (heap_) ::operator delete(heap_, std::align_val_t{kAlignment});
+  data_ = nullptr;
+  size_ = 0;
+  mapping_ = nullptr;
+  heap_ = nullptr;
+  file_ = nullptr;
+}
+
+SkeletonView Asset::skeleton() const { return SkeletonView{file_ ? file_->skeleton() : nullptr}; }
+size_t Asset::mesh_count() const { return file_ ? count_of(file_->meshes()) : 0; }
+MeshView Asset::mesh(size_t i) const {
+  assert(i < mesh_count());
+  return MeshView{file_->meshes()->Get(static_cast<flatbuffers::uoffset_t>(i))};
+}
+size_t Asset::clip_count() const { return file_ ? count_of(file_->clips()) : 0; }
+ClipView Asset::clip(size_t i) const {
+  assert(i < clip_count());
+  return ClipView{file_->clips()->Get(static_cast<flatbuffers::uoffset_t>(i))};
+}
+size_t Asset::material_count() const { return file_ ? count_of(file_->materials()) : 0; }
+const fb::Material& Asset::material(size_t i) const {
+  assert(i < material_count());
+  return *file_->materials()->Get(static_cast<flatbuffers::uoffset_t>(i));
+}
+
+// ---- SkeletonView ------------------------------------------------------------------------------
+
+size_t SkeletonView::joint_count() const { return fb ? fb->joint_names()->size() : 0; }
+
+std::string_view SkeletonView::joint_name(size_t joint) const {
+  if (joint >= joint_count()) return {};
+  return view_of(fb->joint_names()->Get(static_cast<flatbuffers::uoffset_t>(joint)));
+}
+
+std::span<const int16_t> SkeletonView::parents() const { return fb ? scalar_span(fb->parents()) : std::span<const int16_t>(); }
+std::span<const fb::Vec3> SkeletonView::bind_translations() const {
+  return fb ? struct_span(fb->bind_translations()) : std::span<const fb::Vec3>();
+}
+std::span<const fb::Quat> SkeletonView::bind_rotations() const {
+  return fb ? struct_span(fb->bind_rotations()) : std::span<const fb::Quat>();
+}
+std::span<const fb::Vec3> SkeletonView::bind_scales() const {
+  return fb ? struct_span(fb->bind_scales()) : std::span<const fb::Vec3>();
+}
+std::span<const fb::Mat4> SkeletonView::inverse_bind() const {
+  return fb ? struct_span(fb->inverse_bind()) : std::span<const fb::Mat4>();
+}
+uint64_t SkeletonView::hash() const { return fb ? fb->hash() : 0; }
+
+int SkeletonView::find_joint(std::string_view name) const {
+  const size_t n = joint_count();
+  for (size_t i = 0; i < n; ++i)
+    if (view_of(fb->joint_names()->Get(static_cast<flatbuffers::uoffset_t>(i))) == name) return static_cast<int>(i);
+  return -1;
+}
+
+// ---- MeshView ----------------------------------------------------------------------------------
+
+std::string_view MeshView::name() const { return view_of(fb->name()); }
+uint32_t MeshView::vertex_count() const { return fb->vertex_count(); }
+uint32_t MeshView::vertex_stride() const { return fb->vertex_stride(); }
+std::span<const fb::VertexAttribute> MeshView::layout() const { return struct_span(fb->layout()); }
+
+const fb::VertexAttribute* MeshView::attribute(fb::VertexSemantic semantic) const {
+  for (const fb::VertexAttribute& a : layout())
+    if (a.semantic() == semantic) return &a;
+  return nullptr;
+}
+
+std::span<const uint8_t> MeshView::vertex_bytes() const { return scalar_span(fb->vertices()); }
+fb::IndexFormat MeshView::index_format() const { return fb->index_format(); }
+uint32_t MeshView::index_count() const {
+  const size_t index_size = fb->index_format() == fb::IndexFormat::Uint32 ? 4 : 2;
+  return static_cast<uint32_t>(fb->indices()->size() / index_size);
+}
+std::span<const uint8_t> MeshView::index_bytes() const { return scalar_span(fb->indices()); }
+std::span<const fb::Submesh> MeshView::submeshes() const { return struct_span(fb->submeshes()); }
+std::span<const uint16_t> MeshView::joints() const { return scalar_span(fb->joints()); }
+std::span<const fb::Mat4> MeshView::inverse_bind() const { return struct_span(fb->inverse_bind()); }
+
+// ---- ClipView ----------------------------------------------------------------------------------
+
+std::string_view ClipView::name() const { return view_of(fb->name()); }
+float ClipView::duration() const { return fb->duration(); }
+float ClipView::sample_rate() const { return fb->sample_rate(); }
+uint64_t ClipView::skeleton_hash() const { return fb->skeleton_hash(); }
+size_t ClipView::track_count() const { return fb->tracks()->size(); }
+
+const fb::Track& ClipView::track(size_t i) const {
+  assert(i < track_count());
+  return *fb->tracks()->Get(static_cast<flatbuffers::uoffset_t>(i));
+}
+
+size_t ClipView::key_count() const {
+  size_t keys = 0;
+  for (const fb::Track* t : *fb->tracks())
+    keys += count_of(t->translation_times()) + count_of(t->rotation_times()) + count_of(t->scale_times());
+  return keys;
+}
+
+}  // namespace ossa

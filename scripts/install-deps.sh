@@ -1,0 +1,27 @@
+#!/usr/bin/env bash
+# install-deps.sh — installs everything ossa builds, tests and demos with, from Debian 12 packages.
+# Idempotent: apt runs only when a package is missing. Uses sudo when not root.
+set -euo pipefail
+
+PACKAGES=(
+  cmake ninja-build g++ pkg-config git
+  libassimp-dev libglm-dev libglfw3-dev flatbuffers-compiler libflatbuffers-dev libstb-dev
+  libopenmesh-dev libmeshoptimizer-dev libcli11-dev nlohmann-json3-dev
+  libgtest-dev libgmock-dev libbenchmark-dev libimgui-dev libepoxy-dev
+  xvfb xauth libgl1-mesa-dri libglx-mesa0 mesa-utils
+  clang libclang-rt-14-dev
+)
+
+missing=()
+for p in "${PACKAGES[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if ((${#missing[@]} == 0)); then
+  echo "install-deps: all ${#PACKAGES[@]} packages present"
+  exit 0
+fi
+SUDO=""
+[ "$(id -u)" -eq 0 ] || SUDO="sudo"
+echo "install-deps: installing ${missing[*]}"
+$SUDO apt-get update -q
+DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -q --no-install-recommends "${missing[@]}"

@@ -1,0 +1,450 @@
+// accuracy_test.cpp — the cooked file against the source, as Assimp itself evaluates it.
+//
+// For each asset: (1) every cooked joint's bind model-space position equals the global transform
+// of the Assimp node of that name; (2) every de-quantized vertex lies within the quantization bound
+// of a source vertex, and skinning it with the cooked palette in the bind pose lands on Assimp's
+// bind-pose skinning of a source vertex; (3) at the first, middle and last source key times of each
+// clip, the model-space joint positions from the cooked keys equal Assimp's node animation
+// evaluated at that time. Assimp is asked with the cooker's own import flags.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include <assimp/Importer.hpp>
+#include <assimp/config.h>
+#include <assimp/scene.h>
+#include <glm/glm.hpp>
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/quaternion.hpp>
+#include <glm/gtc/type_ptr.hpp>
+
+#include "cooker/cook.h"
+#include "cooker/import_scene.h"
+#include "format/vertex_codec.h"
+#include "runtime/asset.h"
+#include "test_files.h"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+glm::mat4 to_glm(const aiMatrix4x4& m) { return glm::transpose(glm::make_mat4(&m.a1)); }
+glm::mat4 to_glm(const ossa::fb::Mat4& m) {
+  glm::mat4 r;
+  for (int i = 0; i < 16; ++i) glm::value_ptr(r)[i] = m.m()->Get(static_cast<flatbuffers::uoffset_t>(i));
+  return r;
+}
+glm::mat4 trs(glm::vec3 t, glm::quat r, glm::vec3 s) {
+  return glm::translate(glm::mat4(1.0f), t) * glm::mat4_cast(r) * glm::scale(glm::mat4(1.0f), s);
+}
+
+/// Every node with this name: names are not unique in every file (Blender exports an object and
+/// a bone of the same name), so the tests accept the one that matches best.
+void find_nodes(const aiNode* n, const std::string& name, std::vector<const aiNode*>* out) {
+  if (name == n->mName.C_Str()) out->push_back(n);
+  for (unsigned c = 0; c < n->mNumChildren; ++c) find_nodes(n->mChildren[c], name, out);
+}
+
+glm::mat4 node_global(const aiNode* n) {
+  glm::mat4 m(1.0f);
+  for (; n != nullptr; n = n->mParent) m = to_glm(n->mTransformation) * m;
+  return m;
+}
+
+/// Points for nearest-neighbour queries: a uniform hash grid.
+class PointSet {
+ public:
+  explicit PointSet(float cell) : cell_(std::max(cell, 1e-6f)) {}
+  void add(glm::vec3 p) {
+    points_.push_back(p);
+    grid_[key(cell_of(p))].push_back(static_cast<uint32_t>(points_.size() - 1));
+  }
+  /// Distance to the nearest point within one cell's reach (infinity when none).
+  float nearest(glm::vec3 p) const {
+    const glm::ivec3 c = cell_of(p);
+    float best = INFINITY;
+    for (int dz = -1; dz <= 1; ++dz)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
+          auto it = grid_.find(key(c + glm::ivec3(dx, dy, dz)));
+          if (it == grid_.end()) continue;
+          for (uint32_t i : it->second) best = std::min(best, glm::distance(p, points_[i]));
+        }
+    return best;
+  }
+
+ private:
+  glm::ivec3 cell_of(glm::vec3 p) const { return glm::ivec3(glm::floor(p / cell_)); }
+  static int64_t key(glm::ivec3 c) {
+    return (int64_t(c.x) * 73856093) ^ (int64_t(c.y) * 19349663) ^ (int64_t(c.z) * 83492791);
+  }
+  float cell_;
+  std::vector<glm::vec3> points_;
+  std::unordered_map<int64_t, std::vector<uint32_t>> grid_;
+};
+
+struct Sampled {
+  glm::vec3 t;
+  glm::quat r;
+  glm::vec3 s;
+};
+
+template <class Key>
+double key_time(const Key& k) { return k.mTime; }
+
+/// Assimp's channel value at `ticks`, interpolated linearly (slerp for rotations), clamped.
+glm::vec3 eval_vec(const aiVectorKey* keys, unsigned n, double ticks, glm::vec3 fallback) {
+  if (n == 0) return fallback;
+  if (ticks <= keys[0].mTime) return {keys[0].mValue.x, keys[0].mValue.y, keys[0].mValue.z};
+  for (unsigned i = 0; i + 1 < n; ++i)
+    if (ticks < keys[i + 1].mTime) {
+      const float a = static_cast<float>((ticks - keys[i].mTime) / (keys[i + 1].mTime - keys[i].mTime));
+      const aiVector3D v = keys[i].mValue * (1 - a) + keys[i + 1].mValue * a;
+      return {v.x, v.y, v.z};
+    }
+  const aiVector3D& v = keys[n - 1].mValue;
+  return {v.x, v.y, v.z};
+}
+glm::quat eval_quat(const aiQuatKey* keys, unsigned n, double ticks, glm::quat fallback) {
+  auto q = [](const aiQuaternion& a) { return glm::quat(a.w, a.x, a.y, a.z); };
+  if (n == 0) return fallback;
+  if (ticks <= keys[0].mTime) return q(keys[0].mValue);
+  for (unsigned i = 0; i + 1 < n; ++i)
+    if (ticks < keys[i + 1].mTime) {
+      const float a = static_cast<float>((ticks - keys[i].mTime) / (keys[i + 1].mTime - keys[i].mTime));
+      return glm::slerp(q(keys[i].mValue), q(keys[i + 1].mValue), a);
+    }
+  return q(keys[n - 1].mValue);
+}
+
+/// Cooked channel value at `t` seconds: linear / nlerp between the bracketing keys, clamped.
+template <class V, class F>
+V eval_cooked(const flatbuffers::Vector<float>* times, const flatbuffers::Vector<const V*>* values, float t,
+              F&& mix, V fallback_unused, bool* present) {
+  (void)fallback_unused;
+  *present = times != nullptr && times->size() > 0;
+  if (!*present) return V{};
+  const unsigned n = times->size();
+  if (t <= times->Get(0)) return *values->Get(0);
+  for (unsigned i = 0; i + 1 < n; ++i)
+    if (t < times->Get(i + 1)) {
+      const float a = (t - times->Get(i)) / (times->Get(i + 1) - times->Get(i));
+      return mix(*values->Get(i), *values->Get(i + 1), a);
+    }
+  return *values->Get(n - 1);
+}
+
+std::vector<glm::mat4> bind_models(const ossa::SkeletonView& sk) {
+  std::vector<glm::mat4> model(sk.joint_count());
+  for (size_t i = 0; i < sk.joint_count(); ++i) {
+    const auto& t = sk.bind_translations()[i];
+    const auto& r = sk.bind_rotations()[i];
+    const auto& s = sk.bind_scales()[i];
+    const glm::mat4 local = trs({t.x(), t.y(), t.z()}, glm::quat(r.w(), r.x(), r.y(), r.z()), {s.x(), s.y(), s.z()});
+    const int p = sk.parents()[i];
+    model[i] = p < 0 ? local : model[static_cast<size_t>(p)] * local;
+  }
+  return model;
+}
+
+float skeleton_extent(const std::vector<glm::mat4>& model) {
+  glm::vec3 lo(INFINITY), hi(-INFINITY);
+  for (const glm::mat4& m : model) {
+    lo = glm::min(lo, glm::vec3(m[3]));
+    hi = glm::max(hi, glm::vec3(m[3]));
+  }
+  return model.empty() ? 1.0f : std::max(glm::length(hi - lo), 1e-3f);
+}
+
+struct AccuracyCase {
+  const char* name;
+  const char* path;  // relative to the repo (assets/...) or to ../shared/assets (shared:...)
+};
+
+fs::path resolve(const AccuracyCase& c) {
+  const std::string p = c.path;
+  if (p.rfind("shared:", 0) == 0) return ossa::test::shared_assets() / p.substr(7);
+  return ossa::test::source_dir() / p;
+}
+
+class Accuracy : public ::testing::TestWithParam<AccuracyCase> {
+ protected:
+  void SetUp() override {
+    source_ = resolve(GetParam());
+    if (!fs::exists(source_)) GTEST_SKIP() << "notice: " << source_ << " is absent";
+    const fs::path out = ossa::test::make_temp_dir("accuracy") / "out.ossa";
+    const auto rec = ossa::cook::cook_file(source_, out, {});
+    ASSERT_TRUE(rec.ok) << rec.error;
+    auto a = ossa::Asset::open(out.string());
+    ASSERT_TRUE(a.ok()) << a.error().message;
+    asset_ = std::make_unique<ossa::Asset>(std::move(*a));
+    importer_.SetPropertyBool(AI_CONFIG_IMPORT_FBX_PRESERVE_PIVOTS, false);
+    scene_ = importer_.ReadFile(source_.string(), ossa::cook::assimp_import_flags());
+    ASSERT_NE(scene_, nullptr) << importer_.GetErrorString();
+  }
+  fs::path source_;
+  std::unique_ptr<ossa::Asset> asset_;
+  Assimp::Importer importer_;
+  const aiScene* scene_ = nullptr;
+};
+
+TEST_P(Accuracy, BindPoseMatchesAssimpNodes) {
+  const ossa::SkeletonView sk = asset_->skeleton();
+  if (sk.empty()) GTEST_SKIP() << "no skeleton";
+  const auto model = bind_models(sk);
+  const float tol = 1e-4f * skeleton_extent(model) + 1e-5f;
+  for (size_t i = 0; i < sk.joint_count(); ++i) {
+    const std::string name(sk.joint_name(i));
+    std::vector<const aiNode*> nodes;
+    find_nodes(scene_->mRootNode, name, &nodes);
+    ASSERT_FALSE(nodes.empty()) << "cooked joint " << name << " is no node of the source";
+    glm::mat4 g = node_global(nodes[0]);
+    for (const aiNode* n : nodes)
+      if (glm::distance(glm::vec3(node_global(n)[3]), glm::vec3(model[i][3])) <
+          glm::distance(glm::vec3(g[3]), glm::vec3(model[i][3])))
+        g = node_global(n);
+    EXPECT_LE(glm::distance(glm::vec3(g[3]), glm::vec3(model[i][3])), tol) << "joint " << i << " " << name;
+    for (int c = 0; c < 3; ++c)
+      EXPECT_LE(glm::distance(glm::vec3(g[c]), glm::vec3(model[i][c])), 2e-4f * glm::length(glm::vec3(g[c])) + 1e-5f)
+          << "joint " << name << " axis " << c;
+    // The stored inverse bind is the inverse of that model matrix.
+    const glm::mat4 ib = to_glm(sk.inverse_bind()[i]);
+    const glm::mat4 id = ib * model[i];
+    for (int c = 0; c < 4; ++c)
+      for (int r = 0; r < 4; ++r) EXPECT_NEAR(id[c][r], c == r ? 1.0f : 0.0f, 1e-3f) << name;
+  }
+}
+
+TEST_P(Accuracy, DequantizedVerticesMatchSource) {
+  if (asset_->mesh_count() == 0) GTEST_SKIP() << "no mesh";
+  // Candidate source positions: each mesh in its own space and placed by its node (static files
+  // are baked into model space).
+  std::vector<glm::vec3> mesh_space, skinned_bind;
+  std::vector<const aiNode*> stack{scene_->mRootNode};
+  while (!stack.empty()) {
+    const aiNode* n = stack.back();
+    stack.pop_back();
+    for (unsigned c = 0; c < n->mNumChildren; ++c) stack.push_back(n->mChildren[c]);
+    const glm::mat4 g = node_global(n);
+    for (unsigned k = 0; k < n->mNumMeshes; ++k) {
+      const aiMesh* m = scene_->mMeshes[n->mMeshes[k]];
+      // Assimp's bind-pose skinning, limited like the cooker to the 4 largest influences.
+      std::vector<std::vector<std::pair<float, glm::mat4>>> influences(m->mNumVertices);
+      for (unsigned b = 0; b < m->mNumBones; ++b) {
+        const aiBone* bone = m->mBones[b];
+        std::vector<const aiNode*> bone_nodes;
+        find_nodes(scene_->mRootNode, bone->mName.C_Str(), &bone_nodes);
+        if (bone_nodes.empty()) continue;
+        const aiNode* bn = bone_nodes[0];
+        for (const aiNode* cand : bone_nodes)
+          if (cand->mNumMeshes == 0) { bn = cand; break; }
+        const glm::mat4 palette = node_global(bn) * to_glm(bone->mOffsetMatrix);
+        for (unsigned w = 0; w < bone->mNumWeights; ++w) {
+          const auto& vw = bone->mWeights[w];
+          if (vw.mVertexId < m->mNumVertices && vw.mWeight > 0.0f) influences[vw.mVertexId].push_back({vw.mWeight, palette});
+        }
+      }
+      std::vector<glm::mat4> skin(m->mNumVertices, glm::mat4(0.0f));
+      std::vector<float> wsum(m->mNumVertices, 0.0f);
+      for (unsigned v = 0; v < m->mNumVertices; ++v) {
+        auto& inf = influences[v];
+        std::stable_sort(inf.begin(), inf.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+        for (size_t i = 0; i < inf.size() && i < 4; ++i) {
+          skin[v] += inf[i].second * inf[i].first;
+          wsum[v] += inf[i].first;
+        }
+      }
+      for (unsigned v = 0; v < m->mNumVertices; ++v) {
+        const glm::vec3 p(m->mVertices[v].x, m->mVertices[v].y, m->mVertices[v].z);
+        mesh_space.push_back(p);
+        mesh_space.push_back(glm::vec3(g * glm::vec4(p, 1.0f)));
+        skinned_bind.push_back(wsum[v] > 0 ? glm::vec3(skin[v] * glm::vec4(p, 1.0f) / wsum[v])
+                                           : glm::vec3(g * glm::vec4(p, 1.0f)));
+      }
+    }
+  }
+  const ossa::SkeletonView sk = asset_->skeleton();
+  const auto model = sk.empty() ? std::vector<glm::mat4>{} : bind_models(sk);
+  size_t checked = 0;
+  for (size_t mi = 0; mi < asset_->mesh_count(); ++mi) {
+    const ossa::MeshView mesh = asset_->mesh(mi);
+    const auto* pos = mesh.attribute(ossa::fb::VertexSemantic::Position);
+    ASSERT_NE(pos, nullptr);
+    const auto* jnt = mesh.attribute(ossa::fb::VertexSemantic::Joints);
+    const auto* wgt = mesh.attribute(ossa::fb::VertexSemantic::Weights);
+    const auto& off = *mesh.fb->position_offset();
+    const auto& scl = *mesh.fb->position_scale();
+    const glm::vec3 offset(off.x(), off.y(), off.z()), scale(scl.x(), scl.y(), scl.z());
+    const float extent = glm::length(scale);
+    const float tol = pos->format() == ossa::fb::VertexFormat::Float32x3
+                          ? 1e-6f * (extent + glm::length(offset)) + 1e-7f
+                          : 0.5f * extent / 65535.0f * 1.01f + 1e-6f * (extent + glm::length(offset));
+    PointSet source_points(std::max(tol * 4.0f, extent / 512.0f));
+    for (const glm::vec3& p : mesh_space) source_points.add(p);
+    const float skin_tol = 5e-3f * std::max(extent, model.empty() ? 0.0f : skeleton_extent(model)) + tol;
+    PointSet skinned_points(std::max(skin_tol * 2.0f, extent / 512.0f));
+    for (const glm::vec3& p : skinned_bind) skinned_points.add(p);
+
+    const uint8_t* base = mesh.vertex_bytes().data();
+    float worst = 0.0f, worst_skin = 0.0f;
+    for (uint32_t v = 0; v < mesh.vertex_count(); ++v) {
+      const uint8_t* vx = base + size_t(v) * mesh.vertex_stride();
+      glm::vec3 p;
+      if (pos->format() == ossa::fb::VertexFormat::Float32x3) {
+        std::memcpy(&p, vx + pos->offset(), 12);
+      } else {
+        uint16_t q[3];
+        std::memcpy(q, vx + pos->offset(), 6);
+        p = offset + scale * glm::vec3(ossa::unorm16_to_float(q[0]), ossa::unorm16_to_float(q[1]),
+                                       ossa::unorm16_to_float(q[2]));
+      }
+      worst = std::max(worst, source_points.nearest(p));
+      if (jnt != nullptr && wgt != nullptr && !model.empty()) {
+        glm::mat4 skin(0.0f);
+        float wsum = 0.0f;
+        for (int k = 0; k < 4; ++k) {
+          uint32_t slot;
+          if (jnt->format() == ossa::fb::VertexFormat::Uint8x4) slot = vx[jnt->offset() + k];
+          else {
+            uint16_t s16;
+            std::memcpy(&s16, vx + jnt->offset() + 2 * k, 2);
+            slot = s16;
+          }
+          float w;
+          if (wgt->format() == ossa::fb::VertexFormat::Unorm8x4) w = vx[wgt->offset() + k] / 255.0f;
+          else std::memcpy(&w, vx + wgt->offset() + 4 * k, 4);
+          if (w == 0.0f) continue;
+          skin += (model[mesh.joints()[slot]] * to_glm(mesh.inverse_bind()[slot])) * w;
+          wsum += w;
+        }
+        ASSERT_NEAR(wsum, 1.0f, 1e-5f) << "weights of vertex " << v;
+        worst_skin = std::max(worst_skin, skinned_points.nearest(glm::vec3(skin * glm::vec4(p, 1.0f))));
+      }
+      ++checked;
+    }
+    EXPECT_LE(worst, tol) << "mesh " << mesh.name() << ": worst distance to a source vertex";
+    if (jnt != nullptr && !model.empty()) {
+      EXPECT_LE(worst_skin, skin_tol) << "mesh " << mesh.name() << ": bind-pose skinning vs Assimp";
+    }
+    RecordProperty("worst_position_error_" + std::to_string(mi), std::to_string(worst));
+  }
+  EXPECT_GT(checked, 0u);
+}
+
+TEST_P(Accuracy, ClipKeysMatchAssimpAtFirstMiddleLastSourceTimes) {
+  const ossa::SkeletonView sk = asset_->skeleton();
+  if (sk.empty() || asset_->clip_count() == 0) GTEST_SKIP() << "no clip";
+  ASSERT_EQ(asset_->clip_count(), scene_->mNumAnimations);
+  const auto bind = bind_models(sk);
+  const float tol = 1e-3f * skeleton_extent(bind) + 1e-5f;
+  for (unsigned ci = 0; ci < scene_->mNumAnimations; ++ci) {
+    const aiAnimation* anim = scene_->mAnimations[ci];
+    const ossa::ClipView clip = asset_->clip(ci);
+    std::vector<double> ticks;
+    std::map<std::string, const aiNodeAnim*> channels;
+    for (unsigned c = 0; c < anim->mNumChannels; ++c) {
+      const aiNodeAnim* ch = anim->mChannels[c];
+      channels[ch->mNodeName.C_Str()] = ch;
+      for (unsigned k = 0; k < ch->mNumPositionKeys; ++k) ticks.push_back(ch->mPositionKeys[k].mTime);
+      for (unsigned k = 0; k < ch->mNumRotationKeys; ++k) ticks.push_back(ch->mRotationKeys[k].mTime);
+    }
+    if (ticks.empty() || clip.duration() <= 0.0f) continue;
+    std::sort(ticks.begin(), ticks.end());
+    ticks.erase(std::unique(ticks.begin(), ticks.end()), ticks.end());
+    const double ticks_per_second = anim->mDuration / clip.duration();
+    ASSERT_GT(ticks_per_second, 0.0);
+    for (double tk : {ticks.front(), ticks[ticks.size() / 2], ticks.back()}) {
+      const float t = static_cast<float>(tk / ticks_per_second);
+      // Assimp: every node's local, animated where a channel drives it.
+      std::function<glm::mat4(const aiNode*)> global = [&](const aiNode* n) -> glm::mat4 {
+        glm::mat4 local = to_glm(n->mTransformation);
+        auto it = channels.find(n->mName.C_Str());
+        if (it != channels.end()) {
+          const aiNodeAnim* ch = it->second;
+          aiVector3D s0, t0;
+          aiQuaternion r0;
+          n->mTransformation.Decompose(s0, r0, t0);
+          local = trs(eval_vec(ch->mPositionKeys, ch->mNumPositionKeys, tk, {t0.x, t0.y, t0.z}),
+                      eval_quat(ch->mRotationKeys, ch->mNumRotationKeys, tk, glm::quat(r0.w, r0.x, r0.y, r0.z)),
+                      eval_vec(ch->mScalingKeys, ch->mNumScalingKeys, tk, {s0.x, s0.y, s0.z}));
+        }
+        return n->mParent ? global(n->mParent) * local : local;
+      };
+      // Cooked: bind pose overridden by the clip's tracks.
+      std::vector<glm::vec3> T(sk.joint_count());
+      std::vector<glm::quat> R(sk.joint_count());
+      std::vector<glm::vec3> S(sk.joint_count());
+      for (size_t j = 0; j < sk.joint_count(); ++j) {
+        const auto& bt = sk.bind_translations()[j];
+        const auto& br = sk.bind_rotations()[j];
+        const auto& bs = sk.bind_scales()[j];
+        T[j] = {bt.x(), bt.y(), bt.z()};
+        R[j] = glm::quat(br.w(), br.x(), br.y(), br.z());
+        S[j] = {bs.x(), bs.y(), bs.z()};
+      }
+      auto lerp3 = [](const ossa::fb::Vec3& a, const ossa::fb::Vec3& b, float w) {
+        return ossa::fb::Vec3(a.x() + (b.x() - a.x()) * w, a.y() + (b.y() - a.y()) * w, a.z() + (b.z() - a.z()) * w);
+      };
+      auto nlerp = [](const ossa::fb::Quat& a, const ossa::fb::Quat& b, float w) {
+        const glm::quat qa(a.w(), a.x(), a.y(), a.z());
+        glm::quat qb(b.w(), b.x(), b.y(), b.z());
+        const glm::quat r = glm::slerp(qa, qb, w);
+        return ossa::fb::Quat(r.x, r.y, r.z, r.w);
+      };
+      for (size_t k = 0; k < clip.track_count(); ++k) {
+        const ossa::fb::Track& tr = clip.track(k);
+        bool present = false;
+        const auto tv = eval_cooked(tr.translation_times(), tr.translations(), t, lerp3, ossa::fb::Vec3(), &present);
+        if (present) T[tr.joint()] = {tv.x(), tv.y(), tv.z()};
+        const auto rv = eval_cooked(tr.rotation_times(), tr.rotations(), t, nlerp, ossa::fb::Quat(), &present);
+        if (present) R[tr.joint()] = glm::quat(rv.w(), rv.x(), rv.y(), rv.z());
+        const auto sv = eval_cooked(tr.scale_times(), tr.scales(), t, lerp3, ossa::fb::Vec3(), &present);
+        if (present) S[tr.joint()] = {sv.x(), sv.y(), sv.z()};
+      }
+      std::vector<glm::mat4> model(sk.joint_count());
+      for (size_t j = 0; j < sk.joint_count(); ++j) {
+        const glm::mat4 local = trs(T[j], R[j], S[j]);
+        const int p = sk.parents()[j];
+        model[j] = p < 0 ? local : model[static_cast<size_t>(p)] * local;
+        std::vector<const aiNode*> nodes;
+        find_nodes(scene_->mRootNode, std::string(sk.joint_name(j)), &nodes);
+        ASSERT_FALSE(nodes.empty());
+        float err = INFINITY;
+        for (const aiNode* n : nodes) err = std::min(err, glm::distance(glm::vec3(global(n)[3]), glm::vec3(model[j][3])));
+        EXPECT_LE(err, tol)
+            << "clip '" << clip.name() << "' t=" << t << "s joint " << sk.joint_name(j);
+      }
+    }
+  }
+}
+
+const AccuracyCase kCases[] = {
+    {"CesiumMan", "assets/CesiumMan/CesiumMan.glb"},
+    {"Fox", "assets/Fox/Fox.glb"},
+    {"RiggedSimple", "assets/RiggedSimple/RiggedSimple.glb"},
+    {"PabSkeleton", "assets/Pab/skeleton.fbx"},
+    {"PabArnaud", "assets/Pab/arnaud.fbx"},
+    {"PabSkeletonDae", "shared:Pab/skeleton.dae"},
+    {"RobotExpressive", "shared:RobotExpressive/RobotExpressive.glb"},
+    {"QuaterniusRobot", "shared:Quaternius_Robot/Robot.fbx"},
+    {"QuaterniusMale", "shared:Quaternius_Male/Smooth_Male_Casual.fbx"},
+    {"QuaterniusEagle", "shared:Quaternius_Eagle/Eagle.fbx"},
+    {"AnimeBoy", "shared:AnimeBoy/scene.gltf"},
+    {"CmuBvh", "shared:CMU_BVH/01_03.bvh"},
+    {"InterpolationTest", "shared:Khronos_embedded/interpolation_test.gltf"},
+    {"BoxAnimated", "shared:Khronos_embedded/box_animated.gltf"},
+};
+
+INSTANTIATE_TEST_SUITE_P(Assets, Accuracy, ::testing::ValuesIn(kCases),
+                         [](const ::testing::TestParamInfo<AccuracyCase>& i) { return std::string(i.param.name); });
+
+}  // namespace

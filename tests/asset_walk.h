@@ -1,0 +1,285 @@
+// asset_walk.h — reads everything an accepted Asset exposes and re-checks the promises the loader
+// made by accepting it, for tests that feed the loader hostile bytes (bad_input_test, fuzz_load).
+//
+// "Accepted" must mean "safe to use without further checks": every span and name lies inside the
+// asset's own bytes, and every invariant listed in runtime/validate.h holds. walk_asset touches
+// every byte the views expose (so ASan sees any read past the buffer) and checks those invariants
+// independently of runtime/validate.cpp, reading raw values only through bounds it has itself
+// established, so a loader that accepts a bad file is reported instead of trusted. It returns the
+// first broken promise as text (empty when all hold) rather than using GoogleTest, because the
+// libFuzzer target includes it too. Header-only: the fuzz target is built from one source file.
+#pragma once
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <span>
+#include <string>
+#include <string_view>
+#include <type_traits>
+#include <vector>
+
+#include "format/hash.h"
+#include "format/vertex_format.h"
+#include "format/version.h"
+#include "runtime/asset.h"
+
+namespace ossa::test {
+
+class AssetWalker {
+ public:
+  explicit AssetWalker(const Asset& asset)
+      : asset_(asset),
+        begin_(reinterpret_cast<uintptr_t>(asset.bytes().data())),
+        end_(begin_ + asset.bytes().size()) {}
+
+  /// The first broken promise, or "" when every check passed.
+  std::string run() {
+    if (asset_.file().version() != kFormatVersion) fail("file", "version is not kFormatVersion");
+    if (asset_.bytes().size() < 8 || std::memcmp(asset_.bytes().data() + 4, kFileIdentifier, 4) != 0)
+      fail("file", "identifier is not OSSA");
+    skeleton();
+    for (size_t i = 0; i < asset_.mesh_count(); ++i) mesh(i);
+    for (size_t i = 0; i < asset_.clip_count(); ++i) clip(i);
+    for (size_t i = 0; i < asset_.material_count(); ++i) material(i);
+    if (const fb::Provenance* p = asset_.file().provenance()) {
+      text(p->source_name(), "provenance.source_name");
+      text(p->cooker_version(), "provenance.cooker_version");
+      text(p->options(), "provenance.options");
+      sum_ += p->source_hash();
+    }
+    return problem_;
+  }
+
+  /// A value folded from every byte read, so the reads cannot be optimized away.
+  uint64_t checksum() const { return sum_; }
+
+ private:
+  void fail(const std::string& where, const std::string& what) {
+    if (problem_.empty()) problem_ = where + ": " + what;
+  }
+
+  bool inside(const void* p, size_t size) const {
+    const auto a = reinterpret_cast<uintptr_t>(p);
+    return size == 0 || (a >= begin_ && a <= end_ && size <= end_ - a);
+  }
+
+  void touch(const void* p, size_t size, const std::string& what) {
+    if (size == 0) return;
+    if (!inside(p, size)) return fail(what, "points outside the asset's bytes");
+    const auto* b = static_cast<const uint8_t*>(p);
+    for (size_t i = 0; i < size; ++i) sum_ = sum_ * 1099511628211ull + b[i];
+  }
+
+  template <class T>
+  void touch(std::span<const T> s, const std::string& what) {
+    touch(s.data(), s.size_bytes(), what);
+  }
+  void touch(std::string_view s, const std::string& what) { touch(s.data(), s.size(), what); }
+
+  void text(const flatbuffers::String* s, const std::string& what) {
+    if (s) touch(s->data(), s->size() + 1, what);  // with its terminating zero
+  }
+
+  template <class T>
+  static std::span<const T> scalars(const flatbuffers::Vector<T>* v) {
+    return v ? std::span<const T>(v->data(), v->size()) : std::span<const T>();
+  }
+  template <class T>
+  static std::span<const T> structs(const flatbuffers::Vector<const T*>* v) {
+    return v ? std::span<const T>(reinterpret_cast<const T*>(v->Data()), v->size()) : std::span<const T>();
+  }
+
+  static bool finite(const fb::Vec3& v) { return std::isfinite(v.x()) && std::isfinite(v.y()) && std::isfinite(v.z()); }
+  static bool finite(const fb::Quat& q) {
+    return std::isfinite(q.x()) && std::isfinite(q.y()) && std::isfinite(q.z()) && std::isfinite(q.w());
+  }
+
+  void skeleton() {
+    const SkeletonView s = asset_.skeleton();
+    if (s.empty()) return;
+    const size_t n = s.joint_count();
+    touch(s.parents(), "skeleton.parents");
+    touch(s.bind_translations(), "skeleton.bind_translations");
+    touch(s.bind_rotations(), "skeleton.bind_rotations");
+    touch(s.bind_scales(), "skeleton.bind_scales");
+    touch(s.inverse_bind(), "skeleton.inverse_bind");
+    if (s.parents().size() != n || s.bind_translations().size() != n || s.bind_rotations().size() != n ||
+        s.bind_scales().size() != n || s.inverse_bind().size() != n)
+      return fail("skeleton", "per-joint arrays differ in length");
+    std::vector<std::string_view> names;
+    for (size_t i = 0; i < n; ++i) {
+      names.push_back(s.joint_name(i));
+      touch(names.back(), "skeleton.joint_names");
+      const int16_t parent = s.parents()[i];
+      if (parent < -1 || parent >= static_cast<int64_t>(i)) fail("skeleton", "parents[i] not in [-1, i)");
+    }
+    if (s.hash() != skeleton_hash(names, s.parents())) fail("skeleton", "stored hash != recomputed hash");
+    for (size_t i = 0; i < n; ++i) {
+      const int found = s.find_joint(names[i]);
+      if (found < 0 || static_cast<size_t>(found) >= n || s.joint_name(static_cast<size_t>(found)) != names[i])
+        fail("skeleton", "find_joint does not find a joint by its own name");
+    }
+  }
+
+  void mesh(size_t m) {
+    const MeshView v = asset_.mesh(m);
+    const std::string where = "mesh " + std::to_string(m);
+    touch(v.name(), where + " name");
+    const std::span<const fb::VertexAttribute> layout = v.layout();
+    const std::span<const uint8_t> vertices = v.vertex_bytes(), indices = v.index_bytes();
+    touch(layout, where + " layout");
+    touch(vertices, where + " vertices");
+    touch(indices, where + " indices");
+    touch(v.submeshes(), where + " submeshes");
+    touch(v.joints(), where + " joints");
+    touch(v.inverse_bind(), where + " inverse_bind");
+    if (!problem_.empty()) return;
+
+    const uint64_t stride = v.vertex_stride(), count = v.vertex_count();
+    if (count * stride != vertices.size()) return fail(where, "vertex bytes != vertex_count * stride");
+    if (!vertices.empty() && reinterpret_cast<uintptr_t>(vertices.data()) % 16 != 0)
+      fail(where, "vertex bytes not 16-byte aligned");
+    if (!indices.empty() && reinterpret_cast<uintptr_t>(indices.data()) % 16 != 0)
+      fail(where, "index bytes not 16-byte aligned");
+
+    const fb::VertexAttribute* joints_attribute = nullptr;
+    uint32_t seen = 0;
+    for (const fb::VertexAttribute& a : layout) {
+      const VertexFormatInfo info = vertex_format_info(a.format());
+      if (info.size == 0) return fail(where, "unknown vertex format");
+      if (a.offset() + info.size > stride) return fail(where, "attribute past the stride");
+      const auto semantic = static_cast<unsigned>(a.semantic());
+      if (semantic < 32) {
+        if (seen & (1u << semantic)) return fail(where, "duplicate semantic");
+        seen |= 1u << semantic;
+      }
+      const fb::VertexAttribute* found = v.attribute(a.semantic());
+      if (found == nullptr || found->semantic() != a.semantic()) fail(where, "attribute() misses a semantic");
+      if (a.semantic() == fb::VertexSemantic::Joints) joints_attribute = &a;
+    }
+
+    const size_t index_size = v.index_format() == fb::IndexFormat::Uint16 ? 2 : 4;
+    if (v.index_format() != fb::IndexFormat::Uint16 && v.index_format() != fb::IndexFormat::Uint32)
+      return fail(where, "unknown index format");
+    if (indices.size() % index_size != 0) return fail(where, "index bytes not a multiple of the index size");
+    const size_t index_count = indices.size() / index_size;
+    if (v.index_count() != index_count) fail(where, "index_count() != index bytes / index size");
+    if (index_count % 3 != 0) fail(where, "index count not a multiple of 3");
+    for (size_t i = 0; i < index_count; ++i) {
+      uint32_t index = 0;
+      if (index_size == 2) {
+        uint16_t i16;
+        std::memcpy(&i16, indices.data() + 2 * i, 2);
+        index = i16;
+      } else {
+        std::memcpy(&index, indices.data() + 4 * i, 4);
+      }
+      if (index >= count) return fail(where, "index >= vertex_count");
+    }
+    for (const fb::Submesh& s : v.submeshes()) {
+      if (uint64_t{s.first_index()} + s.index_count() > index_count) fail(where, "submesh past the index range");
+      // A file without materials may use material 0: the reader's default material.
+      if (s.material() >= std::max<size_t>(asset_.material_count(), 1)) fail(where, "submesh material out of range");
+    }
+
+    const std::span<const uint16_t> slots = v.joints();
+    if (slots.size() != v.inverse_bind().size()) fail(where, "joints and inverse_bind differ in length");
+    const size_t joint_count = asset_.skeleton().empty() ? 0 : asset_.skeleton().joint_count();
+    for (uint16_t joint : slots)
+      if (joint >= joint_count) fail(where, "slot joint >= skeleton joint count");
+    if (joints_attribute != nullptr) {
+      const bool wide = joints_attribute->format() == fb::VertexFormat::Uint16x4;
+      if (!wide && joints_attribute->format() != fb::VertexFormat::Uint8x4)
+        return fail(where, "joints attribute is not Uint8x4 or Uint16x4");
+      for (uint64_t i = 0; i < count; ++i) {
+        const uint8_t* p = vertices.data() + i * stride + joints_attribute->offset();
+        for (int c = 0; c < 4; ++c) {
+          uint16_t slot = 0;
+          if (wide) std::memcpy(&slot, p + 2 * c, 2);
+          else slot = p[c];
+          if (slot >= slots.size()) return fail(where, "vertex joint slot >= slot count");
+        }
+      }
+    }
+  }
+
+  template <class T>
+  void channel(const flatbuffers::Vector<float>* times_vector, std::span<const T> values, float duration,
+               const std::string& where) {
+    const std::span<const float> times = scalars(times_vector);
+    touch(times, where + " times");
+    touch(values, where + " values");
+    if (times.size() != values.size()) return fail(where, "times and values differ in count");
+    for (size_t k = 0; k < times.size(); ++k) {
+      if (!std::isfinite(times[k])) return fail(where, "key time not finite");
+      // The loader allows a relative 1e-4 slack at both ends (seconds computed from ticks).
+      const float slack = 1e-4f * duration;
+      if (!(times[k] >= -slack && times[k] <= duration + slack)) return fail(where, "key time outside [0, duration]");
+      if (k > 0 && !(times[k] > times[k - 1])) return fail(where, "key times not strictly increasing");
+      if (!finite(values[k])) return fail(where, "key value not finite");
+      if constexpr (std::is_same_v<T, fb::Quat>) {
+        const double x = values[k].x(), y = values[k].y(), z = values[k].z(), w = values[k].w();
+        if (!(x * x + y * y + z * z + w * w > 0.0)) return fail(where, "zero quaternion");
+      }
+    }
+  }
+
+  void clip(size_t c) {
+    const ClipView v = asset_.clip(c);
+    const std::string where = "clip " + std::to_string(c);
+    touch(v.name(), where + " name");
+    const float numbers[2] = {v.duration(), v.sample_rate()};  // folded as bits: they may be NaN
+    uint32_t bits[2];
+    std::memcpy(bits, numbers, sizeof bits);
+    sum_ += bits[0] + bits[1] + v.skeleton_hash();
+    size_t keys = 0;
+    int previous_joint = -1;
+    for (size_t t = 0; t < v.track_count(); ++t) {
+      const fb::Track& track = v.track(t);
+      const std::string at = where + " track " + std::to_string(t);
+      if (track.joint() >= v.fb->joint_count()) fail(at, "joint >= clip joint_count");
+      if (static_cast<int>(track.joint()) <= previous_joint) fail(at, "tracks not sorted by joint (or repeated)");
+      previous_joint = track.joint();
+      channel(track.translation_times(), structs(track.translations()), v.duration(), at + " translations");
+      channel(track.rotation_times(), structs(track.rotations()), v.duration(), at + " rotations");
+      channel(track.scale_times(), structs(track.scales()), v.duration(), at + " scales");
+      keys += scalars(track.translation_times()).size() + scalars(track.rotation_times()).size() +
+              scalars(track.scale_times()).size();
+    }
+    if (v.key_count() != keys) fail(where, "key_count() != keys in the tracks");
+    const Status binding = check_clip_binding(v, asset_.skeleton(), asset_.name());
+    for (char ch : binding.message()) sum_ = sum_ * 31 + static_cast<unsigned char>(ch);  // not file bytes
+  }
+
+  void material(size_t i) {
+    const fb::Material& m = asset_.material(i);
+    const std::string where = "material " + std::to_string(i);
+    text(m.name(), where + " name");
+    if (m.ambient()) touch(m.ambient(), sizeof(fb::Vec3), where + " ambient");
+    if (m.diffuse()) touch(m.diffuse(), sizeof(fb::Vec3), where + " diffuse");
+    if (m.specular()) touch(m.specular(), sizeof(fb::Vec3), where + " specular");
+    if (const auto* textures = m.textures()) {
+      for (const fb::Texture* t : *textures) {
+        text(t->path(), where + " texture path");
+        text(t->mime(), where + " texture mime");
+        touch(scalars(t->data()), where + " texture data");
+      }
+    }
+  }
+
+  const Asset& asset_;
+  uintptr_t begin_, end_;
+  uint64_t sum_ = 0;
+  std::string problem_;
+};
+
+/// Walks every view of an accepted asset; returns the first broken promise, or "" when none.
+inline std::string walk_asset(const Asset& asset, uint64_t* checksum = nullptr) {
+  AssetWalker walker(asset);
+  std::string problem = walker.run();
+  if (checksum) *checksum = walker.checksum();
+  return problem;
+}
+
+}  // namespace ossa::test

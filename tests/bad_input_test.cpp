@@ -1,0 +1,627 @@
+// bad_input_test.cpp — the loader never trusts a file (ARCHITECTURE.md, "Never trusted").
+//
+// Every case hands Asset::from_bytes / Asset::open / verify_buffer something wrong — cut short,
+// bit-flipped, not an .ossa file at all, or well-formed FlatBuffers that break one semantic
+// invariant of runtime/validate.h — and asserts two things: it is rejected, and the message names
+// the file and what is wrong (checked by distinctive words, case-insensitively, so wording can
+// improve without breaking tests). Where damaged bytes are accepted (a flip inside vertex data is
+// harmless), asset_walk.h reads every byte the views expose and re-checks the invariants, so
+// "accepted" is held to "safe to use". CI runs this suite under ASan + UBSan (OSSA_SANITIZE):
+// "never a crash, never undefined behaviour" is checked by the sanitizers, not by hope.
+//
+// Semantic cases start from the valid synthetic file (test_files.h) and change one field, so each
+// test breaks exactly one invariant.
+#include <gtest/gtest.h>
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cctype>
+#include <chrono>
+#include <condition_variable>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <filesystem>
+#include <limits>
+#include <mutex>
+#include <random>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <flatbuffers/flatbuffers.h>
+
+#include "asset_walk.h"
+#include "format/hash.h"
+#include "format/version.h"
+#include "runtime/asset.h"
+#include "test_files.h"
+
+namespace ossa::test {
+namespace {
+
+using Keywords = std::vector<std::vector<std::string>>;  // every group must match; any word of a group
+
+std::string lower(std::string_view s) {
+  std::string out(s);
+  std::transform(out.begin(), out.end(), out.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return out;
+}
+
+bool contains_any(const std::string& message, const std::vector<std::string>& words) {
+  const std::string m = lower(message);
+  return std::any_of(words.begin(), words.end(), [&](const std::string& w) { return m.find(lower(w)) != std::string::npos; });
+}
+
+std::string join(const std::vector<std::string>& words) {
+  std::string out;
+  for (const std::string& w : words) out += (out.empty() ? "\"" : " | \"") + w + "\"";
+  return out;
+}
+
+// A message that names the file and says what is wrong.
+::testing::AssertionResult explains(const std::string& message, const std::string& name, const Keywords& groups) {
+  if (message.empty()) return ::testing::AssertionFailure() << "empty error message";
+  if (message.find(name) == std::string::npos)
+    return ::testing::AssertionFailure() << "message does not name \"" << name << "\": " << message;
+  for (const auto& group : groups)
+    if (!contains_any(message, group))
+      return ::testing::AssertionFailure() << "message mentions none of " << join(group) << ": " << message;
+  return ::testing::AssertionSuccess() << message;
+}
+
+::testing::AssertionResult rejected(const Result<Asset>& result, const std::string& name, const Keywords& groups) {
+  if (result.ok()) return ::testing::AssertionFailure() << name << " was accepted";
+  return explains(result.error().message, name, groups);
+}
+
+std::string current_test_file_name() {
+  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+  return std::string(info->test_suite_name()) + "." + info->name() + ".ossa";
+}
+
+// Both entry points over the same bytes must reject them and explain why.
+::testing::AssertionResult rejects(const std::vector<uint8_t>& bytes, const Keywords& groups) {
+  const std::string name = current_test_file_name();
+  auto loaded = rejected(Asset::from_bytes(bytes, name), name, groups);
+  if (!loaded) return ::testing::AssertionFailure() << "Asset::from_bytes: " << loaded.message();
+  const AlignedBytes aligned(bytes);
+  const Status status = verify_buffer(aligned.span(), name);
+  if (status.ok()) return ::testing::AssertionFailure() << "verify_buffer accepted what from_bytes rejected";
+  auto verified = explains(status.message(), name, groups);
+  if (!verified) return ::testing::AssertionFailure() << "verify_buffer: " << verified.message();
+  return ::testing::AssertionSuccess() << loaded.message();
+}
+
+::testing::AssertionResult rejects(const SyntheticSpec& spec, const Keywords& groups) {
+  return rejects(make_valid_file(spec), groups);
+}
+
+::testing::AssertionResult accepts(const std::vector<uint8_t>& bytes) {
+  const std::string name = current_test_file_name();
+  const Result<Asset> asset = Asset::from_bytes(bytes, name);
+  if (!asset) return ::testing::AssertionFailure() << "rejected: " << asset.error().message;
+  const std::string problem = walk_asset(*asset);
+  if (!problem.empty()) return ::testing::AssertionFailure() << "accepted, but " << problem;
+  const AlignedBytes aligned(bytes);
+  const Status status = verify_buffer(aligned.span(), name);
+  if (!status) return ::testing::AssertionFailure() << "verify_buffer rejected: " << status.message();
+  return ::testing::AssertionSuccess();
+}
+
+const Keywords kMesh = {{"body", "mesh 0", "mesh[0]", "meshes[0]"}};
+const Keywords kClip = {{"walk", "clip 0", "clip[0]", "clips[0]"}};
+
+Keywords with(Keywords base, std::vector<std::string> words) {
+  base.push_back(std::move(words));
+  return base;
+}
+
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+constexpr float kInf = std::numeric_limits<float>::infinity();
+
+// ---------------------------------------------------------------------------------------------
+// The valid file, and variants that must stay valid (the checks must not over-reject).
+
+TEST(ValidFile, AcceptedFromBytes) {
+  const std::vector<uint8_t> bytes = make_valid_file();
+  ASSERT_TRUE(accepts(bytes));
+  const Result<Asset> asset = Asset::from_bytes(bytes, "valid.ossa");
+  ASSERT_TRUE(asset.ok());
+  const SyntheticSpec spec;
+  EXPECT_EQ(asset->name(), "valid.ossa");
+  EXPECT_EQ(asset->bytes().size(), bytes.size());
+  EXPECT_TRUE(std::equal(bytes.begin(), bytes.end(), asset->bytes().begin()));
+  EXPECT_EQ(asset->file().version(), kFormatVersion);
+  EXPECT_EQ(asset->skeleton().joint_count(), spec.skeleton->names.size());
+  EXPECT_EQ(asset->skeleton().joint_name(3), "arm");
+  EXPECT_EQ(asset->skeleton().find_joint("head"), 2);
+  EXPECT_EQ(asset->skeleton().find_joint("tail"), -1);
+  ASSERT_EQ(asset->mesh_count(), 1u);
+  EXPECT_EQ(asset->mesh(0).vertex_count(), spec.meshes[0].vertices.size());
+  EXPECT_EQ(asset->mesh(0).vertex_bytes().size(), spec.meshes[0].vertices.size() * 24);
+  EXPECT_EQ(asset->mesh(0).index_count(), spec.meshes[0].indices.size());
+  EXPECT_EQ(asset->mesh(0).submeshes().size(), 2u);
+  ASSERT_EQ(asset->clip_count(), 1u);
+  EXPECT_EQ(asset->clip(0).name(), "walk");
+  EXPECT_EQ(asset->clip(0).track_count(), 2u);
+  EXPECT_EQ(asset->clip(0).key_count(), 1u + 3u + 2u + 2u);
+  EXPECT_TRUE(check_clip_binding(asset->clip(0), asset->skeleton(), "valid.ossa").ok());
+  ASSERT_EQ(asset->material_count(), 1u);
+  ASSERT_NE(asset->material(0).textures(), nullptr);
+  EXPECT_EQ(asset->material(0).textures()->size(), 2u);
+}
+
+TEST(ValidFile, AcceptedFromDisk) {
+  const std::vector<uint8_t> bytes = make_valid_file();
+  const std::filesystem::path path = make_temp_dir("bad_input") / "valid.ossa";
+  ASSERT_TRUE(write_file(path, bytes));
+  const Result<Asset> asset = Asset::open(path.string());
+  ASSERT_TRUE(asset.ok()) << asset.error().message;
+  EXPECT_EQ(asset->bytes().size(), bytes.size());
+  EXPECT_TRUE(std::equal(bytes.begin(), bytes.end(), asset->bytes().begin()));
+  EXPECT_EQ(walk_asset(*asset), "");
+  // Moving keeps the views valid; the moved-from asset is not used again.
+  Result<Asset> moved_from = Asset::open(path.string());
+  ASSERT_TRUE(moved_from.ok());
+  const Asset moved = std::move(*moved_from);
+  EXPECT_EQ(walk_asset(moved), "");
+}
+
+TEST(ValidFile, VariantsAccepted) {
+  for (const auto& [name, spec] : valid_variants()) EXPECT_TRUE(accepts(make_valid_file(spec))) << name;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Damaged bytes
+
+// Trailing zero bytes can be FlatBuffers alignment padding that nothing references; cutting
+// them off may leave a complete file. Any shorter prefix lacks referenced bytes.
+size_t referenced_size(const std::vector<uint8_t>& bytes) {
+  size_t n = bytes.size();
+  while (n > 0 && bytes[n - 1] == 0) --n;
+  return n;
+}
+
+TEST(DamagedBytes, EveryTruncationRejected) {
+  const std::vector<uint8_t> bytes = make_valid_file();
+  const size_t complete = referenced_size(bytes);
+  std::vector<size_t> lengths;
+  for (size_t n = 0; n <= std::min<size_t>(bytes.size(), 512); ++n) lengths.push_back(n);
+  for (size_t n = 513; n < bytes.size(); n += 37) lengths.push_back(n);
+  lengths.push_back(bytes.size() - 1);
+  std::vector<std::string> failures;
+  for (size_t n : lengths) {
+    const std::vector<uint8_t> prefix(bytes.begin(), bytes.begin() + static_cast<std::ptrdiff_t>(n));
+    const std::string name = "truncated-" + std::to_string(n) + ".ossa";
+    const Result<Asset> asset = Asset::from_bytes(prefix, name);
+    if (asset.ok()) {
+      if (n < complete) failures.push_back(name + ": accepted although referenced bytes are missing");
+      else if (const std::string problem = walk_asset(*asset); !problem.empty()) failures.push_back(name + ": " + problem);
+    } else if (auto e = explains(asset.error().message, name, {}); !e) {
+      failures.push_back(e.message());
+    }
+  }
+  EXPECT_TRUE(failures.empty()) << failures.size() << " failures, first: " << failures.front();
+}
+
+TEST(DamagedBytes, TruncatedFileOnDiskRejected) {
+  const std::vector<uint8_t> bytes = make_valid_file();
+  const std::filesystem::path dir = make_temp_dir("bad_input");
+  for (size_t n : {size_t{1}, size_t{7}, size_t{8}, size_t{64}, bytes.size() / 2, referenced_size(bytes) - 1}) {
+    const std::filesystem::path path = dir / ("cut-" + std::to_string(n) + ".ossa");
+    ASSERT_TRUE(write_file(path, std::span<const uint8_t>(bytes.data(), n)));
+    EXPECT_TRUE(rejected(Asset::open(path.string()), path.string(), {})) << "length " << n;
+  }
+}
+
+// Every byte, several masks: accepted (then safe to walk) or rejected with a message; never UB.
+TEST(DamagedBytes, EveryByteFlipped) {
+  const std::vector<uint8_t> bytes = make_valid_file();
+  std::vector<std::string> failures;
+  size_t accepted = 0, refused = 0;
+  for (size_t offset = 0; offset < bytes.size(); ++offset) {
+    for (uint8_t mask : {uint8_t{0x01}, uint8_t{0x02}, uint8_t{0x10}, uint8_t{0x80}, uint8_t{0xFF}}) {
+      std::vector<uint8_t> damaged = bytes;
+      damaged[offset] ^= mask;
+      const std::string name = "flip-" + std::to_string(offset) + "-" + std::to_string(mask) + ".ossa";
+      const Result<Asset> asset = Asset::from_bytes(damaged, name);
+      const AlignedBytes aligned(damaged);
+      const Status status = verify_buffer(aligned.span(), name);
+      if (status.ok() != asset.ok()) failures.push_back(name + ": verify_buffer and from_bytes disagree");
+      if (asset.ok()) {
+        ++accepted;
+        if (const std::string problem = walk_asset(*asset); !problem.empty())
+          failures.push_back(name + ": accepted, but " + problem);
+      } else {
+        ++refused;
+        if (auto e = explains(asset.error().message, name, {}); !e) failures.push_back(e.message());
+      }
+    }
+  }
+  EXPECT_GT(refused, 0u);
+  EXPECT_TRUE(failures.empty()) << failures.size() << " failures, first: " << failures.front();
+  std::printf("flips: %zu accepted, %zu rejected\n", accepted, refused);
+}
+
+TEST(DamagedBytes, RandomBytesRejected) {
+  std::mt19937 rng(20240601);  // fixed seed: reproducible
+  for (int round = 0; round < 200; ++round) {
+    std::vector<uint8_t> bytes(8 + rng() % 4096);
+    for (uint8_t& b : bytes) b = static_cast<uint8_t>(rng());
+    if (round % 2 == 0) std::copy_n("OSSA", 4, bytes.begin() + 4);  // past the identifier check
+    EXPECT_TRUE(rejected(Asset::from_bytes(bytes, "random.ossa"), "random.ossa", {})) << "round " << round;
+  }
+}
+
+// FlatBuffers tables form a DAG: one big index vector reached through thousands of mesh entries
+// must not cost thousands of scans (validate.h: the checks bound their work by the buffer size).
+TEST(DamagedBytes, SharedTablesDoNotMultiplyWork) {
+  flatbuffers::FlatBufferBuilder fbb;
+  const std::vector<fb::VertexAttribute> layout = {{fb::VertexSemantic::Position, fb::VertexFormat::Float32x3, 0}};
+  const std::vector<uint8_t> vertices(3 * 12, 0);
+  const std::vector<uint8_t> indices(60000 * 2, 0);  // 20000 degenerate triangles over vertex 0
+  const std::vector<fb::Submesh> submeshes = {{0, 60000, 0}};
+  const auto mesh = fb::CreateMeshDirect(fbb, "shared", 3, 12, &layout, &vertices, fb::IndexFormat::Uint16,
+                                         &indices, &submeshes);
+  const std::vector<flatbuffers::Offset<fb::Mesh>> meshes(2000, mesh);
+  fb::FinishFileBuffer(fbb, fb::CreateFileDirect(fbb, kFormatVersion, 1.0f, 0, &meshes));
+  const std::vector<uint8_t> bytes(fbb.GetBufferPointer(), fbb.GetBufferPointer() + fbb.GetSize());
+  EXPECT_TRUE(rejects(bytes, {{"shared", "refusing", "far more"}}));
+  // The same mesh referenced once is fine.
+  flatbuffers::FlatBufferBuilder once;
+  const auto single = fb::CreateMeshDirect(once, "shared", 3, 12, &layout, &vertices, fb::IndexFormat::Uint16,
+                                           &indices, &submeshes);
+  const std::vector<flatbuffers::Offset<fb::Mesh>> one = {single};
+  fb::FinishFileBuffer(once, fb::CreateFileDirect(once, kFormatVersion, 1.0f, 0, &one));
+  EXPECT_TRUE(accepts({once.GetBufferPointer(), once.GetBufferPointer() + once.GetSize()}));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Not an .ossa file at all
+
+TEST(NotOssa, WrongIdentifier) {
+  SyntheticSpec spec;
+  spec.identifier = "OSSB";
+  EXPECT_TRUE(rejects(spec, {{"identifier", "not an ossa", "not a .ossa"}}));
+}
+
+TEST(NotOssa, WrongVersion) {
+  SyntheticSpec spec;
+  spec.version = kFormatVersion + 1;
+  EXPECT_TRUE(rejects(spec, {{"version"}, {std::to_string(kFormatVersion + 1)}}));
+  spec.version = 0;
+  EXPECT_TRUE(rejects(spec, {{"version"}}));
+}
+
+TEST(NotOssa, EmptyBytes) {
+  EXPECT_TRUE(rejected(Asset::from_bytes({}, "empty.ossa"), "empty.ossa",
+                       {{"empty", "small", "short", "truncated", "too few", "0 bytes", "size"}}));
+  const Status status = verify_buffer({}, "empty.ossa");
+  EXPECT_FALSE(status.ok());
+  EXPECT_NE(status.message().find("empty.ossa"), std::string::npos) << status.message();
+}
+
+TEST(NotOssa, EmptyFileOnDisk) {
+  const std::filesystem::path path = make_temp_dir("bad_input") / "empty.ossa";
+  ASSERT_TRUE(write_file(path, std::string_view()));
+  EXPECT_TRUE(rejected(Asset::open(path.string()), path.string(),
+                       {{"empty", "small", "short", "truncated", "too few", "0 bytes", "size"}}));
+}
+
+TEST(NotOssa, Directory) {
+  const std::filesystem::path path = make_temp_dir("bad_input");
+  EXPECT_TRUE(rejected(Asset::open(path.string()), path.string(), {{"directory", "not a regular", "not a file"}}));
+}
+
+TEST(NotOssa, DeviceFile) {
+  EXPECT_TRUE(rejected(Asset::open("/dev/null"), "/dev/null", {{"not a regular", "not a file"}}));
+}
+
+// open(2) on a FIFO waits for a writer; a loader that opens before it checks the file type hangs
+// on `ossa-view some.fifo`. A helper thread stands by to play the writer so that such a loader
+// fails this test instead of hanging the suite; the generous wait is a liveness bound, not a
+// performance expectation.
+TEST(NotOssa, NamedPipeDoesNotBlock) {
+  const std::filesystem::path path = make_temp_dir("bad_input") / "pipe.ossa";
+  ASSERT_EQ(mkfifo(path.c_str(), 0600), 0);
+  std::mutex mutex;
+  std::condition_variable done_cv;
+  bool done = false, had_to_release = false;
+  std::thread writer([&] {
+    std::unique_lock lock(mutex);
+    if (done_cv.wait_for(lock, std::chrono::seconds(10), [&] { return done; })) return;
+    had_to_release = true;
+    const int fd = ::open(path.c_str(), O_WRONLY | O_NONBLOCK);  // unblocks a reader stuck in open
+    if (fd >= 0) ::close(fd);
+  });
+  const Result<Asset> asset = Asset::open(path.string());
+  {
+    std::lock_guard lock(mutex);
+    done = true;
+  }
+  done_cv.notify_one();
+  writer.join();
+  EXPECT_FALSE(had_to_release) << "Asset::open blocked on a FIFO until a writer appeared (open with O_NONBLOCK, "
+                                  "or check the file type before opening)";
+  EXPECT_TRUE(rejected(asset, path.string(), {{"not a regular", "not a file"}}));
+}
+
+TEST(NotOssa, MissingPath) {
+  const std::filesystem::path path = make_temp_dir("bad_input") / "no-such-file.ossa";
+  EXPECT_TRUE(rejected(Asset::open(path.string()), path.string(),
+                       {{"no such", "not found", "does not exist", "cannot open", "can't open"}}));
+}
+
+TEST(NotOssa, GlbFile) {
+  const std::filesystem::path path = source_dir() / "assets" / "CesiumMan" / "CesiumMan.glb";
+  ASSERT_TRUE(std::filesystem::exists(path)) << path;
+  EXPECT_TRUE(rejected(Asset::open(path.string()), path.string(), {{"identifier", "not an ossa", "not a .ossa"}}));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Skeleton invariants
+
+TEST(Skeleton, ParentNotBeforeChild) {
+  for (int16_t parent : {int16_t{2}, int16_t{3}}) {  // itself, a later joint
+    SyntheticSpec spec;
+    spec.skeleton->parents[2] = parent;
+    EXPECT_TRUE(rejects(spec, {{"parent"}})) << "parent " << parent;
+  }
+}
+
+TEST(Skeleton, ParentBelowMinusOne) {
+  SyntheticSpec spec;
+  spec.skeleton->parents[1] = -2;
+  EXPECT_TRUE(rejects(spec, {{"parent"}}));
+}
+
+TEST(Skeleton, HashMismatch) {
+  SyntheticSpec spec;
+  const SyntheticSkeleton& s = *spec.skeleton;
+  const std::vector<std::string_view> names(s.names.begin(), s.names.end());
+  spec.skeleton->hash = skeleton_hash(names, s.parents) ^ 1;
+  EXPECT_TRUE(rejects(spec, {{"hash"}}));
+}
+
+TEST(Skeleton, PerJointArrayLengthMismatch) {
+  const auto mismatched = [](auto edit, const char* word) {
+    SyntheticSpec spec;
+    edit(*spec.skeleton);
+    EXPECT_TRUE(rejects(spec, {{word}})) << word;
+  };
+  mismatched([](SyntheticSkeleton& s) { s.parents.pop_back(); }, "parent");
+  mismatched([](SyntheticSkeleton& s) { s.translations.pop_back(); }, "translation");
+  mismatched([](SyntheticSkeleton& s) { s.rotations.pop_back(); }, "rotation");
+  mismatched([](SyntheticSkeleton& s) { s.scales.push_back(fb::Vec3(1, 1, 1)); }, "scale");
+  mismatched(
+      [](SyntheticSkeleton& s) {
+        s.inverse_bind = std::vector<fb::Mat4>(3);
+      },
+      "inverse");
+}
+
+// ---------------------------------------------------------------------------------------------
+// Mesh invariants
+
+TEST(Mesh, IndexPastVertexCount) {
+  SyntheticSpec spec;
+  spec.meshes[0].indices[4] = 6;  // 6 vertices: 0..5
+  EXPECT_TRUE(rejects(spec, with(kMesh, {"index", "indices"})));
+  spec.meshes[0].index_format = fb::IndexFormat::Uint32;
+  spec.meshes[0].indices[4] = 0xFFFFFFFFu;
+  EXPECT_TRUE(rejects(spec, with(kMesh, {"index", "indices"})));
+}
+
+TEST(Mesh, IndexBytesNotMultipleOfIndexSize) {
+  SyntheticSpec spec;
+  spec.meshes[0].index_padding_bytes = 1;
+  EXPECT_TRUE(rejects(spec, with(kMesh, {"index", "indices"})));
+  spec.meshes[0].index_format = fb::IndexFormat::Uint32;
+  spec.meshes[0].index_padding_bytes = 2;
+  EXPECT_TRUE(rejects(spec, with(kMesh, {"index", "indices"})));
+}
+
+TEST(Mesh, IndexCountNotMultipleOf3) {
+  SyntheticSpec spec;
+  spec.meshes[0].indices.push_back(0);  // 13 indices; the submeshes still cover 0..11
+  EXPECT_TRUE(rejects(spec, with(kMesh, {"index", "indices", "triangle"})));
+}
+
+TEST(Mesh, SubmeshPastIndexRange) {
+  SyntheticSpec spec;
+  spec.meshes[0].submeshes[1] = fb::Submesh(6, 9, 0);  // 15 > 12
+  EXPECT_TRUE(rejects(spec, with(kMesh, {"submesh"})));
+  spec.meshes[0].submeshes[1] = fb::Submesh(0xFFFFFFF0u, 0x20u, 0);  // wraps in 32 bits
+  EXPECT_TRUE(rejects(spec, with(kMesh, {"submesh"})));
+}
+
+TEST(Mesh, SubmeshMaterialOutOfRange) {
+  SyntheticSpec spec;
+  spec.meshes[0].submeshes[1] = fb::Submesh(6, 6, 1);  // one material
+  EXPECT_TRUE(rejects(spec, with(kMesh, {"material"})));
+  // Without materials, material 0 means "the default material"; anything else is out of range.
+  spec.materials.clear();
+  EXPECT_TRUE(rejects(spec, with(kMesh, {"material"})));
+}
+
+TEST(Mesh, AttributePastStride) {
+  SyntheticSpec spec;
+  spec.meshes[0].layout[4] = fb::VertexAttribute(fb::VertexSemantic::Weights, fb::VertexFormat::Unorm8x4, 22);
+  EXPECT_TRUE(rejects(spec, with(kMesh, {"stride", "offset"})));
+  spec.meshes[0].layout[4] = fb::VertexAttribute(fb::VertexSemantic::Weights, fb::VertexFormat::Unorm8x4, 0xFFFF);
+  EXPECT_TRUE(rejects(spec, with(kMesh, {"stride", "offset"})));
+}
+
+TEST(Mesh, UnknownVertexFormat) {
+  SyntheticSpec spec;
+  spec.meshes[0].layout[2] = fb::VertexAttribute(fb::VertexSemantic::TexCoord0, static_cast<fb::VertexFormat>(42), 12);
+  EXPECT_TRUE(rejects(spec, with(kMesh, {"format"})));
+}
+
+TEST(Mesh, DuplicateSemantic) {
+  SyntheticSpec spec;
+  spec.meshes[0].layout[2] = fb::VertexAttribute(fb::VertexSemantic::Normal, fb::VertexFormat::Snorm16x2, 12);
+  EXPECT_TRUE(rejects(spec, with(kMesh, {"two Normal", "duplicate", "twice", "more than once", "repeated"})));
+}
+
+TEST(Mesh, UnknownSemantic) {
+  SyntheticSpec spec;
+  spec.meshes[0].layout[2] = fb::VertexAttribute(static_cast<fb::VertexSemantic>(42), fb::VertexFormat::Float16x2, 12);
+  EXPECT_TRUE(rejects(spec, with(kMesh, {"semantic"})));
+}
+
+TEST(Mesh, VertexBytesNotCountTimesStride) {
+  for (uint32_t count : {5u, 7u}) {
+    SyntheticSpec spec;
+    spec.meshes[0].vertex_count = count;
+    EXPECT_TRUE(rejects(spec, with(kMesh, {"vertex", "vertices"}))) << "vertex_count " << count;
+  }
+}
+
+// count * stride wraps to the real byte size in 32-bit arithmetic; a loader that multiplies in
+// 32 bits accepts a mesh that claims 2^27 more vertices than it holds.
+TEST(Mesh, VertexCountOverflow) {
+  SyntheticSpec spec;
+  spec.meshes[0].vertex_stride = 32;
+  spec.meshes[0].vertex_count = 6u + (1u << 27);
+  EXPECT_TRUE(rejects(spec, with(kMesh, {"vertex", "vertices"})));
+}
+
+TEST(Mesh, JointSlotPastSlotCount) {
+  SyntheticSpec spec;
+  spec.meshes[0].vertices[5].slots[1] = 3;  // slots 0..2; weight 55 on that slot
+  EXPECT_TRUE(rejects(spec, with(kMesh, {"slot"})));
+}
+
+TEST(Mesh, MeshJointPastSkeletonJointCount) {
+  SyntheticSpec spec;
+  spec.meshes[0].joints[2] = 4;  // 4 joints: 0..3
+  EXPECT_TRUE(rejects(spec, with(kMesh, {"joint"})));
+  // Skinned mesh in a file without a skeleton: every slot is out of range.
+  spec.meshes[0].joints[2] = 3;
+  spec.skeleton.reset();
+  spec.clips.clear();
+  EXPECT_TRUE(rejects(spec, with(kMesh, {"joint", "skeleton"})));
+}
+
+TEST(Mesh, JointsInverseBindLengthMismatch) {
+  SyntheticSpec spec;
+  spec.meshes[0].inverse_bind = std::vector<fb::Mat4>(2);  // 3 slots
+  EXPECT_TRUE(rejects(spec, with(kMesh, {"inverse"})));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Clip invariants
+
+TEST(Clip, TrackJointPastJointCount) {
+  SyntheticSpec spec;
+  spec.clips[0].tracks[1].joint = 4;  // joint_count 4
+  EXPECT_TRUE(rejects(spec, with(kClip, {"joint"})));
+}
+
+TEST(Clip, TracksNotSorted) {
+  SyntheticSpec spec;
+  std::swap(spec.clips[0].tracks[0], spec.clips[0].tracks[1]);
+  EXPECT_TRUE(rejects(spec, with(kClip, {"sorted", "order", "increasing"})));
+  spec.clips[0].tracks[0].joint = 1;  // two tracks for joint 1
+  spec.clips[0].tracks[1].joint = 1;
+  EXPECT_TRUE(rejects(spec, with(kClip, {"sorted", "order", "increasing", "duplicate", "twice", "more than one"})));
+}
+
+TEST(Clip, KeyTimesUnsorted) {
+  SyntheticSpec spec;
+  spec.clips[0].tracks[0].rotation_times = {0.0f, 0.75f, 0.5f};
+  EXPECT_TRUE(rejects(spec, with(kClip, {"time"})));
+  spec.clips[0].tracks[0].rotation_times = {0.0f, 0.5f, 0.5f};  // strictly increasing
+  EXPECT_TRUE(rejects(spec, with(kClip, {"time"})));
+}
+
+TEST(Clip, KeyTimesOutsideDuration) {
+  SyntheticSpec spec;
+  spec.clips[0].tracks[1].scale_times = {0.25f, 1.5f};  // duration 1
+  EXPECT_TRUE(rejects(spec, with(kClip, {"outside", "duration"})));
+  spec.clips[0].tracks[1].scale_times = {-0.25f, 0.75f};
+  EXPECT_TRUE(rejects(spec, with(kClip, {"outside", "duration"})));
+}
+
+TEST(Clip, KeyTimeNotFinite) {
+  for (float t : {kNaN, kInf}) {
+    SyntheticSpec spec;
+    spec.clips[0].tracks[0].rotation_times = {0.0f, t, 1.0f};
+    EXPECT_TRUE(rejects(spec, with(kClip, {"time"}))) << t;
+  }
+}
+
+TEST(Clip, DurationInvalid) {
+  for (float d : {kNaN, -1.0f}) {
+    SyntheticSpec spec;
+    spec.clips[0].duration = d;
+    EXPECT_TRUE(rejects(spec, with(kClip, {"duration", "time"}))) << d;
+  }
+}
+
+TEST(Clip, KeyValueNotFinite) {
+  {
+    SyntheticSpec spec;
+    spec.clips[0].tracks[0].rotations[1] = fb::Quat(0, kNaN, 0, 1);
+    EXPECT_TRUE(rejects(spec, with(kClip, {"finite", "nan", "rotation"})));
+  }
+  {
+    SyntheticSpec spec;
+    spec.clips[0].tracks[1].translations[1] = fb::Vec3(kInf, 0, 0);
+    EXPECT_TRUE(rejects(spec, with(kClip, {"finite", "inf", "translation"})));
+  }
+  {
+    SyntheticSpec spec;
+    spec.clips[0].tracks[1].scales[0] = fb::Vec3(1, 1, kNaN);
+    EXPECT_TRUE(rejects(spec, with(kClip, {"finite", "nan", "scale"})));
+  }
+}
+
+TEST(Clip, TimesValuesCountMismatch) {
+  SyntheticSpec spec;
+  spec.clips[0].tracks[0].rotations.pop_back();  // 3 times, 2 values
+  EXPECT_TRUE(rejects(spec, with(kClip, {"rotation"})));
+  SyntheticSpec translations_only;
+  translations_only.clips[0].tracks[1].translation_times = {0.5f};  // 1 time, 2 values
+  EXPECT_TRUE(rejects(translations_only, with(kClip, {"translation"})));
+}
+
+TEST(Clip, ZeroQuaternion) {
+  SyntheticSpec spec;
+  spec.clips[0].tracks[0].rotations[1] = fb::Quat(0, 0, 0, 0);
+  EXPECT_TRUE(rejects(spec, with(kClip, {"quaternion", "rotation"})));
+}
+
+TEST(Clip, BindingToAnotherRigRejected) {
+  SyntheticSpec spec;
+  spec.clips[0].skeleton_hash = 0xBADBADBADull;
+  const Result<Asset> asset = Asset::from_bytes(make_valid_file(spec), "other-rig.ossa");
+  ASSERT_TRUE(asset.ok()) << asset.error().message;  // a clip may belong to another rig
+  const Status status = check_clip_binding(asset->clip(0), asset->skeleton(), "other-rig.ossa");
+  EXPECT_FALSE(status.ok());
+  EXPECT_TRUE(explains(status.message(), "other-rig.ossa", {{"walk"}, {"hash", "skeleton", "rig"}}));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Messages quote untrusted names: they must come out printable and bounded.
+
+TEST(Messages, HostileNamesAreQuotedSafely) {
+  SyntheticSpec spec;
+  spec.clips.clear();  // only the skeleton is wrong
+  spec.skeleton->names[2] = "\x1b[2J\x1b]0;pwned\x07" + std::string(100000, 'x');
+  spec.skeleton->parents[2] = 3;
+  const Result<Asset> asset = Asset::from_bytes(make_valid_file(spec), "hostile.ossa");
+  ASSERT_FALSE(asset.ok());
+  const std::string& message = asset.error().message;
+  EXPECT_LT(message.size(), 2000u);
+  EXPECT_TRUE(std::none_of(message.begin(), message.end(), [](char c) { return c == '\x1b' || c == '\x07'; }))
+      << message.substr(0, 200);
+}
+
+}  // namespace
+}  // namespace ossa::test

@@ -1,0 +1,172 @@
+// cooker_cli_test.cpp — ossa-cook as a user drives it: batches with failures, output planning,
+// --root, --skeleton, --report, and the promise that nothing half-written or lost is left behind.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "runtime/asset.h"
+#include "test_files.h"
+
+namespace fs = std::filesystem;
+using ossa::test::run_command;
+
+namespace {
+
+std::string cook_cmd() { return (ossa::test::bin_dir() / "ossa-cook").string(); }
+fs::path asset(const char* rel) { return ossa::test::source_dir() / "assets" / rel; }
+std::string q(const fs::path& p) { return "'" + p.string() + "'"; }
+
+size_t count_files(const fs::path& dir) {
+  size_t n = 0;
+  std::error_code ec;
+  for (fs::recursive_directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec))
+    if (it->is_regular_file()) ++n;
+  return n;
+}
+
+TEST(CookerCli, CooksOneFileThatVerifies) {
+  const fs::path out = ossa::test::make_temp_dir("cli-one");
+  const auto r = run_command(cook_cmd() + " " + q(asset("RiggedSimple/RiggedSimple.glb")) + " -o " + q(out));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  auto a = ossa::Asset::open((out / "RiggedSimple.ossa").string());
+  ASSERT_TRUE(a.ok()) << a.error().message;
+  EXPECT_GT(a->skeleton().joint_count(), 0u);
+  EXPECT_GT(a->mesh_count(), 0u);
+  EXPECT_EQ(count_files(out), 1u) << "only the output, no temporary files";
+}
+
+TEST(CookerCli, BadInputsFailAloneAndTheBatchGoesOn) {
+  const fs::path dir = ossa::test::make_temp_dir("cli-bad");
+  const fs::path src = dir / "src", out = dir / "out";
+  fs::create_directories(src);
+  ASSERT_TRUE(ossa::test::write_file(src / "garbage.fbx", std::string_view("this is not an FBX file\n")));
+  ASSERT_TRUE(ossa::test::write_file(src / "empty.glb", std::string_view("")));
+  const auto r = run_command(cook_cmd() + " " + q(src / "garbage.fbx") + " " + q(src / "missing.gltf") + " " +
+                             q(asset("RiggedSimple/RiggedSimple.glb")) + " " + q(src / "empty.glb") + " " +
+                             q(asset("Fox/Fox.glb")) + " -o " + q(out) + " --jobs 2 --report " +
+                             q(dir / "report.json"));
+  EXPECT_EQ(r.exit_code, 1);
+  // Each failure is named on stderr with its file.
+  EXPECT_NE(r.err.find("garbage.fbx"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("missing.gltf"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("empty.glb"), std::string::npos) << r.err;
+  // The good inputs were cooked, the bad ones left nothing.
+  EXPECT_TRUE(ossa::Asset::open((out / "RiggedSimple.ossa").string()).ok());
+  EXPECT_TRUE(ossa::Asset::open((out / "Fox.ossa").string()).ok());
+  EXPECT_FALSE(fs::exists(out / "garbage.ossa"));
+  EXPECT_FALSE(fs::exists(out / "missing.ossa"));
+  EXPECT_FALSE(fs::exists(out / "empty.ossa"));
+  EXPECT_EQ(count_files(out), 2u);
+
+  auto text = ossa::test::read_text(dir / "report.json");
+  ASSERT_TRUE(text.has_value());
+  const auto report = nlohmann::json::parse(*text);
+  EXPECT_EQ(report["inputs"], 5);
+  EXPECT_EQ(report["failed"], 3);
+  ASSERT_EQ(report["records"].size(), 5u);
+  EXPECT_EQ(report["records"][0]["status"], "failed");
+  EXPECT_NE(report["records"][0]["error"].get<std::string>().find("garbage.fbx"), std::string::npos);
+  EXPECT_EQ(report["records"][1]["status"], "failed");
+  EXPECT_EQ(report["records"][2]["status"], "ok");
+  EXPECT_GT(report["records"][2]["joints"].get<int>(), 0);
+  EXPECT_GT(report["records"][2]["cooked_bytes"].get<int>(), 0);
+  EXPECT_EQ(report["records"][4]["status"], "ok");
+  EXPECT_EQ(report["records"][4]["clips"], 3);
+}
+
+TEST(CookerCli, FailedCookKeepsThePreviousOutput) {
+  const fs::path dir = ossa::test::make_temp_dir("cli-keep");
+  const fs::path out = dir / "out";
+  fs::create_directories(out);
+  ASSERT_TRUE(ossa::test::write_file(dir / "thing.fbx", std::string_view("not a model")));
+  ASSERT_TRUE(ossa::test::write_file(out / "thing.ossa", std::string_view("previous output")));
+  const auto r = run_command(cook_cmd() + " " + q(dir / "thing.fbx") + " -o " + q(out));
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_EQ(ossa::test::read_text(out / "thing.ossa").value_or(""), "previous output");
+  EXPECT_EQ(count_files(out), 1u);
+}
+
+TEST(CookerCli, OutputCollisionRefusedBeforeCooking) {
+  const fs::path dir = ossa::test::make_temp_dir("cli-collide");
+  fs::create_directories(dir / "a");
+  fs::create_directories(dir / "b");
+  fs::copy_file(asset("RiggedSimple/RiggedSimple.glb"), dir / "a" / "model.glb");
+  fs::copy_file(asset("CesiumMan/CesiumMan.glb"), dir / "b" / "model.glb");
+  const auto r = run_command(cook_cmd() + " " + q(dir / "a" / "model.glb") + " " + q(dir / "b" / "model.glb") +
+                             " -o " + q(dir / "out"));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("would both write"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "out" / "model.ossa"));
+
+  // With --root the tree is mirrored and both cook.
+  const auto m = run_command(cook_cmd() + " " + q(dir / "a") + " " + q(dir / "b") + " --root " + q(dir) + " -o " +
+                             q(dir / "out"));
+  ASSERT_EQ(m.exit_code, 0) << m.err;
+  EXPECT_TRUE(ossa::Asset::open((dir / "out" / "a" / "model.ossa").string()).ok());
+  EXPECT_TRUE(ossa::Asset::open((dir / "out" / "b" / "model.ossa").string()).ok());
+}
+
+TEST(CookerCli, InputOutsideRootIsAnError) {
+  const fs::path dir = ossa::test::make_temp_dir("cli-root");
+  const auto r = run_command(cook_cmd() + " " + q(asset("Fox/Fox.glb")) + " --root " + q(dir) + " -o " +
+                             q(dir / "out"));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("not inside --root"), std::string::npos) << r.err;
+}
+
+TEST(CookerCli, ClipOnlyFileBindsToItsSkeleton) {
+  const fs::path dir = ossa::test::make_temp_dir("cli-skel");
+  auto r = run_command(cook_cmd() + " " + q(asset("Pab/skeleton.fbx")) + " -o " + q(dir));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  r = run_command(cook_cmd() + " " + q(asset("Pab/walk.fbx")) + " --skeleton " + q(dir / "skeleton.ossa") +
+                  " -o " + q(dir / "clips"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  auto skel = ossa::Asset::open((dir / "skeleton.ossa").string());
+  auto walk = ossa::Asset::open((dir / "clips" / "walk.ossa").string());
+  ASSERT_TRUE(skel.ok() && walk.ok());
+  EXPECT_TRUE(walk->skeleton().empty()) << "a clip-only file carries no skeleton of its own";
+  ASSERT_GE(walk->clip_count(), 1u);
+  EXPECT_EQ(walk->clip(0).skeleton_hash(), skel->skeleton().hash());
+  EXPECT_TRUE(ossa::check_clip_binding(walk->clip(0), skel->skeleton(), "walk.ossa").ok());
+  EXPECT_GT(walk->clip(0).track_count(), 10u);
+}
+
+TEST(CookerCli, ClipAgainstTheWrongRigNamesMissingJoints) {
+  const fs::path dir = ossa::test::make_temp_dir("cli-wrong");
+  auto r = run_command(cook_cmd() + " " + q(asset("Fox/Fox.glb")) + " -o " + q(dir));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  r = run_command(cook_cmd() + " " + q(asset("Pab/walk.fbx")) + " --skeleton " + q(dir / "Fox.ossa") + " -o " +
+                  q(dir / "clips"));
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("walk.fbx"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("Hips"), std::string::npos) << "names a Pab joint missing from the Fox rig: " << r.err;
+  EXPECT_FALSE(fs::exists(dir / "clips" / "walk.ossa"));
+}
+
+TEST(CookerCli, BadSkeletonReferenceIsAUsageError) {
+  const fs::path dir = ossa::test::make_temp_dir("cli-badref");
+  ASSERT_TRUE(ossa::test::write_file(dir / "ref.ossa", std::string_view("nope")));
+  const auto r = run_command(cook_cmd() + " " + q(asset("Pab/walk.fbx")) + " --skeleton " + q(dir / "ref.ossa") +
+                             " -o " + q(dir / "out"));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("ref.ossa"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "out"));
+}
+
+TEST(CookerCli, FloatVerticesOption) {
+  const fs::path dir = ossa::test::make_temp_dir("cli-float");
+  auto r = run_command(cook_cmd() + " " + q(asset("CesiumMan/CesiumMan.glb")) + " --float-vertices -o " + q(dir));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  auto a = ossa::Asset::open((dir / "CesiumMan.ossa").string());
+  ASSERT_TRUE(a.ok());
+  ASSERT_GT(a->mesh_count(), 0u);
+  const auto* pos = a->mesh(0).attribute(ossa::fb::VertexSemantic::Position);
+  ASSERT_NE(pos, nullptr);
+  EXPECT_EQ(pos->format(), ossa::fb::VertexFormat::Float32x3);
+  EXPECT_NE(std::string(a->file().provenance()->options()->c_str()).find("float32"), std::string::npos);
+}
+
+}  // namespace

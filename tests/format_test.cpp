@@ -1,0 +1,103 @@
+// format_test.cpp — the shared encoders/decoders and hashes that both cooker and runtime rely on.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <random>
+#include <string_view>
+#include <vector>
+
+#include "format/hash.h"
+#include "format/vertex_codec.h"
+#include "format/vertex_format.h"
+
+namespace {
+
+TEST(Hash, Fnv1aKnownVectors) {
+  // Published FNV-1a 64 test vectors.
+  EXPECT_EQ(ossa::hash_bytes("", 0), 0xcbf29ce484222325ull);
+  EXPECT_EQ(ossa::hash_bytes("a", 1), 0xaf63dc4c8601ec8cull);
+  EXPECT_EQ(ossa::hash_bytes("foobar", 6), 0x85944171f73967e8ull);
+}
+
+TEST(Hash, SkeletonHashSeparatesNamesAndParents) {
+  const std::vector<std::string_view> ab_c{"ab", "c"}, a_bc{"a", "bc"};
+  const std::vector<int16_t> p1{-1, 0}, p2{-1, -1};
+  EXPECT_NE(ossa::skeleton_hash(ab_c, p1), ossa::skeleton_hash(a_bc, p1));
+  EXPECT_NE(ossa::skeleton_hash(ab_c, p1), ossa::skeleton_hash(ab_c, p2));
+  EXPECT_EQ(ossa::skeleton_hash(ab_c, p1), ossa::skeleton_hash(ab_c, p1));
+}
+
+TEST(VertexCodec, OctahedralRoundTripWithinSnorm16Precision) {
+  std::mt19937 rng(7);
+  std::normal_distribution<float> g;
+  float worst_deg = 0.0f;
+  for (int i = 0; i < 100000; ++i) {
+    ossa::Float3 n{g(rng), g(rng), g(rng)};
+    const float len = std::sqrt(n.x * n.x + n.y * n.y + n.z * n.z);
+    if (len < 1e-6f) continue;
+    n = {n.x / len, n.y / len, n.z / len};
+    const ossa::Float2 e = ossa::octahedral_encode(n);
+    const ossa::Float2 q{ossa::snorm16_to_float(ossa::float_to_snorm16(e.x)),
+                         ossa::snorm16_to_float(ossa::float_to_snorm16(e.y))};
+    const ossa::Float3 d = ossa::octahedral_decode(q);
+    // Angle via atan2(|n x d|, n.d) in double: acos of a float dot near 1 is itself off by ~0.02 deg.
+    const double cx = double(n.y) * d.z - double(n.z) * d.y, cy = double(n.z) * d.x - double(n.x) * d.z,
+                 cz = double(n.x) * d.y - double(n.y) * d.x;
+    const double dot = double(n.x) * d.x + double(n.y) * d.y + double(n.z) * d.z;
+    const double deg = std::atan2(std::sqrt(cx * cx + cy * cy + cz * cz), dot) * 57.29577951308232;
+    worst_deg = std::fmax(worst_deg, static_cast<float>(deg));
+  }
+  EXPECT_LT(worst_deg, 0.01f);  // snorm16 octahedral: ~0.003 degrees expected
+}
+
+TEST(VertexCodec, OctahedralAxesExact) {
+  const ossa::Float3 axes[] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+  for (const ossa::Float3& a : axes) {
+    const ossa::Float3 d = ossa::octahedral_decode(ossa::octahedral_encode(a));
+    EXPECT_NEAR(d.x, a.x, 1e-6f);
+    EXPECT_NEAR(d.y, a.y, 1e-6f);
+    EXPECT_NEAR(d.z, a.z, 1e-6f);
+  }
+}
+
+TEST(VertexCodec, HalfFloatExactAndRounded) {
+  const float exact[] = {0.0f, -0.0f, 1.0f, -2.5f, 0.5f, 65504.0f, 6.103515625e-05f, 5.960464477539063e-08f};
+  for (float f : exact) EXPECT_EQ(ossa::half_to_float(ossa::float_to_half(f)), f) << f;
+  EXPECT_TRUE(std::isinf(ossa::half_to_float(ossa::float_to_half(1e6f))));
+  EXPECT_TRUE(std::isnan(ossa::half_to_float(ossa::float_to_half(std::nanf("")))));
+  // Every half value round-trips through float exactly.
+  for (uint32_t h = 0; h < 0x10000; ++h) {
+    const float f = ossa::half_to_float(static_cast<uint16_t>(h));
+    if (std::isnan(f)) continue;
+    EXPECT_EQ(ossa::float_to_half(f), h) << h;
+  }
+  // Round to nearest: UV error in [0, 1] stays under half an ulp at 1 (2^-12).
+  for (int i = 0; i <= 1000; ++i) {
+    const float f = static_cast<float>(i) / 1000.0f;
+    EXPECT_LE(std::fabs(ossa::half_to_float(ossa::float_to_half(f)) - f), 1.0f / 4096.0f);
+  }
+}
+
+TEST(VertexCodec, UnormSnormEndpoints) {
+  EXPECT_EQ(ossa::float_to_unorm16(0.0f), 0);
+  EXPECT_EQ(ossa::float_to_unorm16(1.0f), 65535);
+  EXPECT_EQ(ossa::float_to_unorm16(2.0f), 65535);
+  EXPECT_EQ(ossa::float_to_snorm16(-1.0f), -32767);
+  EXPECT_FLOAT_EQ(ossa::snorm16_to_float(-32768), -1.0f);
+  EXPECT_FLOAT_EQ(ossa::unorm16_to_float(65535), 1.0f);
+}
+
+TEST(VertexFormat, SizesMatchComponentTypes) {
+  using F = ossa::fb::VertexFormat;
+  EXPECT_EQ(ossa::vertex_format_info(F::Float32x3).size, 12);
+  EXPECT_EQ(ossa::vertex_format_info(F::Unorm16x4).size, 8);
+  EXPECT_EQ(ossa::vertex_format_info(F::Snorm16x2).size, 4);
+  EXPECT_EQ(ossa::vertex_format_info(F::Float16x2).size, 4);
+  EXPECT_EQ(ossa::vertex_format_info(F::Uint8x4).size, 4);
+  EXPECT_TRUE(ossa::vertex_format_info(F::Uint16x4).integer);
+  EXPECT_TRUE(ossa::vertex_format_info(F::Unorm8x4).normalized);
+  EXPECT_EQ(ossa::vertex_format_info(static_cast<F>(200)).size, 0);
+}
+
+}  // namespace

@@ -1,0 +1,390 @@
+// runtime_view_test.cpp — the loader's promises to a game: what was written is what the views
+// read, byte ranges are spans into the file (16-byte aligned, no copies), an Asset owns its bytes
+// exactly once across moves, and open() and from_bytes() see the same file.
+//
+// Files come from test_files.h's synthetic writer (independent of the cooker), plus one tiny
+// hand-built file for what that writer always writes (a mesh without joint vectors, a file
+// without a skeleton). Invalid files are the bad-input suite's business, not this one's.
+#include <gtest/gtest.h>
+
+#include <cerrno>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <flatbuffers/flatbuffers.h>
+
+#include "format/hash.h"
+#include "format/version.h"
+#include "runtime/asset.h"
+#include "test_files.h"
+
+namespace ossa {
+namespace {
+
+using test::make_valid_file;
+using test::SyntheticSpec;
+
+bool aligned16(const void* p) { return reinterpret_cast<uintptr_t>(p) % 16 == 0; }
+
+Asset load(std::span<const uint8_t> bytes, std::string name = "synthetic.ossa") {
+  auto asset = Asset::from_bytes(bytes, std::move(name));
+  EXPECT_TRUE(asset.ok()) << (asset.ok() ? "" : asset.error().message);
+  if (!asset.ok()) std::abort();  // every caller needs an asset; nothing sensible follows
+  return std::move(asset).value();
+}
+
+/// A file with no skeleton, no clips, no materials and one static mesh whose optional vectors
+/// (name, joints, inverse_bind, bounds) are all left out.
+std::vector<uint8_t> make_static_mesh_file() {
+  flatbuffers::FlatBufferBuilder fbb;
+  const fb::VertexAttribute layout[] = {{fb::VertexSemantic::Position, fb::VertexFormat::Float32x3, 0}};
+  const float positions[] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+  const uint16_t indices[] = {0, 1, 2};
+  const fb::Submesh submesh(0, 3, 0);
+  const auto layout_vector = fbb.CreateVectorOfStructs(layout, 1);
+  fbb.ForceVectorAlignment(sizeof positions, 1, 16);
+  const auto vertices = fbb.CreateVector(reinterpret_cast<const uint8_t*>(positions), sizeof positions);
+  fbb.ForceVectorAlignment(sizeof indices, 1, 16);
+  const auto index_vector = fbb.CreateVector(reinterpret_cast<const uint8_t*>(indices), sizeof indices);
+  const auto submeshes = fbb.CreateVectorOfStructs(&submesh, 1);
+  fb::MeshBuilder mesh(fbb);
+  mesh.add_vertex_count(3);
+  mesh.add_vertex_stride(12);
+  mesh.add_layout(layout_vector);
+  mesh.add_vertices(vertices);
+  mesh.add_index_format(fb::IndexFormat::Uint16);
+  mesh.add_indices(index_vector);
+  mesh.add_submeshes(submeshes);
+  const auto mesh_offset = mesh.Finish();
+  const std::vector<flatbuffers::Offset<fb::Mesh>> meshes = {mesh_offset};
+  fb::FinishFileBuffer(fbb, fb::CreateFileDirect(fbb, kFormatVersion, 0.01f, 0, &meshes));
+  return {fbb.GetBufferPointer(), fbb.GetBufferPointer() + fbb.GetSize()};
+}
+
+// ---- what was written is what is read ----------------------------------------------------------
+
+TEST(RuntimeView, SkeletonViewsReturnWhatWasWritten) {
+  const SyntheticSpec spec;
+  const auto bytes = make_valid_file(spec);
+  const Asset asset = load(bytes);
+  const SkeletonView s = asset.skeleton();
+  const test::SyntheticSkeleton& want = *spec.skeleton;
+
+  ASSERT_FALSE(s.empty());
+  ASSERT_EQ(s.joint_count(), want.names.size());
+  for (size_t i = 0; i < want.names.size(); ++i) {
+    EXPECT_EQ(s.joint_name(i), want.names[i]);
+    EXPECT_EQ(s.parents()[i], want.parents[i]);
+    EXPECT_EQ(s.find_joint(want.names[i]), static_cast<int>(i));
+    EXPECT_EQ(s.bind_translations()[i].y(), want.translations[i].y());
+    EXPECT_EQ(s.bind_rotations()[i].z(), want.rotations[i].z());
+    EXPECT_EQ(s.bind_rotations()[i].w(), want.rotations[i].w());
+    EXPECT_EQ(s.bind_scales()[i].x(), want.scales[i].x());
+  }
+  EXPECT_EQ(s.parents().size(), want.names.size());
+  EXPECT_EQ(s.bind_translations().size(), want.names.size());
+  EXPECT_EQ(s.bind_rotations().size(), want.names.size());
+  EXPECT_EQ(s.bind_scales().size(), want.names.size());
+  EXPECT_EQ(s.inverse_bind().size(), want.names.size());
+  EXPECT_EQ(s.find_joint("no such joint"), -1);
+  EXPECT_EQ(s.find_joint(""), -1);
+  EXPECT_EQ(s.joint_name(want.names.size()), "");  // out of range: empty, not a crash
+
+  std::vector<std::string_view> names(want.names.begin(), want.names.end());
+  EXPECT_EQ(s.hash(), skeleton_hash(names, want.parents));
+
+  // The spans point into the asset's bytes: no copies were made.
+  const auto file = asset.bytes();
+  EXPECT_GE(reinterpret_cast<const uint8_t*>(s.parents().data()), file.data());
+  EXPECT_LE(reinterpret_cast<const uint8_t*>(s.inverse_bind().data() + s.inverse_bind().size()),
+            file.data() + file.size());
+}
+
+TEST(RuntimeView, MeshViewsReturnWhatWasWritten) {
+  const SyntheticSpec spec;
+  const auto bytes = make_valid_file(spec);
+  const Asset asset = load(bytes);
+  const test::SyntheticMesh& want = spec.meshes[0];
+  ASSERT_EQ(asset.mesh_count(), 1u);
+  const MeshView m = asset.mesh(0);
+
+  EXPECT_EQ(m.name(), want.name);
+  EXPECT_EQ(m.vertex_count(), want.vertices.size());
+  EXPECT_EQ(m.vertex_stride(), want.vertex_stride);
+  ASSERT_EQ(m.layout().size(), want.layout.size());
+  for (size_t i = 0; i < want.layout.size(); ++i) {
+    EXPECT_EQ(m.layout()[i].semantic(), want.layout[i].semantic());
+    EXPECT_EQ(m.layout()[i].format(), want.layout[i].format());
+    EXPECT_EQ(m.layout()[i].offset(), want.layout[i].offset());
+  }
+  const fb::VertexAttribute* joints = m.attribute(fb::VertexSemantic::Joints);
+  ASSERT_NE(joints, nullptr);
+  EXPECT_EQ(joints->format(), fb::VertexFormat::Uint8x4);
+  EXPECT_EQ(joints->offset(), 16);
+  ASSERT_NE(m.attribute(fb::VertexSemantic::Position), nullptr);
+  EXPECT_EQ(m.attribute(fb::VertexSemantic::Position)->format(), fb::VertexFormat::Unorm16x4);
+  EXPECT_EQ(m.attribute(fb::VertexSemantic::Tangent), nullptr);
+  EXPECT_EQ(m.attribute(fb::VertexSemantic::Color0), nullptr);
+
+  // Vertex bytes: vertex_count * stride, 16-byte aligned in memory and in the file, and the
+  // joint slots written for each vertex are where the layout says.
+  ASSERT_EQ(m.vertex_bytes().size(), size_t{m.vertex_count()} * m.vertex_stride());
+  EXPECT_TRUE(aligned16(m.vertex_bytes().data()));
+  EXPECT_EQ((m.vertex_bytes().data() - asset.bytes().data()) % 16, 0);
+  for (size_t v = 0; v < want.vertices.size(); ++v)
+    for (size_t k = 0; k < 4; ++k) {
+      EXPECT_EQ(m.vertex_bytes()[v * m.vertex_stride() + joints->offset() + k], want.vertices[v].slots[k]);
+      EXPECT_EQ(m.vertex_bytes()[v * m.vertex_stride() + 20 + k], want.vertices[v].weights[k]);
+    }
+
+  // Index bytes: the indices as written, 16-byte aligned.
+  EXPECT_EQ(m.index_format(), fb::IndexFormat::Uint16);
+  ASSERT_EQ(m.index_count(), want.indices.size());
+  ASSERT_EQ(m.index_bytes().size(), want.indices.size() * 2);
+  EXPECT_TRUE(aligned16(m.index_bytes().data()));
+  EXPECT_EQ((m.index_bytes().data() - asset.bytes().data()) % 16, 0);
+  for (size_t i = 0; i < want.indices.size(); ++i) {
+    uint16_t index;
+    std::memcpy(&index, m.index_bytes().data() + 2 * i, 2);
+    EXPECT_EQ(index, want.indices[i]);
+  }
+
+  ASSERT_EQ(m.submeshes().size(), want.submeshes.size());
+  for (size_t i = 0; i < want.submeshes.size(); ++i) {
+    EXPECT_EQ(m.submeshes()[i].first_index(), want.submeshes[i].first_index());
+    EXPECT_EQ(m.submeshes()[i].index_count(), want.submeshes[i].index_count());
+    EXPECT_EQ(m.submeshes()[i].material(), want.submeshes[i].material());
+  }
+  ASSERT_EQ(m.joints().size(), want.joints.size());
+  for (size_t i = 0; i < want.joints.size(); ++i) EXPECT_EQ(m.joints()[i], want.joints[i]);
+  // Default inverse binds are the skeleton's for each slot's joint.
+  ASSERT_EQ(m.inverse_bind().size(), want.joints.size());
+  const SkeletonView s = asset.skeleton();
+  for (size_t i = 0; i < want.joints.size(); ++i)
+    EXPECT_EQ(std::memcmp(&m.inverse_bind()[i], &s.inverse_bind()[want.joints[i]], sizeof(fb::Mat4)), 0);
+}
+
+TEST(RuntimeView, ClipAndMaterialViewsReturnWhatWasWritten) {
+  const SyntheticSpec spec;
+  const auto bytes = make_valid_file(spec);
+  const Asset asset = load(bytes);
+  const test::SyntheticClip& want = spec.clips[0];
+  ASSERT_EQ(asset.clip_count(), 1u);
+  const ClipView c = asset.clip(0);
+
+  EXPECT_EQ(c.name(), want.name);
+  EXPECT_EQ(c.duration(), want.duration);
+  EXPECT_EQ(c.sample_rate(), want.sample_rate);
+  EXPECT_EQ(c.skeleton_hash(), asset.skeleton().hash());
+  ASSERT_EQ(c.track_count(), want.tracks.size());
+  size_t keys = 0;
+  for (size_t i = 0; i < want.tracks.size(); ++i) {
+    const fb::Track& t = c.track(i);
+    const test::SyntheticTrack& w = want.tracks[i];
+    EXPECT_EQ(t.joint(), w.joint);
+    EXPECT_EQ(t.rotation_times() ? t.rotation_times()->size() : 0, w.rotation_times.size());
+    keys += w.translation_times.size() + w.rotation_times.size() + w.scale_times.size();
+  }
+  EXPECT_EQ(c.key_count(), keys);
+  EXPECT_EQ(c.track(0).rotations()->Get(1)->y(), want.tracks[0].rotations[1].y());
+  EXPECT_TRUE(check_clip_binding(c, asset.skeleton(), asset.name()).ok());
+
+  ASSERT_EQ(asset.material_count(), 1u);
+  const fb::Material& m = asset.material(0);
+  EXPECT_EQ(m.name()->str(), spec.materials[0].name);
+  EXPECT_EQ(m.shininess(), spec.materials[0].shininess);
+  ASSERT_NE(m.textures(), nullptr);
+  ASSERT_EQ(m.textures()->size(), 2u);
+  const fb::Texture& png = *m.textures()->Get(0);
+  ASSERT_NE(png.data(), nullptr);
+  EXPECT_EQ(png.data()->size(), spec.materials[0].textures[0].data->size());
+  EXPECT_TRUE(aligned16(png.data()->Data()));
+  EXPECT_EQ(m.textures()->Get(1)->path()->str(), "textures/skin_normal.png");
+}
+
+TEST(RuntimeView, AbsentOptionalPartsGiveEmptyViews) {
+  const auto bytes = make_static_mesh_file();
+  const Asset asset = load(bytes);
+  EXPECT_EQ(asset.file().metres_per_unit(), 0.01f);
+
+  const SkeletonView s = asset.skeleton();
+  EXPECT_TRUE(s.empty());
+  EXPECT_EQ(s.joint_count(), 0u);
+  EXPECT_TRUE(s.parents().empty());
+  EXPECT_TRUE(s.bind_rotations().empty());
+  EXPECT_TRUE(s.inverse_bind().empty());
+  EXPECT_EQ(s.find_joint("root"), -1);
+  EXPECT_EQ(s.joint_name(0), "");
+  EXPECT_EQ(s.hash(), 0u);
+  EXPECT_EQ(asset.clip_count(), 0u);
+  EXPECT_EQ(asset.material_count(), 0u);
+
+  ASSERT_EQ(asset.mesh_count(), 1u);
+  const MeshView m = asset.mesh(0);
+  EXPECT_EQ(m.name(), "");
+  EXPECT_TRUE(m.joints().empty());
+  EXPECT_TRUE(m.inverse_bind().empty());
+  EXPECT_EQ(m.attribute(fb::VertexSemantic::Joints), nullptr);
+  EXPECT_EQ(m.index_count(), 3u);
+  EXPECT_EQ(m.vertex_bytes().size(), 36u);
+  EXPECT_TRUE(aligned16(m.vertex_bytes().data()));
+  EXPECT_TRUE(aligned16(m.index_bytes().data()));
+
+  // A clip cannot be bound to a missing skeleton.
+  const auto with_clip = make_valid_file();
+  const Asset clip_asset = load(with_clip);
+  const Status st = check_clip_binding(clip_asset.clip(0), s, "rig.ossa");
+  ASSERT_FALSE(st.ok());
+  EXPECT_NE(st.message().find("rig.ossa"), std::string::npos) << st.message();
+  EXPECT_NE(st.message().find("'walk'"), std::string::npos) << st.message();
+}
+
+TEST(RuntimeView, ClipBindingRejectsAnotherRig) {
+  const auto bytes = make_valid_file();
+  const Asset asset = load(bytes);
+  SyntheticSpec other;
+  other.skeleton->names[3] = "left_arm";  // a different rig: a different hash
+  const auto other_bytes = make_valid_file(other);
+  const Asset other_asset = load(other_bytes, "other.ossa");
+  ASSERT_NE(asset.skeleton().hash(), other_asset.skeleton().hash());
+
+  EXPECT_TRUE(check_clip_binding(other_asset.clip(0), other_asset.skeleton(), "x").ok());
+  const Status st = check_clip_binding(asset.clip(0), other_asset.skeleton(), "other.ossa");
+  ASSERT_FALSE(st.ok());
+  EXPECT_NE(st.message().find("other.ossa: clip 'walk'"), std::string::npos) << st.message();
+}
+
+// ---- ownership -----------------------------------------------------------------------------------
+
+TEST(RuntimeView, MoveTransfersOwnershipOnce) {
+  const auto bytes = make_valid_file();
+  Asset a = load(bytes, "a.ossa");
+  const uint8_t* data = a.bytes().data();
+  const size_t size = a.bytes().size();
+  const MeshView mesh_before = a.mesh(0);
+
+  Asset b = std::move(a);
+  EXPECT_EQ(b.bytes().data(), data);
+  EXPECT_EQ(b.bytes().size(), size);
+  EXPECT_EQ(b.name(), "a.ossa");
+  EXPECT_EQ(b.mesh(0).fb, mesh_before.fb);  // views survive a move: the bytes did not move
+  EXPECT_TRUE(a.bytes().empty());           // NOLINT(bugprone-use-after-move): the moved-from state is specified
+  EXPECT_EQ(a.mesh_count(), 0u);
+  EXPECT_EQ(a.clip_count(), 0u);
+  EXPECT_EQ(a.material_count(), 0u);
+  EXPECT_TRUE(a.skeleton().empty());
+
+  // Assigning over a live asset releases that one's bytes (ASan reports a leak or double free
+  // if not), and a moved-from asset can be assigned to again.
+  Asset c = load(bytes, "c.ossa");
+  c = std::move(b);
+  EXPECT_EQ(c.bytes().data(), data);
+  EXPECT_EQ(c.name(), "a.ossa");
+  a = std::move(c);
+  EXPECT_EQ(a.bytes().data(), data);
+  Asset& self = a;
+  a = std::move(self);  // self-move keeps the asset intact
+  EXPECT_EQ(a.bytes().data(), data);
+  EXPECT_EQ(a.skeleton().joint_count(), 4u);
+
+  // Result<Asset> and containers move Assets around; each still owns exactly one copy.
+  std::vector<Asset> assets;
+  for (int i = 0; i < 8; ++i) assets.push_back(load(bytes));
+  assets.erase(assets.begin() + 2);
+  for (const Asset& x : assets) EXPECT_EQ(x.skeleton().joint_count(), 4u);
+}
+
+TEST(RuntimeView, FromBytesCopiesIntoAlignedStorage) {
+  const auto bytes = make_valid_file();
+  // An unaligned source: from_bytes copies, so it still loads; verify_buffer on the unaligned
+  // bytes themselves says why it refuses.
+  std::vector<uint8_t> shifted(1, 0);
+  shifted.insert(shifted.end(), bytes.begin(), bytes.end());
+  const std::span<const uint8_t> unaligned(shifted.data() + 1, bytes.size());
+  ASSERT_FALSE(aligned16(unaligned.data()));
+  const Status st = verify_buffer(unaligned, "u.ossa");
+  ASSERT_FALSE(st.ok());
+  EXPECT_NE(st.message().find("16-byte aligned"), std::string::npos) << st.message();
+
+  const Asset asset = load(unaligned);
+  EXPECT_TRUE(aligned16(asset.bytes().data()));
+  EXPECT_NE(asset.bytes().data(), unaligned.data());
+  EXPECT_EQ(std::memcmp(asset.bytes().data(), bytes.data(), bytes.size()), 0);
+  EXPECT_TRUE(verify_buffer(asset.bytes(), "aligned.ossa").ok());
+}
+
+// ---- open() --------------------------------------------------------------------------------------
+
+TEST(RuntimeView, OpenMissingFileNamesPathAndReason) {
+  const std::string path = (test::make_temp_dir("view") / "no-such-file.ossa").string();
+  const auto asset = Asset::open(path);
+  ASSERT_FALSE(asset.ok());
+  const std::string& message = asset.error().message;
+  EXPECT_EQ(message.rfind(path + ": ", 0), 0u) << message;
+  EXPECT_NE(message.find(std::strerror(ENOENT)), std::string::npos) << message;
+}
+
+TEST(RuntimeView, OpenRejectsDirectoriesAndEmptyFiles) {
+  const auto dir = test::make_temp_dir("view");
+  const auto as_dir = Asset::open(dir.string());
+  ASSERT_FALSE(as_dir.ok());
+  EXPECT_NE(as_dir.error().message.find("not a regular file"), std::string::npos) << as_dir.error().message;
+
+  const auto empty = dir / "empty.ossa";
+  ASSERT_TRUE(test::write_file(empty, std::string_view()));
+  const auto as_empty = Asset::open(empty.string());
+  ASSERT_FALSE(as_empty.ok());
+  EXPECT_EQ(as_empty.error().message, empty.string() + ": empty file");
+}
+
+TEST(RuntimeView, OpenedFileGivesTheSameViewsAsFromBytes) {
+  const auto bytes = make_valid_file();
+  const auto path = test::make_temp_dir("view") / "synthetic.ossa";
+  ASSERT_TRUE(test::write_file(path, std::span<const uint8_t>(bytes)));
+
+  auto opened = Asset::open(path.string());
+  ASSERT_TRUE(opened.ok()) << opened.error().message;
+  const Asset mapped = std::move(opened).value();
+  const Asset copied = load(bytes);
+
+  EXPECT_EQ(mapped.name(), path.string());
+  ASSERT_EQ(mapped.bytes().size(), bytes.size());
+  EXPECT_EQ(std::memcmp(mapped.bytes().data(), bytes.data(), bytes.size()), 0);
+  EXPECT_TRUE(aligned16(mapped.bytes().data()));  // page-aligned, in fact
+
+  // Same views, at the same offsets into each buffer.
+  const auto offset = [](const Asset& a, const void* p) { return static_cast<const uint8_t*>(p) - a.bytes().data(); };
+  const SkeletonView ms = mapped.skeleton(), cs = copied.skeleton();
+  ASSERT_EQ(ms.joint_count(), cs.joint_count());
+  for (size_t i = 0; i < ms.joint_count(); ++i) EXPECT_EQ(ms.joint_name(i), cs.joint_name(i));
+  EXPECT_EQ(offset(mapped, ms.parents().data()), offset(copied, cs.parents().data()));
+  EXPECT_EQ(ms.hash(), cs.hash());
+
+  ASSERT_EQ(mapped.mesh_count(), copied.mesh_count());
+  const MeshView mm = mapped.mesh(0), cm = copied.mesh(0);
+  EXPECT_EQ(offset(mapped, mm.vertex_bytes().data()), offset(copied, cm.vertex_bytes().data()));
+  EXPECT_EQ(offset(mapped, mm.index_bytes().data()), offset(copied, cm.index_bytes().data()));
+  ASSERT_EQ(mm.vertex_bytes().size(), cm.vertex_bytes().size());
+  EXPECT_EQ(std::memcmp(mm.vertex_bytes().data(), cm.vertex_bytes().data(), mm.vertex_bytes().size()), 0);
+  EXPECT_TRUE(aligned16(mm.vertex_bytes().data()));
+  EXPECT_TRUE(aligned16(mm.index_bytes().data()));
+
+  ASSERT_EQ(mapped.clip_count(), copied.clip_count());
+  EXPECT_EQ(mapped.clip(0).name(), copied.clip(0).name());
+  EXPECT_EQ(mapped.clip(0).key_count(), copied.clip(0).key_count());
+  EXPECT_EQ(mapped.material_count(), copied.material_count());
+
+  // A mapped asset moves like a copied one.
+  Asset moved = load(bytes);
+  const uint8_t* data = mapped.bytes().data();
+  moved = Asset::open(path.string()).value();
+  EXPECT_NE(moved.bytes().data(), data);  // a second mapping
+  EXPECT_EQ(moved.skeleton().hash(), ms.hash());
+}
+
+}  // namespace
+}  // namespace ossa

@@ -1,0 +1,489 @@
+// test_files.cpp — see test_files.h. The writer here is deliberately independent of the cooker's
+// (cooker/write_ossa.*): tests of the loader must not inherit the cooker's mistakes, and they need
+// to write files the cooker never would.
+#include "test_files.h"
+
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+#include <utility>
+
+#include <flatbuffers/flatbuffers.h>
+#include <glm/glm.hpp>
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/quaternion.hpp>
+#include <glm/gtc/type_ptr.hpp>
+
+#include "format/hash.h"
+#include "format/vertex_codec.h"
+#include "format/vertex_format.h"
+#include "format/version.h"
+
+extern char** environ;
+
+// Fallbacks when the environment does not say (a binary run by hand, or a CTest registration
+// that lost the variables): tests/CMakeLists.txt may define these at compile time.
+#ifndef OSSA_TEST_SOURCE_DIR
+#define OSSA_TEST_SOURCE_DIR "."
+#endif
+#ifndef OSSA_TEST_BIN_DIR
+#define OSSA_TEST_BIN_DIR "."
+#endif
+#ifndef OSSA_TEST_SHARED_ASSETS
+#define OSSA_TEST_SHARED_ASSETS "../shared/assets"
+#endif
+#ifndef OSSA_TEST_TMP_DIR
+#define OSSA_TEST_TMP_DIR "/tmp/ossa-test"
+#endif
+
+namespace ossa::test {
+namespace {
+
+// A 2x2 RGBA PNG (generated for these tests; CRCs and zlib stream are real).
+constexpr uint8_t kTinyPng[] = {
+    0x89, 0x50, 0x4e, 0x47, 0x0d, 0x0a, 0x1a, 0x0a, 0x00, 0x00, 0x00, 0x0d, 0x49, 0x48, 0x44, 0x52, 0x00,
+    0x00, 0x00, 0x02, 0x00, 0x00, 0x00, 0x02, 0x08, 0x06, 0x00, 0x00, 0x00, 0x72, 0xb6, 0x0d, 0x24, 0x00,
+    0x00, 0x00, 0x11, 0x49, 0x44, 0x41, 0x54, 0x78, 0xda, 0x63, 0x38, 0x51, 0x11, 0xf5, 0x1f, 0x84, 0x19,
+    0x60, 0x0c, 0x00, 0x5c, 0x88, 0x0a, 0x65, 0x38, 0xa8, 0x9b, 0x14, 0x00, 0x00, 0x00, 0x00, 0x49, 0x45,
+    0x4e, 0x44, 0xae, 0x42, 0x60, 0x82};
+
+fb::Mat4 to_fb(const glm::mat4& m) {
+  float columns[16];
+  std::memcpy(columns, glm::value_ptr(m), sizeof columns);
+  return fb::Mat4(flatbuffers::make_span(std::as_const(columns)));
+}
+
+// Inverse bind model matrix of every joint, from whatever bind pose entries exist.
+std::vector<fb::Mat4> inverse_binds(const SyntheticSkeleton& s) {
+  std::vector<glm::mat4> model(s.names.size(), glm::mat4(1.0f));
+  std::vector<fb::Mat4> out;
+  for (size_t i = 0; i < s.names.size(); ++i) {
+    glm::mat4 local(1.0f);
+    if (i < s.translations.size() && i < s.rotations.size() && i < s.scales.size()) {
+      const fb::Vec3& t = s.translations[i];
+      const fb::Quat& r = s.rotations[i];
+      const fb::Vec3& sc = s.scales[i];
+      local = glm::translate(glm::mat4(1.0f), glm::vec3(t.x(), t.y(), t.z())) *
+              glm::mat4_cast(glm::quat(r.w(), r.x(), r.y(), r.z())) *
+              glm::scale(glm::mat4(1.0f), glm::vec3(sc.x(), sc.y(), sc.z()));
+    }
+    const int parent = i < s.parents.size() ? s.parents[i] : -1;
+    model[i] = parent >= 0 && static_cast<size_t>(parent) < i ? model[parent] * local : local;
+    out.push_back(to_fb(glm::inverse(model[i])));
+  }
+  return out;
+}
+
+uint64_t hash_of(const SyntheticSkeleton& s) {
+  std::vector<std::string_view> names(s.names.begin(), s.names.end());
+  return skeleton_hash(names, s.parents);
+}
+
+template <class T>
+void put(std::vector<uint8_t>& bytes, size_t at, T value) {
+  std::memcpy(bytes.data() + at, &value, sizeof(T));
+}
+
+// Writes one attribute of one vertex at `at` when the format suits the semantic.
+void encode_attribute(const fb::VertexAttribute& a, const SyntheticVertex& v, const fb::Vec3& offset,
+                      const fb::Vec3& scale, std::vector<uint8_t>& bytes, size_t at) {
+  using F = fb::VertexFormat;
+  const F f = a.format();
+  switch (a.semantic()) {
+    case fb::VertexSemantic::Position: {
+      const float p[3] = {v.position.x(), v.position.y(), v.position.z()};
+      if (f == F::Unorm16x4) {
+        const float o[3] = {offset.x(), offset.y(), offset.z()}, s[3] = {scale.x(), scale.y(), scale.z()};
+        for (int c = 0; c < 3; ++c) put(bytes, at + 2 * c, float_to_unorm16((p[c] - o[c]) / s[c]));
+      } else if (f == F::Float32x3 || f == F::Float32x4) {
+        for (int c = 0; c < 3; ++c) put(bytes, at + 4 * c, p[c]);
+        if (f == F::Float32x4) put(bytes, at + 12, 1.0f);
+      }
+      break;
+    }
+    case fb::VertexSemantic::Normal:
+      if (f == F::Snorm16x2) {
+        const Float2 e = octahedral_encode({v.normal.x(), v.normal.y(), v.normal.z()});
+        put(bytes, at, float_to_snorm16(e.x));
+        put(bytes, at + 2, float_to_snorm16(e.y));
+      } else if (f == F::Float32x3) {
+        put(bytes, at, v.normal.x());
+        put(bytes, at + 4, v.normal.y());
+        put(bytes, at + 8, v.normal.z());
+      }
+      break;
+    case fb::VertexSemantic::TexCoord0:
+      if (f == F::Float16x2) {
+        put(bytes, at, float_to_half(v.u));
+        put(bytes, at + 2, float_to_half(v.v));
+      } else if (f == F::Float32x2) {
+        put(bytes, at, v.u);
+        put(bytes, at + 4, v.v);
+      }
+      break;
+    case fb::VertexSemantic::Joints:
+      for (int c = 0; c < 4; ++c) {
+        if (f == F::Uint8x4) put(bytes, at + c, static_cast<uint8_t>(v.slots[c]));
+        if (f == F::Uint16x4) put(bytes, at + 2 * c, v.slots[c]);
+      }
+      break;
+    case fb::VertexSemantic::Weights:
+      if (f == F::Unorm8x4)
+        for (int c = 0; c < 4; ++c) put(bytes, at + c, v.weights[c]);
+      break;
+    default:
+      break;  // Tangent, Color0: left zero
+  }
+}
+
+flatbuffers::Offset<flatbuffers::Vector<uint8_t>> aligned_bytes(flatbuffers::FlatBufferBuilder& fbb,
+                                                                 const std::vector<uint8_t>& bytes) {
+  fbb.ForceVectorAlignment(bytes.size(), 1, 16);
+  return fbb.CreateVector(bytes);
+}
+
+flatbuffers::Offset<fb::Mesh> write_mesh(flatbuffers::FlatBufferBuilder& fbb, const SyntheticMesh& m,
+                                         const std::vector<fb::Mat4>& skeleton_inverse_bind) {
+  // Quantization range: the bounds of the positions (a zero extent quantizes with scale 1).
+  fb::Vec3 lo(0, 0, 0), hi(0, 0, 0);
+  if (!m.vertices.empty()) {
+    float mn[3] = {INFINITY, INFINITY, INFINITY}, mx[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (const SyntheticVertex& v : m.vertices) {
+      const float p[3] = {v.position.x(), v.position.y(), v.position.z()};
+      for (int c = 0; c < 3; ++c) {
+        mn[c] = std::min(mn[c], p[c]);
+        mx[c] = std::max(mx[c], p[c]);
+      }
+    }
+    lo = fb::Vec3(mn[0], mn[1], mn[2]);
+    hi = fb::Vec3(mx[0], mx[1], mx[2]);
+  }
+  const auto extent = [](float a, float b) { return b > a ? b - a : 1.0f; };
+  bool quantized = false;
+  for (const fb::VertexAttribute& a : m.layout)
+    quantized |= a.semantic() == fb::VertexSemantic::Position && a.format() == fb::VertexFormat::Unorm16x4;
+  const fb::Vec3 offset = quantized ? lo : fb::Vec3(0, 0, 0);
+  const fb::Vec3 scale = quantized ? fb::Vec3(extent(lo.x(), hi.x()), extent(lo.y(), hi.y()), extent(lo.z(), hi.z()))
+                                   : fb::Vec3(1, 1, 1);
+
+  std::vector<uint8_t> vertices(m.vertices.size() * m.vertex_stride, 0);
+  for (size_t i = 0; i < m.vertices.size(); ++i) {
+    for (const fb::VertexAttribute& a : m.layout) {
+      const size_t size = vertex_format_info(a.format()).size;
+      if (size == 0 || a.offset() + size > m.vertex_stride) continue;
+      encode_attribute(a, m.vertices[i], offset, scale, vertices, i * m.vertex_stride + a.offset());
+    }
+  }
+
+  std::vector<uint8_t> indices;
+  for (uint32_t index : m.indices) {
+    if (m.index_format == fb::IndexFormat::Uint16) {
+      const auto i16 = static_cast<uint16_t>(index);
+      indices.insert(indices.end(), reinterpret_cast<const uint8_t*>(&i16), reinterpret_cast<const uint8_t*>(&i16) + 2);
+    } else {
+      indices.insert(indices.end(), reinterpret_cast<const uint8_t*>(&index), reinterpret_cast<const uint8_t*>(&index) + 4);
+    }
+  }
+  indices.resize(indices.size() + m.index_padding_bytes, 0);
+
+  std::vector<fb::Mat4> slot_inverse_bind;
+  if (m.inverse_bind) {
+    slot_inverse_bind = *m.inverse_bind;
+  } else {
+    for (uint16_t joint : m.joints)
+      slot_inverse_bind.push_back(joint < skeleton_inverse_bind.size() ? skeleton_inverse_bind[joint]
+                                                                       : to_fb(glm::mat4(1.0f)));
+  }
+
+  const auto name = fbb.CreateString(m.name);
+  const auto layout = fbb.CreateVectorOfStructs(m.layout);
+  const auto vertex_bytes = aligned_bytes(fbb, vertices);
+  const auto index_bytes = aligned_bytes(fbb, indices);
+  const auto submeshes = fbb.CreateVectorOfStructs(m.submeshes);
+  const auto joints = fbb.CreateVector(m.joints);
+  const auto inverse_bind = fbb.CreateVectorOfStructs(slot_inverse_bind);
+  const uint32_t count = m.vertex_count.value_or(static_cast<uint32_t>(m.vertices.size()));
+  return fb::CreateMesh(fbb, name, count, m.vertex_stride, layout, vertex_bytes, m.index_format, index_bytes,
+                        submeshes, &lo, &hi, &offset, &scale, joints, inverse_bind);
+}
+
+template <class T>
+flatbuffers::Offset<flatbuffers::Vector<T>> channel_scalars(flatbuffers::FlatBufferBuilder& fbb,
+                                                             const std::vector<T>& v, bool write_empty) {
+  return v.empty() && !write_empty ? 0 : fbb.CreateVector(v);
+}
+template <class T>
+flatbuffers::Offset<flatbuffers::Vector<const T*>> channel_structs(flatbuffers::FlatBufferBuilder& fbb,
+                                                                   const std::vector<T>& v, bool write_empty) {
+  return v.empty() && !write_empty ? 0 : fbb.CreateVectorOfStructs(v);
+}
+
+flatbuffers::Offset<fb::Clip> write_clip(flatbuffers::FlatBufferBuilder& fbb, const SyntheticClip& c,
+                                         uint64_t skeleton_hash, uint16_t joint_count) {
+  std::vector<flatbuffers::Offset<fb::Track>> tracks;
+  const bool e = c.write_empty_channels;
+  for (const SyntheticTrack& t : c.tracks) {
+    tracks.push_back(fb::CreateTrack(fbb, t.joint, channel_scalars(fbb, t.translation_times, e),
+                                     channel_structs(fbb, t.translations, e), channel_scalars(fbb, t.rotation_times, e),
+                                     channel_structs(fbb, t.rotations, e), channel_scalars(fbb, t.scale_times, e),
+                                     channel_structs(fbb, t.scales, e)));
+  }
+  const auto name = fbb.CreateString(c.name);
+  const auto track_vector = fbb.CreateVector(tracks);
+  return fb::CreateClip(fbb, name, c.duration, c.sample_rate, c.skeleton_hash.value_or(skeleton_hash),
+                        c.joint_count.value_or(joint_count), track_vector);
+}
+
+flatbuffers::Offset<fb::Material> write_material(flatbuffers::FlatBufferBuilder& fbb, const SyntheticMaterial& m) {
+  std::vector<flatbuffers::Offset<fb::Texture>> textures;
+  for (const SyntheticTexture& t : m.textures) {
+    const auto path = t.path.empty() ? 0 : fbb.CreateString(t.path);
+    const auto mime = t.mime.empty() ? 0 : fbb.CreateString(t.mime);
+    const auto data = t.data ? aligned_bytes(fbb, *t.data) : 0;
+    textures.push_back(fb::CreateTexture(fbb, t.role, path, mime, data));
+  }
+  const auto name = fbb.CreateString(m.name);
+  const auto texture_vector = fbb.CreateVector(textures);
+  return fb::CreateMaterial(fbb, name, &m.ambient, &m.diffuse, &m.specular, m.shininess, m.opacity, texture_vector);
+}
+
+}  // namespace
+
+std::vector<fb::VertexAttribute> SyntheticMesh::quantized_layout() {
+  using S = fb::VertexSemantic;
+  using F = fb::VertexFormat;
+  return {{S::Position, F::Unorm16x4, 0}, {S::Normal, F::Snorm16x2, 8}, {S::TexCoord0, F::Float16x2, 12},
+          {S::Joints, F::Uint8x4, 16},    {S::Weights, F::Unorm8x4, 20}};
+}
+
+std::vector<SyntheticVertex> SyntheticMesh::default_vertices() {
+  // Row 0 follows the spine, row 1 blends spine and head, row 2 blends head and arm.
+  std::vector<SyntheticVertex> out;
+  for (int row = 0; row < 3; ++row) {
+    for (int col = 0; col < 2; ++col) {
+      SyntheticVertex v;
+      v.position = fb::Vec3(col == 0 ? -0.5f : 0.5f, static_cast<float>(row), col == 0 ? 0.1f : -0.1f);
+      v.normal = fb::Vec3(0, 0, 1);
+      v.u = static_cast<float>(col);
+      v.v = static_cast<float>(row) / 2.0f;
+      if (row == 0) v.slots = {0, 0, 0, 0}, v.weights = {255, 0, 0, 0};
+      if (row == 1) v.slots = {0, 1, 0, 0}, v.weights = {128, 127, 0, 0};
+      if (row == 2) v.slots = {1, 2, 0, 0}, v.weights = {200, 55, 0, 0};
+      out.push_back(v);
+    }
+  }
+  return out;
+}
+
+std::vector<SyntheticTrack> SyntheticClip::default_tracks() {
+  SyntheticTrack spine{.joint = 1,
+                       .translation_times = {0.0f},
+                       .translations = {{0, 1, 0}},
+                       .rotation_times = {0.0f, 0.5f, 1.0f},
+                       .rotations = {{0, 0, 0, 1}, {0, 0.38268343f, 0, 0.92387953f}, {0, 0, 0, 1}},
+                       .scale_times = {},
+                       .scales = {}};
+  SyntheticTrack arm{.joint = 3,
+                     .translation_times = {0.0f, 1.0f},
+                     .translations = {{0.5f, 0.5f, 0}, {0.6f, 0.4f, 0}},
+                     .rotation_times = {},
+                     .rotations = {},
+                     .scale_times = {0.25f, 0.75f},
+                     .scales = {{1, 1, 1}, {1.2f, 1.2f, 1.2f}}};
+  return {spine, arm};
+}
+
+std::vector<SyntheticTexture> SyntheticMaterial::default_textures() {
+  return {{fb::TextureRole::Diffuse, "", "image/png", std::vector<uint8_t>(std::begin(kTinyPng), std::end(kTinyPng))},
+          {fb::TextureRole::Normal, "textures/skin_normal.png", "", std::nullopt}};
+}
+
+uint32_t SyntheticSpec::default_version() { return kFormatVersion; }
+
+std::vector<std::pair<std::string, SyntheticSpec>> valid_variants() {
+  using S = fb::VertexSemantic;
+  using F = fb::VertexFormat;
+  std::vector<std::pair<std::string, SyntheticSpec>> out;
+  out.emplace_back("default", SyntheticSpec{});
+
+  SyntheticSpec spec;
+  spec.meshes[0].index_format = fb::IndexFormat::Uint32;
+  out.emplace_back("uint32-indices", spec);
+
+  spec = {};
+  spec.meshes[0].layout = {{S::Position, F::Float32x3, 0}, {S::Normal, F::Float32x3, 12}, {S::TexCoord0, F::Float32x2, 24},
+                           {S::Joints, F::Uint16x4, 32},   {S::Weights, F::Unorm8x4, 40}};
+  spec.meshes[0].vertex_stride = 44;
+  out.emplace_back("float32-layout", spec);
+
+  spec = {};
+  spec.skeleton.reset();
+  spec.clips.clear();
+  spec.meshes[0].layout.resize(3);  // position, normal, uv
+  spec.meshes[0].vertex_stride = 16;
+  spec.meshes[0].joints.clear();
+  out.emplace_back("static-mesh", spec);
+
+  spec = {};
+  spec.skeleton.reset();
+  spec.meshes.clear();
+  spec.materials.clear();
+  spec.provenance = false;
+  spec.clips[0].skeleton_hash = 0x1234;
+  spec.clips[0].joint_count = 4;
+  out.emplace_back("clip-only", spec);
+
+  spec = {};
+  spec.clips[0].write_empty_channels = true;
+  SyntheticClip idle;
+  idle.name = "idle";
+  idle.tracks.clear();
+  spec.clips.push_back(idle);
+  out.emplace_back("empty-channels", spec);
+
+  spec = {};
+  spec.meshes.push_back(spec.meshes[0]);
+  spec.meshes[1].name = "head";
+  out.emplace_back("two-meshes", spec);
+  return out;
+}
+
+std::vector<uint8_t> make_valid_file(const SyntheticSpec& spec) {
+  flatbuffers::FlatBufferBuilder fbb(4096);
+
+  flatbuffers::Offset<fb::Skeleton> skeleton = 0;
+  std::vector<fb::Mat4> skeleton_inverse_bind;
+  uint64_t hash = 0;
+  uint16_t joint_count = 0;
+  if (spec.skeleton) {
+    const SyntheticSkeleton& s = *spec.skeleton;
+    skeleton_inverse_bind = s.inverse_bind.value_or(inverse_binds(s));
+    hash = s.hash.value_or(hash_of(s));
+    joint_count = static_cast<uint16_t>(s.names.size());
+    std::vector<flatbuffers::Offset<flatbuffers::String>> names;
+    for (const std::string& n : s.names) names.push_back(fbb.CreateString(n));
+    const auto name_vector = fbb.CreateVector(names);
+    const auto parents = fbb.CreateVector(s.parents);
+    const auto translations = fbb.CreateVectorOfStructs(s.translations);
+    const auto rotations = fbb.CreateVectorOfStructs(s.rotations);
+    const auto scales = fbb.CreateVectorOfStructs(s.scales);
+    const auto inverse_bind = fbb.CreateVectorOfStructs(skeleton_inverse_bind);
+    skeleton = fb::CreateSkeleton(fbb, name_vector, parents, translations, rotations, scales, inverse_bind, hash);
+  }
+
+  std::vector<flatbuffers::Offset<fb::Mesh>> meshes;
+  for (const SyntheticMesh& m : spec.meshes) meshes.push_back(write_mesh(fbb, m, skeleton_inverse_bind));
+  std::vector<flatbuffers::Offset<fb::Clip>> clips;
+  for (const SyntheticClip& c : spec.clips) clips.push_back(write_clip(fbb, c, hash, joint_count));
+  std::vector<flatbuffers::Offset<fb::Material>> materials;
+  for (const SyntheticMaterial& m : spec.materials) materials.push_back(write_material(fbb, m));
+
+  flatbuffers::Offset<fb::Provenance> provenance = 0;
+  if (spec.provenance) {
+    const char source[] = "synthetic";
+    provenance = fb::CreateProvenanceDirect(fbb, "synthetic.gltf", hash_bytes(source, sizeof source - 1),
+                                            kCookerVersion, "synthetic");
+  }
+  const auto root = fb::CreateFileDirect(fbb, spec.version, spec.metres_per_unit, skeleton,
+                                         spec.meshes.empty() ? nullptr : &meshes, spec.clips.empty() ? nullptr : &clips,
+                                         spec.materials.empty() ? nullptr : &materials, provenance);
+  std::string identifier = spec.identifier;
+  identifier.resize(4, ' ');
+  fbb.Finish(root, identifier.c_str());
+  return {fbb.GetBufferPointer(), fbb.GetBufferPointer() + fbb.GetSize()};
+}
+
+AlignedBytes::AlignedBytes(std::span<const uint8_t> bytes) : size_(bytes.size()) {
+  // posix_memalign, not aligned_alloc: it takes the exact size, so AddressSanitizer reports a
+  // read one byte past the end instead of letting it land in rounding slack.
+  void* p = nullptr;
+  if (posix_memalign(&p, 16, bytes.empty() ? 1 : bytes.size()) != 0) std::abort();
+  data_ = static_cast<uint8_t*>(p);
+  if (!bytes.empty()) std::memcpy(data_, bytes.data(), bytes.size());
+}
+
+AlignedBytes::~AlignedBytes() { std::free(data_); }
+
+// ---------------------------------------------------------------------------------------------
+
+std::string env_or(const char* name, const char* fallback) {
+  const char* value = std::getenv(name);
+  return value && *value ? value : fallback;
+}
+
+std::filesystem::path source_dir() { return env_or("OSSA_SOURCE_DIR", OSSA_TEST_SOURCE_DIR); }
+std::filesystem::path bin_dir() { return env_or("OSSA_BIN_DIR", OSSA_TEST_BIN_DIR); }
+std::filesystem::path shared_assets() { return env_or("OSSA_SHARED_ASSETS", OSSA_TEST_SHARED_ASSETS); }
+
+std::filesystem::path make_temp_dir(std::string_view prefix) {
+  const std::filesystem::path root = env_or("OSSA_TEST_TMP", OSSA_TEST_TMP_DIR);
+  std::filesystem::create_directories(root);
+  std::string pattern = (root / (std::string(prefix) + "-XXXXXX")).string();
+  if (mkdtemp(pattern.data()) == nullptr) return {};
+  return pattern;
+}
+
+std::optional<std::vector<uint8_t>> read_file(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return std::nullopt;
+  std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (in.bad()) return std::nullopt;
+  return bytes;
+}
+
+std::optional<std::string> read_text(const std::filesystem::path& path) {
+  auto bytes = read_file(path);
+  if (!bytes) return std::nullopt;
+  return std::string(bytes->begin(), bytes->end());
+}
+
+bool write_file(const std::filesystem::path& path, std::span<const uint8_t> bytes) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+  out.close();
+  return !out.fail();
+}
+
+bool write_file(const std::filesystem::path& path, std::string_view text) {
+  return write_file(path, std::span<const uint8_t>(reinterpret_cast<const uint8_t*>(text.data()), text.size()));
+}
+
+CommandResult run_command(const std::string& command) {
+  CommandResult result;
+  const std::filesystem::path dir = make_temp_dir("cmd");
+  if (dir.empty()) return result;
+  const std::string out_path = (dir / "stdout").string(), err_path = (dir / "stderr").string();
+
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, STDIN_FILENO, "/dev/null", O_RDONLY, 0);
+  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  std::string sh = "/bin/sh", dash_c = "-c", cmd = command;
+  char* argv[] = {sh.data(), dash_c.data(), cmd.data(), nullptr};
+  pid_t pid = 0;
+  const int spawned = posix_spawn(&pid, "/bin/sh", &actions, nullptr, argv, environ);
+  posix_spawn_file_actions_destroy(&actions);
+  if (spawned == 0) {
+    int status = 0;
+    while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+    }
+    result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : WIFSIGNALED(status) ? 128 + WTERMSIG(status) : -1;
+  }
+  result.out = read_text(out_path).value_or("");
+  result.err = read_text(err_path).value_or("");
+  std::error_code ignored;
+  std::filesystem::remove_all(dir, ignored);
+  return result;
+}
+
+}  // namespace ossa::test
