@@ -15,7 +15,7 @@ ctest --test-dir build-asan -L bad_input --output-on-failure -j "$jobs"
 if command -v clang++ >/dev/null; then
   echo "== fuzz build: libFuzzer over the loader"
   CC=clang CXX=clang++ cmake -S . -B build-fuzz -G Ninja -DOSSA_FUZZ=ON -DOSSA_WERROR=ON -DOSSA_BUILD_BENCH=OFF >/dev/null
-  cmake --build build-fuzz -j "$jobs" --target fuzz_load
+  cmake --build build-fuzz -j "$jobs" --target fuzz_load fuzz_make_corpus
   ctest --test-dir build-fuzz -R fuzz_load_bounded --output-on-failure
 else
   echo "== fuzz build skipped: clang++ not found"
