@@ -106,6 +106,21 @@ nlohmann::ordered_json report_json(const std::vector<CookRecord>& records, const
       j["materials"] = r.materials;
       j["textures"] = r.textures;
       j["vertices_over_4_influences"] = r.vertices_over_4_influences;
+      nlohmann::ordered_json clips = nlohmann::ordered_json::array();
+      for (const ClipRecord& c : r.clip_records) {
+        nlohmann::ordered_json cj;
+        cj["name"] = c.name;
+        cj["joints"] = c.joints;
+        cj["frames"] = c.frames;
+        cj["raw_bytes"] = c.raw_bytes;
+        cj["cooked_bytes"] = c.cooked_bytes;
+        cj["ratio"] = c.cooked_bytes > 0 ? static_cast<double>(c.raw_bytes) / c.cooked_bytes : 0.0;
+        cj["max_error_mm"] = c.max_error_mm;
+        cj["mean_error_mm"] = c.mean_error_mm;
+        cj["worst_joint"] = c.worst_joint;
+        clips.push_back(std::move(cj));
+      }
+      j["clip_compression"] = std::move(clips);
     }
     j["source_bytes"] = r.source_bytes;
     j["cooked_bytes"] = r.cooked_bytes;

@@ -13,6 +13,7 @@
 
 #include "cooker/import_scene.h"
 #include "cooker/mesh_build.h"
+#include "cooker/root_motion.h"
 #include "cooker/write_ossa.h"
 #include "format/hash.h"
 #include "runtime/asset.h"
@@ -22,6 +23,15 @@ namespace fs = std::filesystem;
 
 std::string CookOptions::canonical() const {
   std::string s = float_vertices ? "vertices=float32" : "vertices=quantized";
+  if (!clips.enabled) {
+    s += ";clips=lossless";
+  } else {
+    char buf[96];
+    std::snprintf(buf, sizeof buf, ";clips=%gm@%gm", static_cast<double>(clips.tolerance_metres),
+                  static_cast<double>(clips.probe_metres));
+    s += buf;
+  }
+  if (root_motion) s += std::string(";root_motion=") + "xyz"[up_axis % 3];
   if (reference != nullptr) s += ";skeleton=" + reference_name;
   return s;
 }
@@ -67,6 +77,35 @@ void cook_into(CookRecord& record, const fs::path& input, const fs::path& output
     return;
   }
 
+  if (options.root_motion) {
+    for (SourceClip& clip : scene->clips) {
+      if (Status st = extract_root_motion(clip, scene->skeleton, options.up_axis); !st) {
+        record.error = input.string() + ": " + st.message();
+        return;
+      }
+    }
+  }
+  std::vector<CompressedClip> clips;
+  for (const SourceClip& clip : scene->clips) {
+    auto compressed = compress_clip(clip, scene->skeleton, scene->metres_per_unit, options.clips);
+    if (!compressed) {
+      record.error = input.string() + ": " + compressed.error().message;
+      return;
+    }
+    ClipRecord cr;
+    cr.name = compressed->name;
+    cr.joints = static_cast<uint32_t>(scene->skeleton.joints.size());
+    cr.frames = compressed->grid.frame_count;
+    cr.raw_bytes = compressed->raw_bytes;
+    cr.cooked_bytes = compressed->cooked_bytes;
+    cr.max_error_mm = compressed->max_error * scene->metres_per_unit * 1000.0f;
+    cr.mean_error_mm = compressed->mean_error * scene->metres_per_unit * 1000.0f;
+    if (compressed->worst_joint < scene->skeleton.joints.size())
+      cr.worst_joint = scene->skeleton.joints[compressed->worst_joint].name;
+    record.clip_records.push_back(std::move(cr));
+    clips.push_back(std::move(*compressed));
+  }
+
   WriteProvenance provenance;
   provenance.source_name = input.filename().string();
   provenance.source_hash = hash_bytes(source->data(), source->size());
@@ -75,7 +114,7 @@ void cook_into(CookRecord& record, const fs::path& input, const fs::path& output
   // carries the rig its joint palettes index (with --skeleton, the reference's, hash-identical).
   WriteOptions write_options;
   write_options.include_skeleton = options.reference == nullptr || !meshes->empty();
-  const std::vector<uint8_t> bytes = write_ossa(*scene, *meshes, provenance, write_options);
+  const std::vector<uint8_t> bytes = write_ossa(*scene, *meshes, clips, provenance, write_options);
 
   // The writer's output must pass the same checks every reader makes; a cooker bug is caught here
   // rather than in a game.

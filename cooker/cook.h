@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "cooker/clip_compress.h"
 #include "cooker/source_scene.h"
 #include "format/result.h"
 
@@ -17,11 +18,23 @@ namespace ossa::cook {
 
 struct CookOptions {
   bool float_vertices = false;
+  ClipCompressionOptions clips;       // --clip-tolerance, --no-clip-compression
+  bool root_motion = false;           // --root-motion: extract root motion from every clip
+  uint8_t up_axis = 1;                // --up-axis: 0 x, 1 y, 2 z
   /// Clip-only cooking against this rig (loaded from --skeleton REF.ossa); null otherwise.
   const SourceSkeleton* reference = nullptr;
   std::string reference_name;  // REF.ossa's file name, recorded in the options string
   /// Canonical text of the options that change output bytes, recorded in provenance.
   std::string canonical() const;
+};
+
+/// What compression achieved on one clip (--report, ossa-bench-compression).
+struct ClipRecord {
+  std::string name;
+  uint32_t joints = 0, frames = 0;
+  uint32_t raw_bytes = 0, cooked_bytes = 0;
+  float max_error_mm = 0.0f, mean_error_mm = 0.0f;  // in millimetres (via metres_per_unit)
+  std::string worst_joint;
 };
 
 /// One line of the --report file.
@@ -36,6 +49,7 @@ struct CookRecord {
   uint32_t vertices_over_4_influences = 0;
   uint64_t source_bytes = 0, cooked_bytes = 0;
   double seconds = 0.0;
+  std::vector<ClipRecord> clip_records;
 };
 
 /// Cooks `input` to `output` (parent directories are created). Never throws.

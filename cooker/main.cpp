@@ -1,7 +1,8 @@
 // main.cpp — the ossa-cook command line: parse options, plan, cook in parallel, report.
 //
 //   ossa-cook INPUT... -o OUTDIR [--root DIR] [--jobs N] [--report FILE.json]
-//             [--skeleton REF.ossa] [--float-vertices] [--quiet]
+//             [--skeleton REF.ossa] [--float-vertices] [--clip-tolerance MM] [--no-clip-compression]
+//             [--root-motion] [--up-axis x|y|z] [--quiet]
 //
 // Exit status: 0 when every input cooked, 1 when any failed (the rest are still cooked), 2 for a
 // usage error or a plan that cannot be carried out (nothing is written then).
@@ -49,7 +50,9 @@ int main(int argc, char** argv) {
   std::vector<std::string> inputs;
   std::string out_dir, root, report_path, skeleton_path;
   unsigned jobs = std::max(1u, std::thread::hardware_concurrency());
-  bool float_vertices = false, quiet = false;
+  bool float_vertices = false, quiet = false, lossless_clips = false, root_motion = false;
+  double clip_tolerance_mm = 0.1;
+  std::string up_axis = "y";
   app.add_option("inputs", inputs, "source files or directories (searched recursively)")->required();
   app.add_option("-o,--output", out_dir, "output directory")->required();
   app.add_option("--root", root, "mirror inputs' paths relative to this directory under the output directory");
@@ -57,12 +60,22 @@ int main(int argc, char** argv) {
   app.add_option("--report", report_path, "write a JSON record per input to this file");
   app.add_option("--skeleton", skeleton_path, "cook clip-only files against this cooked skeleton (.ossa)");
   app.add_flag("--float-vertices", float_vertices, "store vertices as float32 instead of quantized");
+  app.add_option("--clip-tolerance", clip_tolerance_mm,
+                 "largest model-space error of any joint, in millimetres at 10 cm from it (default 0.1)")
+      ->check(CLI::Range(1e-6, 1e4));
+  app.add_flag("--no-clip-compression", lossless_clips, "keep every clip key exact (raw floats at every frame)");
+  app.add_flag("--root-motion", root_motion, "extract root translation and yaw from clips into a root-motion track");
+  app.add_option("--up-axis", up_axis, "up axis for --root-motion")->check(CLI::IsMember({"x", "y", "z"}));
   app.add_flag("-q,--quiet", quiet, "print only failures");
   app.set_version_flag("--version", std::string(ossa::kCookerVersion));
   CLI11_PARSE(app, argc, argv);
 
   CookOptions options;
   options.float_vertices = float_vertices;
+  options.clips.enabled = !lossless_clips;
+  options.clips.tolerance_metres = static_cast<float>(clip_tolerance_mm / 1000.0);
+  options.root_motion = root_motion;
+  options.up_axis = static_cast<uint8_t>(up_axis == "x" ? 0 : up_axis == "z" ? 2 : 1);
   SourceSkeleton reference;
   if (!skeleton_path.empty()) {
     auto loaded = load_reference_skeleton(skeleton_path);

@@ -57,11 +57,21 @@ struct SourceTrack {
   std::vector<glm::vec3> scales;
 };
 
+/// Root motion taken out of a clip at cook time (cooker/root_motion.h), one sample per frame of
+/// the clip's frame grid (cooker/clip_grid.h), relative to frame 0.
+struct SourceRootMotion {
+  std::vector<glm::vec3> translations;
+  std::vector<float> yaws;               // radians about up_axis
+  uint8_t up_axis = 1;                   // 0 x, 1 y, 2 z
+};
+
 struct SourceClip {
   std::string name;
   float duration = 0.0f;                 // seconds
   float sample_rate = 0.0f;              // source keys per second, 0 when unknown
   std::vector<SourceTrack> tracks;       // sorted by joint, one per animated joint
+  bool has_root_motion = false;
+  SourceRootMotion root_motion;          // when has_root_motion
 };
 
 enum class TextureRole : uint8_t { Diffuse = 0, Normal = 1, Specular = 2 };

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "cooker/clip_compress.h"
 #include "cooker/mesh_build.h"
 #include "cooker/source_scene.h"
 
@@ -28,8 +29,10 @@ struct WriteOptions {
 /// The skeleton hash of a SourceSkeleton (format/hash.h's skeleton_hash over its names/parents).
 uint64_t skeleton_hash_of(const SourceSkeleton& skeleton);
 
-/// Serializes. Clips are tagged with the hash of scene.skeleton. O(output size).
+/// Serializes. `clips` are the compressed forms of scene.clips (same order); they are tagged with
+/// the hash of scene.skeleton. O(output size).
 std::vector<uint8_t> write_ossa(const SourceScene& scene, std::span<const CookedMesh> meshes,
-                                const WriteProvenance& provenance, const WriteOptions& options);
+                                std::span<const CompressedClip> clips, const WriteProvenance& provenance,
+                                const WriteOptions& options);
 
 }  // namespace ossa::cook

@@ -7,7 +7,7 @@
 #include <cstdint>
 
 namespace ossa {
-inline constexpr uint32_t kFormatVersion = 1;
-inline constexpr const char* kCookerVersion = "ossa-cook 0.1.0";
+inline constexpr uint32_t kFormatVersion = 2;  // 2: compressed clips (ClipCompression, RootMotion)
+inline constexpr const char* kCookerVersion = "ossa-cook 0.2.0";
 inline constexpr const char* kFileIdentifier = "OSSA";
 }  // namespace ossa

@@ -1,0 +1,98 @@
+// clip_codec.h — the key encoding of compressed clips (format/ossa.fbs, AnimatedChannel), one
+// definition for the cooker that packs keys and the runtime that unpacks them.
+//
+// Keys are three components of `bits` bits each, packed LSB-first into a byte stream, each
+// component range-reduced to its channel's [min, min + extent]. Rotations drop w (stored with
+// w >= 0) as ACL's default rotation format does: for the small ranges real joints move through,
+// range reduction buys 3-5 bits per component over smallest-three's fixed range, and no per-key
+// selector bits are needed. bits == 32 stores raw floats: the escape for channels no quantization
+// can hold within tolerance (and for lossless cooks).
+//
+// Decoding reads 64 bits at a time: the stream must be followed by at least 8 readable bytes
+// (kKeyValuePadding), which the writer appends and the loader checks.
+#pragma once
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <vector>
+
+namespace ossa {
+
+inline constexpr uint32_t kKeyValuePadding = 8;
+inline constexpr uint32_t kRawFloatBits = 32;
+
+/// Largest quantized value for a bit count in 1..16.
+constexpr uint32_t quant_max(uint32_t bits) { return (1u << bits) - 1u; }
+
+/// Bits one key of a channel takes.
+constexpr uint64_t key_bits(uint32_t bits) { return 3ull * bits; }
+
+/// Quantizes v in [lo, lo + extent] to bits (1..16), rounding to nearest, clamped.
+inline uint32_t quantize(float v, float lo, float extent, uint32_t bits) {
+  if (!(extent > 0.0f)) return 0;
+  float u = (v - lo) / extent;
+  u = u < 0.0f ? 0.0f : (u > 1.0f ? 1.0f : u);
+  return static_cast<uint32_t>(std::lround(u * static_cast<float>(quant_max(bits))));
+}
+inline float dequantize(uint32_t q, float lo, float extent, uint32_t bits) {
+  return lo + extent * (static_cast<float>(q) / static_cast<float>(quant_max(bits)));
+}
+
+/// Reads `count` (<= 57) bits at bit position `bit` of a padded stream.
+inline uint64_t read_bits(const uint8_t* stream, uint64_t bit, uint32_t count) {
+  uint64_t word;
+  std::memcpy(&word, stream + (bit >> 3), 8);  // little-endian host assumed (as FlatBuffers does)
+  return (word >> (bit & 7u)) & ((count >= 64 ? 0 : (1ull << count)) - 1ull);
+}
+
+/// Decodes key `key` of a channel: three floats (rotation: x, y, z with w >= 0 implied).
+/// O(1), no branches but the raw-float escape.
+inline void decode_key(const uint8_t* stream, uint64_t bit_offset, uint32_t bits, const float range_min[3],
+                       const float range_extent[3], uint32_t key, float out[3]) {
+  if (bits == kRawFloatBits) {
+    std::memcpy(out, stream + ((bit_offset + 96ull * key) >> 3), 12);
+    return;
+  }
+  const uint64_t packed = read_bits(stream, bit_offset + key_bits(bits) * key, 3 * bits);
+  const uint32_t mask = quant_max(bits);
+  for (uint32_t c = 0; c < 3; ++c)
+    out[c] = dequantize(static_cast<uint32_t>(packed >> (c * bits)) & mask, range_min[c], range_extent[c], bits);
+}
+
+/// w of a unit quaternion stored as xyz with w >= 0.
+inline float rotation_w(const float xyz[3]) {
+  const float w2 = 1.0f - xyz[0] * xyz[0] - xyz[1] * xyz[1] - xyz[2] * xyz[2];
+  return w2 > 0.0f ? std::sqrt(w2) : 0.0f;
+}
+
+/// Appends bit fields LSB-first; pad() finishes the stream with kKeyValuePadding zero bytes.
+class BitWriter {
+ public:
+  uint64_t bit_size() const { return bits_; }
+  void write(uint64_t value, uint32_t count) {
+    for (uint32_t i = 0; i < count; ++i, ++bits_) {
+      if ((bits_ >> 3) >= bytes_.size()) bytes_.push_back(0);
+      if ((value >> i) & 1u) bytes_[bits_ >> 3] |= static_cast<uint8_t>(1u << (bits_ & 7u));
+    }
+  }
+  void write_float(float f) {
+    uint32_t u;
+    std::memcpy(&u, &f, 4);
+    write(u, 32);
+  }
+  /// Aligns the next field to a byte boundary (raw-float channels start byte-aligned).
+  void align_byte() {
+    while (bits_ & 7u) write(0, 1);
+  }
+  std::vector<uint8_t> finish() {
+    std::vector<uint8_t> out = bytes_;
+    out.resize(out.size() + kKeyValuePadding, 0);
+    return out;
+  }
+
+ private:
+  std::vector<uint8_t> bytes_;
+  uint64_t bits_ = 0;
+};
+
+}  // namespace ossa

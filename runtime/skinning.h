@@ -1,0 +1,42 @@
+// skinning.h — skinning palettes, and linear-blend skinning on the CPU: the reference the GPU
+// path is tested against, and a fallback for tools.
+//
+// A mesh's palette folds in the vertex de-quantization (Mesh.position_offset/scale), so the GPU
+// shader and skin_cpu both multiply the raw normalized position by the palette matrix with no
+// special case for quantized meshes (the design's promise).
+#pragma once
+#include <cstdint>
+#include <span>
+
+#include <glm/glm.hpp>
+
+#include "runtime/asset.h"
+
+namespace ossa {
+
+/// palette[s] = model[mesh.joints()[s]] * mesh.inverse_bind()[s] * D, D the de-quantizing affine
+/// (translate(position_offset) * scale(position_scale); identity for float positions).
+/// palette.size() == mesh.joints().size(). For a mesh without joints (static), palette[0] = D
+/// (palette.size() == 1). O(slots).
+void skinning_matrices(const MeshView& mesh, std::span<const glm::mat4> model, std::span<glm::mat4> palette);
+
+enum class SkinningMethod : uint8_t {
+  Linear,          // linear blend skinning: the classic, what the GPU shader does
+  DualQuaternion,  // no candy-wrapper collapse on twisting joints; rigid palettes only
+};
+
+/// Where skin_cpu writes: xyz per vertex for positions and normals, xyzw for tangents (w = the
+/// bitangent sign). A span may be empty to skip that stream (the mesh must have the attribute
+/// otherwise). Sizes: 3 * vertex_count, 3 * vertex_count, 4 * vertex_count.
+struct SkinnedStreams {
+  std::span<float> positions;
+  std::span<float> normals;
+  std::span<float> tangents;
+};
+
+/// Skins every vertex of `mesh` with `palette` (from skinning_matrices), decoding the quantized
+/// or float layout. Normals and tangents are transformed by the blended matrix's linear part and
+/// renormalized. Allocation-free. O(vertices * influences).
+void skin_cpu(const MeshView& mesh, std::span<const glm::mat4> palette, SkinningMethod method, SkinnedStreams out);
+
+}  // namespace ossa
