@@ -20,7 +20,8 @@
 namespace ossa::cook {
 
 struct ClipCompressionOptions {
-  bool enabled = true;              // false: every channel animated at every frame, raw floats
+  bool enabled = true;              // false: lossless (bind/constant only when bit-equal, every
+                                    // other channel raw floats at every frame)
   float tolerance_metres = 0.0001f; // 0.1 mm ...
   float probe_metres = 0.1f;        // ... at 10 cm
 };
@@ -34,7 +35,8 @@ struct CompressedConstant {
 struct CompressedAnimated {
   uint16_t joint = 0;
   uint8_t channel = 0;
-  uint8_t bits = 0;                 // 1..16 or 32
+  uint8_t bits = 0;                 // 1..kMaxQuantBits (19) or 32
+  uint8_t dropped = 3;              // rotations: the component not stored (format/clip_codec.h)
   uint32_t first_key = 0;
   uint32_t key_count = 0;
   uint32_t bit_offset = 0;
@@ -54,7 +56,9 @@ struct CompressedClip {
   float tolerance = 0.0f, probe_distance = 0.0f, max_error = 0.0f, mean_error = 0.0f;
   uint16_t worst_joint = 0;
   uint32_t raw_bytes = 0;                     // 10 floats * joints * frames
-  uint32_t cooked_bytes = 0;                  // bytes this clip adds to the file (its vectors)
+  uint32_t cooked_bytes = 0;                  // the clip's vectors as stored: constants, animated,
+                                              // key_frames, key_values (padding included); tables'
+                                              // overhead excluded
   bool has_root_motion = false;
   SourceRootMotion root_motion;
 };

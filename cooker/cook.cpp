@@ -102,6 +102,13 @@ void cook_into(CookRecord& record, const fs::path& input, const fs::path& output
     cr.mean_error_mm = compressed->mean_error * scene->metres_per_unit * 1000.0f;
     if (compressed->worst_joint < scene->skeleton.joints.size())
       cr.worst_joint = scene->skeleton.joints[compressed->worst_joint].name;
+    if (compressed->tolerance > 0.0f && compressed->max_error > compressed->tolerance) {
+      char buf[160];
+      std::snprintf(buf, sizeof buf, "clip '%s': max error %.4f mm exceeds the %.4f mm tolerance", cr.name.c_str(),
+                    static_cast<double>(cr.max_error_mm),
+                    static_cast<double>(compressed->tolerance * scene->metres_per_unit * 1000.0f));
+      record.warnings.push_back(buf);
+    }
     record.clip_records.push_back(std::move(cr));
     clips.push_back(std::move(*compressed));
   }

@@ -5,9 +5,9 @@
 // order, materials in order, provenance, file — and every input is an ordered container, so the
 // bytes depend only on the input. Nothing time- or address-dependent is written.
 //
-// The GPU byte vectors (vertices, indices) and embedded texture data get 16-byte alignment from
-// ForceVectorAlignment right before CreateVector: flatc 2.0.8 accepts force_align on vectors in the
-// schema but generates nothing for it. The builder raises its minimum alignment to 16 with it, and
+// The GPU byte vectors (vertices, indices), embedded texture data and clips' key_values get
+// 16-byte alignment from ForceVectorAlignment right before CreateVector: flatc 2.0.8 accepts
+// force_align on vectors in the schema but generates nothing for it. The builder raises its minimum alignment to 16 with it, and
 // Finish pads the whole buffer to that, so "aligned from the end" is also "aligned from the start".
 #include "cooker/write_ossa.h"
 
@@ -15,6 +15,7 @@
 
 #include <string_view>
 
+#include "format/clip_codec.h"
 #include "format/hash.h"
 #include "format/version.h"
 
@@ -83,29 +84,45 @@ Offset<fb::Mesh> write_mesh(FlatBufferBuilder& fbb, const CookedMesh& mesh) {
                         indices, submeshes, &bounds_min, &bounds_max, &offset, &scale, joints, inverse_bind_v);
 }
 
-Offset<fb::Track> write_track(FlatBufferBuilder& fbb, const SourceTrack& t) {
-  std::vector<fb::Vec3> translations, scales;
-  std::vector<fb::Quat> rotations;
-  for (const glm::vec3& v : t.translations) translations.push_back(vec3(v));
-  for (const glm::quat& q : t.rotations) rotations.push_back(quat(q));
-  for (const glm::vec3& v : t.scales) scales.push_back(vec3(v));
-  const auto translation_times = fbb.CreateVector(t.translation_times);
+Offset<fb::RootMotion> write_root_motion(FlatBufferBuilder& fbb, const SourceRootMotion& rm) {
+  std::vector<fb::Vec3> translations;
+  translations.reserve(rm.translations.size());
+  for (const glm::vec3& v : rm.translations) translations.push_back(vec3(v));
   const auto translations_v = fbb.CreateVectorOfStructs(translations);
-  const auto rotation_times = fbb.CreateVector(t.rotation_times);
-  const auto rotations_v = fbb.CreateVectorOfStructs(rotations);
-  const auto scale_times = fbb.CreateVector(t.scale_times);
-  const auto scales_v = fbb.CreateVectorOfStructs(scales);
-  return fb::CreateTrack(fbb, t.joint, translation_times, translations_v, rotation_times, rotations_v, scale_times,
-                         scales_v);
+  const auto yaws_v = fbb.CreateVector(rm.yaws);
+  return fb::CreateRootMotion(fbb, translations_v, yaws_v, rm.up_axis);
 }
 
-Offset<fb::Clip> write_clip(FlatBufferBuilder& fbb, const SourceClip& clip, uint64_t skeleton_hash,
+// Every vector is written, empty or not, so readers see the same shape for every clip.
+Offset<fb::Clip> write_clip(FlatBufferBuilder& fbb, const CompressedClip& clip, uint64_t skeleton_hash,
                             uint16_t joint_count) {
   const auto name = fbb.CreateString(clip.name);
-  std::vector<Offset<fb::Track>> tracks;
-  for (const SourceTrack& t : clip.tracks) tracks.push_back(write_track(fbb, t));
-  const auto tracks_v = fbb.CreateVector(tracks);
-  return fb::CreateClip(fbb, name, clip.duration, clip.sample_rate, skeleton_hash, joint_count, tracks_v);
+  std::vector<fb::ConstantChannel> constants;
+  constants.reserve(clip.constants.size());
+  for (const CompressedConstant& c : clip.constants) {
+    constants.emplace_back(c.joint, static_cast<fb::Channel>(c.channel),
+                           fb::Quat(c.value[0], c.value[1], c.value[2], c.value[3]));
+  }
+  std::vector<fb::AnimatedChannel> animated;
+  animated.reserve(clip.animated.size());
+  for (const CompressedAnimated& a : clip.animated) {
+    animated.emplace_back(a.joint, static_cast<fb::Channel>(a.channel), a.bits, a.dropped, a.first_key, a.key_count,
+                          a.bit_offset, fb::Vec3(a.range_min[0], a.range_min[1], a.range_min[2]),
+                          fb::Vec3(a.range_extent[0], a.range_extent[1], a.range_extent[2]));
+  }
+  const auto constants_v = fbb.CreateVectorOfStructs(constants);
+  const auto animated_v = fbb.CreateVectorOfStructs(animated);
+  const auto key_frames_v = fbb.CreateVector(clip.key_frames);
+  // Decoders read 64 bits at a time: the stream ends with kKeyValuePadding zero bytes (the
+  // compressor's BitWriter appends them; a hand-made clip without them gets them here).
+  std::vector<uint8_t> key_values = clip.key_values;
+  if (key_values.size() < kKeyValuePadding) key_values.resize(kKeyValuePadding, 0);
+  const auto key_values_v = aligned_bytes(fbb, key_values);
+  const auto compression = fb::CreateClipCompression(fbb, clip.tolerance, clip.probe_distance, clip.max_error,
+                                                     clip.mean_error, clip.worst_joint, clip.raw_bytes);
+  const auto root_motion = clip.has_root_motion ? write_root_motion(fbb, clip.root_motion) : Offset<fb::RootMotion>();
+  return fb::CreateClip(fbb, name, clip.grid.duration(), clip.grid.sample_rate, clip.grid.frame_count, skeleton_hash,
+                        joint_count, constants_v, animated_v, key_frames_v, key_values_v, compression, root_motion);
 }
 
 Offset<fb::Material> write_material(FlatBufferBuilder& fbb, const SourceMaterial& material) {
@@ -138,7 +155,8 @@ uint64_t skeleton_hash_of(const SourceSkeleton& skeleton) {
 }
 
 std::vector<uint8_t> write_ossa(const SourceScene& scene, std::span<const CookedMesh> meshes,
-                                const WriteProvenance& provenance, const WriteOptions& options) {
+                                std::span<const CompressedClip> clips, const WriteProvenance& provenance,
+                                const WriteOptions& options) {
   FlatBufferBuilder fbb(1 << 16);
 
   // A file without joints has no skeleton table (readers see "no skeleton", not an empty one).
@@ -152,7 +170,7 @@ std::vector<uint8_t> write_ossa(const SourceScene& scene, std::span<const Cooked
   const uint64_t rig_hash = skeleton_hash_of(scene.skeleton);
   const auto joint_count = static_cast<uint16_t>(scene.skeleton.joints.size());
   std::vector<Offset<fb::Clip>> clip_offsets;
-  for (const SourceClip& clip : scene.clips) clip_offsets.push_back(write_clip(fbb, clip, rig_hash, joint_count));
+  for (const CompressedClip& clip : clips) clip_offsets.push_back(write_clip(fbb, clip, rig_hash, joint_count));
   const auto clips_v = fbb.CreateVector(clip_offsets);
 
   std::vector<Offset<fb::Material>> material_offsets;

@@ -1,12 +1,13 @@
 // clip_codec.h — the key encoding of compressed clips (format/ossa.fbs, AnimatedChannel), one
 // definition for the cooker that packs keys and the runtime that unpacks them.
 //
-// Keys are three components of `bits` bits each, packed LSB-first into a byte stream, each
-// component range-reduced to its channel's [min, min + extent]. Rotations drop w (stored with
-// w >= 0) as ACL's default rotation format does: for the small ranges real joints move through,
-// range reduction buys 3-5 bits per component over smallest-three's fixed range, and no per-key
-// selector bits are needed. bits == 32 stores raw floats: the escape for channels no quantization
-// can hold within tolerance (and for lossless cooks).
+// Keys are three components of `bits` bits each (1..19), packed LSB-first into a byte stream,
+// each component range-reduced to its channel's [min, min + extent]. Rotations drop one component
+// per channel (stored with that component >= 0): like ACL's drop-w format, range reduction then
+// buys 3-5 bits per component over smallest-three's fixed range and no per-key selector bits are
+// needed; unlike always dropping w, choosing the component that stays largest over the channel
+// keeps the rebuilt component precise near half turns. bits == 32 stores raw floats: the escape
+// for channels no quantization can hold within tolerance (and for lossless cooks).
 //
 // Decoding reads 64 bits at a time: the stream must be followed by at least 8 readable bytes
 // (kKeyValuePadding), which the writer appends and the loader checks.
@@ -20,14 +21,16 @@ namespace ossa {
 
 inline constexpr uint32_t kKeyValuePadding = 8;
 inline constexpr uint32_t kRawFloatBits = 32;
+/// 3 * 19 = 57 bits: one unaligned 64-bit read holds a key at any bit position.
+inline constexpr uint32_t kMaxQuantBits = 19;
 
-/// Largest quantized value for a bit count in 1..16.
+/// Largest quantized value for a bit count in 1..kMaxQuantBits.
 constexpr uint32_t quant_max(uint32_t bits) { return (1u << bits) - 1u; }
 
 /// Bits one key of a channel takes.
 constexpr uint64_t key_bits(uint32_t bits) { return 3ull * bits; }
 
-/// Quantizes v in [lo, lo + extent] to bits (1..16), rounding to nearest, clamped.
+/// Quantizes v in [lo, lo + extent] to bits (1..kMaxQuantBits), rounding to nearest, clamped.
 inline uint32_t quantize(float v, float lo, float extent, uint32_t bits) {
   if (!(extent > 0.0f)) return 0;
   float u = (v - lo) / extent;
@@ -59,10 +62,27 @@ inline void decode_key(const uint8_t* stream, uint64_t bit_offset, uint32_t bits
     out[c] = dequantize(static_cast<uint32_t>(packed >> (c * bits)) & mask, range_min[c], range_extent[c], bits);
 }
 
-/// w of a unit quaternion stored as xyz with w >= 0.
+/// The dropped component of a unit quaternion from the three stored ones (it was >= 0). The
+/// cooker tunes stored values to this exact float expression: keep it as written (no reordering,
+/// no FMA contraction, no -ffast-math).
 inline float rotation_w(const float xyz[3]) {
   const float w2 = 1.0f - xyz[0] * xyz[0] - xyz[1] * xyz[1] - xyz[2] * xyz[2];
   return w2 > 0.0f ? std::sqrt(w2) : 0.0f;
+}
+
+/// A rotation key as x, y, z, w from its three stored components and the dropped index (0..3).
+inline void rotation_from_stored(const float stored[3], uint32_t dropped, float out[4]) {
+  const float rebuilt = rotation_w(stored);
+  uint32_t j = 0;
+  for (uint32_t c = 0; c < 4; ++c) out[c] = c == dropped ? rebuilt : stored[j++];
+}
+
+/// The three components of x, y, z, w stored for a rotation with `dropped` left out (in order).
+inline void rotation_to_stored(const float xyzw[4], uint32_t dropped, float stored[3]) {
+  const float sign = xyzw[dropped] < 0.0f ? -1.0f : 1.0f;
+  uint32_t j = 0;
+  for (uint32_t c = 0; c < 4; ++c)
+    if (c != dropped) stored[j++] = sign * xyzw[c];
 }
 
 /// Appends bit fields LSB-first; pad() finishes the stream with kKeyValuePadding zero bytes.

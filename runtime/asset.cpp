@@ -13,7 +13,7 @@
 //
 // Cost: open is O(file size) (the verifier visits every table; the semantic checks scan indices
 // and joint slots); from_bytes adds one copy; every view accessor is O(1) except find_joint
-// (O(joints)) and ClipView::key_count (O(tracks)).
+// (O(joints)) and ClipView::key_count (O(channels)).
 #include "runtime/asset.h"
 
 #include <fcntl.h>
@@ -108,7 +108,7 @@ Status check_clip_binding(const ClipView& clip, const SkeletonView& skeleton, st
                                       static_cast<unsigned long long>(clip.skeleton_hash()),
                                       static_cast<unsigned long long>(skeleton.hash())));
   // Equal hashes mean equal rigs for honest files; a crafted clip could still claim more joints
-  // than the rig has, and its track indices are only checked against its own joint count.
+  // than the rig has, and its channel joints are only checked against its own joint count.
   if (clip.fb->joint_count() != skeleton.joint_count())
     return error(name, detail::format("%s addresses %u joints, the skeleton has %zu", label.c_str(),
                                       static_cast<unsigned>(clip.fb->joint_count()), skeleton.joint_count()));
@@ -295,18 +295,19 @@ std::span<const fb::Mat4> MeshView::inverse_bind() const { return struct_span(fb
 std::string_view ClipView::name() const { return view_of(fb->name()); }
 float ClipView::duration() const { return fb->duration(); }
 float ClipView::sample_rate() const { return fb->sample_rate(); }
+uint32_t ClipView::frame_count() const { return fb->frame_count(); }
 uint64_t ClipView::skeleton_hash() const { return fb->skeleton_hash(); }
-size_t ClipView::track_count() const { return fb->tracks()->size(); }
-
-const fb::Track& ClipView::track(size_t i) const {
-  assert(i < track_count());
-  return *fb->tracks()->Get(static_cast<flatbuffers::uoffset_t>(i));
-}
+uint32_t ClipView::joint_count() const { return fb->joint_count(); }
+std::span<const fb::ConstantChannel> ClipView::constants() const { return struct_span(fb->constants()); }
+std::span<const fb::AnimatedChannel> ClipView::animated() const { return struct_span(fb->animated()); }
+std::span<const uint16_t> ClipView::key_frames() const { return scalar_span(fb->key_frames()); }
+std::span<const uint8_t> ClipView::key_values() const { return scalar_span(fb->key_values()); }
+const fb::ClipCompression* ClipView::compression() const { return fb->compression(); }
+const fb::RootMotion* ClipView::root_motion() const { return fb->root_motion(); }
 
 size_t ClipView::key_count() const {
-  size_t keys = 0;
-  for (const fb::Track* t : *fb->tracks())
-    keys += count_of(t->translation_times()) + count_of(t->rotation_times()) + count_of(t->scale_times());
+  size_t keys = constants().size();
+  for (const fb::AnimatedChannel& a : animated()) keys += a.key_count();
   return keys;
 }
 

@@ -55,17 +55,31 @@ struct MeshView {
   std::span<const fb::Mat4> inverse_bind() const; // one per slot
 };
 
-/// Read-only view of one clip.
+/// Read-only view of one compressed clip (format v2, ossa.fbs "Clip"). Validation proved every
+/// invariant the sampler relies on (sorted disjoint channels, key ranges inside key_frames and
+/// key_values, frames strictly increasing from 0 to frame_count - 1), so these are plain reads.
 struct ClipView {
   const fb::Clip* fb = nullptr;
 
   std::string_view name() const;
   float duration() const;
   float sample_rate() const;
+  uint32_t frame_count() const;
   uint64_t skeleton_hash() const;
-  size_t track_count() const;
-  const fb::Track& track(size_t i) const;  // i < track_count()
-  /// Number of keys over all channels and tracks.
+  uint32_t joint_count() const;
+  /// Channels holding one value, sorted by (joint, channel).
+  std::span<const fb::ConstantChannel> constants() const;
+  /// Channels with keys, sorted by (joint, channel), disjoint from constants().
+  std::span<const fb::AnimatedChannel> animated() const;
+  /// Key frames of every animated channel; channel c owns [first_key, first_key + key_count).
+  std::span<const uint16_t> key_frames() const;
+  /// Packed key values (format/clip_codec.h), followed by kKeyValuePadding zero bytes.
+  std::span<const uint8_t> key_values() const;
+  /// What the cooker measured, or null.
+  const fb::ClipCompression* compression() const;
+  /// Extracted root motion, or null.
+  const fb::RootMotion* root_motion() const;
+  /// Keys over all channels: each animated channel's key_count plus one per constant. O(channels).
   size_t key_count() const;
 };
 
@@ -121,7 +135,7 @@ Status verify_buffer(std::span<const uint8_t> bytes, std::string_view name);
 
 /// A clip can be played on a skeleton when its skeleton_hash equals the skeleton's hash and its
 /// joint count equals the skeleton's (a crafted clip could match the hash but claim more joints,
-/// and its track joints were only checked against its own count). Errors name the clip. O(1).
+/// and its channel joints were only checked against its own count). Errors name the clip. O(1).
 Status check_clip_binding(const ClipView& clip, const SkeletonView& skeleton, std::string_view name);
 
 }  // namespace ossa

@@ -25,6 +25,9 @@ void blend_space_1d_weights(std::span<const float> positions, float parameter, s
 struct BlendSpace2D {
   std::vector<glm::vec2> points;
   std::vector<std::array<uint16_t, 3>> triangles;  // counter-clockwise
+  /// 1 / the points' extent per axis. Axes carry different units (m/s, degrees), so the
+  /// triangulation and the "nearest" of the outside projection measure in these normalized units.
+  glm::vec2 axis_scale{1.0f};
 };
 
 /// Triangulates sample points (>= 3, not all collinear, no duplicates). Error otherwise.

@@ -11,8 +11,12 @@
 
 namespace ossa {
 
+/// The character's motion from one time to another, expressed in its own frame at the first
+/// time (its position and heading then). A host keeping world position P and yaw Psi does
+///   P += rotate(Psi, delta.translation); Psi += delta.yaw
+/// with rotate = right-handed rotation about the clip's up axis (glm::angleAxis(Psi, up)).
 struct RootMotionDelta {
-  glm::vec3 translation{0.0f};  // in the clip's frame at `from`'s start (model space of frame 0)
+  glm::vec3 translation{0.0f};  // ground plane (0 along up), in the character's frame at `from`
   float yaw = 0.0f;             // radians about the clip's up axis
 };
 

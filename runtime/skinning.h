@@ -22,7 +22,8 @@ void skinning_matrices(const MeshView& mesh, std::span<const glm::mat4> model, s
 
 enum class SkinningMethod : uint8_t {
   Linear,          // linear blend skinning: the classic, what the GPU shader does
-  DualQuaternion,  // no candy-wrapper collapse on twisting joints; rigid palettes only
+  DualQuaternion,  // no candy-wrapper collapse on twisting joints: the rotation + translation of
+                   // each palette matrix blends as a dual quaternion, its scale / shear linearly
 };
 
 /// Where skin_cpu writes: xyz per vertex for positions and normals, xyzw for tangents (w = the
@@ -36,7 +37,19 @@ struct SkinnedStreams {
 
 /// Skins every vertex of `mesh` with `palette` (from skinning_matrices), decoding the quantized
 /// or float layout. Normals and tangents are transformed by the blended matrix's linear part and
-/// renormalized. Allocation-free. O(vertices * influences).
+/// renormalized; since the palette holds D, directions are first divided by position_scale, so
+/// they see model * inverse_bind only (a GPU shader must do the same). Tangent w is the stored
+/// bitangent sign (+-1). All-zero weights give zero outputs. Sizes are preconditions (asserted;
+/// a release build skips a stream that does not fit, or everything for a too-small palette).
+/// Allocation-free. O(vertices * influences).
 void skin_cpu(const MeshView& mesh, std::span<const glm::mat4> palette, SkinningMethod method, SkinnedStreams out);
+
+/// Which implementation skin_cpu's linear blending uses for the cooker's quantized layout (other
+/// layouts and dual quaternions always take the portable one). Default: the best the CPU has.
+/// For tests and benchmarks that compare them; set_skinning_isa returns false and changes nothing
+/// when the CPU lacks the instructions. Process-wide, thread-safe.
+enum class SkinningIsa : uint8_t { Portable, Avx2, Avx512 };
+SkinningIsa skinning_isa();
+bool set_skinning_isa(SkinningIsa isa);
 
 }  // namespace ossa

@@ -26,6 +26,7 @@
 #include <string>
 #include <vector>
 
+#include "format/clip_codec.h"
 #include "format/hash.h"
 #include "format/vertex_format.h"
 #include "runtime/message.h"
@@ -126,6 +127,22 @@ uint32_t max_joint_slot(const uint8_t* first, size_t n, size_t stride) {
   T r = m[0];
   for (int k = 1; k < 4; ++k) r = m[k] > r ? m[k] : r;
   return r;
+}
+
+/// True when some 8-bit joint slot of n vertices is >= limit (1..128): the SWAR "has a byte greater
+/// than limit - 1" test on each vertex's 4 slots as one 32-bit word, OR-accumulated, so the loop
+/// is ~5 operations a vertex with no data-dependent branch (a byte-wise max over strided bytes does
+/// not vectorize and costs ~30). Exact: a byte b has bit 7 of (b & 0x7f) + (128 - limit) or of b set
+/// exactly when b >= limit.
+inline bool any_u8_slot_at_least(const uint8_t* first, size_t n, size_t stride, uint32_t limit) {
+  const uint32_t add = 0x01010101u * (128u - limit);
+  uint32_t acc = 0;
+  for (size_t v = 0; v < n; ++v) {
+    uint32_t w;
+    std::memcpy(&w, first + v * stride, 4);
+    acc |= ((w & 0x7f7f7f7fu) + add) | w;
+  }
+  return (acc & 0x80808080u) != 0;
 }
 
 template <class T>
@@ -391,9 +408,12 @@ class Validator {
         if (!spend(vertices->size())) return over_budget(where);
         const uint8_t* first = vertices->Data() + joints_attr->offset();
         const bool wide = joints_attr->format() == fb::VertexFormat::Uint16x4;
-        const uint32_t max = wide ? max_joint_slot<uint16_t>(first, vertex_count, stride)
-                                  : max_joint_slot<uint8_t>(first, vertex_count, stride);
-        if (max >= slot_count) {
+        const bool out_of_range =
+            !wide && slot_count <= 128
+                ? any_u8_slot_at_least(first, vertex_count, stride, static_cast<uint32_t>(slot_count))
+                : (wide ? max_joint_slot<uint16_t>(first, vertex_count, stride)
+                        : max_joint_slot<uint8_t>(first, vertex_count, stride)) >= slot_count;
+        if (out_of_range) {
           uint32_t slot = 0;
           const auto limit = static_cast<uint32_t>(slot_count);
           const size_t v = wide ? first_joint_slot_at_least<uint16_t>(first, vertex_count, stride, limit, &slot)
@@ -418,73 +438,189 @@ class Validator {
   }
 
   // ---- clips ----
+  //
+  // Everything the sampler (runtime/sample.cpp) and root_motion.cpp dereference is proven here,
+  // before any of them runs: channel joints < joint_count, each animated channel's key range
+  // inside key_frames and its bit range inside key_values minus the 8 padding bytes the decoder's
+  // 64-bit reads may touch, frames strictly increasing from 0 to frame_count - 1 (so a cursor or a
+  // binary search always finds a bracketing pair), ranges finite (so decoded values are), raw-float
+  // keys finite, rotations bounded (so normalizing never divides by zero or infinity).
 
-  /// One channel of one track: as many values as times; times finite, strictly increasing,
-  /// inside [0, duration] up to a 1e-4 relative slack (float seconds computed from ticks do not
-  /// land exactly on the duration); values finite, rotations normalizable.
-  template <class Value, class Check>
-  Status check_channel(const std::string& where, const char* channel, const flatbuffers::Vector<float>* times,
-                       const flatbuffers::Vector<const Value*>* values, float duration, Check value_ok,
-                       const char* value_problem) {
-    const size_t n = count_of(times);
-    if (count_of(values) != n)
-      return fail(where, format("%zu %s times but %zu %s values", n, channel, count_of(values), channel));
-    if (n == 0) return {};
-    if (!spend(static_cast<uint64_t>(n) * (sizeof(float) + sizeof(Value)))) return over_budget(where);
-    const float slack = 1e-4f * duration;
-    const float* t = times->data();
-    for (size_t i = 0; i < n; ++i) {
-      if (!std::isfinite(t[i])) return fail(where, format("%s key %zu: time is not finite", channel, i));
-      if (t[i] < -slack || t[i] > duration + slack)
-        return fail(where, format("%s key %zu at %g s is outside the clip [0, %g s]", channel, i, t[i], duration));
-      if (i > 0 && !(t[i] > t[i - 1]))
-        return fail(where, format("%s key %zu at %g s is not after key %zu at %g s (times must strictly increase)",
-                                  channel, i, t[i], i - 1, t[i - 1]));
-      if (!value_ok(*values->Get(static_cast<flatbuffers::uoffset_t>(i))))
-        return fail(where, format("%s key %zu: %s", channel, i, value_problem));
-    }
-    return {};
+  /// "animated channel 3 (joint 5 'Hips' rotation)".
+  std::string channel_label(const char* kind, size_t index, size_t joint, unsigned channel, bool binds_here) const {
+    const char* cn = channel <= static_cast<unsigned>(fb::Channel::MAX)
+                         ? fb::EnumNameChannel(static_cast<fb::Channel>(channel))
+                         : "unknown channel";
+    return format("%s channel %zu (", kind, index) + (binds_here ? joint_label(joint) : format("joint %zu", joint)) +
+           " " + cn + ")";
   }
+
+  /// Sort key of a (joint, channel) pair.
+  static uint32_t channel_key(uint16_t joint, fb::Channel channel) {
+    return (static_cast<uint32_t>(joint) << 8) | static_cast<uint8_t>(channel);
+  }
+
+  /// A rotation component bound: xyz of a unit quaternion lie in [-1, 1]; the slack admits a
+  /// cooker's rounding. Bounding them keeps the squared norm far from overflow when normalizing.
+  static constexpr float kRotationComponentLimit = 1.01f;
 
   Status check_clip(const fb::Clip& c, size_t clip_index) {
     const std::string where = label("clip", clip_index, c.name());
+    const float rate = c.sample_rate();
+    if (!std::isfinite(rate) || !(rate > 0.0f))
+      return fail(where, format("sample rate %g must be a finite number > 0", rate));
+    const uint32_t frame_count = c.frame_count();
+    if (frame_count < 1 || frame_count > 65536)
+      return fail(where, format("frame count %u must be in 1..65536 (frames are 16-bit)", frame_count));
     const float duration = c.duration();
-    if (!std::isfinite(duration) || duration < 0.0f)
-      return fail(where, format("duration %g s must be a finite number >= 0", duration));
-    if (!std::isfinite(c.sample_rate()) || c.sample_rate() < 0.0f)
-      return fail(where, format("sample rate %g must be a finite number >= 0", c.sample_rate()));
+    const double expected = static_cast<double>(frame_count - 1) / rate;
+    if (!std::isfinite(duration) || std::fabs(duration - expected) > 1e-4 * expected + 1e-7)
+      return fail(where, format("duration %g s does not match %u frames at %g frames/s (%g s)", duration, frame_count,
+                                rate, expected));
     const size_t joint_count = c.joint_count();
     const bool binds_here = skeleton_ && c.skeleton_hash() == skeleton_->hash();
     if (binds_here && joint_count != joint_count_)
       return fail(where, format("addresses %s, but its skeleton (this file's, by hash) has %zu",
                                 count_text(joint_count, "joint").c_str(), joint_count_));
 
-    const auto* tracks = c.tracks();
-    if (!spend(static_cast<uint64_t>(tracks->size()) * 4)) return over_budget(where);
-    long previous = -1;
-    for (flatbuffers::uoffset_t k = 0; k < tracks->size(); ++k) {
-      const fb::Track& t = *tracks->Get(k);
-      const size_t joint = t.joint();
-      std::string tl = format("track %u (", k) + (binds_here ? joint_label(joint) : format("joint %zu", joint)) + ")";
-      if (static_cast<long>(joint) <= previous)
-        return fail(where, tl + format(" is not after track %u (joint %ld): tracks are sorted by joint, one per joint",
-                                       k - 1, previous));
-      previous = static_cast<long>(joint);
-      if (joint >= joint_count)
-        return fail(where, tl + format(" addresses a joint past the clip's joint count %zu", joint_count));
-      const std::string track_where = where + ": " + tl;
-      if (Status s = check_channel(track_where, "translation", t.translation_times(), t.translations(), duration,
-                                   finite3, "translation is not finite");
-          !s)
-        return s;
-      if (Status s = check_channel(track_where, "rotation", t.rotation_times(), t.rotations(), duration,
-                                   normalizable, "rotation is not a finite, non-zero quaternion");
-          !s)
-        return s;
-      if (Status s = check_channel(track_where, "scale", t.scale_times(), t.scales(), duration, finite3,
-                                   "scale is not finite");
-          !s)
-        return s;
+    // Constant channels.
+    const size_t constant_count = count_of(c.constants());
+    if (!spend(static_cast<uint64_t>(constant_count) * sizeof(fb::ConstantChannel))) return over_budget(where);
+    for (size_t k = 0; k < constant_count; ++k) {
+      const fb::ConstantChannel& ch = *c.constants()->Get(static_cast<flatbuffers::uoffset_t>(k));
+      const auto channel = static_cast<unsigned>(ch.channel());
+      const auto cl = [&] { return channel_label("constant", k, ch.joint(), channel, binds_here); };
+      if (channel > static_cast<unsigned>(fb::Channel::MAX))
+        return fail(where, cl() + format(" has unknown channel %u", channel));
+      if (ch.joint() >= joint_count)
+        return fail(where, cl() + format(" addresses a joint past the clip's joint count %zu", joint_count));
+      if (k > 0) {
+        const fb::ConstantChannel& prev = *c.constants()->Get(static_cast<flatbuffers::uoffset_t>(k - 1));
+        if (channel_key(ch.joint(), ch.channel()) <= channel_key(prev.joint(), prev.channel()))
+          return fail(where, cl() + format(" is not after constant channel %zu: channels are sorted by (joint, "
+                                         "channel), each at most once", k - 1));
+      }
+      if (ch.channel() == fb::Channel::Rotation) {
+        if (!normalizable(ch.value())) return fail(where, cl() + ": value is not a finite, non-zero quaternion");
+      } else if (!std::isfinite(ch.value().x()) || !std::isfinite(ch.value().y()) || !std::isfinite(ch.value().z())) {
+        return fail(where, cl() + ": value is not finite");
+      }
+    }
+
+    // Animated channels.
+    const size_t animated_count = count_of(c.animated());
+    const size_t frame_total = count_of(c.key_frames());
+    const size_t value_bytes = count_of(c.key_values());
+    if (!spend(static_cast<uint64_t>(animated_count) * sizeof(fb::AnimatedChannel))) return over_budget(where);
+    if (animated_count > 0 && value_bytes < kKeyValuePadding)
+      return fail(where, format("key values are %zu bytes, less than the %u padding bytes decoders read past the "
+                                "last key", value_bytes, kKeyValuePadding));
+    const uint64_t value_bits = value_bytes >= kKeyValuePadding ? 8ull * (value_bytes - kKeyValuePadding) : 0;
+    const uint16_t* frames = c.key_frames() ? c.key_frames()->data() : nullptr;
+    const uint8_t* values = c.key_values() ? c.key_values()->data() : nullptr;
+    size_t next_constant = 0;  // merge walk: both lists are sorted, so disjointness is one pass
+    for (size_t k = 0; k < animated_count; ++k) {
+      const fb::AnimatedChannel& ch = *c.animated()->Get(static_cast<flatbuffers::uoffset_t>(k));
+      const auto channel = static_cast<unsigned>(ch.channel());
+      const auto cl = [&] { return channel_label("animated", k, ch.joint(), channel, binds_here); };
+      if (channel > static_cast<unsigned>(fb::Channel::MAX))
+        return fail(where, cl() + format(" has unknown channel %u", channel));
+      if (ch.joint() >= joint_count)
+        return fail(where, cl() + format(" addresses a joint past the clip's joint count %zu", joint_count));
+      const uint32_t key = channel_key(ch.joint(), ch.channel());
+      if (k > 0) {
+        const fb::AnimatedChannel& prev = *c.animated()->Get(static_cast<flatbuffers::uoffset_t>(k - 1));
+        if (key <= channel_key(prev.joint(), prev.channel()))
+          return fail(where, cl() + format(" is not after animated channel %zu: channels are sorted by (joint, "
+                                         "channel), each at most once", k - 1));
+      }
+      while (next_constant < constant_count) {
+        const fb::ConstantChannel& cc = *c.constants()->Get(static_cast<flatbuffers::uoffset_t>(next_constant));
+        const uint32_t ck = channel_key(cc.joint(), cc.channel());
+        if (ck > key) break;
+        if (ck == key) return fail(where, cl() + format(" is also constant channel %zu", next_constant));
+        ++next_constant;
+      }
+
+      // Keys: range inside key_frames, frames strictly increasing from 0 to the last frame.
+      const uint32_t n = ch.key_count();
+      if (n < 2) return fail(where, cl() + format(" has %u keys; an animated channel has at least 2", n));
+      const uint64_t first = ch.first_key();
+      if (first + n > frame_total)
+        return fail(where, cl() + format(" uses keys [%llu, %llu), past the %zu key frames", static_cast<unsigned long long>(first),
+                                       static_cast<unsigned long long>(first + n), frame_total));
+      if (!spend(static_cast<uint64_t>(n) * sizeof(uint16_t))) return over_budget(where);
+      const uint16_t* f = frames + first;
+      if (f[0] != 0) return fail(where, cl() + format(": first key is at frame %u, must be 0", f[0]));
+      for (uint32_t i = 1; i < n; ++i)
+        if (!(f[i] > f[i - 1]))
+          return fail(where, cl() + format(": key %u at frame %u is not after key %u at frame %u (frames must strictly "
+                                         "increase)", i, f[i], i - 1, f[i - 1]));
+      if (f[n - 1] != frame_count - 1)
+        return fail(where, cl() + format(": last key is at frame %u, must be the last frame %u", f[n - 1], frame_count - 1));
+
+      // Bits: inside key_values, minus the padding.
+      const uint32_t bits = ch.bits();
+      if (!((bits >= 1 && bits <= kMaxQuantBits) || bits == kRawFloatBits))
+        return fail(where, cl() + format(" has %u bits per component; must be 1..%u or 32", bits, kMaxQuantBits));
+      // Rotations name the component they leave out (0..3). Other channels ignore the field (the
+      // schema asks writers for 0 there, but nothing reads it, so a reader need not insist).
+      const bool rotation = ch.channel() == fb::Channel::Rotation;
+      if (rotation && ch.dropped() > 3)
+        return fail(where, cl() + format(" has dropped component %u; must be 0..3 (x, y, z, w)", ch.dropped()));
+      const uint64_t offset = ch.bit_offset();
+      if (bits == kRawFloatBits && offset % 8 != 0)
+        return fail(where, cl() + format(": raw-float keys start at bit %llu, not on a byte boundary",
+                                       static_cast<unsigned long long>(offset)));
+      const uint64_t end = offset + key_bits(bits) * n;
+      if (end > value_bits)
+        return fail(where, cl() + format(" needs key value bits [%llu, %llu), the clip has %llu (before padding)",
+                                       static_cast<unsigned long long>(offset), static_cast<unsigned long long>(end),
+                                       static_cast<unsigned long long>(value_bits)));
+
+      // Ranges: finite, extents >= 0, and the top of the range finite, so every decoded value
+      // (lo + extent * q / max <= lo + extent) is.
+      const fb::Vec3& lo = ch.range_min();
+      const fb::Vec3& ex = ch.range_extent();
+      const float los[3] = {lo.x(), lo.y(), lo.z()}, exs[3] = {ex.x(), ex.y(), ex.z()};
+      if (bits != kRawFloatBits) {
+        for (int i = 0; i < 3; ++i) {
+          if (!std::isfinite(los[i]) || !std::isfinite(exs[i]) || !(exs[i] >= 0.0f) || !std::isfinite(los[i] + exs[i]))
+            return fail(where, cl() + format(": range min %s extent %s must be finite with extents >= 0",
+                                           vec3_text(lo).c_str(), vec3_text(ex).c_str()));
+          if (rotation && (los[i] < -kRotationComponentLimit || los[i] + exs[i] > kRotationComponentLimit))
+            return fail(where, cl() + format(": rotation range min %s extent %s leaves [-1, 1]", vec3_text(lo).c_str(),
+                                           vec3_text(ex).c_str()));
+        }
+      } else {
+        // Raw floats carry their own values: scan them (O(keys), once, at load).
+        if (!spend(static_cast<uint64_t>(n) * 12)) return over_budget(where);
+        const uint8_t* raw = values + offset / 8;
+        for (uint32_t i = 0; i < n; ++i) {
+          float v[3];
+          std::memcpy(v, raw + 12ull * i, sizeof v);
+          for (int j = 0; j < 3; ++j) {
+            if (!std::isfinite(v[j])) return fail(where, cl() + format(": raw key %u is not finite", i));
+            if (rotation && std::fabs(v[j]) > kRotationComponentLimit)
+              return fail(where, cl() + format(": raw rotation key %u component %g leaves [-1, 1]", i, v[j]));
+          }
+        }
+      }
+    }
+
+    // Root motion: one sample per frame, finite.
+    if (const fb::RootMotion* rm = c.root_motion()) {
+      const size_t nt = rm->translations()->size(), ny = rm->yaws()->size();
+      if (nt != frame_count || ny != frame_count)
+        return fail(where, format("root motion has %zu translations and %zu yaws, the clip has %u frames", nt, ny,
+                                  frame_count));
+      if (rm->up_axis() > 2) return fail(where, format("root motion up axis %u must be 0, 1 or 2", rm->up_axis()));
+      if (!spend(static_cast<uint64_t>(frame_count) * 16)) return over_budget(where);
+      for (size_t i = 0; i < nt; ++i) {
+        const auto idx = static_cast<flatbuffers::uoffset_t>(i);
+        if (!finite3(*rm->translations()->Get(idx)) || !std::isfinite(rm->yaws()->Get(idx)))
+          return fail(where, format("root motion frame %zu is not finite", i));
+      }
     }
     return {};
   }

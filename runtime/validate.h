@@ -5,8 +5,15 @@
 // same length, the stored hash equals the recomputed one, layouts inside the stride with known
 // formats, vertex/index byte sizes consistent with counts, indices < vertex_count, submeshes inside
 // the index range with valid materials, joint slots < slot count and slots -> joints < joint count,
-// track joints < the clip's joint count and sorted, key times finite, sorted and inside the clip,
-// key values finite, as many values as times. Runs after verification; never reads out of bounds.
+// compressed clips (format v2) that a sampler can decode without a single check: sample rate > 0,
+// 1..65536 frames, duration = (frames - 1) / rate; constant and animated channels each sorted by
+// (joint, channel), disjoint, joints < the clip's joint count, known channels; every animated
+// channel with >= 2 keys whose frames lie inside key_frames, strictly increase from 0 to the last
+// frame, whose bits are 1..19 or 32, whose dropped rotation component is 0..3, and whose packed
+// keys lie inside key_values before its 8 padding bytes; finite ranges, raw-float keys finite,
+// rotation components inside [-1, 1] (up to rounding); constants finite, rotation constants
+// normalizable; root motion one finite sample
+// per frame. Runs after verification; never reads out of bounds.
 //
 // Also checked, because a reader relies on them: metres_per_unit finite and > 0; joint names
 // non-empty; bind pose and inverse binds finite, rotations normalizable (also for keys); vertex

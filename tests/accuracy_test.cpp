@@ -4,8 +4,11 @@
 // of the Assimp node of that name; (2) every de-quantized vertex lies within the quantization bound
 // of a source vertex, and skinning it with the cooked palette in the bind pose lands on Assimp's
 // bind-pose skinning of a source vertex; (3) at the first, middle and last source key times of each
-// clip, the model-space joint positions from the cooked keys equal Assimp's node animation
-// evaluated at that time. Assimp is asked with the cooker's own import flags.
+// clip, the model-space joint positions of the cooked clip sampled by ossa::sample() equal Assimp's
+// node animation evaluated at that time, within the compression error the cooker reports
+// (Clip.compression.max_error) plus 1e-3 of the rig's size for resampling onto the frame grid, and
+// a pose one frame off fails that bound (so the bound can catch a wrong sampler). Assimp is asked
+// with the cooker's own import flags.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -31,6 +34,8 @@
 #include "cooker/import_scene.h"
 #include "format/vertex_codec.h"
 #include "runtime/asset.h"
+#include "runtime/pose.h"
+#include "runtime/sample.h"
 #include "test_files.h"
 
 namespace fs = std::filesystem;
@@ -124,23 +129,6 @@ glm::quat eval_quat(const aiQuatKey* keys, unsigned n, double ticks, glm::quat f
       return glm::slerp(q(keys[i].mValue), q(keys[i + 1].mValue), a);
     }
   return q(keys[n - 1].mValue);
-}
-
-/// Cooked channel value at `t` seconds: linear / nlerp between the bracketing keys, clamped.
-template <class V, class F>
-V eval_cooked(const flatbuffers::Vector<float>* times, const flatbuffers::Vector<const V*>* values, float t,
-              F&& mix, V fallback_unused, bool* present) {
-  (void)fallback_unused;
-  *present = times != nullptr && times->size() > 0;
-  if (!*present) return V{};
-  const unsigned n = times->size();
-  if (t <= times->Get(0)) return *values->Get(0);
-  for (unsigned i = 0; i + 1 < n; ++i)
-    if (t < times->Get(i + 1)) {
-      const float a = (t - times->Get(i)) / (times->Get(i + 1) - times->Get(i));
-      return mix(*values->Get(i), *values->Get(i + 1), a);
-    }
-  return *values->Get(n - 1);
 }
 
 std::vector<glm::mat4> bind_models(const ossa::SkeletonView& sk) {
@@ -340,15 +328,39 @@ TEST_P(Accuracy, DequantizedVerticesMatchSource) {
   EXPECT_GT(checked, 0u);
 }
 
-TEST_P(Accuracy, ClipKeysMatchAssimpAtFirstMiddleLastSourceTimes) {
+/// Model-space joint positions of a sampled local pose (an independent forward loop, so this test
+/// does not lean on pose_ops' local_to_model).
+std::vector<glm::vec3> model_positions(const ossa::SkeletonView& sk, const ossa::Pose& pose) {
+  std::vector<glm::mat4> model(sk.joint_count());
+  std::vector<glm::vec3> out(sk.joint_count());
+  for (size_t j = 0; j < sk.joint_count(); ++j) {
+    const ossa::Transform x = ossa::get_transform(pose, static_cast<uint32_t>(j));
+    const glm::mat4 local = trs(x.translation, x.rotation, x.scale);
+    const int p = sk.parents()[j];
+    model[j] = p < 0 ? local : model[static_cast<size_t>(p)] * local;
+    out[j] = glm::vec3(model[j][3]);
+  }
+  return out;
+}
+
+TEST_P(Accuracy, ClipSamplesMatchAssimpAtFirstMiddleLastSourceTimes) {
   const ossa::SkeletonView sk = asset_->skeleton();
   if (sk.empty() || asset_->clip_count() == 0) GTEST_SKIP() << "no clip";
   ASSERT_EQ(asset_->clip_count(), scene_->mNumAnimations);
-  const auto bind = bind_models(sk);
-  const float tol = 1e-3f * skeleton_extent(bind) + 1e-5f;
+  const float extent = skeleton_extent(bind_models(sk));
+  const auto joints = static_cast<uint32_t>(sk.joint_count());
+  ossa::Pose pose(joints);
+  bool negative_control_ran = false;
   for (unsigned ci = 0; ci < scene_->mNumAnimations; ++ci) {
     const aiAnimation* anim = scene_->mAnimations[ci];
     const ossa::ClipView clip = asset_->clip(ci);
+    // The cooker's stated bound: the compression error it measured against the resampled source
+    // (in source units), plus 1e-3 of the rig's size for what resampling onto the frame grid and
+    // Assimp's slerp-vs-nlerp evaluation add between grid frames.
+    const float max_error = clip.compression() ? clip.compression()->max_error() : 0.0f;
+    const float tol = max_error + 1e-3f * extent + 1e-5f;
+    auto cache = ossa::make_sampling_cache(clip, sk);
+    ASSERT_TRUE(cache.ok()) << cache.error().message;
     std::vector<double> ticks;
     std::map<std::string, const aiNodeAnim*> channels;
     for (unsigned c = 0; c < anim->mNumChannels; ++c) {
@@ -362,9 +374,8 @@ TEST_P(Accuracy, ClipKeysMatchAssimpAtFirstMiddleLastSourceTimes) {
     ticks.erase(std::unique(ticks.begin(), ticks.end()), ticks.end());
     const double ticks_per_second = anim->mDuration / clip.duration();
     ASSERT_GT(ticks_per_second, 0.0);
-    for (double tk : {ticks.front(), ticks[ticks.size() / 2], ticks.back()}) {
-      const float t = static_cast<float>(tk / ticks_per_second);
-      // Assimp: every node's local, animated where a channel drives it.
+    // Assimp: every node's local, animated where a channel drives it; global at `tk` ticks.
+    const auto assimp_positions = [&](double tk) {
       std::function<glm::mat4(const aiNode*)> global = [&](const aiNode* n) -> glm::mat4 {
         glm::mat4 local = to_glm(n->mTransformation);
         auto it = channels.find(n->mName.C_Str());
@@ -379,52 +390,51 @@ TEST_P(Accuracy, ClipKeysMatchAssimpAtFirstMiddleLastSourceTimes) {
         }
         return n->mParent ? global(n->mParent) * local : local;
       };
-      // Cooked: bind pose overridden by the clip's tracks.
-      std::vector<glm::vec3> T(sk.joint_count());
-      std::vector<glm::quat> R(sk.joint_count());
-      std::vector<glm::vec3> S(sk.joint_count());
+      // Every candidate node per joint (names are not always unique): the test takes the nearest.
+      std::vector<std::vector<glm::vec3>> out(sk.joint_count());
       for (size_t j = 0; j < sk.joint_count(); ++j) {
-        const auto& bt = sk.bind_translations()[j];
-        const auto& br = sk.bind_rotations()[j];
-        const auto& bs = sk.bind_scales()[j];
-        T[j] = {bt.x(), bt.y(), bt.z()};
-        R[j] = glm::quat(br.w(), br.x(), br.y(), br.z());
-        S[j] = {bs.x(), bs.y(), bs.z()};
-      }
-      auto lerp3 = [](const ossa::fb::Vec3& a, const ossa::fb::Vec3& b, float w) {
-        return ossa::fb::Vec3(a.x() + (b.x() - a.x()) * w, a.y() + (b.y() - a.y()) * w, a.z() + (b.z() - a.z()) * w);
-      };
-      auto nlerp = [](const ossa::fb::Quat& a, const ossa::fb::Quat& b, float w) {
-        const glm::quat qa(a.w(), a.x(), a.y(), a.z());
-        glm::quat qb(b.w(), b.x(), b.y(), b.z());
-        const glm::quat r = glm::slerp(qa, qb, w);
-        return ossa::fb::Quat(r.x, r.y, r.z, r.w);
-      };
-      for (size_t k = 0; k < clip.track_count(); ++k) {
-        const ossa::fb::Track& tr = clip.track(k);
-        bool present = false;
-        const auto tv = eval_cooked(tr.translation_times(), tr.translations(), t, lerp3, ossa::fb::Vec3(), &present);
-        if (present) T[tr.joint()] = {tv.x(), tv.y(), tv.z()};
-        const auto rv = eval_cooked(tr.rotation_times(), tr.rotations(), t, nlerp, ossa::fb::Quat(), &present);
-        if (present) R[tr.joint()] = glm::quat(rv.w(), rv.x(), rv.y(), rv.z());
-        const auto sv = eval_cooked(tr.scale_times(), tr.scales(), t, lerp3, ossa::fb::Vec3(), &present);
-        if (present) S[tr.joint()] = {sv.x(), sv.y(), sv.z()};
-      }
-      std::vector<glm::mat4> model(sk.joint_count());
-      for (size_t j = 0; j < sk.joint_count(); ++j) {
-        const glm::mat4 local = trs(T[j], R[j], S[j]);
-        const int p = sk.parents()[j];
-        model[j] = p < 0 ? local : model[static_cast<size_t>(p)] * local;
         std::vector<const aiNode*> nodes;
         find_nodes(scene_->mRootNode, std::string(sk.joint_name(j)), &nodes);
-        ASSERT_FALSE(nodes.empty());
-        float err = INFINITY;
-        for (const aiNode* n : nodes) err = std::min(err, glm::distance(glm::vec3(global(n)[3]), glm::vec3(model[j][3])));
-        EXPECT_LE(err, tol)
-            << "clip '" << clip.name() << "' t=" << t << "s joint " << sk.joint_name(j);
+        for (const aiNode* n : nodes) out[j].push_back(glm::vec3(global(n)[3]));
+      }
+      return out;
+    };
+    const auto error_of = [&](const std::vector<glm::vec3>& cooked, const std::vector<glm::vec3>& source, size_t j) {
+      float err = INFINITY;
+      for (const glm::vec3& p : source) err = std::min(err, glm::distance(p, cooked[j]));
+      return err;
+    };
+    for (double tk : {ticks.front(), ticks[ticks.size() / 2], ticks.back()}) {
+      const auto t = static_cast<float>(tk / ticks_per_second);
+      const auto source = assimp_positions(tk);
+      ossa::sample(clip, t, ossa::SampleOptions{.loop = false}, *cache, pose);
+      const std::vector<glm::vec3> cooked = model_positions(sk, pose);
+      for (size_t j = 0; j < sk.joint_count(); ++j) {
+        ASSERT_FALSE(source[j].empty()) << "cooked joint " << sk.joint_name(j) << " is no node of the source";
+        EXPECT_LE(error_of(cooked, source[j], j), tol)
+            << "clip '" << clip.name() << "' t=" << t << "s joint " << sk.joint_name(j) << " (max_error " << max_error
+            << ")";
+      }
+      // Negative control: a pose one frame off must fail the same comparison wherever the clip
+      // moves more than twice the tolerance in that frame; otherwise the bound could not catch a
+      // sampler that is a frame late. (Motion is measured on the cooked clip, not on Assimp: for
+      // glTF STEP samplers Assimp's linear evaluation between keys is not the source's.)
+      const float step = 1.0f / clip.sample_rate();
+      const float shifted = t + step <= clip.duration() ? t + step : t - step;
+      ossa::sample(clip, shifted, ossa::SampleOptions{.loop = false}, *cache, pose);
+      const std::vector<glm::vec3> wrong = model_positions(sk, pose);
+      float moved = 0.0f, worst = 0.0f;
+      for (size_t j = 0; j < sk.joint_count(); ++j) {
+        moved = std::max(moved, glm::distance(wrong[j], cooked[j]));
+        worst = std::max(worst, error_of(wrong, source[j], j));
+      }
+      if (moved > 2.0f * tol) {
+        EXPECT_GT(worst, tol) << "clip '" << clip.name() << "': a pose one frame off still passes the tolerance";
+        negative_control_ran = true;
       }
     }
   }
+  RecordProperty("negative_control", negative_control_ran ? "ran" : "no clip moved enough");
 }
 
 const AccuracyCase kCases[] = {

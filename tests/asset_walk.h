@@ -8,6 +8,8 @@
 // established, so a loader that accepts a bad file is reported instead of trusted. It returns the
 // first broken promise as text (empty when all hold) rather than using GoogleTest, because the
 // libFuzzer target includes it too. Header-only: the fuzz target is built from one source file.
+// Every accepted clip is also played once through sample() at a few times (looping, clamped,
+// nlerp, slerp), so the fuzzer proves the sampler never reads outside a validated file.
 #pragma once
 #include <algorithm>
 #include <cmath>
@@ -19,10 +21,14 @@
 #include <type_traits>
 #include <vector>
 
+#include <flatbuffers/flatbuffers.h>
+
 #include "format/hash.h"
 #include "format/vertex_format.h"
 #include "format/version.h"
 #include "runtime/asset.h"
+#include "runtime/pose.h"
+#include "runtime/sample.h"
 
 namespace ossa::test {
 
@@ -204,52 +210,152 @@ class AssetWalker {
     }
   }
 
-  template <class T>
-  void channel(const flatbuffers::Vector<float>* times_vector, std::span<const T> values, float duration,
-               const std::string& where) {
-    const std::span<const float> times = scalars(times_vector);
-    touch(times, where + " times");
-    touch(values, where + " values");
-    if (times.size() != values.size()) return fail(where, "times and values differ in count");
-    for (size_t k = 0; k < times.size(); ++k) {
-      if (!std::isfinite(times[k])) return fail(where, "key time not finite");
-      // The loader allows a relative 1e-4 slack at both ends (seconds computed from ticks).
-      const float slack = 1e-4f * duration;
-      if (!(times[k] >= -slack && times[k] <= duration + slack)) return fail(where, "key time outside [0, duration]");
-      if (k > 0 && !(times[k] > times[k - 1])) return fail(where, "key times not strictly increasing");
-      if (!finite(values[k])) return fail(where, "key value not finite");
-      if constexpr (std::is_same_v<T, fb::Quat>) {
-        const double x = values[k].x(), y = values[k].y(), z = values[k].z(), w = values[k].w();
-        if (!(x * x + y * y + z * z + w * w > 0.0)) return fail(where, "zero quaternion");
-      }
-    }
+  /// (joint, channel) as one sortable number.
+  static uint32_t channel_key(uint16_t joint, fb::Channel channel) {
+    return (static_cast<uint32_t>(joint) << 8) | static_cast<uint8_t>(channel);
   }
 
   void clip(size_t c) {
     const ClipView v = asset_.clip(c);
     const std::string where = "clip " + std::to_string(c);
     touch(v.name(), where + " name");
+    const std::span<const fb::ConstantChannel> constants = v.constants();
+    const std::span<const fb::AnimatedChannel> animated = v.animated();
+    const std::span<const uint16_t> frames = v.key_frames();
+    const std::span<const uint8_t> values = v.key_values();
+    touch(constants, where + " constants");
+    touch(animated, where + " animated");
+    touch(frames, where + " key_frames");
+    touch(values, where + " key_values");
     const float numbers[2] = {v.duration(), v.sample_rate()};  // folded as bits: they may be NaN
     uint32_t bits[2];
     std::memcpy(bits, numbers, sizeof bits);
-    sum_ += bits[0] + bits[1] + v.skeleton_hash();
-    size_t keys = 0;
-    int previous_joint = -1;
-    for (size_t t = 0; t < v.track_count(); ++t) {
-      const fb::Track& track = v.track(t);
-      const std::string at = where + " track " + std::to_string(t);
-      if (track.joint() >= v.fb->joint_count()) fail(at, "joint >= clip joint_count");
-      if (static_cast<int>(track.joint()) <= previous_joint) fail(at, "tracks not sorted by joint (or repeated)");
-      previous_joint = track.joint();
-      channel(track.translation_times(), structs(track.translations()), v.duration(), at + " translations");
-      channel(track.rotation_times(), structs(track.rotations()), v.duration(), at + " rotations");
-      channel(track.scale_times(), structs(track.scales()), v.duration(), at + " scales");
-      keys += scalars(track.translation_times()).size() + scalars(track.rotation_times()).size() +
-              scalars(track.scale_times()).size();
+    sum_ += bits[0] + bits[1] + v.skeleton_hash() + v.frame_count() + v.joint_count();
+    if (!problem_.empty()) return;
+
+    const float rate = v.sample_rate();
+    const uint32_t frame_count = v.frame_count();
+    if (!(std::isfinite(rate) && rate > 0.0f)) return fail(where, "sample rate not finite and > 0");
+    if (frame_count < 1 || frame_count > 65536) return fail(where, "frame count not in 1..65536");
+    const double expected = (frame_count - 1) / static_cast<double>(rate);
+    if (!(std::fabs(v.duration() - expected) <= 1e-4 * expected + 1e-6))
+      return fail(where, "duration != (frame_count - 1) / sample_rate");
+    const uint32_t joints = v.joint_count();
+
+    size_t keys = constants.size();
+    for (size_t k = 0; k < constants.size(); ++k) {
+      const fb::ConstantChannel& ch = constants[k];
+      if (static_cast<unsigned>(ch.channel()) > 2) return fail(where, "constant channel enum unknown");
+      if (ch.joint() >= joints) return fail(where, "constant joint >= clip joint_count");
+      if (k > 0 && channel_key(ch.joint(), ch.channel()) <= channel_key(constants[k - 1].joint(), constants[k - 1].channel()))
+        return fail(where, "constants not sorted by (joint, channel) or repeated");
+      if (!finite(fb::Vec3(ch.value().x(), ch.value().y(), ch.value().z())))
+        return fail(where, "constant value not finite");
+      if (ch.channel() == fb::Channel::Rotation) {
+        if (!std::isfinite(ch.value().w())) return fail(where, "rotation constant not finite");
+        const double x = ch.value().x(), y = ch.value().y(), z = ch.value().z(), w = ch.value().w();
+        if (!(x * x + y * y + z * z + w * w > 1e-30)) return fail(where, "zero rotation constant");
+      }
     }
-    if (v.key_count() != keys) fail(where, "key_count() != keys in the tracks");
+    for (size_t k = 0; k < animated.size(); ++k) {
+      const fb::AnimatedChannel& ch = animated[k];
+      const std::string at = where + " animated " + std::to_string(k);
+      if (static_cast<unsigned>(ch.channel()) > 2) return fail(at, "channel enum unknown");
+      if (ch.joint() >= joints) return fail(at, "joint >= clip joint_count");
+      const uint32_t key = channel_key(ch.joint(), ch.channel());
+      if (k > 0 && key <= channel_key(animated[k - 1].joint(), animated[k - 1].channel()))
+        return fail(at, "animated not sorted by (joint, channel) or repeated");
+      for (const fb::ConstantChannel& cc : constants)
+        if (channel_key(cc.joint(), cc.channel()) == key) return fail(at, "also a constant channel");
+      const uint64_t first = ch.first_key(), n = ch.key_count();
+      keys += n;
+      if (n < 2) return fail(at, "fewer than 2 keys");
+      if (first + n > frames.size()) return fail(at, "keys past key_frames");
+      if (frames[first] != 0 || frames[first + n - 1] != frame_count - 1)
+        return fail(at, "keys do not run from frame 0 to the last frame");
+      for (uint64_t i = first + 1; i < first + n; ++i)
+        if (!(frames[i] > frames[i - 1])) return fail(at, "key frames not strictly increasing");
+      const uint32_t b = ch.bits();
+      if (!((b >= 1 && b <= 19) || b == 32)) return fail(at, "bits not in 1..19 or 32");
+      if (ch.channel() == fb::Channel::Rotation && ch.dropped() > 3) return fail(at, "rotation drops no component 0..3");
+      if (values.size() < 8) return fail(at, "key values shorter than their padding");
+      const uint64_t end = ch.bit_offset() + 3ull * b * n;
+      if (end > 8ull * (values.size() - 8)) return fail(at, "keys past key_values (before padding)");
+      if (b == 32) {
+        if (ch.bit_offset() % 8 != 0) return fail(at, "raw keys not byte-aligned");
+        for (uint64_t i = 0; i < 3 * n; ++i) {
+          float f;
+          std::memcpy(&f, values.data() + ch.bit_offset() / 8 + 4 * i, 4);
+          if (!std::isfinite(f)) return fail(at, "raw key not finite");
+        }
+      } else if (!finite(ch.range_min()) || !finite(ch.range_extent()) || ch.range_extent().x() < 0 ||
+                 ch.range_extent().y() < 0 || ch.range_extent().z() < 0) {
+        return fail(at, "range not finite or negative extent");
+      }
+    }
+    if (v.key_count() != keys) fail(where, "key_count() != constants + animated keys");
+    if (const fb::RootMotion* rm = v.root_motion()) {
+      touch(structs(rm->translations()), where + " root motion translations");
+      touch(scalars(rm->yaws()), where + " root motion yaws");
+      if (rm->translations()->size() != frame_count || rm->yaws()->size() != frame_count)
+        fail(where, "root motion not one sample per frame");
+      if (rm->up_axis() > 2) fail(where, "root motion up axis > 2");
+    }
+    if (const fb::ClipCompression* cc = v.compression()) sum_ += cc->raw_bytes() + cc->worst_joint();
     const Status binding = check_clip_binding(v, asset_.skeleton(), asset_.name());
     for (char ch : binding.message()) sum_ = sum_ * 31 + static_cast<unsigned char>(ch);  // not file bytes
+    if (problem_.empty()) play(v, where, binding.ok());
+  }
+
+  /// Samples an accepted clip at a few times, looping and clamped, nlerp and slerp, on its own
+  /// skeleton when it binds to the file's, else on a stand-in rig with the clip's hash and joint
+  /// count (identity bind pose): the sampler must stay inside the file and produce finite poses.
+  void play(const ClipView& v, const std::string& where, bool binds_here) {
+    flatbuffers::FlatBufferBuilder fbb;
+    SkeletonView skeleton = asset_.skeleton();
+    if (!binds_here) {
+      const uint32_t n = v.joint_count();
+      std::vector<std::string> names(n);
+      for (uint32_t i = 0; i < n; ++i) names[i] = "j" + std::to_string(i);
+      const std::vector<int16_t> parents(n, -1);
+      const std::vector<fb::Vec3> zero(n, fb::Vec3(0, 0, 0)), one(n, fb::Vec3(1, 1, 1));
+      const std::vector<fb::Quat> identity(n, fb::Quat(0, 0, 0, 1));
+      const std::vector<fb::Mat4> matrices(n);
+      const auto name_vector = fbb.CreateVectorOfStrings(names);
+      const auto parent_vector = fbb.CreateVector(parents);
+      const auto t = fbb.CreateVectorOfStructs(zero);
+      const auto r = fbb.CreateVectorOfStructs(identity);
+      const auto sc = fbb.CreateVectorOfStructs(one);
+      const auto m = fbb.CreateVectorOfStructs(matrices);
+      fbb.Finish(fb::CreateSkeleton(fbb, name_vector, parent_vector, t, r, sc, m, v.skeleton_hash()));
+      skeleton = SkeletonView{flatbuffers::GetRoot<fb::Skeleton>(fbb.GetBufferPointer())};
+    }
+    Result<SamplingCache> cache = make_sampling_cache(v, skeleton);
+    if (!cache) return fail(where, "make_sampling_cache refused a clip bound to its rig: " + cache.error().message);
+    const uint32_t joints = v.joint_count();
+    const uint32_t stride = pose_stride(joints);
+    std::vector<float> storage(size_t(kPoseComponents) * stride);
+    const PoseSpan pose{storage.data(), joints, stride};
+    const float d = v.duration();
+    const float times[] = {0.0f, d * 0.37f, d, d * 0.5f, -0.25f * d - 0.01f, d * 2.6f, 0.0f};
+    for (int mode = 0; mode < 4; ++mode) {
+      SampleOptions options;
+      options.loop = (mode & 1) == 0;
+      options.rotation = mode & 2 ? RotationInterpolation::Slerp : RotationInterpolation::Nlerp;
+      for (float t : times) {
+        sample(v, t, options, *cache, pose);
+        for (uint32_t j = 0; j < joints; ++j) {
+          for (PoseComponent k : {kTx, kTy, kTz, kSx, kSy, kSz})
+            if (std::isnan(pose[k][j])) return fail(where, "sample() produced a NaN translation or scale");
+          const double x = pose[kRx][j], y = pose[kRy][j], z = pose[kRz][j], w = pose[kRw][j];
+          if (!(std::fabs(x * x + y * y + z * z + w * w - 1.0) < 1e-3))
+            return fail(where, "sample() produced a rotation that is not unit");
+          uint32_t word;
+          std::memcpy(&word, &pose[kRx][j], 4);
+          sum_ += word;
+        }
+      }
+    }
   }
 
   void material(size_t i) {

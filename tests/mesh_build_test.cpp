@@ -18,8 +18,10 @@
 #include <string>
 #include <vector>
 
+#include "cooker/clip_compress.h"
 #include "cooker/mesh_build.h"
 #include "cooker/write_ossa.h"
+#include "format/clip_codec.h"
 #include "format/hash.h"
 #include "format/vertex_codec.h"
 #include "format/vertex_format.h"
@@ -274,7 +276,13 @@ std::vector<uint8_t> write(const SourceScene& scene, const std::vector<CookedMes
   prov.source_name = "synthetic.glb";
   prov.source_hash = 0x1234567890abcdefull;
   prov.options = "float_vertices=0";
-  return write_ossa(scene, meshes, prov, options);
+  std::vector<CompressedClip> clips;
+  for (const SourceClip& clip : scene.clips) {
+    auto compressed = compress_clip(clip, scene.skeleton, scene.metres_per_unit, {});
+    EXPECT_TRUE(compressed.ok()) << (compressed.ok() ? "" : compressed.error().message);
+    if (compressed.ok()) clips.push_back(std::move(*compressed));
+  }
+  return write_ossa(scene, meshes, clips, prov, options);
 }
 
 const std::vector<std::pair<std::array<uint16_t, 4>, glm::vec4>> kSkinPatterns = {
@@ -842,15 +850,27 @@ TEST(WriteOssa, WritesAFileTheRuntimeAccepts) {
     EXPECT_EQ((raw->indices()->Data() - bytes.data()) % 16, 0);
   }
 
-  // Clip: tagged with the rig it addresses.
+  // Clip: tagged with the rig it addresses; only joint 1's rotation moves, everything else is the
+  // bind pose and stored as nothing; key values 16-byte aligned and padded for 64-bit reads.
   ASSERT_EQ(asset->clip_count(), 1u);
   const ClipView clip = asset->clip(0);
   EXPECT_EQ(clip.name(), "Wave");
   EXPECT_EQ(clip.skeleton_hash(), sk.hash());
-  EXPECT_EQ(clip.fb->joint_count(), 3u);
-  ASSERT_EQ(clip.track_count(), 1u);
-  EXPECT_EQ(clip.track(0).joint(), 1u);
-  EXPECT_EQ(clip.track(0).rotations()->size(), 2u);
+  EXPECT_EQ(clip.joint_count(), 3u);
+  EXPECT_EQ(clip.frame_count(), 31u);
+  EXPECT_FLOAT_EQ(clip.sample_rate(), 30.0f);
+  EXPECT_FLOAT_EQ(clip.duration(), 1.0f);
+  EXPECT_TRUE(clip.constants().empty());
+  ASSERT_EQ(clip.animated().size(), 1u);
+  EXPECT_EQ(clip.animated()[0].joint(), 1u);
+  EXPECT_EQ(clip.animated()[0].channel(), fb::Channel::Rotation);
+  EXPECT_GE(clip.animated()[0].key_count(), 2u);
+  EXPECT_GE(clip.key_values().size(), kKeyValuePadding);
+  EXPECT_EQ((clip.key_values().data() - asset->bytes().data()) % 16, 0);
+  ASSERT_NE(clip.compression(), nullptr);
+  EXPECT_LE(clip.compression()->max_error(), clip.compression()->tolerance());
+  EXPECT_EQ(clip.compression()->raw_bytes(), 10u * 4u * 3u * 31u);
+  EXPECT_EQ(clip.root_motion(), nullptr);
   EXPECT_TRUE(check_clip_binding(clip, sk, "synthetic").ok());
 
   // Materials and textures: embedded data aligned, external path kept.

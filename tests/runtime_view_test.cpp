@@ -17,6 +17,7 @@
 
 #include <flatbuffers/flatbuffers.h>
 
+#include "format/clip_codec.h"
 #include "format/hash.h"
 #include "format/version.h"
 #include "runtime/asset.h"
@@ -177,20 +178,46 @@ TEST(RuntimeView, ClipAndMaterialViewsReturnWhatWasWritten) {
   const ClipView c = asset.clip(0);
 
   EXPECT_EQ(c.name(), want.name);
-  EXPECT_EQ(c.duration(), want.duration);
+  EXPECT_EQ(c.duration(), want.duration_value());
   EXPECT_EQ(c.sample_rate(), want.sample_rate);
+  EXPECT_EQ(c.frame_count(), want.frame_count);
   EXPECT_EQ(c.skeleton_hash(), asset.skeleton().hash());
-  ASSERT_EQ(c.track_count(), want.tracks.size());
-  size_t keys = 0;
-  for (size_t i = 0; i < want.tracks.size(); ++i) {
-    const fb::Track& t = c.track(i);
-    const test::SyntheticTrack& w = want.tracks[i];
-    EXPECT_EQ(t.joint(), w.joint);
-    EXPECT_EQ(t.rotation_times() ? t.rotation_times()->size() : 0, w.rotation_times.size());
-    keys += w.translation_times.size() + w.rotation_times.size() + w.scale_times.size();
+  EXPECT_EQ(c.joint_count(), asset.skeleton().joint_count());
+  ASSERT_EQ(c.constants().size(), want.constants.size());
+  for (size_t i = 0; i < want.constants.size(); ++i) {
+    EXPECT_EQ(c.constants()[i].joint(), want.constants[i].joint);
+    EXPECT_EQ(c.constants()[i].channel(), want.constants[i].channel);
+    EXPECT_EQ(c.constants()[i].value().z(), want.constants[i].value.z());
   }
+  ASSERT_EQ(c.animated().size(), want.animated.size());
+  size_t keys = want.constants.size(), frames = 0;
+  for (size_t i = 0; i < want.animated.size(); ++i) {
+    const fb::AnimatedChannel& a = c.animated()[i];
+    const test::SyntheticAnimated& w = want.animated[i];
+    EXPECT_EQ(a.joint(), w.joint);
+    EXPECT_EQ(a.channel(), w.channel);
+    EXPECT_EQ(a.bits(), w.bits);
+    EXPECT_EQ(a.first_key(), frames);
+    ASSERT_EQ(a.key_count(), w.frames.size());
+    for (size_t k = 0; k < w.frames.size(); ++k) EXPECT_EQ(c.key_frames()[a.first_key() + k], w.frames[k]);
+    // Keys decode to the written values within the quantization step (exactly for raw floats).
+    const float lo[3] = {a.range_min().x(), a.range_min().y(), a.range_min().z()};
+    const float ex[3] = {a.range_extent().x(), a.range_extent().y(), a.range_extent().z()};
+    for (uint32_t k = 0; k < a.key_count(); ++k) {
+      float v[3];
+      decode_key(c.key_values().data(), a.bit_offset(), a.bits(), lo, ex, k, v);
+      const float step = a.bits() == kRawFloatBits ? 0.0f : 0.5f / static_cast<float>(quant_max(a.bits()));
+      for (int j = 0; j < 3; ++j) EXPECT_NEAR(v[j], w.values[k][j], step * ex[j] + 1e-7f) << i << " " << k << " " << j;
+    }
+    keys += w.frames.size();
+    frames += w.frames.size();
+  }
+  EXPECT_EQ(c.key_frames().size(), frames);
+  EXPECT_GE(c.key_values().size(), kKeyValuePadding);
   EXPECT_EQ(c.key_count(), keys);
-  EXPECT_EQ(c.track(0).rotations()->Get(1)->y(), want.tracks[0].rotations[1].y());
+  ASSERT_NE(c.compression(), nullptr);
+  EXPECT_GT(c.compression()->raw_bytes(), 0u);
+  EXPECT_EQ(c.root_motion(), nullptr);
   EXPECT_TRUE(check_clip_binding(c, asset.skeleton(), asset.name()).ok());
 
   ASSERT_EQ(asset.material_count(), 1u);

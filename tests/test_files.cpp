@@ -23,6 +23,7 @@
 #include <glm/gtc/quaternion.hpp>
 #include <glm/gtc/type_ptr.hpp>
 
+#include "format/clip_codec.h"
 #include "format/hash.h"
 #include "format/vertex_codec.h"
 #include "format/vertex_format.h"
@@ -216,31 +217,71 @@ flatbuffers::Offset<fb::Mesh> write_mesh(flatbuffers::FlatBufferBuilder& fbb, co
                         submeshes, &lo, &hi, &offset, &scale, joints, inverse_bind);
 }
 
-template <class T>
-flatbuffers::Offset<flatbuffers::Vector<T>> channel_scalars(flatbuffers::FlatBufferBuilder& fbb,
-                                                             const std::vector<T>& v, bool write_empty) {
-  return v.empty() && !write_empty ? 0 : fbb.CreateVector(v);
-}
-template <class T>
-flatbuffers::Offset<flatbuffers::Vector<const T*>> channel_structs(flatbuffers::FlatBufferBuilder& fbb,
-                                                                   const std::vector<T>& v, bool write_empty) {
-  return v.empty() && !write_empty ? 0 : fbb.CreateVectorOfStructs(v);
-}
-
 flatbuffers::Offset<fb::Clip> write_clip(flatbuffers::FlatBufferBuilder& fbb, const SyntheticClip& c,
                                          uint64_t skeleton_hash, uint16_t joint_count) {
-  std::vector<flatbuffers::Offset<fb::Track>> tracks;
-  const bool e = c.write_empty_channels;
-  for (const SyntheticTrack& t : c.tracks) {
-    tracks.push_back(fb::CreateTrack(fbb, t.joint, channel_scalars(fbb, t.translation_times, e),
-                                     channel_structs(fbb, t.translations, e), channel_scalars(fbb, t.rotation_times, e),
-                                     channel_structs(fbb, t.rotations, e), channel_scalars(fbb, t.scale_times, e),
-                                     channel_structs(fbb, t.scales, e)));
+  // Pack every animated channel in order: frames appended to key_frames, keys to one bit stream.
+  std::vector<uint16_t> key_frames;
+  BitWriter writer;
+  std::vector<fb::AnimatedChannel> animated;
+  for (const SyntheticAnimated& a : c.animated) {
+    float lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+    for (size_t k = 0; k < a.values.size(); ++k)
+      for (int i = 0; i < 3; ++i) {
+        lo[i] = k == 0 ? a.values[k][i] : std::min(lo[i], a.values[k][i]);
+        hi[i] = k == 0 ? a.values[k][i] : std::max(hi[i], a.values[k][i]);
+      }
+    const fb::Vec3 range_min = a.range_min.value_or(fb::Vec3(lo[0], lo[1], lo[2]));
+    const fb::Vec3 range_extent = a.range_extent.value_or(fb::Vec3(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]));
+    const float rmin[3] = {range_min.x(), range_min.y(), range_min.z()};
+    const float rext[3] = {range_extent.x(), range_extent.y(), range_extent.z()};
+    const auto first_key = static_cast<uint32_t>(key_frames.size());
+    key_frames.insert(key_frames.end(), a.frames.begin(), a.frames.end());
+    if (a.bits == kRawFloatBits) writer.align_byte();
+    const auto bit_offset = static_cast<uint32_t>(writer.bit_size());
+    for (const auto& v : a.values) {
+      for (int i = 0; i < 3; ++i) {
+        if (a.bits == kRawFloatBits)
+          writer.write_float(v[i]);
+        else if (a.bits >= 1 && a.bits <= kMaxQuantBits)
+          writer.write(quantize(v[i], rmin[i], rext[i], a.bits), a.bits);
+      }
+    }
+    animated.emplace_back(a.joint, a.channel, a.bits, a.dropped.value_or(a.channel == fb::Channel::Rotation ? 3 : 0),
+                          a.first_key.value_or(first_key),
+                          a.key_count.value_or(static_cast<uint32_t>(a.frames.size())), a.bit_offset.value_or(bit_offset),
+                          range_min, range_extent);
   }
+  std::vector<uint8_t> key_values = writer.finish();
+  key_values.resize(key_values.size() - kKeyValuePadding + c.key_value_padding, 0);
+  if (c.key_frames) key_frames = *c.key_frames;
+  if (c.key_values) key_values = *c.key_values;
+
+  std::vector<fb::ConstantChannel> constants;
+  for (const SyntheticConstant& k : c.constants) constants.emplace_back(k.joint, k.channel, k.value);
+
+  const bool e = c.write_empty_channels;
   const auto name = fbb.CreateString(c.name);
-  const auto track_vector = fbb.CreateVector(tracks);
-  return fb::CreateClip(fbb, name, c.duration, c.sample_rate, c.skeleton_hash.value_or(skeleton_hash),
-                        c.joint_count.value_or(joint_count), track_vector);
+  const auto constant_vector = constants.empty() && !e ? 0 : fbb.CreateVectorOfStructs(constants);
+  const auto animated_vector = animated.empty() && !e ? 0 : fbb.CreateVectorOfStructs(animated);
+  const auto frame_vector = key_frames.empty() && !e ? 0 : fbb.CreateVector(key_frames);
+  // A clip without animated channels needs no key stream (nor its padding).
+  const bool write_values = !animated.empty() || c.key_values || e;
+  const auto value_vector = write_values ? aligned_bytes(fbb, key_values) : 0;
+  const uint16_t joints = c.joint_count.value_or(joint_count);
+  flatbuffers::Offset<fb::ClipCompression> compression = 0;
+  if (c.compression) {
+    const auto raw = static_cast<uint32_t>(10ull * 4 * joints * c.frame_count);
+    compression = fb::CreateClipCompression(fbb, 0.0001f, 0.1f, 0.00005f, 0.00001f, 1, raw);
+  }
+  flatbuffers::Offset<fb::RootMotion> root_motion = 0;
+  if (c.root_motion) {
+    const auto translations = fbb.CreateVectorOfStructs(c.root_motion->translations);
+    const auto yaws = fbb.CreateVector(c.root_motion->yaws);
+    root_motion = fb::CreateRootMotion(fbb, translations, yaws, c.root_motion->up_axis);
+  }
+  return fb::CreateClip(fbb, name, c.duration_value(), c.sample_rate, c.frame_count,
+                        c.skeleton_hash.value_or(skeleton_hash), joints, constant_vector, animated_vector, frame_vector,
+                        value_vector, compression, root_motion);
 }
 
 flatbuffers::Offset<fb::Material> write_material(flatbuffers::FlatBufferBuilder& fbb, const SyntheticMaterial& m) {
@@ -284,22 +325,25 @@ std::vector<SyntheticVertex> SyntheticMesh::default_vertices() {
   return out;
 }
 
-std::vector<SyntheticTrack> SyntheticClip::default_tracks() {
-  SyntheticTrack spine{.joint = 1,
-                       .translation_times = {0.0f},
-                       .translations = {{0, 1, 0}},
-                       .rotation_times = {0.0f, 0.5f, 1.0f},
-                       .rotations = {{0, 0, 0, 1}, {0, 0.38268343f, 0, 0.92387953f}, {0, 0, 0, 1}},
-                       .scale_times = {},
-                       .scales = {}};
-  SyntheticTrack arm{.joint = 3,
-                     .translation_times = {0.0f, 1.0f},
-                     .translations = {{0.5f, 0.5f, 0}, {0.6f, 0.4f, 0}},
-                     .rotation_times = {},
-                     .rotations = {},
-                     .scale_times = {0.25f, 0.75f},
-                     .scales = {{1, 1, 1}, {1.2f, 1.2f, 1.2f}}};
-  return {spine, arm};
+std::vector<SyntheticConstant> SyntheticClip::default_constants() {
+  return {{1, fb::Channel::Translation, fb::Quat(0, 1, 0, 0)},
+          {2, fb::Channel::Rotation, fb::Quat(0, 0, 0.25881905f, 0.96592583f)}};
+}
+
+std::vector<SyntheticAnimated> SyntheticClip::default_animated() {
+  const auto channel = [](uint16_t joint, fb::Channel c, uint8_t bits, std::vector<uint16_t> frames,
+                          std::vector<std::array<float, 3>> values) {
+    SyntheticAnimated a;
+    a.joint = joint;
+    a.channel = c;
+    a.bits = bits;
+    a.frames = std::move(frames);
+    a.values = std::move(values);
+    return a;
+  };
+  return {channel(1, fb::Channel::Rotation, 16, {0, 15, 30}, {{0, 0, 0}, {0, 0.38268343f, 0}, {0, 0, 0}}),
+          channel(3, fb::Channel::Translation, 12, {0, 30}, {{0.5f, 0.5f, 0}, {0.6f, 0.4f, 0}}),
+          channel(3, fb::Channel::Scale, 32, {0, 8, 23, 30}, {{1, 1, 1}, {1, 1, 1}, {1.2f, 1.2f, 1.2f}, {1.2f, 1.2f, 1.2f}})};
 }
 
 std::vector<SyntheticTexture> SyntheticMaterial::default_textures() {
@@ -346,9 +390,41 @@ std::vector<std::pair<std::string, SyntheticSpec>> valid_variants() {
   spec.clips[0].write_empty_channels = true;
   SyntheticClip idle;
   idle.name = "idle";
-  idle.tracks.clear();
+  idle.constants.clear();
+  idle.animated.clear();
   spec.clips.push_back(idle);
   out.emplace_back("empty-channels", spec);
+
+  spec = {};
+  spec.clips[0].name = "pose";
+  spec.clips[0].frame_count = 1;
+  spec.clips[0].animated.clear();
+  spec.clips[0].constants.push_back({3, fb::Channel::Scale, fb::Quat(2, 2, 2, 0)});
+  out.emplace_back("single-frame", spec);
+
+  spec = {};
+  {
+    SyntheticRootMotion rm;
+    for (uint32_t f = 0; f < spec.clips[0].frame_count; ++f) {
+      rm.translations.emplace_back(0.0f, 0.0f, 0.05f * static_cast<float>(f));
+      rm.yaws.push_back(0.01f * static_cast<float>(f));
+    }
+    spec.clips[0].root_motion = rm;
+  }
+  out.emplace_back("root-motion", spec);
+
+  spec = {};
+  spec.clips[0].animated[0].bits = 3;
+  spec.clips[0].animated[1].bits = 1;
+  spec.clips[0].compression = false;
+  out.emplace_back("low-bits", spec);
+
+  spec = {};
+  // The spine turns about y, so y is its largest component: store x, z, w and rebuild y.
+  spec.clips[0].animated[0].dropped = 1;
+  spec.clips[0].animated[0].bits = 19;
+  spec.clips[0].animated[0].values = {{0, 0, 1}, {0, 0, 0.92387953f}, {0, 0, 1}};
+  out.emplace_back("drop-y", spec);
 
   spec = {};
   spec.meshes.push_back(spec.meshes[0]);

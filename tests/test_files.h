@@ -77,28 +77,68 @@ struct SyntheticMesh {
   static std::vector<SyntheticVertex> default_vertices();
 };
 
-struct SyntheticTrack {
+/// A channel with one value (ossa.fbs ConstantChannel): xyz for translation/scale, xyzw rotation.
+struct SyntheticConstant {
   uint16_t joint = 0;
-  std::vector<float> translation_times;
-  std::vector<fb::Vec3> translations;
-  std::vector<float> rotation_times;
-  std::vector<fb::Quat> rotations;
-  std::vector<float> scale_times;
-  std::vector<fb::Vec3> scales;
+  fb::Channel channel = fb::Channel::Translation;
+  fb::Quat value{0, 0, 0, 0};
+};
+
+/// An animated channel given by its key frames and decoded-to-be values; make_valid_file packs
+/// them with format/clip_codec.h (range-reduced to `bits`, or raw floats for bits == 32). The
+/// optional fields override what is derived, which is how defects are written.
+struct SyntheticAnimated {
+  uint16_t joint = 0;
+  fb::Channel channel = fb::Channel::Translation;
+  uint8_t bits = 16;                          // 1..19, or 32 (raw floats)
+  /// Rotations: the component not stored (0..3 = x, y, z, w). Default: 3 (w) for rotations, 0
+  /// for other channels (which store 0).
+  std::optional<uint8_t> dropped;
+  std::vector<uint16_t> frames;               // one per key
+  /// One per key, as stored: rotations give the three components other than `dropped` (in x, y,
+  /// z, w order) of the unit quaternion taken with its dropped component >= 0.
+  std::vector<std::array<float, 3>> values;
+  std::optional<fb::Vec3> range_min;          // default: the values' minimum per component
+  std::optional<fb::Vec3> range_extent;       // default: max - min
+  std::optional<uint32_t> first_key;          // default: where its frames were appended
+  std::optional<uint32_t> key_count;          // default: frames.size()
+  std::optional<uint32_t> bit_offset;         // default: where its keys were packed
+};
+
+struct SyntheticRootMotion {
+  std::vector<fb::Vec3> translations;  // one per frame
+  std::vector<float> yaws;             // one per frame
+  uint8_t up_axis = 1;
 };
 
 struct SyntheticClip {
   std::string name = "walk";
-  float duration = 1.0f;
   float sample_rate = 30.0f;
+  uint32_t frame_count = 31;
+  std::optional<float> duration;          // default: (frame_count - 1) / sample_rate
   std::optional<uint64_t> skeleton_hash;  // default: the file skeleton's hash (0 without one)
   std::optional<uint16_t> joint_count;    // default: the file skeleton's joint count
-  std::vector<SyntheticTrack> tracks = default_tracks();
-  /// Write empty channels as empty vectors instead of leaving the fields out.
+  std::vector<SyntheticConstant> constants = default_constants();
+  std::vector<SyntheticAnimated> animated = default_animated();
+  /// Zero bytes after the packed keys (the decoder reads 64 bits at a time).
+  uint32_t key_value_padding = 8;
+  /// Replace the derived key_frames / key_values vectors wholesale.
+  std::optional<std::vector<uint16_t>> key_frames;
+  std::optional<std::vector<uint8_t>> key_values;
+  /// Write a ClipCompression table (plausible numbers).
+  bool compression = true;
+  std::optional<SyntheticRootMotion> root_motion;
+  /// Write empty channel vectors instead of leaving the fields out.
   bool write_empty_channels = false;
 
-  /// spine: 1 translation key, 3 rotation keys; arm: 2 translation keys, 2 scale keys.
-  static std::vector<SyntheticTrack> default_tracks();
+  float duration_value() const { return duration.value_or(static_cast<float>(frame_count - 1) / sample_rate); }
+
+  /// spine: constant translation (0, 1, 0); head: constant rotation (30 degrees about z).
+  static std::vector<SyntheticConstant> default_constants();
+  /// spine rotation: 3 keys (frames 0, 15, 30: identity, 45 degrees about y, identity), 16 bits,
+  /// w dropped;
+  /// arm translation: 2 keys (frames 0, 30), 12 bits; arm scale: 4 raw-float keys (0, 8, 23, 30).
+  static std::vector<SyntheticAnimated> default_animated();
 };
 
 struct SyntheticTexture {
@@ -139,8 +179,9 @@ struct SyntheticSpec {
 std::vector<uint8_t> make_valid_file(const SyntheticSpec& spec = {});
 
 /// Valid files of different shapes, by name: default, uint32-indices, float32-layout (16-bit joint
-/// slots), static-mesh (no skeleton), clip-only, empty-channels (plus a clip without tracks),
-/// two-meshes. For suites that must not over-fit the default, and for seeding fuzz corpora.
+/// slots), static-mesh (no skeleton), clip-only, empty-channels (plus a clip without channels),
+/// single-frame (a 1-frame clip of constants), root-motion, low-bits (1- and 3-bit keys), drop-y
+/// (a rotation storing x, z, w in 19 bits), two-meshes. For suites that must not over-fit the default, and for seeding fuzz corpora.
 std::vector<std::pair<std::string, SyntheticSpec>> valid_variants();
 
 /// A 16-byte aligned copy of some bytes: what verify_buffer expects, and what a std::vector

@@ -77,29 +77,63 @@ json describe_mesh(const MeshView& mesh) {
               {"position_scale", vec3(m.position_scale())}};
 }
 
-json describe_clip(const ClipView& clip, const SkeletonView& skeleton) {
-  size_t translation_keys = 0, rotation_keys = 0, scale_keys = 0, bytes = 0;
-  for (size_t i = 0; i < clip.track_count(); ++i) {
-    const fb::Track& t = clip.track(i);
-    const size_t nt = count_of(t.translation_times()), nr = count_of(t.rotation_times()),
-                 ns = count_of(t.scale_times());
-    translation_keys += nt;
-    rotation_keys += nr;
-    scale_keys += ns;
-    // The clip's payload: every times and values vector (validation proved values == times).
-    bytes += nt * (sizeof(float) + sizeof(fb::Vec3)) + nr * (sizeof(float) + sizeof(fb::Quat)) +
-             ns * (sizeof(float) + sizeof(fb::Vec3));
+/// Clip payload bytes: what its channel tables and key streams take in the file.
+size_t clip_bytes(const ClipView& clip) {
+  return clip.constants().size_bytes() + clip.animated().size_bytes() + clip.key_frames().size_bytes() +
+         clip.key_values().size_bytes();
+}
+
+json describe_compression(const ClipView& clip, const SkeletonView& skeleton, float metres_per_unit) {
+  const fb::ClipCompression* c = clip.compression();
+  if (!c) return nullptr;
+  const double mm = 1000.0 * metres_per_unit;
+  const size_t bytes = clip_bytes(clip);
+  // The worst joint is named only when this file's skeleton is the clip's rig; a clip-only file
+  // knows just the index.
+  const bool named = !skeleton.empty() && skeleton.hash() == clip.skeleton_hash() && c->worst_joint() < skeleton.joint_count();
+  return json{{"tolerance", round6(c->tolerance())},
+              {"tolerance_mm", round6(c->tolerance() * mm)},
+              {"probe_distance", round6(c->probe_distance())},
+              {"max_error", round6(c->max_error())},
+              {"max_error_mm", round6(c->max_error() * mm)},
+              {"mean_error", round6(c->mean_error())},
+              {"mean_error_mm", round6(c->mean_error() * mm)},
+              {"worst_joint", c->worst_joint()},
+              {"worst_joint_name", named ? json(std::string(skeleton.joint_name(c->worst_joint()))) : json(nullptr)},
+              {"raw_bytes", c->raw_bytes()},
+              {"ratio", bytes ? round6(static_cast<double>(c->raw_bytes()) / static_cast<double>(bytes)) : 0.0}};
+}
+
+json describe_clip(const ClipView& clip, const SkeletonView& skeleton, float metres_per_unit) {
+  size_t constants[3] = {0, 0, 0}, animated[3] = {0, 0, 0}, keys[3] = {0, 0, 0};
+  // Validation proved every channel enum is 0..2.
+  for (const fb::ConstantChannel& c : clip.constants()) ++constants[static_cast<size_t>(c.channel())];
+  for (const fb::AnimatedChannel& a : clip.animated()) {
+    ++animated[static_cast<size_t>(a.channel())];
+    keys[static_cast<size_t>(a.channel())] += a.key_count();
+  }
+  const auto by_kind = [](const size_t v[3]) {
+    return json{{"translation", v[0]}, {"rotation", v[1]}, {"scale", v[2]}};
+  };
+  json root_motion = nullptr;
+  if (const fb::RootMotion* rm = clip.root_motion()) {
+    static const char* const kAxes[] = {"x", "y", "z"};
+    root_motion = json{{"up_axis", rm->up_axis() <= 2 ? kAxes[rm->up_axis()] : "?"}};
   }
   return json{{"name", std::string(clip.name())},
               {"duration", round6(clip.duration())},
               {"sample_rate", round6(clip.sample_rate())},
+              {"frame_count", clip.frame_count()},
               {"skeleton_hash", hex16(clip.skeleton_hash())},
-              {"joint_count", clip.fb->joint_count()},
+              {"joint_count", clip.joint_count()},
               {"binds_to_file_skeleton", !skeleton.empty() && skeleton.hash() == clip.skeleton_hash()},
-              {"track_count", clip.track_count()},
-              {"key_count", translation_keys + rotation_keys + scale_keys},
-              {"keys", json{{"translation", translation_keys}, {"rotation", rotation_keys}, {"scale", scale_keys}}},
-              {"bytes", bytes}};
+              {"constant_channels", by_kind(constants)},
+              {"animated_channels", by_kind(animated)},
+              {"key_count", clip.key_count()},
+              {"animated_keys", by_kind(keys)},
+              {"bytes", clip_bytes(clip)},
+              {"compression", describe_compression(clip, skeleton, metres_per_unit)},
+              {"root_motion", std::move(root_motion)}};
 }
 
 json describe_material(const fb::Material& m) {
@@ -162,7 +196,7 @@ json describe(const Asset& asset, std::string_view file_name) {
   const SkeletonView skeleton = asset.skeleton();
   json meshes = json::array(), clips = json::array(), materials = json::array();
   for (size_t i = 0; i < asset.mesh_count(); ++i) meshes.push_back(describe_mesh(asset.mesh(i)));
-  for (size_t i = 0; i < asset.clip_count(); ++i) clips.push_back(describe_clip(asset.clip(i), skeleton));
+  for (size_t i = 0; i < asset.clip_count(); ++i) clips.push_back(describe_clip(asset.clip(i), skeleton, file.metres_per_unit()));
   for (size_t i = 0; i < asset.material_count(); ++i) materials.push_back(describe_material(asset.material(i)));
   return json{{"file", std::string(file_name)},
               {"file_bytes", asset.bytes().size()},
@@ -224,13 +258,30 @@ std::string describe_text(const json& d) {
 
   index = 0;
   for (const json& c : d["clips"]) {
+    const auto kinds = [](const json& k) {
+      return text(k["translation"]) + " translation, " + text(k["rotation"]) + " rotation, " + text(k["scale"]) +
+             " scale";
+    };
     line("");
     line(format("clip %zu", index++) + quoted_name(c["name"]) + ": " + text(c["duration"]) + " s, " +
-         text(c["sample_rate"]) + " samples/s, " + text(c["track_count"]) + " tracks, " + text(c["key_count"]) +
-         " keys (" + text(c["keys"]["translation"]) + " translation, " + text(c["keys"]["rotation"]) +
-         " rotation, " + text(c["keys"]["scale"]) + " scale), " + text(c["bytes"]) + " bytes");
+         text(c["frame_count"]) + " frames at " + text(c["sample_rate"]) + " frames/s, " + text(c["key_count"]) +
+         " keys, " + text(c["bytes"]) + " bytes");
     line("  skeleton       " + text(c["skeleton_hash"]) + ", " + text(c["joint_count"]) + " joints" +
          (c["binds_to_file_skeleton"].get<bool>() ? " (this file's skeleton)" : " (another file's skeleton)"));
+    line("  constant       " + kinds(c["constant_channels"]));
+    line("  animated       " + kinds(c["animated_channels"]) + " (keys: " + kinds(c["animated_keys"]) + ")");
+    if (const json& k = c["compression"]; k.is_object()) {
+      const std::string worst = k["worst_joint_name"].is_string() ? " '" + text(k["worst_joint_name"]) + "'" : "";
+      line("  compression    tolerance " + text(k["tolerance"]) + " (" + text(k["tolerance_mm"]) + " mm), max error " +
+           text(k["max_error"]) + " (" + text(k["max_error_mm"]) + " mm) at joint " + text(k["worst_joint"]) + worst +
+           ", mean " + text(k["mean_error"]) + " (" + text(k["mean_error_mm"]) + " mm), probe " +
+           text(k["probe_distance"]));
+      line("  size           " + text(c["bytes"]) + " bytes, raw " + text(k["raw_bytes"]) + " bytes, ratio " +
+           text(k["ratio"]) + ":1");
+    } else {
+      line("  compression    -");
+    }
+    line("  root motion    " + (c["root_motion"].is_object() ? "yes, up axis " + text(c["root_motion"]["up_axis"]) : std::string("no")));
   }
 
   index = 0;

@@ -6,7 +6,7 @@
 // machines the description holds nothing machine-dependent: the file is named without its
 // directory, floats are rounded to 6 significant digits, hashes are 16-digit hex strings.
 //
-// Cost: describe is O(joints + meshes*layout + submeshes + tracks + textures); nothing per vertex
+// Cost: describe is O(joints + meshes*layout + submeshes + clip channels + textures); nothing per vertex
 // or per key. describe_text is linear in the size of the description.
 #pragma once
 #include <string>
