@@ -117,6 +117,9 @@ Status check_clip_binding(const ClipView& clip, const SkeletonView& skeleton, st
 
 // ---- Asset -------------------------------------------------------------------------------------
 
+/// Files up to this size are read rather than memory-mapped (see Asset::open).
+constexpr uint64_t kReadBelow = 256 * 1024;
+
 Result<Asset> Asset::open(const std::string& path) {
   // O_NONBLOCK: opening a FIFO (or a device) for reading must not wait for a writer before
   // fstat can say it is not a regular file; it changes nothing for regular files or mmap.
@@ -143,6 +146,41 @@ Result<Asset> Asset::open(const std::string& path) {
                            ? detail::format("too small to be an .ossa file (%llu bytes)", static_cast<unsigned long long>(size))
                            : detail::format("too large for a FlatBuffer (%llu bytes, the limit is 2 GiB)",
                                             static_cast<unsigned long long>(size)));
+  }
+  if (size <= kReadBelow) {
+    // Small files are read into aligned memory: one read() costs less than setting up a mapping,
+    // faulting its pages in and unmapping it (ossa-bench-load: 6.5 vs 13 us for a 114 KB file);
+    // for large files the mapping wins, since verification touches only the pages it reads.
+    void* heap = ::operator new(static_cast<size_t>(size), std::align_val_t{kAlignment}, std::nothrow);
+    if (!heap) {
+      ::close(fd);
+      return error(path, detail::format("out of memory reading %llu bytes", static_cast<unsigned long long>(size)));
+    }
+    size_t done = 0;
+    while (done < size) {
+      const ssize_t n = ::read(fd, static_cast<uint8_t*>(heap) + done, static_cast<size_t>(size) - done);
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) {
+        const int err = n < 0 ? errno : 0;
+        ::close(fd);
+        ::operator delete(heap, std::align_val_t{kAlignment});
+        return error(path, err ? os_error("cannot read", err) : std::string("file shrank while being read"));
+      }
+      done += static_cast<size_t>(n);
+    }
+    ::close(fd);
+    const std::span<const uint8_t> bytes(static_cast<const uint8_t*>(heap), static_cast<size_t>(size));
+    if (Status s = verify_buffer(bytes, path); !s) {
+      ::operator delete(heap, std::align_val_t{kAlignment});
+      return s.error();
+    }
+    Asset asset;
+    asset.name_ = path;
+    asset.data_ = bytes.data();
+    asset.size_ = bytes.size();
+    asset.heap_ = heap;
+    asset.file_ = fb::GetFile(bytes.data());
+    return asset;
   }
   void* mapping = ::mmap(nullptr, static_cast<size_t>(size), PROT_READ, MAP_PRIVATE, fd, 0);
   const int map_errno = errno;

@@ -1,10 +1,11 @@
 // asset.h — opening a .ossa file: map it, verify it, then read it through typed views.
 //
-// Loading is the whole point of the format: Asset::open memory-maps the file read-only, checks
-// the identifier, runs flatbuffers::Verifier over every byte the reader could touch, checks the
+// Loading is the whole point of the format: Asset::open memory-maps the file read-only (files
+// under 256 KiB are read into aligned memory instead: one read() is cheaper than mapping and
+// faulting in a few pages), checks the identifier, runs flatbuffers::Verifier over every byte the reader could touch, checks the
 // format version, and then the semantic invariants FlatBuffers cannot see (validate.h). Only then
 // is an Asset handed out, so every view below can read without further checks. No per-vertex or
-// per-key work happens here: views are spans straight into the mapping, ready for glBufferData.
+// per-key work happens here: views are spans straight into the file's bytes, ready for glBufferData.
 //
 // Assumes a little-endian host (as FlatBuffers' in-place struct access does).
 #pragma once
