@@ -169,36 +169,14 @@ Result<Asset> Asset::open(const std::string& path) {
       done += static_cast<size_t>(n);
     }
     ::close(fd);
-    const std::span<const uint8_t> bytes(static_cast<const uint8_t*>(heap), static_cast<size_t>(size));
-    if (Status s = verify_buffer(bytes, path); !s) {
-      ::operator delete(heap, std::align_val_t{kAlignment});
-      return s.error();
-    }
-    Asset asset;
-    asset.name_ = path;
-    asset.data_ = bytes.data();
-    asset.size_ = bytes.size();
-    asset.heap_ = heap;
-    asset.file_ = fb::GetFile(bytes.data());
-    return asset;
+    return adopt(path, static_cast<size_t>(size), heap, nullptr);
   }
   void* mapping = ::mmap(nullptr, static_cast<size_t>(size), PROT_READ, MAP_PRIVATE, fd, 0);
   const int map_errno = errno;
   ::close(fd);  // the mapping keeps the file alive; the descriptor is no longer needed
   if (mapping == MAP_FAILED) return error(path, os_error("cannot map", map_errno));
 
-  const std::span<const uint8_t> bytes(static_cast<const uint8_t*>(mapping), static_cast<size_t>(size));
-  if (Status s = verify_buffer(bytes, path); !s) {
-    ::munmap(mapping, static_cast<size_t>(size));
-    return s.error();
-  }
-  Asset asset;
-  asset.name_ = path;
-  asset.data_ = bytes.data();
-  asset.size_ = bytes.size();
-  asset.mapping_ = mapping;
-  asset.file_ = fb::GetFile(bytes.data());
-  return asset;
+  return adopt(path, static_cast<size_t>(size), nullptr, mapping);
 }
 
 Result<Asset> Asset::from_bytes(std::span<const uint8_t> bytes, std::string name) {
@@ -209,17 +187,24 @@ Result<Asset> Asset::from_bytes(std::span<const uint8_t> bytes, std::string name
   void* heap = ::operator new(bytes.size(), std::align_val_t{kAlignment}, std::nothrow);
   if (!heap) return error(name, detail::format("out of memory copying %zu bytes", bytes.size()));
   std::memcpy(heap, bytes.data(), bytes.size());
-  const std::span<const uint8_t> copy(static_cast<const uint8_t*>(heap), bytes.size());
-  if (Status s = verify_buffer(copy, name); !s) {
-    ::operator delete(heap, std::align_val_t{kAlignment});
+  return adopt(std::move(name), bytes.size(), heap, nullptr);
+}
+
+Result<Asset> Asset::adopt(std::string name, size_t size, void* heap, void* mapping) {
+  const void* data = heap != nullptr ? heap : mapping;
+  const std::span<const uint8_t> bytes(static_cast<const uint8_t*>(data), size);
+  if (Status s = verify_buffer(bytes, name); !s) {
+    if (heap != nullptr) ::operator delete(heap, std::align_val_t{kAlignment});
+    if (mapping != nullptr) ::munmap(mapping, size);
     return s.error();
   }
   Asset asset;
   asset.name_ = std::move(name);
-  asset.data_ = copy.data();
-  asset.size_ = copy.size();
+  asset.data_ = bytes.data();
+  asset.size_ = size;
   asset.heap_ = heap;
-  asset.file_ = fb::GetFile(copy.data());
+  asset.mapping_ = mapping;
+  asset.file_ = fb::GetFile(bytes.data());
   return asset;
 }
 

@@ -120,6 +120,9 @@ class Asset {
  private:
   Asset() = default;
   void release();
+  /// Verifies bytes the Asset will own (an aligned heap block or a mapping, exactly one non-null)
+  /// and wraps them, or frees them and returns the error.
+  static Result<Asset> adopt(std::string name, size_t size, void* heap, void* mapping);
 
   std::string name_;
   const uint8_t* data_ = nullptr;

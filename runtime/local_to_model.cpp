@@ -24,19 +24,9 @@
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
+#include "runtime/vector_clones.h"
 #endif
 
-// OSSA_NO_TARGET_CLONES builds only the baseline code (to test or time it on an AVX2 machine).
-#if defined(__x86_64__) && defined(__has_attribute) && !defined(OSSA_NO_TARGET_CLONES)
-#if __has_attribute(target_clones)
-#define OSSA_VECTOR_CLONES __attribute__((target_clones("avx2", "default")))
-#endif
-#endif
-#ifndef OSSA_VECTOR_CLONES
-#define OSSA_VECTOR_CLONES
-#endif
-// Inlined into each clone so that it is compiled for the clone's ISA.
-#define OSSA_INLINE [[gnu::always_inline]] inline
 
 namespace ossa {
 

@@ -36,19 +36,8 @@
 #include <cstddef>
 
 #include "runtime/pose_ops.h"
+#include "runtime/vector_clones.h"
 
-// OSSA_NO_TARGET_CLONES builds only the baseline code (to test or time it on an AVX2 machine).
-#if defined(__x86_64__) && defined(__has_attribute) && !defined(OSSA_NO_TARGET_CLONES)
-#if __has_attribute(target_clones)
-#define OSSA_VECTOR_CLONES __attribute__((target_clones("avx2", "default")))
-#endif
-#endif
-#ifndef OSSA_VECTOR_CLONES
-#define OSSA_VECTOR_CLONES
-#endif
-// Lane kernels must be inlined into each clone to be compiled (and vectorized) for its ISA; a
-// call from the avx2 clone to an out-of-line helper would run the helper's SSE code.
-#define OSSA_INLINE [[gnu::always_inline]] inline
 
 // No-alias promise for GCC's vectorizer (see the comment above). Clang gets none: its loop hint
 // forces vectorization and warns where it cannot (sanitizer builds), and its vectorizer adds its

@@ -16,37 +16,8 @@
 #include <vector>
 
 #include "runtime/blend_space.h"
+#include "allocation_counter.h"
 
-namespace {
-std::atomic<size_t> g_allocations{0};
-}  // namespace
-
-// Every replaceable form that pairs with free() is replaced, so that no allocation comes from a
-// library's (or a sanitizer's) operator new and is released here, or the other way round. The
-// align_val_t forms are left alone: they allocate and free as a pair on their own.
-namespace {
-void* counted_malloc(std::size_t size) noexcept {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  return std::malloc(size == 0 ? 1 : size);
-}
-void* counted_new(std::size_t size) {
-  if (void* p = counted_malloc(size)) return p;
-  throw std::bad_alloc();
-}
-}  // namespace
-
-void* operator new(std::size_t size) { return counted_new(size); }
-void* operator new[](std::size_t size) { return counted_new(size); }
-void* operator new(std::size_t size, const std::nothrow_t&) noexcept { return counted_malloc(size); }
-void* operator new[](std::size_t size, const std::nothrow_t&) noexcept { return counted_malloc(size); }
-// Out of line, so the compiler does not inline them into callers and then see a free() of memory
-// from operator new (GCC's -Wmismatched-new-delete).
-[[gnu::noinline]] void operator delete(void* p) noexcept { std::free(p); }
-[[gnu::noinline]] void operator delete[](void* p) noexcept { std::free(p); }
-[[gnu::noinline]] void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-[[gnu::noinline]] void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
-[[gnu::noinline]] void operator delete(void* p, const std::nothrow_t&) noexcept { std::free(p); }
-[[gnu::noinline]] void operator delete[](void* p, const std::nothrow_t&) noexcept { std::free(p); }
 
 namespace ossa {
 namespace {
@@ -453,14 +424,14 @@ TEST(BlendSpace2D, EvaluationDoesNotAllocate) {
   const std::vector<float> positions = {1.4f, 3.0f, 5.5f};
   std::vector<float> w1(3);
   float checksum = 0.0f;
-  const size_t before = g_allocations.load();
+  const size_t before = ossa::test::allocation_count();
   for (int i = 0; i < 1000; ++i) {
     const glm::vec2 p(-1.0f + 0.007f * float(i), -200.0f + 0.4f * float(i));
     blend_space_2d_weights(*s, p, w);
     blend_space_1d_weights(positions, p.x, w1);
     checksum += w[0] + w1[0];
   }
-  const size_t after = g_allocations.load();
+  const size_t after = ossa::test::allocation_count();
   EXPECT_EQ(after, before);
   EXPECT_TRUE(std::isfinite(checksum));
 }
