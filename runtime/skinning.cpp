@@ -916,6 +916,49 @@ void skinning_matrices(const MeshView& mesh, std::span<const glm::mat4> model, s
   }
 }
 
+void prepare_bind_matrices(const MeshView& mesh, std::span<glm::mat4> bind) {
+  const MeshFacts m = mesh_facts(mesh);
+  const std::span<const fb::Mat4> inverse_bind = mesh.inverse_bind();
+  const size_t slots = std::max<size_t>(1, inverse_bind.size());
+  assert(bind.size() >= slots);
+  for (size_t s = 0; s < std::min(bind.size(), slots); ++s) {
+    glm::mat4 a(1.0f);
+    if (!inverse_bind.empty()) std::memcpy(&a[0][0], inverse_bind[s].m()->data(), sizeof a);
+    if (m.dequantize) {  // a * D: scale columns 0-2, move column 3 (as skinning_matrices does)
+      a[3] = a[0] * m.offset.x + a[1] * m.offset.y + a[2] * m.offset.z + a[3];
+      for (int c = 0; c < 3; ++c) a[c] = a[c] * m.scale[c];
+    }
+    bind[s] = a;
+  }
+}
+
+void skinning_matrices(std::span<const uint16_t> joints, std::span<const glm::mat4> bind,
+                       std::span<const glm::mat4> model, std::span<glm::mat4> palette) {
+  if (joints.empty()) {
+    if (!palette.empty() && !bind.empty()) palette[0] = bind[0];
+    return;
+  }
+  static const glm::mat4 identity(1.0f);
+  const size_t n = std::min({joints.size(), bind.size(), palette.size()});
+  for (size_t s = 0; s < n; ++s) {
+    const glm::mat4& a = joints[s] < model.size() ? model[joints[s]] : identity;
+    const glm::mat4& b = bind[s];
+#if defined(OSSA_SKIN_X86)
+    // Column c of a * b = sum_k a.col(k) * b[c][k]: four broadcasts and multiply-adds per column,
+    // in SSE (x86-64's baseline); GLM's generic product runs scalar here.
+    const __m128 a0 = _mm_loadu_ps(&a[0][0]), a1 = _mm_loadu_ps(&a[1][0]), a2 = _mm_loadu_ps(&a[2][0]),
+                 a3 = _mm_loadu_ps(&a[3][0]);
+    for (int c = 0; c < 4; ++c) {
+      const __m128 lo = _mm_add_ps(_mm_mul_ps(a0, _mm_set1_ps(b[c][0])), _mm_mul_ps(a1, _mm_set1_ps(b[c][1])));
+      const __m128 hi = _mm_add_ps(_mm_mul_ps(a2, _mm_set1_ps(b[c][2])), _mm_mul_ps(a3, _mm_set1_ps(b[c][3])));
+      _mm_storeu_ps(&palette[s][c][0], _mm_add_ps(lo, hi));
+    }
+#else
+    palette[s] = a * b;
+#endif
+  }
+}
+
 void skin_cpu(const MeshView& mesh, std::span<const glm::mat4> palette, SkinningMethod method, SkinnedStreams out) {
   const MeshFacts m = mesh_facts(mesh);
   if (m.count == 0 || m.position == nullptr) return;

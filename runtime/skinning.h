@@ -20,6 +20,18 @@ namespace ossa {
 /// (palette.size() == 1). O(slots).
 void skinning_matrices(const MeshView& mesh, std::span<const glm::mat4> model, std::span<glm::mat4> palette);
 
+/// The per-mesh constant half of the palette: bind[s] = inverse_bind[s] * D (D as above; for a
+/// static mesh bind[0] = D). Compute once per mesh (at load), then build each frame's palette with
+/// skinning_matrices(joints, bind, model, palette): one matrix product per slot instead of two and
+/// the de-quantization fold. bind.size() == max(1, slots). O(slots).
+void prepare_bind_matrices(const MeshView& mesh, std::span<glm::mat4> bind);
+
+/// palette[s] = model[joints[s]] * bind[s] (bind from prepare_bind_matrices; for a static mesh,
+/// joints is empty and palette[0] = bind[0]). A joint index past model.size() uses identity.
+/// O(slots), one SSE 4x4 product each; allocation-free.
+void skinning_matrices(std::span<const uint16_t> joints, std::span<const glm::mat4> bind,
+                       std::span<const glm::mat4> model, std::span<glm::mat4> palette);
+
 enum class SkinningMethod : uint8_t {
   Linear,          // linear blend skinning: the classic, what the GPU shader does
   DualQuaternion,  // no candy-wrapper collapse on twisting joints: the rotation + translation of

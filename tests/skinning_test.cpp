@@ -653,6 +653,48 @@ TEST(Skinning, PaletteFoldsDequantization) {
   }
 }
 
+TEST_P(SkinAsset, PreparedPaletteEqualsThePaletteDefinition) {
+  // prepare_bind_matrices once + skinning_matrices(joints, bind, ...) per frame must build the same
+  // palette as the definition model * inverse_bind * D, computed here in double precision.
+  const Poses pose = make_pose(data_->skeleton(), 0.6f, 11);
+  for (size_t mi = 0; mi < data_->asset->mesh_count(); ++mi) {
+    const ossa::MeshView mesh = data_->asset->mesh(mi);
+    ASSERT_FALSE(mesh.joints().empty());
+    std::vector<glm::mat4> bind(mesh.joints().size()), palette(mesh.joints().size());
+    ossa::prepare_bind_matrices(mesh, bind);
+    ossa::skinning_matrices(mesh.joints(), bind, pose.model, palette);
+    const auto& o = *mesh.fb->position_offset();
+    const auto& sc = *mesh.fb->position_scale();
+    const bool quantized = mesh.attribute(ossa::fb::VertexSemantic::Position)->format() ==
+                           ossa::fb::VertexFormat::Unorm16x4;
+    const glm::dmat4 d = quantized ? glm::scale(glm::translate(glm::dmat4(1.0), glm::dvec3(o.x(), o.y(), o.z())),
+                                                glm::dvec3(sc.x(), sc.y(), sc.z()))
+                                   : glm::dmat4(1.0);
+    for (size_t slot = 0; slot < palette.size(); ++slot) {
+      const glm::dmat4 expected = pose.model_d[mesh.joints()[slot]] * inverse_bind_d(mesh, slot) * d;
+      double scale = 0.0;
+      for (int c = 0; c < 4; ++c) scale = std::max(scale, glm::length(expected[c]));
+      for (int c = 0; c < 4; ++c)
+        for (int r = 0; r < 4; ++r)
+          EXPECT_NEAR(palette[slot][c][r], expected[c][r], 1e-5 * scale) << mesh.name() << " slot " << slot;
+    }
+  }
+}
+
+TEST(Skinning, PreparedPaletteOfAStaticMeshIsItsDequantization) {
+  for (const auto& [name, spec] : ossa::test::valid_variants()) {
+    if (name != "static-mesh") continue;
+    SyntheticAsset s = load(ossa::test::make_valid_file(spec));
+    ASSERT_NE(s.asset, nullptr);
+    const ossa::MeshView mesh = s.asset->mesh(0);
+    std::vector<glm::mat4> bind(1), prepared(1), direct(1);
+    ossa::prepare_bind_matrices(mesh, bind);
+    ossa::skinning_matrices(mesh.joints(), bind, {}, prepared);
+    ossa::skinning_matrices(mesh, {}, direct);
+    EXPECT_EQ(prepared[0], direct[0]);
+  }
+}
+
 TEST(Skinning, StaticMeshIsItsDequantizedPositions) {
   for (const auto& [name, spec] : ossa::test::valid_variants()) {
     if (name != "static-mesh") continue;
