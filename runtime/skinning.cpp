@@ -887,32 +887,55 @@ bool set_skinning_isa(SkinningIsa isa) {
 
 // ---------------------------------------------------------------------------------------------
 
+namespace {
+
+/// Slot s's constant palette half: inverse_bind[s] * D, D = translate(offset) * scale(scale) applied
+/// on the right (scale columns 0-2, move column 3). A mesh without slots gets D alone.
+glm::mat4 bind_matrix(const MeshFacts& m, std::span<const fb::Mat4> inverse_bind, size_t s) {
+  glm::mat4 a(1.0f);
+  if (!inverse_bind.empty()) std::memcpy(&a[0][0], inverse_bind[s].m()->data(), sizeof a);
+  if (m.dequantize) {
+    a[3] = a[0] * m.offset.x + a[1] * m.offset.y + a[2] * m.offset.z + a[3];
+    for (int c = 0; c < 3; ++c) a[c] = a[c] * m.scale[c];
+  }
+  return a;
+}
+
+/// out = a * b, column-major. Column c of the product is sum_k a.col(k) * b[c][k]: four broadcasts
+/// and multiply-adds per column in SSE (x86-64's baseline); GLM's generic product runs scalar.
+inline void palette_product(const glm::mat4& a, const glm::mat4& b, glm::mat4& out) {
+#if defined(OSSA_SKIN_X86)
+  const __m128 a0 = _mm_loadu_ps(&a[0][0]), a1 = _mm_loadu_ps(&a[1][0]), a2 = _mm_loadu_ps(&a[2][0]),
+               a3 = _mm_loadu_ps(&a[3][0]);
+  for (int c = 0; c < 4; ++c) {
+    const __m128 lo = _mm_add_ps(_mm_mul_ps(a0, _mm_set1_ps(b[c][0])), _mm_mul_ps(a1, _mm_set1_ps(b[c][1])));
+    const __m128 hi = _mm_add_ps(_mm_mul_ps(a2, _mm_set1_ps(b[c][2])), _mm_mul_ps(a3, _mm_set1_ps(b[c][3])));
+    _mm_storeu_ps(&out[c][0], _mm_add_ps(lo, hi));
+  }
+#else
+  out = a * b;
+#endif
+}
+
+const glm::mat4 kIdentity(1.0f);
+
+}  // namespace
+
 void skinning_matrices(const MeshView& mesh, std::span<const glm::mat4> model, std::span<glm::mat4> palette) {
   const MeshFacts m = mesh_facts(mesh);
-  // D = translate(offset) * scale(scale), applied on the right: scale columns 0-2, move column 3.
-  const auto times_d = [&m](const glm::mat4& a) {
-    glm::mat4 r = a;
-    if (m.dequantize) {
-      r[3] = a[0] * m.offset.x + a[1] * m.offset.y + a[2] * m.offset.z + a[3];
-      for (int c = 0; c < 3; ++c) r[c] = a[c] * m.scale[c];
-    }
-    return r;
-  };
   const std::span<const uint16_t> joints = mesh.joints();
   const std::span<const fb::Mat4> inverse_bind = mesh.inverse_bind();
   if (joints.empty()) {
     assert(!palette.empty());
-    if (!palette.empty()) palette[0] = times_d(glm::mat4(1.0f));
+    if (!palette.empty()) palette[0] = bind_matrix(m, inverse_bind, 0);
     return;
   }
   assert(palette.size() >= joints.size());
   const size_t n = std::min(palette.size(), joints.size());
   for (size_t s = 0; s < n; ++s) {
-    glm::mat4 ib;
-    std::memcpy(&ib[0][0], inverse_bind[s].m()->data(), sizeof ib);
     assert(joints[s] < model.size());
-    const glm::mat4 joint_model = joints[s] < model.size() ? model[joints[s]] : glm::mat4(1.0f);
-    palette[s] = times_d(joint_model * ib);
+    palette_product(joints[s] < model.size() ? model[joints[s]] : kIdentity, bind_matrix(m, inverse_bind, s),
+                    palette[s]);
   }
 }
 
@@ -921,15 +944,7 @@ void prepare_bind_matrices(const MeshView& mesh, std::span<glm::mat4> bind) {
   const std::span<const fb::Mat4> inverse_bind = mesh.inverse_bind();
   const size_t slots = std::max<size_t>(1, inverse_bind.size());
   assert(bind.size() >= slots);
-  for (size_t s = 0; s < std::min(bind.size(), slots); ++s) {
-    glm::mat4 a(1.0f);
-    if (!inverse_bind.empty()) std::memcpy(&a[0][0], inverse_bind[s].m()->data(), sizeof a);
-    if (m.dequantize) {  // a * D: scale columns 0-2, move column 3 (as skinning_matrices does)
-      a[3] = a[0] * m.offset.x + a[1] * m.offset.y + a[2] * m.offset.z + a[3];
-      for (int c = 0; c < 3; ++c) a[c] = a[c] * m.scale[c];
-    }
-    bind[s] = a;
-  }
+  for (size_t s = 0; s < std::min(bind.size(), slots); ++s) bind[s] = bind_matrix(m, inverse_bind, s);
 }
 
 void skinning_matrices(std::span<const uint16_t> joints, std::span<const glm::mat4> bind,
@@ -938,25 +953,9 @@ void skinning_matrices(std::span<const uint16_t> joints, std::span<const glm::ma
     if (!palette.empty() && !bind.empty()) palette[0] = bind[0];
     return;
   }
-  static const glm::mat4 identity(1.0f);
   const size_t n = std::min({joints.size(), bind.size(), palette.size()});
-  for (size_t s = 0; s < n; ++s) {
-    const glm::mat4& a = joints[s] < model.size() ? model[joints[s]] : identity;
-    const glm::mat4& b = bind[s];
-#if defined(OSSA_SKIN_X86)
-    // Column c of a * b = sum_k a.col(k) * b[c][k]: four broadcasts and multiply-adds per column,
-    // in SSE (x86-64's baseline); GLM's generic product runs scalar here.
-    const __m128 a0 = _mm_loadu_ps(&a[0][0]), a1 = _mm_loadu_ps(&a[1][0]), a2 = _mm_loadu_ps(&a[2][0]),
-                 a3 = _mm_loadu_ps(&a[3][0]);
-    for (int c = 0; c < 4; ++c) {
-      const __m128 lo = _mm_add_ps(_mm_mul_ps(a0, _mm_set1_ps(b[c][0])), _mm_mul_ps(a1, _mm_set1_ps(b[c][1])));
-      const __m128 hi = _mm_add_ps(_mm_mul_ps(a2, _mm_set1_ps(b[c][2])), _mm_mul_ps(a3, _mm_set1_ps(b[c][3])));
-      _mm_storeu_ps(&palette[s][c][0], _mm_add_ps(lo, hi));
-    }
-#else
-    palette[s] = a * b;
-#endif
-  }
+  for (size_t s = 0; s < n; ++s)
+    palette_product(joints[s] < model.size() ? model[joints[s]] : kIdentity, bind[s], palette[s]);
 }
 
 void skin_cpu(const MeshView& mesh, std::span<const glm::mat4> palette, SkinningMethod method, SkinnedStreams out) {
