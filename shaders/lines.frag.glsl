@@ -1,0 +1,7 @@
+// lines.frag.glsl — flat colour for the skeleton overlay and the grid.
+#version 330 core
+
+in vec4 v_color;
+out vec4 o_color;
+
+void main() { o_color = v_color; }

@@ -1,0 +1,59 @@
+// phong.frag.glsl — Phong shading with the seed thesis's terms: ambient 0.1, diffuse, specular
+// strength 0.5 and shininess 32, all times the surface colour (material diffuse x vertex colour x
+// diffuse map). A normal map (tangent space, needs tangents) bends the normal; a specular map
+// scales the specular term. Surfaces are lit on the side that faces the eye: the normal is
+// flipped when it points away from the viewer, not by gl_FrontFacing, because sources may be
+// open, inconsistently wound, or placed by a mirroring bind matrix (which flips the winding but
+// not the transformed normal). A non-zero u_flat_color.a replaces shading
+// with that colour (wireframe overlay).
+#version 330 core
+
+in vec3 v_position;
+in vec3 v_normal;
+in vec4 v_tangent;
+in vec2 v_uv;
+in vec4 v_color;
+
+uniform vec3 u_camera_position;
+uniform vec3 u_light_direction;  // towards the light
+uniform vec3 u_diffuse_color;
+uniform float u_opacity;
+uniform sampler2D u_diffuse_map;
+uniform sampler2D u_normal_map;
+uniform sampler2D u_specular_map;
+uniform bool u_has_diffuse_map;
+uniform bool u_has_normal_map;
+uniform bool u_has_specular_map;
+uniform vec4 u_flat_color;
+
+out vec4 o_color;
+
+const float kAmbient = 0.1;
+const float kSpecularStrength = 0.5;
+const float kShininess = 32.0;
+
+void main() {
+  if (u_flat_color.a > 0.0) {
+    o_color = u_flat_color;
+    return;
+  }
+  vec3 v = normalize(u_camera_position - v_position);
+  vec3 n = normalize(v_normal);
+  if (dot(n, v) < 0.0) n = -n;
+  if (u_has_normal_map && dot(v_tangent.xyz, v_tangent.xyz) > 0.0) {
+    vec3 t = normalize(v_tangent.xyz - n * dot(n, v_tangent.xyz));
+    vec3 b = cross(n, t) * v_tangent.w;
+    vec3 m = texture(u_normal_map, v_uv).xyz * 2.0 - 1.0;
+    n = normalize(mat3(t, b, n) * m);
+  }
+
+  vec3 colour = u_diffuse_color * v_color.rgb;
+  if (u_has_diffuse_map) colour *= texture(u_diffuse_map, v_uv).rgb;
+
+  vec3 l = normalize(u_light_direction);
+  float diffuse = max(dot(n, l), 0.0);
+  float specular = kSpecularStrength * pow(max(dot(v, reflect(-l, n)), 0.0), kShininess);
+  if (u_has_specular_map) specular *= texture(u_specular_map, v_uv).r;
+
+  o_color = vec4((kAmbient + diffuse + specular) * colour, u_opacity);
+}

@@ -1,0 +1,81 @@
+// skinned.vert.glsl — linear blend skinning on the GPU (4 influences), reading the cooked vertex
+// layout exactly as it is stored in the .ossa file.
+//
+// The viewer binds the file's vertex bytes with glVertexAttribPointer straight from the layout
+// table (format/vertex_format.h), so GL itself does the unorm / snorm / half-float decoding and
+// attribute locations equal fb::VertexSemantic values (Position 0 ... Weights 6):
+//  - position: Unorm16x4 (normalized into [0, 1] inside the mesh bounds) or Float32x3. The
+//    de-quantizing affine D = translate(position_offset) * scale(position_scale) is folded into
+//    every palette matrix on the CPU (runtime/skinning.h), so both cases are palette * (p.xyz, 1).
+//  - normal: Snorm16x2 octahedral (decoded here, as format/vertex_codec.h) or Float32x3 xyz.
+//    Directions must not see D's per-axis scale, so they are multiplied by u_direction_prescale
+//    (1 / position_scale; 1 for float layouts) before the palette, exactly as skin_cpu does:
+//    palette3x3 * (n / s) = (model * inverse_bind)3x3 * n.
+//  - tangent: Snorm16x4 (octahedral xy, bitangent sign in z) or Float32x4 (xyz, sign in w).
+//  - joints: integer slots (glVertexAttribIPointer), weights unorm8 / float summing to 1.
+// A static mesh has no joint / weight arrays: the constant attribute values the viewer sets
+// (slot 0, weight (1, 0, 0, 0)) select palette[0] = D.
+//
+// The palette is a texture buffer (RGBA32F, four texels per column-major matrix) that holds the
+// palettes of every instance back to back: rigs with more joints than the uniform limits allow,
+// and crowds drawn with one instanced call, need no shader change. The CPU-skinning reference
+// path feeds already skinned float streams through this same shader with an identity palette.
+#version 330 core
+
+layout(location = 0) in vec4 a_position;
+layout(location = 1) in vec4 a_normal;
+layout(location = 2) in vec4 a_tangent;
+layout(location = 3) in vec2 a_uv;
+layout(location = 4) in vec4 a_color;
+layout(location = 5) in uvec4 a_joints;
+layout(location = 6) in vec4 a_weights;
+
+uniform samplerBuffer u_palette;
+uniform int u_palette_base;      // first texel of this mesh's palette for instance 0
+uniform int u_instance_texels;   // texels from one instance's palettes to the next
+uniform int u_normal_encoding;   // 0: xyz, 1: octahedral xy
+uniform int u_tangent_encoding;  // 0: none, 1: octahedral xy + sign z, 2: xyz + sign w
+uniform vec3 u_direction_prescale;
+uniform mat4 u_view_projection;
+
+out vec3 v_position;
+out vec3 v_normal;
+out vec4 v_tangent;
+out vec2 v_uv;
+out vec4 v_color;
+
+vec3 octahedral_decode(vec2 e) {
+  vec3 n = vec3(e, 1.0 - abs(e.x) - abs(e.y));
+  float t = max(-n.z, 0.0);
+  n.x += n.x >= 0.0 ? -t : t;
+  n.y += n.y >= 0.0 ? -t : t;
+  return normalize(n);
+}
+
+mat4 palette(uint slot) {
+  int t = u_palette_base + gl_InstanceID * u_instance_texels + 4 * int(slot);
+  return mat4(texelFetch(u_palette, t), texelFetch(u_palette, t + 1), texelFetch(u_palette, t + 2),
+              texelFetch(u_palette, t + 3));
+}
+
+void main() {
+  mat4 skin = a_weights.x * palette(a_joints.x) + a_weights.y * palette(a_joints.y) +
+              a_weights.z * palette(a_joints.z) + a_weights.w * palette(a_joints.w);
+  vec4 world = skin * vec4(a_position.xyz, 1.0);
+  mat3 linear = mat3(skin);
+
+  vec3 n = u_normal_encoding == 1 ? octahedral_decode(a_normal.xy) : a_normal.xyz;
+  v_normal = linear * (n * u_direction_prescale);
+
+  v_tangent = vec4(0.0);
+  if (u_tangent_encoding == 1) {
+    v_tangent = vec4(linear * (octahedral_decode(a_tangent.xy) * u_direction_prescale), a_tangent.z < 0.0 ? -1.0 : 1.0);
+  } else if (u_tangent_encoding == 2) {
+    v_tangent = vec4(linear * (a_tangent.xyz * u_direction_prescale), a_tangent.w < 0.0 ? -1.0 : 1.0);
+  }
+
+  v_position = world.xyz;
+  v_uv = a_uv;
+  v_color = a_color;
+  gl_Position = u_view_projection * world;
+}

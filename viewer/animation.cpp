@@ -1,0 +1,133 @@
+// animation.cpp — see animation.h.
+#include "viewer/animation.h"
+
+#include <chrono>
+#include <cmath>
+#include <utility>
+
+#include "runtime/pose_ops.h"
+
+namespace ossa::view {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+
+float duration_of(const Scene& scene, int clip) {
+  return clip >= 0 ? scene.clips[static_cast<size_t>(clip)].clip.duration() : 0.0f;
+}
+
+float instance_time(float time, float offset, float duration, bool loop) {
+  return offset == 0.0f ? time : advance_time(time, offset, 1.0f, duration, loop);
+}
+
+}  // namespace
+
+Animator make_animator(const Scene& scene, size_t instance_count) {
+  Animator a;
+  const auto joints = static_cast<uint32_t>(scene.joint_count());
+  a.instances.resize(instance_count == 0 ? 1 : instance_count);
+  for (size_t i = 0; i < a.instances.size(); ++i) {
+    AnimInstance& inst = a.instances[i];
+    inst.local = Pose(joints);
+    inst.from_local = Pose(joints);
+    inst.model.assign(joints, glm::mat4(1.0f));
+    if (joints > 0) set_bind_pose(scene.skeleton(), inst.local);
+    const double phase = static_cast<double>(i) * 0.6180339887;
+    inst.time_offset = static_cast<float>(phase - std::floor(phase));  // fraction of a loop; scaled per clip
+  }
+  return a;
+}
+
+Status select_clip(const Scene& scene, Animator& animator, int clip, bool crossfade) {
+  Playback& p = animator.playback;
+  const bool fade = crossfade && p.clip >= 0 && clip >= 0 && clip != p.clip && !p.bind_pose;
+  std::vector<SamplingCache> caches;
+  if (clip >= 0) {
+    const ClipView view = scene.clips[static_cast<size_t>(clip)].clip;
+    for (size_t i = 0; i < animator.instances.size(); ++i) {
+      Result<SamplingCache> c = make_sampling_cache(view, scene.skeleton());
+      if (!c) return c.error();
+      caches.push_back(std::move(*c));
+    }
+  }
+  for (size_t i = 0; i < animator.instances.size(); ++i) {
+    AnimInstance& inst = animator.instances[i];
+    if (fade) inst.from_cache = std::move(inst.cache);
+    inst.cache = clip >= 0 ? std::move(caches[i]) : SamplingCache();
+  }
+  if (fade) {
+    p.from_clip = p.clip;
+    p.from_time = p.time;
+    p.fade = 0.0f;
+  } else {
+    p.from_clip = -1;
+    p.fade = 1.0f;
+  }
+  p.clip = clip;
+  p.time = 0.0f;
+  return {};
+}
+
+float clip_duration(const Scene& scene, const Animator& animator) { return duration_of(scene, animator.playback.clip); }
+
+void advance(const Scene& scene, Animator& animator, float dt) {
+  Playback& p = animator.playback;
+  if (!p.playing) return;
+  if (p.clip >= 0) p.time = advance_time(p.time, dt, p.speed, duration_of(scene, p.clip), p.loop);
+  if (p.fade < 1.0f) {
+    p.from_time = advance_time(p.from_time, dt, p.speed, duration_of(scene, p.from_clip), true);
+    p.fade = p.fade_seconds > 0.0f ? std::min(1.0f, p.fade + dt / p.fade_seconds) : 1.0f;
+    if (p.fade >= 1.0f) p.from_clip = -1;
+  }
+}
+
+void set_time(const Scene& scene, Animator& animator, float time) {
+  Playback& p = animator.playback;
+  p.time = p.clip >= 0 ? advance_time(0.0f, time, 1.0f, duration_of(scene, p.clip), p.loop) : 0.0f;
+}
+
+void produce_local_poses(const Scene& scene, Animator& animator, PoseTimings& timings) {
+  const Playback& p = animator.playback;
+  if (scene.joint_count() == 0) return;
+  if (p.bind_pose || p.clip < 0) {
+    const auto t0 = Clock::now();
+    for (AnimInstance& inst : animator.instances) set_bind_pose(scene.skeleton(), inst.local);
+    timings.sample_ms += ms_since(t0);
+    return;
+  }
+  const ClipView clip = scene.clips[static_cast<size_t>(p.clip)].clip;
+  SampleOptions options;
+  options.loop = p.loop;
+  SampleOptions looping;
+  looping.loop = true;
+  const float duration = clip.duration();
+  const bool fading = p.fade < 1.0f && p.from_clip >= 0;
+  const auto t0 = Clock::now();
+  for (AnimInstance& inst : animator.instances) {
+    sample(clip, instance_time(p.time, inst.time_offset * duration, duration, p.loop), options, inst.cache, inst.local);
+    if (fading) {
+      const ClipView from = scene.clips[static_cast<size_t>(p.from_clip)].clip;
+      const float d = from.duration();
+      sample(from, instance_time(p.from_time, inst.time_offset * d, d, true), looping, inst.from_cache,
+             inst.from_local);
+    }
+  }
+  timings.sample_ms += ms_since(t0);
+  if (fading) {
+    const auto t1 = Clock::now();
+    for (AnimInstance& inst : animator.instances) blend(inst.from_local, inst.local, p.fade, inst.local);
+    timings.blend_ms += ms_since(t1);
+  }
+}
+
+void compute_model_poses(const Scene& scene, Animator& animator, PoseTimings& timings) {
+  if (scene.joint_count() == 0) return;
+  const auto t0 = Clock::now();
+  const auto parents = scene.skeleton().parents();
+  for (AnimInstance& inst : animator.instances) local_to_model(parents, inst.local, inst.model);
+  timings.blend_ms += ms_since(t0);
+}
+
+}  // namespace ossa::view

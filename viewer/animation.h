@@ -1,0 +1,82 @@
+// animation.h — what moves the character: clip playback for one or many instances, and the one
+// per-frame step that produces their local poses.
+//
+// produce_local_poses is the viewer's single "where does this frame's pose come from" point: today
+// it samples the selected clip (cross-fading for a moment after the clip changes) or writes the
+// bind pose; an animation graph plugs in here as a third source that updates a graph instance
+// per character and writes its output pose. Everything after it (local -> model, palettes,
+// drawing) does not care where the pose came from.
+//
+// A crowd is N instances of the same character playing the same clip at different phases; each
+// has its own sampling caches (runtime/sample.h: one cache per clip and playing instance) and pose
+// storage, allocated when a clip is selected, never per frame.
+#pragma once
+#include <cstddef>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "format/result.h"
+#include "runtime/pose.h"
+#include "runtime/sample.h"
+#include "viewer/scene.h"
+
+namespace ossa::view {
+
+struct Playback {
+  int clip = -1;            // index into Scene::clips; -1: none (bind pose)
+  float time = 0.0f;        // seconds into the clip, for instance 0
+  float speed = 1.0f;       // playback rate (negative plays backwards)
+  bool playing = true;
+  bool loop = true;
+  bool bind_pose = false;   // show the skeleton's bind pose instead of the clip
+  // Cross-fade from the previously selected clip, which keeps playing until the fade ends.
+  int from_clip = -1;
+  float from_time = 0.0f;
+  float fade = 1.0f;        // 0 -> 1 over fade_seconds; 1: no fade in progress
+  float fade_seconds = 0.25f;
+};
+
+struct AnimInstance {
+  float time_offset = 0.0f;   // phase of this instance relative to Playback::time
+  SamplingCache cache, from_cache;
+  Pose local, from_local;
+  std::vector<glm::mat4> model;  // model-space joint matrices, one per skeleton joint
+};
+
+struct Animator {
+  Playback playback;
+  std::vector<AnimInstance> instances;
+};
+
+/// Instances with bind-pose storage and phases spread over the clip (instance i starts i * 0.618
+/// of a loop later). No clip selected yet.
+Animator make_animator(const Scene& scene, size_t instance_count);
+
+/// Selects clip `clip` (-1: none) for every instance and rewinds to time 0; with `crossfade` the
+/// previous clip fades out over playback.fade_seconds. Errors when a cache cannot be made.
+Status select_clip(const Scene& scene, Animator& animator, int clip, bool crossfade);
+
+/// Duration of the selected clip (0 without one).
+float clip_duration(const Scene& scene, const Animator& animator);
+
+/// Moves time by dt * speed when playing (wrapping or clamping as playback.loop says) and the
+/// cross-fade by dt.
+void advance(const Scene& scene, Animator& animator, float dt);
+
+/// Sets the clip time (scrub, --time): wrapped or clamped into the clip.
+void set_time(const Scene& scene, Animator& animator, float time);
+
+struct PoseTimings {
+  double sample_ms = 0.0;  // sampling clips
+  double blend_ms = 0.0;   // blending (cross-fade) and local -> model
+};
+
+/// This frame's local pose of every instance: the bind pose, the selected clip sampled at each
+/// instance's time, or the cross-fade of the previous and the selected clip. Allocation-free.
+void produce_local_poses(const Scene& scene, Animator& animator, PoseTimings& timings);
+
+/// Local -> model matrices of every instance (AnimInstance::model). Allocation-free.
+void compute_model_poses(const Scene& scene, Animator& animator, PoseTimings& timings);
+
+}  // namespace ossa::view

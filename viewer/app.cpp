@@ -1,0 +1,130 @@
+// app.cpp — see app.h.
+#include "viewer/app.h"
+
+#include <cmath>
+#include <utility>
+
+namespace ossa::view {
+namespace {
+
+/// Crowd placement: a square-ish grid on the ground, spaced by the character's footprint.
+std::vector<glm::vec3> crowd_offsets(size_t n, const Box& one) {
+  std::vector<glm::vec3> out;
+  const auto columns = static_cast<size_t>(std::ceil(std::sqrt(static_cast<double>(n))));
+  const glm::vec3 size = one.empty() ? glm::vec3(1.0f) : one.size();
+  const float spacing = 1.25f * std::max(std::max(size.x, size.z), 0.35f * size.y);
+  const size_t rows = (n + columns - 1) / columns;
+  for (size_t i = 0; i < n; ++i) {
+    const float x = (static_cast<float>(i % columns) - 0.5f * static_cast<float>(columns - 1)) * spacing;
+    const float z = (static_cast<float>(i / columns) - 0.5f * static_cast<float>(rows - 1)) * spacing;
+    out.emplace_back(n == 1 ? 0.0f : x, 0.0f, n == 1 ? 0.0f : -z);
+  }
+  return out;
+}
+
+}  // namespace
+
+void frame_camera(App& app, float aspect) {
+  app.camera = frame_box(app.framing, app.angles.yaw, app.angles.pitch, aspect);
+  app.follow_applied = glm::vec3(0.0f);
+}
+
+Status open_scene(App& app, std::span<const std::string> paths, size_t crowd, float aspect) {
+  Result<Scene> scene = load_scene(paths);
+  if (!scene) return scene.error();
+  return open_loaded_scene(app, std::move(*scene), crowd, aspect);
+}
+
+Status open_loaded_scene(App& app, Scene scene, size_t crowd, float aspect) {
+  std::vector<std::string> warnings;
+  if (Status s = upload_scene(app.renderer, scene, warnings); !s) {
+    // Put the previous scene back on the GPU (its files are still open).
+    if (!app.scene.assets.empty()) {
+      std::vector<std::string> ignored;
+      (void)upload_scene(app.renderer, app.scene, ignored);
+    }
+    return s;
+  }
+  app.scene = std::move(scene);
+  app.messages = std::move(warnings);
+  app.animator = Animator{};
+  return set_crowd(app, crowd, aspect);
+}
+
+Status set_crowd(App& app, size_t crowd, float aspect) {
+  const Playback previous = app.animator.playback;
+  const bool had_clip = !app.animator.instances.empty();
+  app.crowd = crowd == 0 ? 1 : crowd;
+  app.animator = make_animator(app.scene, app.crowd);
+
+  // Bind pose bounds of one character, then of the whole crowd.
+  Animator& a = app.animator;
+  PoseTimings ignored;
+  produce_local_poses(app.scene, a, ignored);  // no clip yet: bind pose
+  compute_model_poses(app.scene, a, ignored);
+  const Box one = bind_pose_bounds(app.scene.character(), a.instances.front().model);
+  app.offsets = crowd_offsets(app.crowd, one);
+  app.framing = Box{};
+  for (const glm::vec3& o : app.offsets) {
+    if (!one.empty()) {
+      app.framing.add(one.min + o);
+      app.framing.add(one.max + o);
+    }
+  }
+  app.root_bind = a.instances.front().model.empty() ? glm::vec3(0.0f) : glm::vec3(a.instances.front().model[0][3]);
+  app.follow = app.crowd == 1;
+  const float radius = one.empty() ? 1.0f : 0.5f * glm::length(one.size());
+  set_grid(app.renderer, app.framing, app.framing.empty() ? 0.0f : app.framing.min.y, radius);
+  frame_camera(app, aspect);
+
+  const int clip = had_clip ? previous.clip : (app.scene.clips.empty() ? -1 : 0);
+  if (Status s = play_clip(app, clip, false); !s) return s;
+  if (had_clip) {
+    Playback& p = a.playback;
+    p.time = previous.time;
+    p.speed = previous.speed;
+    p.playing = previous.playing;
+    p.loop = previous.loop;
+    p.bind_pose = previous.bind_pose;
+  }
+  return {};
+}
+
+Status open_or_add(App& app, std::span<const std::string> paths, float aspect) {
+  for (const std::string& p : paths) {
+    Result<bool> has_mesh = file_has_mesh(p);
+    if (!has_mesh) return has_mesh.error();
+    if (*has_mesh) return open_scene(app, paths, app.crowd, aspect);
+  }
+  if (app.scene.assets.empty()) return Error{paths.empty() ? "nothing to open" : paths.front() + ": has no mesh to show"};
+  const size_t before = app.scene.clips.size();
+  for (const std::string& p : paths) {
+    if (Status s = add_clip_file(app.scene, p); !s) return s;
+  }
+  // Play the first clip added.
+  return play_clip(app, static_cast<int>(before), true);
+}
+
+Status play_clip(App& app, int clip, bool crossfade) { return select_clip(app.scene, app.animator, clip, crossfade); }
+
+Status step_and_render(App& app, float dt, int width, int height, FrameTimings& timings) {
+  advance(app.scene, app.animator, dt);
+  PoseTimings pose;
+  produce_local_poses(app.scene, app.animator, pose);
+  compute_model_poses(app.scene, app.animator, pose);
+  timings.sample_ms += pose.sample_ms;
+  timings.blend_ms += pose.blend_ms;
+
+  // Follow instance 0's root over the ground, so a clip that travels stays in view.
+  const auto& model = app.animator.instances.front().model;
+  if (app.follow && !model.empty()) {
+    glm::vec3 moved = glm::vec3(model[0][3]) - app.root_bind;
+    moved.y = 0.0f;
+    app.camera.target += moved - app.follow_applied;
+    app.follow_applied = moved;
+  }
+  return render_frame(app.renderer, app.scene, app.animator, app.offsets, app.camera, app.toggles, width, height,
+                      timings);
+}
+
+}  // namespace ossa::view

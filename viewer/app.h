@@ -1,0 +1,70 @@
+// app.h — the viewer's state and its per-frame step, shared by the window and headless modes.
+//
+// One App holds the scene (opened files), its GPU form, the animator (clip playback for one
+// character or a crowd), the camera and the view toggles. Both front ends do the same thing each
+// frame — step_and_render — and differ only in where time and input come from and where the
+// pixels go (a window, or an offscreen framebuffer written to a PNG).
+#pragma once
+#include <cstddef>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "format/result.h"
+#include "viewer/animation.h"
+#include "viewer/bounds.h"
+#include "viewer/camera.h"
+#include "viewer/renderer.h"
+#include "viewer/scene.h"
+
+namespace ossa::view {
+
+struct CameraAngles {
+  float yaw = 0.5235988f;   // 30 degrees: a three-quarter view of a character facing +Z
+  float pitch = 0.1745329f; // 10 degrees above
+};
+
+struct App {
+  Scene scene;
+  Renderer renderer;
+  Animator animator;
+  OrbitCamera camera;
+  CameraAngles angles;
+  ViewToggles toggles;
+  std::vector<glm::vec3> offsets;  // instance placements (crowd grid), one per instance
+  Box framing;                     // everything the camera frames: the crowd in its bind pose
+  size_t crowd = 1;
+  bool follow = true;              // keep the camera on instance 0's root as it moves (crowd: off)
+  glm::vec3 root_bind{0.0f};       // instance 0's root in the bind pose
+  glm::vec3 follow_applied{0.0f};  // how far follow has moved the camera target so far
+  std::vector<std::string> messages;  // warnings and errors for the panel / stderr
+};
+
+/// Replaces the scene with `paths` (scene.h load_scene), uploads it, builds the crowd and frames
+/// the camera for the given aspect ratio. On error the App keeps its previous scene. The renderer
+/// must exist (create_renderer).
+Status open_scene(App& app, std::span<const std::string> paths, size_t crowd, float aspect);
+/// The same for a scene already loaded (the headless mode opens files before it makes a context).
+Status open_loaded_scene(App& app, Scene scene, size_t crowd, float aspect);
+
+/// Rebuilds the animator for `crowd` instances (keeping the clip, its time and playback
+/// settings), lays them out on a grid, and re-frames the camera and the grid.
+Status set_crowd(App& app, size_t crowd, float aspect);
+
+/// Dropped / typed paths: if one has a mesh they replace the scene; otherwise their clips are
+/// added to the current character.
+Status open_or_add(App& app, std::span<const std::string> paths, float aspect);
+
+/// Points the camera at app.framing from app.angles.
+void frame_camera(App& app, float aspect);
+
+/// Selects a clip by index (-1: none) with an optional cross-fade.
+Status play_clip(App& app, int clip, bool crossfade);
+
+/// Advances playback by dt (when playing), produces this frame's poses, follows the character,
+/// and draws into the bound framebuffer. Timings accumulate into `timings`.
+Status step_and_render(App& app, float dt, int width, int height, FrameTimings& timings);
+
+}  // namespace ossa::view

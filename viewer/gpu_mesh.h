@@ -1,0 +1,56 @@
+// gpu_mesh.h — a cooked mesh on the GPU: buffers made straight from the file's bytes.
+//
+// create_gpu_mesh hands MeshView::vertex_bytes() and index_bytes() to glBufferData as they are
+// and sets one attribute pointer per layout entry from format/vertex_format.h's table (location =
+// fb::VertexSemantic, integer formats through glVertexAttribIPointer). Nothing is decoded,
+// converted or copied on the CPU: the skinned vertex shader reads the quantized layout itself.
+//
+// The CPU-skinning reference path (--cpu-skinning) needs a second vertex array: skin_cpu's float
+// positions / normals / tangents streamed into their own buffers each frame, with texture
+// coordinates and colours still read from the file's buffer. Those buffers are created empty
+// here and filled by the renderer only when that path is used.
+#pragma once
+#include <cstdint>
+#include <string_view>
+
+#include <glm/glm.hpp>
+
+#include "format/result.h"
+#include "runtime/asset.h"
+#include "viewer/gl.h"
+
+namespace ossa::view {
+
+/// Vertex attribute locations in shaders/skinned.vert.glsl (= fb::VertexSemantic values).
+enum AttributeLocation : GLuint { kPosition = 0, kNormal = 1, kTangent = 2, kTexCoord0 = 3, kColor0 = 4, kJoints = 5, kWeights = 6 };
+
+/// How the shader must read directions (uniforms u_normal_encoding / u_tangent_encoding).
+enum class NormalEncoding : int { Xyz = 0, Octahedral = 1 };
+enum class TangentEncoding : int { None = 0, OctahedralSignZ = 1, XyzSignW = 2 };
+
+struct GpuMesh {
+  GLuint vao = 0, vertex_buffer = 0, index_buffer = 0;
+  GLenum index_type = GL_UNSIGNED_SHORT;
+  uint32_t index_size = 2;
+  uint32_t vertex_count = 0;
+  uint32_t palette_slots = 1;           // max(1, mesh joints): matrices in this mesh's palette
+  NormalEncoding normal_encoding = NormalEncoding::Xyz;
+  TangentEncoding tangent_encoding = TangentEncoding::None;
+  glm::vec3 direction_prescale{1.0f};   // 1 / position_scale for quantized positions
+  bool has_normals = false, has_tangents = false, has_joints = false, has_colors = false;
+
+  // CPU-skinning path: float streams skinned by skin_cpu (empty until used).
+  GLuint cpu_vao = 0, cpu_positions = 0, cpu_normals = 0, cpu_tangents = 0;
+};
+
+/// Uploads one mesh. Errors (naming `asset_name` and the mesh) for layouts the shader cannot
+/// read: a format outside the table, integer joints missing or not integer.
+Result<GpuMesh> create_gpu_mesh(const MeshView& mesh, std::string_view asset_name);
+void destroy_gpu_mesh(GpuMesh& mesh);
+
+/// The constant attribute values the shader sees for arrays a mesh lacks: colour white, joint
+/// slot 0 with weight 1 (palette[0]), +z normal, +x tangent. Call before drawing a mesh (they
+/// are context state, not vertex array state).
+void set_default_attributes();
+
+}  // namespace ossa::view

@@ -1,0 +1,100 @@
+// headless.cpp — see headless.h.
+#include "viewer/headless.h"
+
+#include <chrono>
+#include <cstdio>
+#include <string>
+
+#include <stb_image_write.h>
+
+#include "viewer/app.h"
+#include "viewer/gl_util.h"
+#include "viewer/offscreen.h"
+#include "viewer/setup.h"
+#include "viewer/window.h"
+
+namespace ossa::view {
+namespace {
+
+constexpr float kFrameStep = 1.0f / 60.0f;
+
+int fail(const std::string& message) {
+  std::fprintf(stderr, "ossa-view: %s\n", message.c_str());
+  return 1;
+}
+
+/// The whole run, with errors as values; run_headless turns them into the exit status.
+Status render_headless(const ViewerOptions& o) {
+  const auto start = std::chrono::steady_clock::now();
+  const std::string& name = o.files.front();
+  // Open the files first: a bad file is reported as such even where no display exists.
+  Result<Scene> scene = load_scene(o.files);
+  if (!scene) return scene.error();
+
+  WindowOptions wo;
+  wo.width = 64;
+  wo.height = 64;
+  wo.visible = false;
+  Result<Window> window = create_window(wo);
+  if (!window) return Error{name + ": " + window.error().message};
+  if (Status s = check_gl("creating the context"); !s) return Error{name + ": " + s.message()};
+
+  Result<Renderer> renderer = create_renderer();
+  if (!renderer) return Error{name + ": " + renderer.error().message};
+  App app;
+  app.renderer = std::move(*renderer);
+  const float aspect = static_cast<float>(o.width) / static_cast<float>(o.height);
+  if (Status s = setup_app(app, std::move(*scene), o, aspect); !s) return s;
+
+  Playback& p = app.animator.playback;
+  p.playing = true;  // --paused means nothing here: frames step 1/60 s towards --time
+  // N frames 1/60 s apart, the last at --time: start (N - 1) steps earlier.
+  const float rate = o.speed != 0.0f ? o.speed : 1.0f;
+  p.time = advance_time(p.time, -kFrameStep * static_cast<float>(o.frames - 1), rate, clip_duration(app.scene, app.animator), p.loop);
+
+  Result<Offscreen> target = create_offscreen(o.width, o.height, o.msaa);
+  if (!target) return Error{name + ": " + target.error().message};
+  if (Status s = check_gl("setting up"); !s) return Error{name + ": " + s.message()};
+
+  FrameTimings total;
+  for (int f = 0; f < o.frames; ++f) {
+    bind_offscreen(*target);
+    if (f == o.frames - 1) set_time(app.scene, app.animator, o.time);  // exactly --time, no drift
+    if (Status s = step_and_render(app, f == 0 || f == o.frames - 1 ? 0.0f : kFrameStep, o.width, o.height, total); !s) return s;
+    if (Status s = check_gl("drawing frame " + std::to_string(f)); !s) return Error{name + ": " + s.message()};
+    if (f == 0 && o.first_frame_time) {
+      glFinish();
+      const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+      std::printf("first-frame-ms %.3f\n", ms);
+      std::fflush(stdout);
+    }
+  }
+  if (!o.screenshot.empty()) {
+    const std::vector<uint8_t> rgb = read_rgb(*target);
+    if (Status s = check_gl("reading the image back"); !s) return Error{name + ": " + s.message()};
+    stbi_flip_vertically_on_write(1);
+    if (stbi_write_png(o.screenshot.c_str(), o.width, o.height, 3, rgb.data(), o.width * 3) == 0) {
+      return Error{o.screenshot + ": cannot write the PNG"};
+    }
+  }
+  if (o.stats) {
+    const double n = o.frames;
+    std::printf("framed (%g %g %g) .. (%g %g %g)\n", app.framing.min.x, app.framing.min.y, app.framing.min.z,
+                app.framing.max.x, app.framing.max.y, app.framing.max.z);
+    std::printf("frames %d  sample %.3f ms  blend %.3f ms  skin %.3f ms  draw %.3f ms  gpu %.3f ms (per frame)\n",
+                o.frames, total.sample_ms / n, total.blend_ms / n, total.skin_ms / n, total.draw_ms / n, total.gpu_ms / n);
+  }
+  destroy_offscreen(*target);
+  release_scene(app.renderer);
+  destroy_renderer(app.renderer);
+  return {};
+}
+
+}  // namespace
+
+int run_headless(const ViewerOptions& options) {
+  const Status s = render_headless(options);
+  return s ? 0 : fail(s.message());
+}
+
+}  // namespace ossa::view

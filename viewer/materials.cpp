@@ -1,0 +1,105 @@
+// materials.cpp — see materials.h.
+#include "viewer/materials.h"
+
+#include <climits>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+
+#include <stb_image.h>
+
+namespace ossa::view {
+namespace {
+
+/// Decodes an encoded image into an RGBA8 texture with mipmaps; 0 on failure (`why` says).
+GLuint decode_texture(const uint8_t* bytes, size_t size, std::string& why) {
+  if (size > static_cast<size_t>(INT_MAX)) {
+    why = "image too large";
+    return 0;
+  }
+  int w = 0, h = 0, channels = 0;
+  // Assimp (and so the cooker) keeps texture coordinates with v = 0 at the bottom, as GL does;
+  // images start with their top row, so flip them on load.
+  stbi_set_flip_vertically_on_load(1);
+  stbi_uc* pixels = stbi_load_from_memory(bytes, static_cast<int>(size), &w, &h, &channels, 4);
+  if (pixels == nullptr) {
+    why = stbi_failure_reason() ? stbi_failure_reason() : "cannot decode";
+    return 0;
+  }
+  GLuint t = 0;
+  glGenTextures(1, &t);
+  glBindTexture(GL_TEXTURE_2D, t);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, w, h, 0, GL_RGBA, GL_UNSIGNED_BYTE, pixels);
+  glGenerateMipmap(GL_TEXTURE_2D);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_REPEAT);
+  stbi_image_free(pixels);
+  return t;
+}
+
+GLuint load_texture(const fb::Texture& texture, const std::string& asset_path, std::vector<std::string>& warnings) {
+  std::string why;
+  std::string what;
+  GLuint t = 0;
+  if (texture.data() != nullptr && texture.data()->size() > 0) {
+    what = "embedded texture";
+    t = decode_texture(texture.data()->data(), texture.data()->size(), why);
+  } else if (texture.path() != nullptr && texture.path()->size() > 0) {
+    const std::filesystem::path p = std::filesystem::path(asset_path).parent_path() / texture.path()->str();
+    what = "texture " + p.string();
+    std::ifstream in(p, std::ios::binary);
+    if (!in) {
+      why = "cannot open it";
+    } else {
+      const std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+      t = decode_texture(bytes.data(), bytes.size(), why);
+    }
+  } else {
+    return 0;
+  }
+  if (t == 0) warnings.push_back(asset_path + ": " + what + " left out: " + why);
+  return t;
+}
+
+}  // namespace
+
+std::vector<GpuMaterial> create_materials(const Asset& asset, const std::string& asset_path,
+                                          std::vector<std::string>& warnings) {
+  std::vector<GpuMaterial> out;
+  for (size_t i = 0; i < asset.material_count(); ++i) {
+    const fb::Material& m = asset.material(i);
+    GpuMaterial g;
+    if (const fb::Vec3* d = m.diffuse()) g.diffuse = glm::vec3(d->x(), d->y(), d->z());
+    g.opacity = m.opacity();
+    if (m.textures() != nullptr) {
+      for (const fb::Texture* t : *m.textures()) {
+        GLuint* slot = t->role() == fb::TextureRole::Diffuse   ? &g.diffuse_map
+                       : t->role() == fb::TextureRole::Normal  ? &g.normal_map
+                       : t->role() == fb::TextureRole::Specular ? &g.specular_map
+                                                                : nullptr;
+        if (slot == nullptr || *slot != 0) continue;
+        *slot = load_texture(*t, asset_path, warnings);
+      }
+    }
+    // A material whose colour is black but which has a diffuse map means "the map is the colour".
+    if (g.diffuse_map != 0 && g.diffuse == glm::vec3(0.0f)) g.diffuse = glm::vec3(1.0f);
+    out.push_back(g);
+  }
+  if (out.empty()) out.push_back(GpuMaterial{});
+  return out;
+}
+
+void destroy_materials(std::vector<GpuMaterial>& materials) {
+  for (GpuMaterial& m : materials) {
+    const GLuint textures[] = {m.diffuse_map, m.normal_map, m.specular_map};
+    for (GLuint t : textures) {
+      if (t != 0) glDeleteTextures(1, &t);
+    }
+  }
+  materials.clear();
+}
+
+}  // namespace ossa::view

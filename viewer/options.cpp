@@ -1,0 +1,67 @@
+// options.cpp — see options.h. CLI11 (as ossa-cook uses) does the parsing; its exceptions stay
+// inside this file.
+#include "viewer/options.h"
+
+#include <charconv>
+#include <cstdio>
+
+#include <CLI/CLI.hpp>
+
+namespace ossa::view {
+
+std::optional<std::pair<int, int>> parse_size(const std::string& text) {
+  const size_t x = text.find('x');
+  if (x == std::string::npos) return std::nullopt;
+  int w = 0, h = 0;
+  const char* b = text.data();
+  const auto rw = std::from_chars(b, b + x, w);
+  const auto rh = std::from_chars(b + x + 1, b + text.size(), h);
+  if (rw.ec != std::errc() || rw.ptr != b + x || rh.ec != std::errc() || rh.ptr != b + text.size()) return std::nullopt;
+  if (w < 1 || h < 1 || w > 16384 || h > 16384) return std::nullopt;
+  return std::make_pair(w, h);
+}
+
+ParsedOptions parse_options(int argc, const char* const* argv) {
+  CLI::App app{"ossa-view: look at cooked .ossa characters and play their clips (GLFW + OpenGL 3.3)"};
+  ViewerOptions o;
+  std::string size;
+  bool no_grid = false;
+  app.add_option("files", o.files, "a character .ossa, then any clip files cooked for its skeleton")->required();
+  app.add_option("--clip", o.clip, "start with this clip (its name)");
+  app.add_option("--time", o.time, "clip time in seconds (headless: of the captured frame)");
+  app.add_option("--speed", o.speed, "playback rate");
+  app.add_flag("--paused", o.paused, "start paused");
+  app.add_flag("--bind-pose", o.bind_pose, "show the bind pose instead of the clip");
+  app.add_flag("--cpu-skinning", o.cpu_skinning, "skin on the CPU with the runtime's skin_cpu (reference path)");
+  app.add_option("--crowd", o.crowd, "draw N instances with offset times, instanced")->check(CLI::Range(1u, 4096u));
+  app.add_flag("--wireframe", o.wireframe, "wireframe overlay");
+  app.add_flag("--skeleton", o.skeleton, "skeleton overlay");
+  app.add_flag("--no-grid", no_grid, "no ground grid");
+  app.add_option("--yaw", o.yaw_degrees, "camera yaw in degrees (0: from +Z)");
+  app.add_option("--pitch", o.pitch_degrees, "camera elevation in degrees")->check(CLI::Range(-89.0f, 89.0f));
+  app.add_option("--size", size, "window / image size, WxH (default 1280x720)");
+  app.add_option("--msaa", o.msaa, "multisampling (1: off)")->check(CLI::Range(1, 16));
+  app.add_option("--frames", o.frames, "headless: render N frames, 1/60 s apart, ending at --time")->check(CLI::Range(1, 100000));
+  app.add_option("--screenshot", o.screenshot, "headless: write the last frame to this PNG");
+  app.add_flag("--first-frame-time", o.first_frame_time, "print first-frame-ms once the first frame is finished");
+  app.add_flag("--stats", o.stats, "headless: print the average frame-time split");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return {std::nullopt, app.exit(e)};
+  }
+  if (!size.empty()) {
+    const auto wh = parse_size(size);
+    if (!wh) {
+      std::fprintf(stderr, "--size: expected WxH with both in 1..16384, got '%s'\n", size.c_str());
+      return {std::nullopt, 2};
+    }
+    o.width = wh->first;
+    o.height = wh->second;
+  }
+  o.grid = !no_grid;
+  if (!o.screenshot.empty() && o.frames == 0) o.frames = 1;
+  return {o, 0};
+}
+
+}  // namespace ossa::view

@@ -1,0 +1,55 @@
+// options.h — the ossa-view command line.
+//
+//   ossa-view FILE.ossa [MORE.ossa ...] [--clip NAME] [--time T] [--speed S] [--paused]
+//             [--bind-pose] [--cpu-skinning] [--crowd N] [--wireframe] [--skeleton] [--no-grid]
+//             [--yaw DEG] [--pitch DEG] [--size WxH] [--msaa N]
+//             [--frames N] [--screenshot OUT.png] [--first-frame-time] [--stats]
+//
+// With --frames or --screenshot the viewer runs headless (hidden window, offscreen framebuffer):
+// it renders N frames 1/60 s apart ending at --time, writes the last one as a PNG, and exits.
+// Parsing is separate from running so tests and the bench can build command lines with the same
+// names.
+#pragma once
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace ossa::view {
+
+struct ViewerOptions {
+  std::vector<std::string> files;
+  std::string clip;             // empty: the first clip
+  float time = 0.0f;            // clip time (s) of the captured frame / where playback starts
+  float speed = 1.0f;
+  bool paused = false;
+  bool bind_pose = false;
+  bool cpu_skinning = false;
+  unsigned crowd = 1;
+  bool wireframe = false;
+  bool skeleton = false;
+  bool grid = true;
+  float yaw_degrees = 30.0f;
+  float pitch_degrees = 10.0f;
+  int width = 1280;
+  int height = 720;
+  int msaa = 4;
+  int frames = 0;               // headless: frames to render (default 1 with --screenshot)
+  std::string screenshot;       // headless: PNG to write
+  bool first_frame_time = false;  // print "first-frame-ms X" once the first frame is finished
+  bool stats = false;           // headless: print the frame-time split
+
+  bool headless() const { return frames > 0 || !screenshot.empty(); }
+};
+
+/// The parsed options, or the exit status to end with right away (help printed: 0; a usage
+/// error printed with the usage: 2).
+struct ParsedOptions {
+  std::optional<ViewerOptions> options;
+  int exit_code = 0;
+};
+ParsedOptions parse_options(int argc, const char* const* argv);
+
+/// "640x480" -> (640, 480); nullopt unless both are in 1..16384.
+std::optional<std::pair<int, int>> parse_size(const std::string& text);
+
+}  // namespace ossa::view

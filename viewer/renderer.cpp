@@ -1,0 +1,394 @@
+// renderer.cpp — see renderer.h.
+#include "viewer/renderer.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+
+#include "runtime/skinning.h"
+#include "viewer/gl_util.h"
+#include "viewer/shader_sources.h"
+
+namespace ossa::view {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+
+const void* byte_offset(size_t offset) { return reinterpret_cast<const void*>(static_cast<uintptr_t>(offset)); }
+
+constexpr glm::vec4 kBackground{0.17f, 0.18f, 0.20f, 1.0f};
+constexpr glm::vec4 kBoneColor{1.0f, 0.85f, 0.2f, 1.0f};
+constexpr glm::vec4 kJointColor{1.0f, 0.35f, 0.15f, 1.0f};
+constexpr glm::vec4 kWireColor{0.05f, 0.05f, 0.08f, 1.0f};
+
+GLuint make_line_array(GLuint& buffer) {
+  GLuint vao = 0;
+  glGenVertexArrays(1, &vao);
+  glBindVertexArray(vao);
+  glGenBuffers(1, &buffer);
+  glBindBuffer(GL_ARRAY_BUFFER, buffer);
+  glEnableVertexAttribArray(0);
+  glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, sizeof(LineVertex), byte_offset(offsetof(LineVertex, position)));
+  glEnableVertexAttribArray(1);
+  glVertexAttribPointer(1, 4, GL_FLOAT, GL_FALSE, sizeof(LineVertex), byte_offset(offsetof(LineVertex, color)));
+  glBindVertexArray(0);
+  return vao;
+}
+
+void upload_lines(GLuint buffer, const std::vector<LineVertex>& v) {
+  glBindBuffer(GL_ARRAY_BUFFER, buffer);
+  glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(v.size() * sizeof(LineVertex)), v.data(), GL_STREAM_DRAW);
+}
+
+template <class T>
+void upload_stream(GLuint buffer, const std::vector<T>& v) {
+  glBindBuffer(GL_ARRAY_BUFFER, buffer);
+  glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(v.size() * sizeof(T)), v.data(), GL_STREAM_DRAW);
+}
+
+/// Binds the submesh's material to the mesh program.
+void bind_material(const Renderer& r, const GpuMaterial& m) {
+  const auto& u = r.mesh_uniforms;
+  glUniform3f(u.diffuse_color, m.diffuse.x, m.diffuse.y, m.diffuse.z);
+  glUniform1f(u.opacity, m.opacity);
+  const GLuint maps[] = {m.diffuse_map, m.normal_map, m.specular_map};
+  const GLint flags[] = {u.has_diffuse_map, u.has_normal_map, u.has_specular_map};
+  for (int i = 0; i < 3; ++i) {
+    glActiveTexture(GL_TEXTURE1 + static_cast<GLenum>(i));
+    glBindTexture(GL_TEXTURE_2D, maps[i]);
+    glUniform1i(flags[i], maps[i] != 0 ? 1 : 0);
+  }
+  glActiveTexture(GL_TEXTURE0);
+}
+
+/// Draws every submesh of `mesh` from the currently bound vertex array.
+void draw_submeshes(const Renderer& r, const MeshView& view, const GpuMesh& mesh, GLsizei instances, bool shaded) {
+  for (const fb::Submesh& s : view.submeshes()) {
+    if (shaded) bind_material(r, r.materials[std::min<size_t>(s.material(), r.materials.size() - 1)]);
+    glDrawElementsInstanced(GL_TRIANGLES, static_cast<GLsizei>(s.index_count()), mesh.index_type,
+                            byte_offset(static_cast<size_t>(s.first_index()) * mesh.index_size), instances);
+  }
+}
+
+void set_mesh_encoding(const Renderer& r, const GpuMesh& m, bool cpu_skinned) {
+  const auto& u = r.mesh_uniforms;
+  if (cpu_skinned) {  // skin_cpu wrote unit xyz normals and xyz + sign tangents, in world space
+    glUniform1i(u.normal_encoding, static_cast<int>(NormalEncoding::Xyz));
+    glUniform1i(u.tangent_encoding, static_cast<int>(m.has_tangents ? TangentEncoding::XyzSignW : TangentEncoding::None));
+    glUniform3f(u.direction_prescale, 1.0f, 1.0f, 1.0f);
+  } else {
+    glUniform1i(u.normal_encoding, static_cast<int>(m.normal_encoding));
+    glUniform1i(u.tangent_encoding, static_cast<int>(m.tangent_encoding));
+    glUniform3f(u.direction_prescale, m.direction_prescale.x, m.direction_prescale.y, m.direction_prescale.z);
+  }
+}
+
+/// Bones (joint to parent) and joints of every instance.
+void build_skeleton_lines(Renderer& r, const Scene& scene, const Animator& animator, std::span<const glm::vec3> offsets,
+                          size_t& bone_vertices) {
+  r.lines.clear();
+  const auto parents = scene.skeleton().parents();
+  for (size_t i = 0; i < animator.instances.size(); ++i) {
+    const auto& model = animator.instances[i].model;
+    const glm::vec3 o = i < offsets.size() ? offsets[i] : glm::vec3(0.0f);
+    for (size_t j = 0; j < model.size() && j < parents.size(); ++j) {
+      if (parents[j] < 0) continue;
+      r.lines.push_back({glm::vec3(model[static_cast<size_t>(parents[j])][3]) + o, kBoneColor});
+      r.lines.push_back({glm::vec3(model[j][3]) + o, kBoneColor});
+    }
+  }
+  bone_vertices = r.lines.size();
+  for (size_t i = 0; i < animator.instances.size(); ++i) {
+    const glm::vec3 o = i < offsets.size() ? offsets[i] : glm::vec3(0.0f);
+    for (const glm::mat4& m : animator.instances[i].model) r.lines.push_back({glm::vec3(m[3]) + o, kJointColor});
+  }
+}
+
+}  // namespace
+
+Result<Renderer> create_renderer() {
+  Renderer r;
+  Result<GLuint> mesh = build_program("skinned.vert.glsl + phong.frag.glsl", shaders::kSkinnedVert, shaders::kPhongFrag);
+  if (!mesh) return mesh.error();
+  r.mesh_program = *mesh;
+  Result<GLuint> lines = build_program("lines.vert.glsl + lines.frag.glsl", shaders::kLinesVert, shaders::kLinesFrag);
+  if (!lines) {
+    glDeleteProgram(r.mesh_program);
+    return lines.error();
+  }
+  r.line_program = *lines;
+
+  auto& u = r.mesh_uniforms;
+  const GLuint p = r.mesh_program;
+  u.palette = glGetUniformLocation(p, "u_palette");
+  u.palette_base = glGetUniformLocation(p, "u_palette_base");
+  u.instance_texels = glGetUniformLocation(p, "u_instance_texels");
+  u.normal_encoding = glGetUniformLocation(p, "u_normal_encoding");
+  u.tangent_encoding = glGetUniformLocation(p, "u_tangent_encoding");
+  u.direction_prescale = glGetUniformLocation(p, "u_direction_prescale");
+  u.view_projection = glGetUniformLocation(p, "u_view_projection");
+  u.camera_position = glGetUniformLocation(p, "u_camera_position");
+  u.light_direction = glGetUniformLocation(p, "u_light_direction");
+  u.diffuse_color = glGetUniformLocation(p, "u_diffuse_color");
+  u.opacity = glGetUniformLocation(p, "u_opacity");
+  u.diffuse_map = glGetUniformLocation(p, "u_diffuse_map");
+  u.normal_map = glGetUniformLocation(p, "u_normal_map");
+  u.specular_map = glGetUniformLocation(p, "u_specular_map");
+  u.has_diffuse_map = glGetUniformLocation(p, "u_has_diffuse_map");
+  u.has_normal_map = glGetUniformLocation(p, "u_has_normal_map");
+  u.has_specular_map = glGetUniformLocation(p, "u_has_specular_map");
+  u.flat_color = glGetUniformLocation(p, "u_flat_color");
+  r.line_uniforms.view_projection = glGetUniformLocation(r.line_program, "u_view_projection");
+  r.line_uniforms.point_size = glGetUniformLocation(r.line_program, "u_point_size");
+
+  // Texture units: 0 palette, 1 diffuse, 2 normal, 3 specular.
+  glUseProgram(p);
+  glUniform1i(u.palette, 0);
+  glUniform1i(u.diffuse_map, 1);
+  glUniform1i(u.normal_map, 2);
+  glUniform1i(u.specular_map, 3);
+  glUseProgram(0);
+
+  glGenBuffers(1, &r.palette_buffer);
+  glBindBuffer(GL_TEXTURE_BUFFER, r.palette_buffer);
+  glBufferData(GL_TEXTURE_BUFFER, sizeof(glm::mat4), nullptr, GL_STREAM_DRAW);
+  glGenTextures(1, &r.palette_texture);
+  glBindTexture(GL_TEXTURE_BUFFER, r.palette_texture);
+  glTexBuffer(GL_TEXTURE_BUFFER, GL_RGBA32F, r.palette_buffer);
+  glBindTexture(GL_TEXTURE_BUFFER, 0);
+  glGetIntegerv(GL_MAX_TEXTURE_BUFFER_SIZE, &r.max_texels);
+
+  r.lines_vao = make_line_array(r.lines_buffer);
+  r.grid_vao = make_line_array(r.grid_buffer);
+  glGenQueries(2, r.timer_queries);
+  if (Status s = check_gl("creating the renderer"); !s) {
+    destroy_renderer(r);
+    return s.error();
+  }
+  return r;
+}
+
+void release_scene(Renderer& r) {
+  for (GpuMesh& m : r.meshes) destroy_gpu_mesh(m);
+  r.meshes.clear();
+  destroy_materials(r.materials);
+  r.bind.clear();
+  r.palette_base.clear();
+  r.instance_matrices = 0;
+}
+
+void destroy_renderer(Renderer& r) {
+  release_scene(r);
+  if (r.mesh_program) glDeleteProgram(r.mesh_program);
+  if (r.line_program) glDeleteProgram(r.line_program);
+  const GLuint buffers[] = {r.palette_buffer, r.lines_buffer, r.grid_buffer};
+  for (GLuint b : buffers) {
+    if (b) glDeleteBuffers(1, &b);
+  }
+  if (r.palette_texture) glDeleteTextures(1, &r.palette_texture);
+  const GLuint arrays[] = {r.lines_vao, r.grid_vao};
+  for (GLuint a : arrays) {
+    if (a) glDeleteVertexArrays(1, &a);
+  }
+  if (r.timer_queries[0]) glDeleteQueries(2, r.timer_queries);
+  r = Renderer{};
+}
+
+Status upload_scene(Renderer& r, const Scene& scene, std::vector<std::string>& warnings) {
+  release_scene(r);
+  const Asset& asset = scene.character();
+  const std::string& path = scene.paths.front();
+  for (size_t i = 0; i < asset.mesh_count(); ++i) {
+    const MeshView view = asset.mesh(i);
+    Result<GpuMesh> g = create_gpu_mesh(view, path);
+    if (!g) {
+      release_scene(r);
+      return g.error();
+    }
+    r.palette_base.push_back(r.instance_matrices);
+    r.instance_matrices += g->palette_slots;
+    std::vector<glm::mat4> bind(g->palette_slots);
+    prepare_bind_matrices(view, bind);
+    r.bind.push_back(std::move(bind));
+    r.meshes.push_back(*g);
+  }
+  r.materials = create_materials(asset, path, warnings);
+  return check_gl("uploading " + path);
+}
+
+void set_grid(Renderer& r, const Box& area, float ground, float character_radius) {
+  const float cell = 0.5f * std::pow(10.0f, std::round(std::log10(std::max(character_radius, 1e-6f))));
+  const glm::vec3 c = area.empty() ? glm::vec3(0.0f) : area.centre();
+  const float half_extent = std::max(5.0f * character_radius, area.empty() ? 0.0f : 0.75f * std::max(area.size().x, area.size().z));
+  const int n = std::clamp(static_cast<int>(std::ceil(half_extent / cell)), 1, 200);
+  const float x0 = std::round(c.x / cell) * cell, z0 = std::round(c.z / cell) * cell;
+  std::vector<LineVertex> v;
+  const glm::vec4 minor{0.32f, 0.33f, 0.36f, 1.0f}, major{0.45f, 0.46f, 0.50f, 1.0f};
+  for (int k = -n; k <= n; ++k) {
+    const glm::vec4 col = (k % 5 == 0) ? major : minor;
+    const float x = x0 + static_cast<float>(k) * cell, z = z0 + static_cast<float>(k) * cell;
+    const float e = static_cast<float>(n) * cell;
+    v.push_back({{x, ground, z0 - e}, col});
+    v.push_back({{x, ground, z0 + e}, col});
+    v.push_back({{x0 - e, ground, z}, col});
+    v.push_back({{x0 + e, ground, z}, col});
+  }
+  glBindBuffer(GL_ARRAY_BUFFER, r.grid_buffer);
+  glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(v.size() * sizeof(LineVertex)), v.data(), GL_STATIC_DRAW);
+  r.grid_vertices = static_cast<GLsizei>(v.size());
+}
+
+Status render_frame(Renderer& r, const Scene& scene, const Animator& animator, std::span<const glm::vec3> offsets,
+                    const OrbitCamera& camera, const ViewToggles& toggles, int width, int height,
+                    FrameTimings& timings) {
+  const Asset& asset = scene.character();
+  const size_t instances = animator.instances.size();
+
+  // ---- skin: palettes of every instance and mesh, one upload.
+  auto t_skin = Clock::now();
+  const size_t matrices = instances * r.instance_matrices + 1;
+  if (matrices * 4 > static_cast<size_t>(r.max_texels)) {
+    return Error{scene.paths.front() + ": " + std::to_string(instances) + " instances x " +
+                 std::to_string(r.instance_matrices) + " palette matrices exceed this GL's texture buffer (" +
+                 std::to_string(r.max_texels / 4) + " matrices)"};
+  }
+  r.palette.resize(matrices);
+  for (size_t i = 0; i < instances; ++i) {
+    const auto& model = animator.instances[i].model;
+    const glm::vec3 o = i < offsets.size() ? offsets[i] : glm::vec3(0.0f);
+    for (size_t m = 0; m < r.meshes.size(); ++m) {
+      const std::span<glm::mat4> out(r.palette.data() + i * r.instance_matrices + r.palette_base[m], r.meshes[m].palette_slots);
+      skinning_matrices(asset.mesh(m).joints(), r.bind[m], model, out);
+      for (glm::mat4& p : out) p[3] += glm::vec4(o * p[3].w, 0.0f);  // translate(o) * p
+    }
+  }
+  r.palette.back() = glm::mat4(1.0f);
+  glBindBuffer(GL_TEXTURE_BUFFER, r.palette_buffer);
+  glBufferData(GL_TEXTURE_BUFFER, static_cast<GLsizeiptr>(r.palette.size() * sizeof(glm::mat4)), r.palette.data(),
+               GL_STREAM_DRAW);
+  timings.skin_ms += ms_since(t_skin);
+
+  // ---- draw
+  const auto t_draw = Clock::now();
+  double cpu_skin_ms = 0.0;
+  const unsigned slot = r.frame_index++ & 1u;
+  if (r.timer_pending[slot]) {
+    GLuint64 ns = 0;
+    glGetQueryObjectui64v(r.timer_queries[slot], GL_QUERY_RESULT, &ns);
+    timings.gpu_ms += static_cast<double>(ns) * 1e-6;
+    r.timer_pending[slot] = false;
+  }
+  glBeginQuery(GL_TIME_ELAPSED, r.timer_queries[slot]);
+
+  glViewport(0, 0, width, height);
+  glClearColor(kBackground.r, kBackground.g, kBackground.b, kBackground.a);
+  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_LESS);
+  glDisable(GL_CULL_FACE);
+  glEnable(GL_BLEND);
+  glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+
+  const float aspect = height > 0 ? static_cast<float>(width) / static_cast<float>(height) : 1.0f;
+  const glm::mat4 view_projection = projection_matrix(camera, aspect) * view_matrix(camera);
+  const glm::vec3 eye = eye_position(camera);
+  const glm::mat4 v = view_matrix(camera);
+  const glm::vec3 right(v[0][0], v[1][0], v[2][0]), up(v[0][1], v[1][1], v[2][1]), back(v[0][2], v[1][2], v[2][2]);
+  const glm::vec3 light = glm::normalize(back + 0.8f * up + 0.4f * right);  // from above, behind the camera
+
+  if (toggles.grid && r.grid_vertices > 0) {
+    glUseProgram(r.line_program);
+    glUniformMatrix4fv(r.line_uniforms.view_projection, 1, GL_FALSE, &view_projection[0][0]);
+    glBindVertexArray(r.grid_vao);
+    glDrawArrays(GL_LINES, 0, r.grid_vertices);
+  }
+
+  glUseProgram(r.mesh_program);
+  const auto& u = r.mesh_uniforms;
+  glUniformMatrix4fv(u.view_projection, 1, GL_FALSE, &view_projection[0][0]);
+  glUniform3f(u.camera_position, eye.x, eye.y, eye.z);
+  glUniform3f(u.light_direction, light.x, light.y, light.z);
+  glActiveTexture(GL_TEXTURE0);
+  glBindTexture(GL_TEXTURE_BUFFER, r.palette_texture);
+  set_default_attributes();
+
+  const int passes = toggles.wireframe ? 2 : 1;
+  for (int pass = 0; pass < passes; ++pass) {
+    const bool shaded = pass == 0;
+    if (shaded) {
+      glUniform4f(u.flat_color, 0.0f, 0.0f, 0.0f, 0.0f);
+      if (toggles.wireframe) {
+        glEnable(GL_POLYGON_OFFSET_FILL);
+        glPolygonOffset(1.0f, 1.0f);
+      }
+    } else {
+      glDisable(GL_POLYGON_OFFSET_FILL);
+      glPolygonMode(GL_FRONT_AND_BACK, GL_LINE);
+      glUniform4f(u.flat_color, kWireColor.r, kWireColor.g, kWireColor.b, kWireColor.a);
+    }
+    if (!toggles.cpu_skinning) {
+      glUniform1i(u.instance_texels, static_cast<GLint>(4 * r.instance_matrices));
+      for (size_t m = 0; m < r.meshes.size(); ++m) {
+        set_mesh_encoding(r, r.meshes[m], false);
+        glUniform1i(u.palette_base, static_cast<GLint>(4 * r.palette_base[m]));
+        glBindVertexArray(r.meshes[m].vao);
+        draw_submeshes(r, asset.mesh(m), r.meshes[m], static_cast<GLsizei>(instances), shaded);
+      }
+    } else {
+      // Reference path: skin_cpu per instance and mesh, drawn with the identity palette entry.
+      glUniform1i(u.instance_texels, 0);
+      glUniform1i(u.palette_base, static_cast<GLint>(4 * (matrices - 1)));
+      for (size_t i = 0; i < instances; ++i) {
+        for (size_t m = 0; m < r.meshes.size(); ++m) {
+          const GpuMesh& g = r.meshes[m];
+          const MeshView view = asset.mesh(m);
+          const auto t0 = Clock::now();
+          const size_t n = view.vertex_count();
+          r.skinned_positions.resize(3 * n);
+          r.skinned_normals.resize(g.has_normals ? 3 * n : 0);
+          r.skinned_tangents.resize(g.has_tangents ? 4 * n : 0);
+          const std::span<const glm::mat4> palette(r.palette.data() + i * r.instance_matrices + r.palette_base[m], g.palette_slots);
+          skin_cpu(view, palette, SkinningMethod::Linear, {r.skinned_positions, r.skinned_normals, r.skinned_tangents});
+          upload_stream(g.cpu_positions, r.skinned_positions);
+          if (g.has_normals) upload_stream(g.cpu_normals, r.skinned_normals);
+          if (g.has_tangents) upload_stream(g.cpu_tangents, r.skinned_tangents);
+          cpu_skin_ms += ms_since(t0);
+          set_mesh_encoding(r, g, true);
+          glBindVertexArray(g.cpu_vao);
+          draw_submeshes(r, view, g, 1, shaded);
+        }
+      }
+    }
+  }
+  glPolygonMode(GL_FRONT_AND_BACK, GL_FILL);
+  glDisable(GL_POLYGON_OFFSET_FILL);
+
+  if (toggles.skeleton && scene.joint_count() > 0) {
+    size_t bone_vertices = 0;
+    build_skeleton_lines(r, scene, animator, offsets, bone_vertices);
+    upload_lines(r.lines_buffer, r.lines);
+    glDisable(GL_DEPTH_TEST);  // the skeleton is inside the mesh: draw it on top
+    glUseProgram(r.line_program);
+    glUniformMatrix4fv(r.line_uniforms.view_projection, 1, GL_FALSE, &view_projection[0][0]);
+    glUniform1f(r.line_uniforms.point_size, 6.0f);
+    glEnable(GL_PROGRAM_POINT_SIZE);
+    glBindVertexArray(r.lines_vao);
+    glDrawArrays(GL_LINES, 0, static_cast<GLsizei>(bone_vertices));
+    glDrawArrays(GL_POINTS, static_cast<GLint>(bone_vertices), static_cast<GLsizei>(r.lines.size() - bone_vertices));
+    glDisable(GL_PROGRAM_POINT_SIZE);
+    glEnable(GL_DEPTH_TEST);
+  }
+  glBindVertexArray(0);
+  glUseProgram(0);
+  glEndQuery(GL_TIME_ELAPSED);
+  r.timer_pending[slot] = true;
+
+  timings.skin_ms += cpu_skin_ms;
+  timings.draw_ms += ms_since(t_draw) - cpu_skin_ms;
+  return {};
+}
+
+}  // namespace ossa::view

@@ -1,0 +1,98 @@
+// renderer.h — draws a scene: skinned meshes (GPU or CPU skinning), skeleton overlay, grid.
+//
+// Per frame the CPU work is per joint, never per vertex (on the GPU path): each instance's model
+// matrices become palettes (runtime/skinning.h, with the bind matrices prepared once per mesh),
+// the palettes of every instance and mesh go into one texture buffer, and each submesh is drawn
+// once for all instances with glDrawElementsInstanced. The --cpu-skinning path instead runs
+// skin_cpu per instance and streams the skinned floats into the mesh's CPU vertex array; it draws
+// through the same shader with an identity palette, so the two paths differ only in who skins.
+#pragma once
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "format/result.h"
+#include "viewer/animation.h"
+#include "viewer/bounds.h"
+#include "viewer/camera.h"
+#include "viewer/gpu_mesh.h"
+#include "viewer/materials.h"
+#include "viewer/scene.h"
+
+namespace ossa::view {
+
+struct ViewToggles {
+  bool wireframe = false;
+  bool skeleton = false;
+  bool grid = true;
+  bool cpu_skinning = false;
+};
+
+/// Milliseconds spent in each stage of a frame (CPU time; gpu_ms from a timer query, a frame
+/// late, 0 until available).
+struct FrameTimings {
+  double sample_ms = 0, blend_ms = 0, skin_ms = 0, draw_ms = 0, gpu_ms = 0;
+};
+
+struct LineVertex {
+  glm::vec3 position;
+  glm::vec4 color;
+};
+
+struct Renderer {
+  GLuint mesh_program = 0, line_program = 0;
+  struct {
+    GLint palette, palette_base, instance_texels, normal_encoding, tangent_encoding, direction_prescale,
+        view_projection, camera_position, light_direction, diffuse_color, opacity, diffuse_map, normal_map,
+        specular_map, has_diffuse_map, has_normal_map, has_specular_map, flat_color;
+  } mesh_uniforms{};
+  struct {
+    GLint view_projection, point_size;
+  } line_uniforms{};
+
+  // Palette texture buffer: RGBA32F, 4 texels per matrix; one identity matrix at the end serves
+  // the CPU-skinning path.
+  GLuint palette_buffer = 0, palette_texture = 0;
+  GLint max_texels = 0;
+  GLuint lines_vao = 0, lines_buffer = 0, grid_vao = 0, grid_buffer = 0;
+  GLsizei grid_vertices = 0;
+  GLuint timer_queries[2] = {0, 0};
+  bool timer_pending[2] = {false, false};
+  unsigned frame_index = 0;
+
+  // The scene on the GPU.
+  std::vector<GpuMesh> meshes;
+  std::vector<GpuMaterial> materials;
+  std::vector<std::vector<glm::mat4>> bind;  // prepare_bind_matrices, per mesh
+  std::vector<uint32_t> palette_base;        // first matrix of each mesh's palette in an instance
+  uint32_t instance_matrices = 0;            // matrices per instance (all meshes)
+
+  // Per-frame scratch, sized once.
+  std::vector<glm::mat4> palette;
+  std::vector<float> skinned_positions, skinned_normals, skinned_tangents;
+  std::vector<LineVertex> lines;
+};
+
+/// Programs, the palette texture buffer, line buffers, timer queries. Errors carry the shader log.
+Result<Renderer> create_renderer();
+void destroy_renderer(Renderer& r);
+
+/// Uploads the character's meshes (their file bytes as they are) and materials, prepares bind
+/// matrices. `warnings` receives textures left out. Replaces any previous scene.
+Status upload_scene(Renderer& r, const Scene& scene, std::vector<std::string>& warnings);
+void release_scene(Renderer& r);
+
+/// A ground grid under `area` at height `ground`, cells sized to the character.
+void set_grid(Renderer& r, const Box& area, float ground, float character_radius);
+
+/// Draws one frame into the bound framebuffer (viewport width x height). `offsets` places each
+/// instance (crowd); the animator's model matrices must be current. Adds skin/draw timings.
+/// Errors: too many instances x joints for the palette buffer.
+Status render_frame(Renderer& r, const Scene& scene, const Animator& animator, std::span<const glm::vec3> offsets,
+                    const OrbitCamera& camera, const ViewToggles& toggles, int width, int height,
+                    FrameTimings& timings);
+
+}  // namespace ossa::view

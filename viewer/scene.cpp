@@ -1,0 +1,87 @@
+// scene.cpp — see scene.h.
+#include "viewer/scene.h"
+
+#include <filesystem>
+#include <utility>
+
+namespace ossa::view {
+namespace {
+
+/// Appends `asset`'s clips to the scene after checking each binds to the character's skeleton.
+Status add_clips(Scene& scene, Asset asset, const std::string& path, bool is_character) {
+  const SkeletonView skeleton = scene.assets.empty() ? asset.skeleton() : scene.skeleton();
+  std::vector<SceneClip> added;
+  for (size_t c = 0; c < asset.clip_count(); ++c) {
+    const ClipView clip = asset.clip(c);
+    if (Status s = check_clip_binding(clip, skeleton, path); !s) {
+      return Error{s.message() + (is_character ? "" : " (clips added to a character must be cooked for its skeleton)")};
+    }
+    SceneClip entry{clip, scene.assets.size(), std::string(clip.name())};
+    if (!is_character) entry.label += " (" + std::filesystem::path(path).filename().string() + ")";
+    added.push_back(std::move(entry));
+  }
+  if (!is_character && added.empty()) return Error{path + ": no clips to add"};
+  scene.assets.push_back(std::move(asset));
+  scene.paths.push_back(path);
+  scene.clips.insert(scene.clips.end(), added.begin(), added.end());
+  return {};
+}
+
+}  // namespace
+
+Result<Scene> load_scene(std::span<const std::string> paths) {
+  if (paths.empty()) return Error{"no .ossa file given"};
+  std::vector<Asset> opened;
+  size_t character = paths.size();
+  for (size_t i = 0; i < paths.size(); ++i) {
+    Result<Asset> a = Asset::open(paths[i]);
+    if (!a) return a.error();
+    if (character == paths.size() && a->mesh_count() > 0) character = i;
+    opened.push_back(std::move(*a));
+  }
+  if (character == paths.size()) {
+    return Error{paths.size() == 1 ? paths[0] + ": has no mesh to show (a clip-only file needs its character: "
+                                                "ossa-view CHARACTER.ossa " + paths[0] + ")"
+                                   : paths[0] + " and the other files given: none has a mesh to show"};
+  }
+  Scene scene;
+  if (Status s = add_clips(scene, std::move(opened[character]), paths[character], true); !s) return s.error();
+  for (size_t i = 0; i < paths.size(); ++i) {
+    if (i == character) continue;
+    if (Status s = add_clips(scene, std::move(opened[i]), paths[i], false); !s) return s.error();
+  }
+  return scene;
+}
+
+Status add_clip_file(Scene& scene, const std::string& path) {
+  Result<Asset> a = Asset::open(path);
+  if (!a) return a.error();
+  return add_clips(scene, std::move(*a), path, false);
+}
+
+Result<bool> file_has_mesh(const std::string& path) {
+  Result<Asset> a = Asset::open(path);
+  if (!a) return a.error();
+  return a->mesh_count() > 0;
+}
+
+int find_clip(const Scene& scene, std::string_view name) {
+  for (size_t i = 0; i < scene.clips.size(); ++i) {
+    if (scene.clips[i].clip.name() == name || scene.clips[i].label == name) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+SceneCounts count(const Scene& scene) {
+  SceneCounts c;
+  const Asset& a = scene.character();
+  c.meshes = a.mesh_count();
+  c.joints = scene.joint_count();
+  for (size_t m = 0; m < a.mesh_count(); ++m) {
+    c.vertices += a.mesh(m).vertex_count();
+    c.triangles += a.mesh(m).index_count() / 3;
+  }
+  return c;
+}
+
+}  // namespace ossa::view

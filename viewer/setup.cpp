@@ -1,0 +1,39 @@
+// setup.cpp — see setup.h.
+#include "viewer/setup.h"
+
+#include <cstdio>
+#include <utility>
+
+#include <glm/gtc/constants.hpp>
+
+namespace ossa::view {
+
+Status setup_app(App& app, Scene scene, const ViewerOptions& o, float aspect) {
+  const std::string name = o.files.front();
+  app.angles.yaw = glm::radians(o.yaw_degrees);
+  app.angles.pitch = glm::radians(o.pitch_degrees);
+  app.toggles.cpu_skinning = o.cpu_skinning;
+  app.toggles.wireframe = o.wireframe;
+  app.toggles.skeleton = o.skeleton;
+  app.toggles.grid = o.grid;
+  if (Status s = open_loaded_scene(app, std::move(scene), o.crowd, aspect); !s) return s;
+  for (const std::string& w : app.messages) std::fprintf(stderr, "ossa-view: warning: %s\n", w.c_str());
+
+  if (!o.clip.empty()) {
+    const int c = find_clip(app.scene, o.clip);
+    if (c < 0) {
+      std::string names;
+      for (const SceneClip& sc : app.scene.clips) names += (names.empty() ? "'" : ", '") + sc.label + "'";
+      return Error{name + ": no clip named '" + o.clip + "' (clips: " + (names.empty() ? "none" : names) + ")"};
+    }
+    if (Status s = play_clip(app, c, false); !s) return s;
+  }
+  Playback& p = app.animator.playback;
+  p.bind_pose = o.bind_pose;
+  p.speed = o.speed;
+  p.playing = !o.paused;
+  set_time(app.scene, app.animator, o.time);
+  return {};
+}
+
+}  // namespace ossa::view

@@ -1,0 +1,14 @@
+// setup.h — turning command-line options into a running App, the same way for both front ends.
+#pragma once
+#include "format/result.h"
+#include "viewer/app.h"
+#include "viewer/options.h"
+
+namespace ossa::view {
+
+/// Applies the view options (camera angles, toggles), opens `scene` into `app` (whose renderer
+/// must exist) and starts playback as asked: --clip (an error lists the clips when the name is
+/// unknown), --time, --speed, --paused, --bind-pose. Warnings (textures left out) go to stderr.
+Status setup_app(App& app, Scene scene, const ViewerOptions& options, float aspect);
+
+}  // namespace ossa::view
