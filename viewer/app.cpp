@@ -12,11 +12,12 @@ std::vector<glm::vec3> crowd_offsets(size_t n, const Box& one) {
   std::vector<glm::vec3> out;
   const auto columns = static_cast<size_t>(std::ceil(std::sqrt(static_cast<double>(n))));
   const glm::vec3 size = one.empty() ? glm::vec3(1.0f) : one.size();
-  const float spacing = 1.25f * std::max(std::max(size.x, size.z), 0.35f * size.y);
+  const float spacing_x = 1.25f * std::max(size.x, 0.6f * size.y);
+  const float spacing_z = 1.25f * std::max(size.z, 0.6f * size.y);
   const size_t rows = (n + columns - 1) / columns;
   for (size_t i = 0; i < n; ++i) {
-    const float x = (static_cast<float>(i % columns) - 0.5f * static_cast<float>(columns - 1)) * spacing;
-    const float z = (static_cast<float>(i / columns) - 0.5f * static_cast<float>(rows - 1)) * spacing;
+    const float x = (static_cast<float>(i % columns) - 0.5f * static_cast<float>(columns - 1)) * spacing_x;
+    const float z = (static_cast<float>(i / columns) - 0.5f * static_cast<float>(rows - 1)) * spacing_z;
     out.emplace_back(n == 1 ? 0.0f : x, 0.0f, n == 1 ? 0.0f : -z);
   }
   return out;

@@ -24,14 +24,29 @@ OrbitCamera frame_box(const Box& box, float yaw, float pitch, float aspect) {
   OrbitCamera c;
   c.yaw = yaw;
   c.pitch = std::clamp(pitch, -kMaxPitch, kMaxPitch);
-  if (!box.empty()) {
-    c.target = box.centre();
-    c.radius = std::max(glm::length(box.size()) * 0.5f, 1e-4f);
+  if (box.empty()) {
+    c.distance = 3.0f;
+    fit_planes(c);
+    return c;
   }
-  // The narrower of the two fields of view decides; the sphere must fit inside it.
-  const float fov_x = 2.0f * std::atan(std::tan(c.fov_y * 0.5f) * aspect);
-  const float fov = std::min(c.fov_y, fov_x);
-  c.distance = 1.1f * c.radius / std::sin(fov * 0.5f);
+  c.target = box.centre();
+  c.radius = std::max(glm::length(box.size()) * 0.5f, 1e-4f);
+  // The nearest distance at which every corner of the box projects inside the view: a corner at
+  // (x right, y up, z towards the eye) from the target is inside when |x| <= (d - z) tan(fov_x / 2)
+  // and |y| <= (d - z) tan(fov_y / 2). Tighter than the bounding sphere for long or flat boxes.
+  c.distance = 1.0f;
+  const glm::mat4 v = view_matrix(c);
+  const glm::vec3 right(v[0][0], v[1][0], v[2][0]), up(v[0][1], v[1][1], v[2][1]), back(v[0][2], v[1][2], v[2][2]);
+  const float tan_y = std::tan(c.fov_y * 0.5f), tan_x = tan_y * aspect;
+  float d = 0.0f;
+  for (int corner = 0; corner < 8; ++corner) {
+    const glm::vec3 p((corner & 1) ? box.max.x : box.min.x, (corner & 2) ? box.max.y : box.min.y,
+                      (corner & 4) ? box.max.z : box.min.z);
+    const glm::vec3 q = p - c.target;
+    const float z = glm::dot(q, back);
+    d = std::max({d, z + std::fabs(glm::dot(q, right)) / tan_x, z + std::fabs(glm::dot(q, up)) / tan_y});
+  }
+  c.distance = std::max(1.08f * d, 0.1f * c.radius);  // a small margin around the silhouette
   fit_planes(c);
   return c;
 }

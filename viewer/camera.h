@@ -22,8 +22,9 @@ struct OrbitCamera {
   float far_plane = 100.0f;
 };
 
-/// A camera at (yaw, pitch) that fits `box` (its bounding sphere, with a 10 % margin) into a view
-/// of the given aspect ratio (width / height). Near and far planes follow the distance.
+/// A camera at (yaw, pitch) looking at the centre of `box` from the nearest distance at which all
+/// eight corners are in view (8 % margin), for the given aspect ratio (width / height). Near and
+/// far planes follow the distance.
 OrbitCamera frame_box(const Box& box, float yaw, float pitch, float aspect);
 
 glm::vec3 eye_position(const OrbitCamera& camera);

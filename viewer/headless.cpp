@@ -5,12 +5,11 @@
 #include <cstdio>
 #include <string>
 
-#include <stb_image_write.h>
-
 #include "viewer/app.h"
 #include "viewer/gl_util.h"
 #include "viewer/offscreen.h"
 #include "viewer/setup.h"
+#include "viewer/snapshot.h"
 #include "viewer/window.h"
 
 namespace ossa::view {
@@ -72,10 +71,7 @@ Status render_headless(const ViewerOptions& o) {
   if (!o.screenshot.empty()) {
     const std::vector<uint8_t> rgb = read_rgb(*target);
     if (Status s = check_gl("reading the image back"); !s) return Error{name + ": " + s.message()};
-    stbi_flip_vertically_on_write(1);
-    if (stbi_write_png(o.screenshot.c_str(), o.width, o.height, 3, rgb.data(), o.width * 3) == 0) {
-      return Error{o.screenshot + ": cannot write the PNG"};
-    }
+    if (Status s = write_png(o.screenshot, o.width, o.height, rgb); !s) return s;
   }
   if (o.stats) {
     const double n = o.frames;

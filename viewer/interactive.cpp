@@ -18,6 +18,7 @@
 #include "viewer/app.h"
 #include "viewer/gl_util.h"
 #include "viewer/setup.h"
+#include "viewer/snapshot.h"
 #include "viewer/ui.h"
 #include "viewer/window.h"
 
@@ -137,7 +138,8 @@ int run_interactive(const ViewerOptions& o) {
 
   UiState ui;
   auto last = std::chrono::steady_clock::now();
-  while (!glfwWindowShouldClose(w)) {
+  int status = 0;
+  for (int frame = 1; !glfwWindowShouldClose(w); ++frame) {
     glfwPollEvents();
     glfwGetFramebufferSize(w, &fb_width, &fb_height);
     if (fb_width <= 0 || fb_height <= 0) {  // minimized
@@ -168,6 +170,17 @@ int run_interactive(const ViewerOptions& o) {
     record_frame(ui, timings, frame_ms);
     ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
     if (Status s = check_gl("drawing a frame"); !s) ui.status = s.message();
+    if (frame == o.window_frames) {  // automation: capture the window, panel included, and stop
+      if (!o.screenshot.empty()) {
+        glReadBuffer(GL_BACK);
+        if (Status s = write_png(o.screenshot, fb_width, fb_height, read_framebuffer_rgb(fb_width, fb_height)); !s) {
+          status = fail(s.message());
+        }
+      }
+      if (Status s = check_gl("the window frames"); !s) status = fail(o.files.front() + ": " + s.message());
+      if (!ui.status.empty()) status = fail(ui.status);
+      glfwSetWindowShouldClose(w, GLFW_TRUE);
+    }
     glfwSwapBuffers(w);
   }
 
@@ -175,7 +188,7 @@ int run_interactive(const ViewerOptions& o) {
   ImGui_ImplGlfw_Shutdown();
   ImGui::DestroyContext();
   destroy_renderer(app.renderer);
-  return 0;
+  return status;
 }
 
 }  // namespace ossa::view

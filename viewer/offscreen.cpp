@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <string>
 
+#include "viewer/snapshot.h"
+
 namespace ossa::view {
 namespace {
 
@@ -83,10 +85,8 @@ std::vector<uint8_t> read_rgb(const Offscreen& o) {
     glBlitFramebuffer(0, 0, o.width, o.height, 0, 0, o.width, o.height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
     source = o.resolve_fbo;
   }
-  std::vector<uint8_t> pixels(static_cast<size_t>(o.width) * static_cast<size_t>(o.height) * 3);
   glBindFramebuffer(GL_READ_FRAMEBUFFER, source);
-  glPixelStorei(GL_PACK_ALIGNMENT, 1);
-  glReadPixels(0, 0, o.width, o.height, GL_RGB, GL_UNSIGNED_BYTE, pixels.data());
+  std::vector<uint8_t> pixels = read_framebuffer_rgb(o.width, o.height);
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
   return pixels;
 }

@@ -45,10 +45,13 @@ ParsedOptions parse_options(int argc, const char* const* argv) {
   app.add_option("--screenshot", o.screenshot, "headless: write the last frame to this PNG");
   app.add_flag("--first-frame-time", o.first_frame_time, "print first-frame-ms once the first frame is finished");
   app.add_flag("--stats", o.stats, "headless: print the average frame-time split");
+  app.add_option("--window-frames", o.window_frames, "window mode: exit after N frames (--screenshot captures the window)")
+      ->check(CLI::Range(1, 1000000));
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return {std::nullopt, app.exit(e)};
+    const int code = app.exit(e);  // prints the help, or the error and a hint
+    return {std::nullopt, code == 0 ? 0 : 2};  // one usage-error status, as ossa-cook documents
   }
   if (!size.empty()) {
     const auto wh = parse_size(size);
@@ -60,7 +63,7 @@ ParsedOptions parse_options(int argc, const char* const* argv) {
     o.height = wh->second;
   }
   o.grid = !no_grid;
-  if (!o.screenshot.empty() && o.frames == 0) o.frames = 1;
+  if (!o.screenshot.empty() && o.frames == 0 && o.window_frames == 0) o.frames = 1;
   return {o, 0};
 }
 

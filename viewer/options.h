@@ -4,9 +4,12 @@
 //             [--bind-pose] [--cpu-skinning] [--crowd N] [--wireframe] [--skeleton] [--no-grid]
 //             [--yaw DEG] [--pitch DEG] [--size WxH] [--msaa N]
 //             [--frames N] [--screenshot OUT.png] [--first-frame-time] [--stats]
+//             [--window-frames N]
 //
 // With --frames or --screenshot the viewer runs headless (hidden window, offscreen framebuffer):
 // it renders N frames 1/60 s apart ending at --time, writes the last one as a PNG, and exits.
+// --window-frames N runs the window mode (panel included) for N frames and exits, writing the
+// window's last frame to --screenshot if given: how the interactive path is tested.
 // Parsing is separate from running so tests and the bench can build command lines with the same
 // names.
 #pragma once
@@ -35,10 +38,11 @@ struct ViewerOptions {
   int msaa = 4;
   int frames = 0;               // headless: frames to render (default 1 with --screenshot)
   std::string screenshot;       // headless: PNG to write
-  bool first_frame_time = false;  // print "first-frame-ms X" once the first frame is finished
+  bool first_frame_time = false;  // print "first-frame-ms X" (since main) once the first frame is finished
   bool stats = false;           // headless: print the frame-time split
+  int window_frames = 0;        // window mode: exit after this many frames (0: when closed)
 
-  bool headless() const { return frames > 0 || !screenshot.empty(); }
+  bool headless() const { return window_frames == 0 && (frames > 0 || !screenshot.empty()); }
 };
 
 /// The parsed options, or the exit status to end with right away (help printed: 0; a usage

@@ -1,0 +1,184 @@
+// viewer_unit_test.cpp — the viewer's parts that need no display: the command line, camera
+// framing, bind-pose bounds and how files become a scene (which files are the character, which
+// add clips, which are refused).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "runtime/pose.h"
+#include "runtime/pose_ops.h"
+#include "test_files.h"
+#include "viewer/bounds.h"
+#include "viewer/camera.h"
+#include "viewer/options.h"
+#include "viewer/scene.h"
+
+namespace fs = std::filesystem;
+using namespace ossa;
+using namespace ossa::view;
+
+namespace {
+
+#ifndef OSSA_TEST_VIEWER_COOKED_DIR
+#define OSSA_TEST_VIEWER_COOKED_DIR "viewer-cooked"
+#endif
+fs::path cooked(const char* rel) {
+  return fs::path(test::env_or("OSSA_VIEWER_COOKED", OSSA_TEST_VIEWER_COOKED_DIR)) / "quantized" / rel;
+}
+
+ParsedOptions parse(std::vector<const char*> args) {
+  args.insert(args.begin(), "ossa-view");
+  return parse_options(static_cast<int>(args.size()), args.data());
+}
+
+TEST(ViewerOptions, SizeParsesWidthByHeight) {
+  EXPECT_EQ(parse_size("640x480"), std::make_pair(640, 480));
+  EXPECT_FALSE(parse_size("640"));
+  EXPECT_FALSE(parse_size("640x"));
+  EXPECT_FALSE(parse_size("0x10"));
+  EXPECT_FALSE(parse_size("10x99999"));
+  EXPECT_FALSE(parse_size("64x48px"));
+}
+
+TEST(ViewerOptions, ScreenshotMeansHeadlessOneFrame) {
+  const ParsedOptions p = parse({"a.ossa", "b.ossa", "--screenshot", "out.png", "--size", "320x200", "--time", "1.5"});
+  ASSERT_TRUE(p.options);
+  EXPECT_TRUE(p.options->headless());
+  EXPECT_EQ(p.options->frames, 1);
+  EXPECT_EQ(p.options->files, (std::vector<std::string>{"a.ossa", "b.ossa"}));
+  EXPECT_EQ(p.options->width, 320);
+  EXPECT_EQ(p.options->height, 200);
+  EXPECT_FLOAT_EQ(p.options->time, 1.5f);
+
+  const ParsedOptions window = parse({"a.ossa", "--window-frames", "3", "--screenshot", "w.png"});
+  ASSERT_TRUE(window.options);
+  EXPECT_FALSE(window.options->headless());
+  EXPECT_FALSE(parse({"a.ossa"}).options->headless());
+}
+
+TEST(ViewerOptions, UsageErrorsExitWithTwo) {
+  EXPECT_FALSE(parse({}).options);
+  EXPECT_EQ(parse({}).exit_code, 2);  // no file
+  EXPECT_EQ(parse({"a.ossa", "--size", "big"}).exit_code, 2);
+  EXPECT_EQ(parse({"a.ossa", "--crowd", "0"}).exit_code, 2);
+  EXPECT_EQ(parse({"a.ossa", "--help"}).exit_code, 0);
+}
+
+/// Every corner of `box` projects inside the view, and the framing is tight: some corner lies
+/// near the edge (within the 8 % margin and a bit).
+void expect_framed(const Box& box, float yaw, float pitch, float aspect) {
+  const OrbitCamera c = frame_box(box, yaw, pitch, aspect);
+  const glm::mat4 vp = projection_matrix(c, aspect) * view_matrix(c);
+  float extent = 0.0f;
+  for (int corner = 0; corner < 8; ++corner) {
+    const glm::vec3 p((corner & 1) ? box.max.x : box.min.x, (corner & 2) ? box.max.y : box.min.y,
+                      (corner & 4) ? box.max.z : box.min.z);
+    const glm::vec4 clip = vp * glm::vec4(p, 1.0f);
+    ASSERT_GT(clip.w, 0.0f) << "corner behind the camera";
+    const glm::vec3 ndc = glm::vec3(clip) / clip.w;
+    EXPECT_LE(std::fabs(ndc.x), 1.0f);
+    EXPECT_LE(std::fabs(ndc.y), 1.0f);
+    EXPECT_GT(ndc.z, -1.0f) << "corner in front of the near plane";
+    EXPECT_LT(ndc.z, 1.0f) << "corner past the far plane";
+    extent = std::max({extent, std::fabs(ndc.x), std::fabs(ndc.y)});
+  }
+  EXPECT_GT(extent, 0.85f) << "framing is loose";
+}
+
+TEST(ViewerCamera, FrameBoxFitsEveryCornerTightly) {
+  Box human;
+  human.add({-0.9f, 0.0f, -0.2f});
+  human.add({0.9f, 1.8f, 0.2f});
+  Box fox;  // long along z, in centimetres
+  fox.add({-12.6f, -0.2f, -87.0f});
+  fox.add({12.6f, 78.9f, 67.8f});
+  for (float aspect : {1.0f, 16.0f / 9.0f, 0.5f}) {
+    for (float yaw : {0.0f, 0.52f, 2.0f}) {
+      expect_framed(human, yaw, 0.17f, aspect);
+      expect_framed(fox, yaw, 0.8f, aspect);
+    }
+  }
+}
+
+TEST(ViewerCamera, OrbitClampsPitchAndZoomStaysPositive) {
+  Box b;
+  b.add({-1, -1, -1});
+  b.add({1, 1, 1});
+  OrbitCamera c = frame_box(b, 0.0f, 0.0f, 1.0f);
+  orbit(c, 0.0f, 10.0f);
+  EXPECT_LT(c.pitch, 1.5708f);
+  zoom(c, 1000.0f);
+  EXPECT_GT(c.distance, 0.0f);
+  EXPECT_GT(c.near_plane, 0.0f);
+  EXPECT_LT(c.near_plane, c.far_plane);
+}
+
+std::vector<glm::mat4> bind_model(const SkeletonView& skeleton) {
+  Pose pose(static_cast<uint32_t>(skeleton.joint_count()));
+  set_bind_pose(skeleton, pose);
+  std::vector<glm::mat4> model(skeleton.joint_count());
+  local_to_model(skeleton.parents(), pose, model);
+  return model;
+}
+
+TEST(ViewerBounds, BindPoseBoundsMatchTheMeshWhereSkinAndRigAgree) {
+  Result<Asset> a = Asset::open(cooked("CesiumMan/CesiumMan.ossa").string());
+  ASSERT_TRUE(a) << a.error().message;
+  const Box b = bind_pose_bounds(*a, bind_model(a->skeleton()));
+  // CesiumMan stands 1.51 m tall in its cooked bounds, arms out to +-0.57 m.
+  EXPECT_NEAR(b.size().y, 1.51f, 0.02f);
+  EXPECT_NEAR(b.size().x, 1.14f, 0.02f);
+}
+
+TEST(ViewerBounds, SlotsPlacedByAnotherBindPoseDoNotInflateTheBox) {
+  // Pab's mesh was skinned with its fingers posed unlike the rig's bind pose: those slots place
+  // the mesh box elsewhere. The box must follow the slots that agree (the T-pose, 1.73 m span).
+  Result<Asset> a = Asset::open(cooked("Pab/arnaud.ossa").string());
+  ASSERT_TRUE(a) << a.error().message;
+  const MeshView mesh = a->mesh(0);
+  const float mesh_width = mesh.fb->bounds_max()->x() - mesh.fb->bounds_min()->x();
+  const Box b = bind_pose_bounds(*a, bind_model(a->skeleton()));
+  EXPECT_LT(b.size().x, 1.05f * mesh_width);
+  EXPECT_GT(b.size().x, 0.95f * mesh_width);
+}
+
+TEST(ViewerScene, CharacterFirstThenClipFiles) {
+  const std::vector<std::string> paths{cooked("Pab/walk.ossa").string(), cooked("Pab/arnaud.ossa").string(),
+                                       cooked("Pab/run.ossa").string()};
+  Result<Scene> s = load_scene(paths);
+  ASSERT_TRUE(s) << s.error().message;
+  EXPECT_EQ(s->paths.front(), paths[1]) << "the file with a mesh is the character, wherever it is given";
+  ASSERT_EQ(s->clips.size(), 2u);
+  EXPECT_EQ(find_clip(*s, "walk"), 0);
+  EXPECT_EQ(find_clip(*s, "run"), 1);
+  EXPECT_EQ(find_clip(*s, "run (run.ossa)"), 1);
+  EXPECT_EQ(find_clip(*s, "jog"), -1);
+  EXPECT_EQ(count(*s).joints, 67u);
+  EXPECT_EQ(count(*s).vertices, 3748u);
+}
+
+TEST(ViewerScene, RefusesWithTheFileNamed) {
+  const std::string walk = cooked("Pab/walk.ossa").string(), fox = cooked("Fox/Fox.ossa").string();
+  Result<Scene> alone = load_scene(std::vector<std::string>{walk});
+  ASSERT_FALSE(alone);
+  EXPECT_NE(alone.error().message.find(walk), std::string::npos);
+  EXPECT_NE(alone.error().message.find("no mesh"), std::string::npos);
+
+  Result<Scene> mismatch = load_scene(std::vector<std::string>{fox, walk});
+  ASSERT_FALSE(mismatch);
+  EXPECT_NE(mismatch.error().message.find(walk), std::string::npos) << mismatch.error().message;
+
+  Result<Scene> ok = load_scene(std::vector<std::string>{fox});
+  ASSERT_TRUE(ok);
+  const size_t clips = ok->clips.size();
+  EXPECT_FALSE(add_clip_file(*ok, walk));
+  EXPECT_EQ(ok->clips.size(), clips) << "a refused file leaves the scene as it was";
+  EXPECT_EQ(ok->assets.size(), 1u);
+}
+
+}  // namespace
