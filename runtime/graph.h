@@ -70,8 +70,9 @@ struct MachineStatus {
   float inertial_remaining = 0.0f;  // seconds left on an inertialization offset (0: none)
 };
 
-/// The immutable, shared part. Build once per (graph, clip sources); it must outlive its instances,
-/// and the Assets it was made from must outlive it.
+/// The immutable, shared part. Build once per (graph, clip sources); it must outlive its instances
+/// and stay where it is while they live (they point at it), and the Assets it was made from must
+/// outlive it (moving an Asset is fine: its bytes stay put).
 class GraphDefinition {
  public:
   /// Binds `graph_name` of `asset` (the file's skeleton is the rig) to its clips, looked up by name
@@ -149,6 +150,8 @@ class GraphInstance {
   MachineStatus machine_status(size_t machine) const;
   /// The weight a node contributed to the output in the last update (0 when it was not evaluated).
   float node_weight(size_t node) const;
+  /// A node's normalized phase in [0, 1] (its leading clip's time / duration), for tools and tests.
+  float node_phase(size_t node) const;
 
   struct State;
 

@@ -191,6 +191,10 @@ class Validator {
       for (flatbuffers::uoffset_t i = 0; i < materials->size(); ++i)
         if (Status st = check_material(*materials->Get(i), i); !st) return st;
     }
+    if (const auto* graphs = file_.graphs()) {
+      for (flatbuffers::uoffset_t i = 0; i < graphs->size(); ++i)
+        if (Status st = validate_graph(*graphs->Get(i), i, name_, budget_); !st) return st;
+    }
     return {};
   }
 
@@ -620,6 +624,23 @@ class Validator {
         const auto idx = static_cast<flatbuffers::uoffset_t>(i);
         if (!finite3(*rm->translations()->Get(idx)) || !std::isfinite(rm->yaws()->Get(idx)))
           return fail(where, format("root motion frame %zu is not finite", i));
+      }
+    }
+
+    // Events: named, finite, inside the clip, sorted by time (the graph's event scan relies on it).
+    if (const auto* events = c.events()) {
+      if (!spend(static_cast<uint64_t>(events->size()) * 8)) return over_budget(where);
+      float previous = 0.0f;
+      for (flatbuffers::uoffset_t i = 0; i < events->size(); ++i) {
+        const fb::ClipEvent& e = *events->Get(i);
+        if (view_of(e.name()).empty()) return fail(where, format("event %u has an empty name", i));
+        const float t = e.time();
+        if (!std::isfinite(t) || t < 0.0f || t > duration)
+          return fail(where, format("event %u '%s' at %g s lies outside the clip [0, %g s]", i,
+                                    detail::printable(view_of(e.name())).c_str(), t, duration));
+        if (t < previous) return fail(where, format("event %u at %g s comes before event %u's %g s: not sorted", i, t,
+                                                    i - 1, previous));
+        previous = t;
       }
     }
     return {};

@@ -42,4 +42,12 @@ namespace ossa {
 /// verify_buffer passes it. Vertex/index/texture data must be 16-byte aligned in memory.
 Status validate_file(const fb::File& file, std::string_view name, size_t buffer_size = 0);
 
+/// The graph checks (validate_graph.cpp), run by validate_file for each of File.graphs: every index
+/// in range (parameters, clips, joints, nodes, machines, states), parameter types fit their uses,
+/// nodes children first with one referrer each and at most kMaxGraphDepth levels deep, each
+/// machine played by one node, finite numbers, sane durations, conditions well formed with a stack
+/// of at most 16. `budget` (bytes of vector data still allowed to be scanned) is charged.
+inline constexpr uint32_t kMaxGraphDepth = 64;
+Status validate_graph(const fb::Graph& graph, size_t index, std::string_view name, uint64_t& budget);
+
 }  // namespace ossa
