@@ -110,12 +110,33 @@ class GraphDefinition {
   std::unique_ptr<Impl> impl_;
 };
 
+/// The memory an update needs only while it runs (scratch poses, model rotations for mesh-space
+/// layers): about three poses for the Pab sample. Every instance owns one by default; a host with
+/// thousands of characters makes instances without (GraphInstance::create(..., false)) and gives
+/// one GraphScratch per thread to update(), so each character's own state stays small and the
+/// scratch stays hot in cache. One scratch serves every instance of the definition it was made for.
+class GraphScratch {
+ public:
+  static GraphScratch create(const GraphDefinition& definition);
+  GraphScratch(GraphScratch&&) noexcept;
+  GraphScratch& operator=(GraphScratch&&) noexcept;
+  ~GraphScratch();
+  struct Buffers;
+  Buffers& buffers() { return *buffers_; }
+
+ private:
+  explicit GraphScratch(std::unique_ptr<Buffers> b);
+  std::unique_ptr<Buffers> buffers_;
+};
+
 /// One character playing a graph.
 class GraphInstance {
  public:
   /// Reserves everything update() will use. `event_capacity` bounds the events kept per update
-  /// (more are counted in dropped_events()). O(joints * (scratch poses + machines) + clip channels).
-  static Result<GraphInstance> create(const GraphDefinition& definition, size_t event_capacity = 64);
+  /// (more are counted in dropped_events()). own_scratch = false: update(dt, scratch) only.
+  /// O(joints * (scratch poses + machines) + clip channels).
+  static Result<GraphInstance> create(const GraphDefinition& definition, size_t event_capacity = 64,
+                                      bool own_scratch = true);
 
   GraphInstance(GraphInstance&&) noexcept;
   GraphInstance& operator=(GraphInstance&&) noexcept;
@@ -135,8 +156,10 @@ class GraphInstance {
   /// Any parameter's current value as stored (bools and triggers 0 / 1). NaN for a bad index.
   float value(int parameter) const;
 
-  /// Advances by dt seconds (>= 0) and evaluates the output pose. Allocation-free.
+  /// Advances by dt seconds (>= 0) and evaluates the output pose. Allocation-free. The first form
+  /// uses the instance's own scratch (it must have one); the second a shared one.
   void update(float dt);
+  void update(float dt, GraphScratch& scratch);
   /// Back to the state a fresh instance has (parameters to defaults, machines to entry, times to
   /// start offsets). Allocation-free.
   void reset();
@@ -157,6 +180,7 @@ class GraphInstance {
 
  private:
   explicit GraphInstance(std::unique_ptr<State> state);
+  void update(float dt, GraphScratch::Buffers& buffers);
   std::unique_ptr<State> state_;
 };
 

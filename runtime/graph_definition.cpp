@@ -163,20 +163,19 @@ Result<GraphDefinition> GraphDefinition::create(const Asset& asset, std::string_
         for (const fb::Layer* layer : *t->layers()) {
           std::vector<float> mask(d.joints, 0.0f);
           for (const fb::MaskEntry* e : *layer->mask()) build_joint_mask(parents, e->joint(), e->depth(), mask);
+          // Mask roots and their ancestors: the joints a mesh-space blend needs model rotations of.
           LayerJoints lj;
-          lj.masked.assign(d.joints, 0);
-          std::vector<uint8_t> relevant(d.joints, 0), below_mask(d.joints, 0);
+          std::vector<uint8_t> on_chain(d.joints, 0), is_root(d.joints, 0);
           for (uint32_t j = 0; j < d.joints; ++j) {
-            lj.masked[j] = mask[j] > 0.0f;
             const int p = parents[j];
-            below_mask[j] = p >= 0 && (lj.masked[p] || below_mask[p]);
-            if (!lj.masked[j]) continue;
-            for (int a = static_cast<int>(j); a >= 0 && !relevant[a]; a = parents[a]) relevant[a] = 1;
+            if (!(mask[j] > 0.0f) || (p >= 0 && mask[p] > 0.0f)) continue;
+            is_root[j] = 1;
+            for (int a = static_cast<int>(j); a >= 0 && !on_chain[a]; a = parents[a]) on_chain[a] = 1;
           }
           for (uint32_t j = 0; j < d.joints; ++j) {
-            if (!relevant[j]) continue;
-            lj.relevant.push_back(static_cast<uint16_t>(j));
-            if (!lj.masked[j] && below_mask[j]) lj.closed = false;
+            if (!on_chain[j]) continue;
+            lj.chain.push_back(static_cast<uint16_t>(j));
+            lj.root.push_back(is_root[j]);
           }
           d.masks.push_back(std::move(mask));
           d.layer_joints.push_back(std::move(lj));

@@ -191,7 +191,7 @@ void evaluate_blend_space(State& s, uint16_t n, const NodeInfo& info, const Adva
     const float d = clip.duration();
     const float t0 = p0 * d, t1 = p1 * d;
     if (dominant && k == leader) collect_events(s, clip, smp.clip(), n, t0, t1, loops, b.rate() >= 0.0f, b.loop());
-    PoseSpan target = active == 1 ? out : s.scratch[depth + k].span();
+    PoseSpan target = active == 1 ? out : s.scratch->poses[depth + k].span();
     sample(clip, t1, options, s.caches[info.caches + indices[k]], target);
     poses[k] = target;
   }
@@ -242,7 +242,7 @@ void evaluate_select(State& s, const NodeInfo& info, const Advance& advance, flo
     if (accumulated == 0.0f) {
       evaluate(s, child, advance, weight * share, dominant && i == leader, out, depth);
     } else {
-      PoseSpan tmp = s.scratch[depth].span();
+      PoseSpan tmp = s.scratch->poses[depth].span();
       evaluate(s, child, advance, weight * share, dominant && i == leader, tmp, depth + 1);
       blend(out, tmp, w[i] / (accumulated + w[i]), out);
     }
@@ -267,52 +267,33 @@ glm::quat nlerp(const glm::quat& a, glm::quat b, float t) {
   return glm::normalize(a * (1.0f - t) + b * t);
 }
 
-/// Blends the layer's rotations into out (holding the base) in model space on the masked joints:
-/// each masked joint gets the model rotation nlerp(base, layer, w) and the local rotation that
-/// puts it there under its (blended) parent. Translations and scales blend locally.
+/// A layer whose rotations blend in model space at the mask roots: the masked subtree is blended
+/// locally (vectorized, like any layer), then each mask root gets the local rotation that puts its
+/// model rotation at nlerp(base model, layer model, w) under its unmasked parent. At full weight
+/// the masked chain therefore has the layer's model-space orientation whatever the base did above
+/// it (the spine keeps facing where the layer faces while the hips swing); below the roots, where
+/// parents agree, local and model blends coincide, so the cost is the two ancestor chains only.
 void blend_mesh_space(State& s, const LayerJoints& lj, std::span<const float> mask, float w, ConstPoseSpan layer,
                       PoseSpan out) {
   const auto parents = s.def->skeleton.parents();
-  glm::quat* mb = s.model_base.data();
-  glm::quat* ml = s.model_layer.data();
-  glm::quat* mo = s.model_out.data();
-  const glm::quat identity(1.0f, 0.0f, 0.0f, 0.0f);
-  // Translations and scales of masked joints: local lerp (the rotation pass overwrites rotations).
-  for (uint16_t j : lj.relevant) {
-    if (!lj.masked[j]) continue;
-    const float t = clamp01(w * mask[j]);
-    for (PoseComponent k : {kTx, kTy, kTz, kSx, kSy, kSz}) out[k][j] += t * (layer[k][j] - out[k][j]);
-  }
-  if (w >= 1.0f && lj.closed) {
-    // Full weight on a closed mask: below a mask root the output's model rotation is the layer's,
-    // so the local rotation is the layer's own; only mask roots need the two model chains.
-    for (uint16_t j : lj.relevant) {
-      const int p = parents[j];
-      const glm::quat qb = rotation_at(out, j), ql = rotation_at(layer, j);
-      if (!lj.masked[j]) {
-        mb[j] = p >= 0 ? mb[p] * qb : qb;
-        ml[j] = p >= 0 ? ml[p] * ql : ql;
-      } else if (p < 0 || !lj.masked[p]) {
-        const glm::quat parent_base = p >= 0 ? mb[p] : identity, parent_layer = p >= 0 ? ml[p] : identity;
-        set_rotation(out, j, glm::normalize(glm::conjugate(parent_base) * (parent_layer * ql)));
-      } else {
-        set_rotation(out, j, ql);
-      }
-    }
-    return;
-  }
-  for (uint16_t j : lj.relevant) {
+  GraphScratch::Buffers& b = *s.scratch;
+  // Base model rotations along the chain, and the roots' base local rotations, before blending.
+  for (size_t k = 0; k < lj.chain.size(); ++k) {
+    const uint16_t j = lj.chain[k];
     const int p = parents[j];
     const glm::quat qb = rotation_at(out, j), ql = rotation_at(layer, j);
-    mb[j] = p >= 0 ? mb[p] * qb : qb;
-    ml[j] = p >= 0 ? ml[p] * ql : ql;
-    const glm::quat parent_out = p >= 0 ? mo[p] : identity;
-    if (!lj.masked[j]) {
-      mo[j] = parent_out * qb;
-      continue;
-    }
-    mo[j] = nlerp(mb[j], ml[j], clamp01(w * mask[j]));
-    set_rotation(out, j, glm::normalize(glm::conjugate(parent_out) * mo[j]));
+    b.model_base[j] = p >= 0 ? b.model_base[p] * qb : qb;
+    b.model_layer[j] = p >= 0 ? b.model_layer[p] * ql : ql;
+  }
+  blend_layered(out, layer, mask, w, out);
+  const glm::quat identity(1.0f, 0.0f, 0.0f, 0.0f);
+  for (size_t k = 0; k < lj.chain.size(); ++k) {
+    if (!lj.root[k]) continue;
+    const uint16_t j = lj.chain[k];
+    const int p = parents[j];
+    const glm::quat parent = p >= 0 ? b.model_base[p] : identity;  // unmasked: the base's
+    const glm::quat model = nlerp(b.model_base[j], b.model_layer[j], clamp01(w * mask[j]));
+    set_rotation(out, j, glm::normalize(glm::conjugate(parent) * model));
   }
 }
 
@@ -327,7 +308,7 @@ void evaluate_layered(State& s, const NodeInfo& info, const Advance& advance, fl
     const float target = clamp01(layer.weight() * param_or(s, layer.weight_parameter(), 1.0f));
     current = ease(current, target, advance.dt, layer.blend_time());
     if (!(current > 0.0f)) continue;
-    PoseSpan tmp = s.scratch[depth].span();
+    PoseSpan tmp = s.scratch->poses[depth].span();
     evaluate(s, layer.node(), advance, weight * current, dominant && current >= 0.5f, tmp, depth + 1);
     const std::vector<float>& mask = s.def->masks[info.aux + k];
     if (layer.mesh_space_rotation())
@@ -346,7 +327,7 @@ void evaluate_alpha(State& s, const NodeInfo& info, const Advance& advance, floa
   if (alpha <= 0.0f) return evaluate(s, a.a(), advance, weight, dominant, out, depth);
   if (alpha >= 1.0f) return evaluate(s, a.b(), advance, weight, dominant, out, depth);
   evaluate(s, a.a(), advance, weight * (1.0f - alpha), dominant && alpha < 0.5f, out, depth);
-  PoseSpan tmp = s.scratch[depth].span();
+  PoseSpan tmp = s.scratch->poses[depth].span();
   evaluate(s, a.b(), advance, weight * alpha, dominant && alpha >= 0.5f, tmp, depth + 1);
   blend(out, tmp, alpha, out);
 }
@@ -357,7 +338,7 @@ void evaluate_additive(State& s, const NodeInfo& info, const Advance& advance, f
   evaluate(s, a.base(), advance, weight, dominant, out, depth);
   const float w = a.weight() * param_or(s, a.weight_parameter(), 1.0f);
   if (w == 0.0f) return;
-  PoseSpan tmp = s.scratch[depth].span();
+  PoseSpan tmp = s.scratch->poses[depth].span();
   evaluate(s, a.additive(), advance, weight * std::fabs(w), dominant && std::fabs(w) >= 0.5f, tmp, depth + 1);
   make_additive(tmp, s.def->bind, tmp);
   add(out, tmp, w, out);

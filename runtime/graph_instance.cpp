@@ -23,7 +23,29 @@ GraphInstance::GraphInstance(GraphInstance&&) noexcept = default;
 GraphInstance& GraphInstance::operator=(GraphInstance&&) noexcept = default;
 GraphInstance::~GraphInstance() = default;
 
-Result<GraphInstance> GraphInstance::create(const GraphDefinition& definition, size_t event_capacity) {
+namespace {
+
+std::unique_ptr<GraphScratch::Buffers> make_buffers(const GraphDefinition::Impl& d) {
+  auto b = std::make_unique<GraphScratch::Buffers>();
+  b->poses.reserve(d.scratch_depth);
+  for (uint32_t k = 0; k < d.scratch_depth; ++k) b->poses.emplace_back(d.joints);
+  b->model_base.resize(d.joints);
+  b->model_layer.resize(d.joints);
+  return b;
+}
+
+}  // namespace
+
+GraphScratch::GraphScratch(std::unique_ptr<Buffers> b) : buffers_(std::move(b)) {}
+GraphScratch::GraphScratch(GraphScratch&&) noexcept = default;
+GraphScratch& GraphScratch::operator=(GraphScratch&&) noexcept = default;
+GraphScratch::~GraphScratch() = default;
+GraphScratch GraphScratch::create(const GraphDefinition& definition) {
+  return GraphScratch(make_buffers(definition.impl()));
+}
+
+Result<GraphInstance> GraphInstance::create(const GraphDefinition& definition, size_t event_capacity,
+                                            bool own_scratch) {
   const GraphDefinition::Impl& d = definition.impl();
   auto s = std::make_unique<State>();
   s->def = &d;
@@ -47,8 +69,7 @@ Result<GraphInstance> GraphInstance::create(const GraphDefinition& definition, s
       }
     }
   }
-  s->scratch.reserve(d.scratch_depth);
-  for (uint32_t k = 0; k < d.scratch_depth; ++k) s->scratch.emplace_back(d.joints);
+  if (own_scratch) s->own_scratch = make_buffers(d);
   s->machines.resize(d.machines.size());
   for (MachineState& m : s->machines) {
     m.translation.resize(d.joints);
@@ -59,9 +80,6 @@ Result<GraphInstance> GraphInstance::create(const GraphDefinition& definition, s
   s->output = Pose(d.joints);
   s->event_capacity = event_capacity;
   s->events.reserve(event_capacity);
-  s->model_base.resize(d.joints);
-  s->model_layer.resize(d.joints);
-  s->model_out.resize(d.joints);
   GraphInstance instance(std::move(s));
   instance.reset();
   return instance;
@@ -126,7 +144,15 @@ void GraphInstance::reset() {
 }
 
 void GraphInstance::update(float dt) {
+  if (!state_->own_scratch) return;  // made to share scratch: update(dt, scratch) only
+  update(dt, *state_->own_scratch);
+}
+
+void GraphInstance::update(float dt, GraphScratch& scratch) { update(dt, scratch.buffers()); }
+
+void GraphInstance::update(float dt, GraphScratch::Buffers& buffers) {
   State& s = *state_;
+  s.scratch = &buffers;
   if (!(dt >= 0.0f) || !std::isfinite(dt)) dt = 0.0f;
   s.events.clear();
   s.dropped = 0;
@@ -135,6 +161,7 @@ void GraphInstance::update(float dt) {
   Advance advance;
   advance.dt = dt;
   evaluate(s, s.def->graph->root(), advance, 1.0f, true, s.output, 0);
+  s.scratch = nullptr;
 }
 
 ConstPoseSpan GraphInstance::pose() const { return state_->output.span(); }

@@ -42,13 +42,12 @@ struct MachineInfo {
   std::vector<TransitionInfo> transitions;    // priority order
 };
 
-/// Per-layer joint data for a mesh-space rotation blend: the joints whose model rotation matters
-/// (masked joints and their ancestors), and whether the mask is closed downwards (no unmasked
-/// joint below a masked one among them), which lets a full-weight layer touch only mask roots.
+/// Per-layer joint data for a mesh-space rotation blend: the mask roots (masked joints whose parent
+/// is not masked) and their ancestors, ascending (parents first), whose model rotations the
+/// blend needs.
 struct LayerJoints {
-  std::vector<uint16_t> relevant;   // masked joints and their ancestors, ascending (parents first)
-  std::vector<uint8_t> masked;      // per joint: mask weight > 0
-  bool closed = true;
+  std::vector<uint16_t> chain;      // ancestors of mask roots and the roots, ascending
+  std::vector<uint8_t> root;        // per chain entry: 1 when it is a mask root
 };
 
 }  // namespace ossa::graph_detail
@@ -104,6 +103,13 @@ struct MachineState {
 
 }  // namespace graph_detail
 
+/// Memory an update uses only while it runs: shareable by every instance updated on one thread.
+struct GraphScratch::Buffers {
+  std::vector<Pose> poses;
+  // Mesh-space layering: model rotations of base and layer along a mask's chain, one per joint.
+  std::vector<glm::quat> model_base, model_layer;
+};
+
 struct GraphInstance::State {
   const GraphDefinition::Impl* def = nullptr;
   const GraphDefinition* owner = nullptr;
@@ -111,15 +117,14 @@ struct GraphInstance::State {
   std::vector<float> floats;        // node variable state
   std::vector<float> node_weights;  // per node, last update
   std::vector<SamplingCache> caches;
-  std::vector<Pose> scratch;
+  std::unique_ptr<GraphScratch::Buffers> own_scratch;  // null when made to share a GraphScratch
+  GraphScratch::Buffers* scratch = nullptr;  // during update(): the buffers in use
   std::vector<graph_detail::MachineState> machines;
   Pose output;
   std::vector<GraphEvent> events;   // capacity reserved; size() = events of the last update
   size_t event_capacity = 0;
   size_t dropped = 0;
   uint64_t update_counter = 0;
-  // Mesh-space layering scratch: model rotations of base, layer and output, one per joint.
-  std::vector<glm::quat> model_base, model_layer, model_out;
 };
 
 namespace graph_detail {

@@ -267,7 +267,7 @@ void evaluate_machine(State& s, uint16_t n, const Advance& advance, float weight
       evaluate(s, target, both, weight, dominant, out, depth);
     } else {
       evaluate(s, target, both, weight * w, dominant && w >= 0.5f, out, depth);
-      PoseSpan tmp = s.scratch[depth].span();
+      PoseSpan tmp = s.scratch->poses[depth].span();
       evaluate(s, source, both, weight * (1.0f - w), dominant && w < 0.5f, tmp, depth + 1);
       blend(tmp, out, w, out);
     }
