@@ -75,9 +75,15 @@ float param_or(const State& s, int16_t parameter, float fallback) {
   return parameter >= 0 ? s.params[static_cast<size_t>(parameter)] : fallback;
 }
 
+/// Products of a node's factor and a parameter a host may set anywhere in the parameter's range
+/// are kept where float arithmetic stays finite (validation bounds the factors themselves).
+constexpr float kMaxScaledRate = 1000.0f, kMaxScaledWeight = 100.0f, kMaxCoordinate = 1e6f;
+
 // ---- clip ----
 
-float clip_rate(const State& s, const fb::ClipNode& c) { return c.rate() * param_or(s, c.rate_parameter(), 1.0f); }
+float clip_rate(const State& s, const fb::ClipNode& c) {
+  return std::clamp(c.rate() * param_or(s, c.rate_parameter(), 1.0f), -kMaxScaledRate, kMaxScaledRate);
+}
 
 void evaluate_clip(State& s, uint16_t n, const NodeInfo& info, const Advance& advance, bool dominant, PoseSpan out) {
   const auto& c = *static_cast<const fb::ClipNode*>(info.table);
@@ -105,7 +111,7 @@ uint32_t blend_space_weights(State& s, const NodeInfo& info) {
   const auto& samples = *b.samples();
   const uint32_t count = samples.size();
   float* w = &s.floats[info.floats + 1];
-  const float x = s.params[b.x_parameter()];
+  const float x = std::clamp(s.params[b.x_parameter()], -kMaxCoordinate, kMaxCoordinate);
   if (b.y_parameter() < 0) {
     // 1D: the two neighbours of x among the sorted sample positions (validated strictly increasing).
     for (uint32_t i = 0; i < count; ++i) w[i] = 0.0f;
@@ -122,7 +128,7 @@ uint32_t blend_space_weights(State& s, const NodeInfo& info) {
       w[hi] = t;
     }
   } else {
-    const float y = s.params[static_cast<size_t>(b.y_parameter())];
+    const float y = std::clamp(s.params[static_cast<size_t>(b.y_parameter())], -kMaxCoordinate, kMaxCoordinate);
     blend_space_2d_weights(s.def->spaces[info.aux], glm::vec2(x, y), std::span<float>(w, count));
   }
   return count;
@@ -336,7 +342,7 @@ void evaluate_additive(State& s, const NodeInfo& info, const Advance& advance, f
                        PoseSpan out, uint32_t depth) {
   const auto& a = *static_cast<const fb::AdditiveNode*>(info.table);
   evaluate(s, a.base(), advance, weight, dominant, out, depth);
-  const float w = a.weight() * param_or(s, a.weight_parameter(), 1.0f);
+  const float w = std::clamp(a.weight() * param_or(s, a.weight_parameter(), 1.0f), -kMaxScaledWeight, kMaxScaledWeight);
   if (w == 0.0f) return;
   PoseSpan tmp = s.scratch->poses[depth].span();
   evaluate(s, a.additive(), advance, weight * std::fabs(w), dominant && std::fabs(w) >= 0.5f, tmp, depth + 1);

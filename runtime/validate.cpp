@@ -54,6 +54,13 @@ std::string label(const char* kind, size_t index, const flatbuffers::String* nam
 
 bool finite3(const fb::Vec3& v) { return std::isfinite(v.x()) && std::isfinite(v.y()) && std::isfinite(v.z()); }
 
+/// Pose values (translations, scales) are bounded so that blending, layering and adding poses —
+/// differences, weighted sums, ratios — stay finite: a finite but astronomically large value
+/// (a flipped exponent bit) would overflow there. 1e7 source units is 100 km in centimetres.
+constexpr float kMaxPoseValue = 1e7f;
+bool bounded(float v) { return std::isfinite(v) && std::fabs(v) <= kMaxPoseValue; }
+bool bounded3(const fb::Vec3& v) { return bounded(v.x()) && bounded(v.y()) && bounded(v.z()); }
+
 bool finite4(const fb::Quat& q) {
   return std::isfinite(q.x()) && std::isfinite(q.y()) && std::isfinite(q.z()) && std::isfinite(q.w());
 }
@@ -255,11 +262,11 @@ class Validator {
           return fail(where, jl() + format(" has parent %d, must be -1 (the first joint is a root)", parent));
         return fail(where, jl() + format(" has parent %d, must be -1 or < %zu (parents come first)", parent, i));
       }
-      if (!finite3(*s.bind_translations()->Get(idx)))
+      if (!bounded3(*s.bind_translations()->Get(idx)))
         return fail(where, jl() + ": bind translation is not finite");
       if (!normalizable(*s.bind_rotations()->Get(idx)))
         return fail(where, jl() + ": bind rotation is not a finite, non-zero quaternion");
-      if (!finite3(*s.bind_scales()->Get(idx))) return fail(where, jl() + ": bind scale is not finite");
+      if (!bounded3(*s.bind_scales()->Get(idx))) return fail(where, jl() + ": bind scale is not finite (or beyond 1e7)");
       if (!finite_matrix(*s.inverse_bind()->Get(idx)))
         return fail(where, jl() + ": inverse bind matrix is not finite");
     }
@@ -506,8 +513,8 @@ class Validator {
       }
       if (ch.channel() == fb::Channel::Rotation) {
         if (!normalizable(ch.value())) return fail(where, cl() + ": value is not a finite, non-zero quaternion");
-      } else if (!std::isfinite(ch.value().x()) || !std::isfinite(ch.value().y()) || !std::isfinite(ch.value().z())) {
-        return fail(where, cl() + ": value is not finite");
+      } else if (!bounded(ch.value().x()) || !bounded(ch.value().y()) || !bounded(ch.value().z())) {
+        return fail(where, cl() + ": value is not finite (or beyond 1e7)");
       }
     }
 
@@ -589,8 +596,8 @@ class Validator {
       const float los[3] = {lo.x(), lo.y(), lo.z()}, exs[3] = {ex.x(), ex.y(), ex.z()};
       if (bits != kRawFloatBits) {
         for (int i = 0; i < 3; ++i) {
-          if (!std::isfinite(los[i]) || !std::isfinite(exs[i]) || !(exs[i] >= 0.0f) || !std::isfinite(los[i] + exs[i]))
-            return fail(where, cl() + format(": range min %s extent %s must be finite with extents >= 0",
+          if (!bounded(los[i]) || !bounded(exs[i]) || !(exs[i] >= 0.0f) || !bounded(los[i] + exs[i]))
+            return fail(where, cl() + format(": range min %s extent %s must be finite (within 1e7) with extents >= 0",
                                            vec3_text(lo).c_str(), vec3_text(ex).c_str()));
           if (rotation && (los[i] < -kRotationComponentLimit || los[i] + exs[i] > kRotationComponentLimit))
             return fail(where, cl() + format(": rotation range min %s extent %s leaves [-1, 1]", vec3_text(lo).c_str(),
@@ -604,7 +611,7 @@ class Validator {
           float v[3];
           std::memcpy(v, raw + 12ull * i, sizeof v);
           for (int j = 0; j < 3; ++j) {
-            if (!std::isfinite(v[j])) return fail(where, cl() + format(": raw key %u is not finite", i));
+            if (!bounded(v[j])) return fail(where, cl() + format(": raw key %u is not finite (or beyond 1e7)", i));
             if (rotation && std::fabs(v[j]) > kRotationComponentLimit)
               return fail(where, cl() + format(": raw rotation key %u component %g leaves [-1, 1]", i, v[j]));
           }

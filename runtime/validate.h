@@ -15,7 +15,8 @@
 // normalizable; root motion one finite sample
 // per frame. Runs after verification; never reads out of bounds.
 //
-// Also checked, because a reader relies on them: metres_per_unit finite and > 0; joint names
+// Also checked, because a reader relies on them: pose values (bind translations and scales,
+// clip constants, ranges and raw keys) within 1e7 so pose arithmetic cannot overflow; metres_per_unit finite and > 0; joint names
 // non-empty; bind pose and inverse binds finite, rotations normalizable (also for keys); vertex
 // stride a multiple of 4 and attribute offsets aligned to their component size (so CPU decoding
 // reads aligned data); Joints uses an integer format and nothing else does; Position has >= 3

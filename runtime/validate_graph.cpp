@@ -135,6 +135,13 @@ class GraphChecker {
   }
 
   static bool finite(float v) { return std::isfinite(v); }
+  /// Magnitudes the evaluator can multiply together without overflowing a float: rates, weights,
+  /// times and blend-space coordinates of real graphs are far inside these.
+  static bool rate_ok(float v) { return std::isfinite(v) && std::fabs(v) <= kMaxRate; }
+  static bool weight_ok(float v) { return std::isfinite(v) && std::fabs(v) <= kMaxWeight; }
+  static bool time_ok(float v) { return std::isfinite(v) && v >= 0.0f && v <= kMaxSeconds; }
+  static bool coordinate_ok(float v) { return std::isfinite(v) && std::fabs(v) <= kMaxCoordinate; }
+  static constexpr float kMaxRate = 1000.0f, kMaxWeight = 100.0f, kMaxSeconds = 1e6f, kMaxCoordinate = 1e6f;
 
   Status check_node(size_t n) {
     const fb::Node& node = *g_.nodes()->Get(static_cast<flatbuffers::uoffset_t>(n));
@@ -143,8 +150,8 @@ class GraphChecker {
       case fb::NodeData::ClipNode: {
         const auto& c = *node.data_as_ClipNode();
         if (c.clip() >= clip_count_) return fail(at + format(": clip %u is out of range (%zu clips)", c.clip(), clip_count_));
-        if (!finite(c.rate())) return fail(at + ": rate is not finite");
-        if (!finite(c.start_offset()) || c.start_offset() < 0.0f) return fail(at + ": start offset must be finite and >= 0");
+        if (!rate_ok(c.rate())) return fail(at + format(": rate %g must be finite and within +-%g", c.rate(), kMaxRate));
+        if (!time_ok(c.start_offset())) return fail(at + ": start offset must be finite and in [0, 1e6] s");
         return check_param_ref(at + " rate", c.rate_parameter(), true, {fb::ParameterType::Float, fb::ParameterType::Int});
       }
       case fb::NodeData::BlendAlphaNode: {
@@ -158,7 +165,7 @@ class GraphChecker {
         const size_t count = sel.children()->size();
         if (!spend(uint64_t(count) * 2)) return over_budget();
         if (count == 0) return fail(at + ": a select node needs children");
-        if (!finite(sel.blend_time()) || sel.blend_time() < 0.0f) return fail(at + ": blend time must be finite and >= 0");
+        if (!time_ok(sel.blend_time())) return fail(at + ": blend time must be finite and in [0, 1e6] s");
         if (Status st = check_param_ref(at + " selector", sel.parameter(), false,
                                         {fb::ParameterType::Bool, fb::ParameterType::Int, fb::ParameterType::Enum});
             !st)
@@ -177,9 +184,8 @@ class GraphChecker {
           const fb::Layer& layer = *l.layers()->Get(k);
           const std::string lat = at + format(" layer %u", k);
           if (Status st = child(n, layer.node(), "layer"); !st) return st;
-          if (!finite(layer.weight())) return fail(lat + ": weight is not finite");
-          if (!finite(layer.blend_time()) || layer.blend_time() < 0.0f)
-            return fail(lat + ": blend time must be finite and >= 0");
+          if (!weight_ok(layer.weight())) return fail(lat + format(": weight must be finite and within +-%g", kMaxWeight));
+          if (!time_ok(layer.blend_time())) return fail(lat + ": blend time must be finite and in [0, 1e6] s");
           if (Status st = check_param_ref(lat + " weight", layer.weight_parameter(), true,
                                           {fb::ParameterType::Float, fb::ParameterType::Bool});
               !st)
@@ -199,7 +205,7 @@ class GraphChecker {
         if (samples.size() == 0 || (two_d && samples.size() < 3))
           return fail(at + format(": a %s blend space needs at least %d samples", two_d ? "2D" : "1D", two_d ? 3 : 1));
         if (samples.size() > 1024) return fail(at + ": more than 1024 blend-space samples");
-        if (!finite(b.rate())) return fail(at + ": rate is not finite");
+        if (!rate_ok(b.rate())) return fail(at + format(": rate %g must be finite and within +-%g", b.rate(), kMaxRate));
         if (Status st = check_param_ref(at + " x", b.x_parameter(), false, {fb::ParameterType::Float, fb::ParameterType::Int});
             !st)
           return st;
@@ -209,7 +215,8 @@ class GraphChecker {
         for (flatbuffers::uoffset_t k = 0; k < samples.size(); ++k) {
           const fb::BlendSample& smp = *samples.Get(k);
           if (smp.clip() >= clip_count_) return fail(at + format(": sample %u clip %u is out of range", k, smp.clip()));
-          if (!finite(smp.x()) || !finite(smp.y())) return fail(at + format(": sample %u position is not finite", k));
+          if (!coordinate_ok(smp.x()) || !coordinate_ok(smp.y()))
+            return fail(at + format(": sample %u position must be finite and within +-%g", k, kMaxCoordinate));
           if (!two_d && k > 0 && !(smp.x() > samples.Get(k - 1)->x()))
             return fail(at + format(": 1D samples must have strictly increasing x (sample %u)", k));
         }
@@ -219,7 +226,7 @@ class GraphChecker {
         const auto& a = *node.data_as_AdditiveNode();
         if (Status st = child(n, a.base(), "base"); !st) return st;
         if (Status st = child(n, a.additive(), "additive input"); !st) return st;
-        if (!finite(a.weight())) return fail(at + ": weight is not finite");
+        if (!weight_ok(a.weight())) return fail(at + format(": weight must be finite and within +-%g", kMaxWeight));
         return check_param_ref(at + " weight", a.weight_parameter(), true,
                                {fb::ParameterType::Float, fb::ParameterType::Bool});
       }
@@ -260,8 +267,8 @@ class GraphChecker {
         return fail(tat + format(": source state %d is out of range", t.from()));
       if (t.to() >= states) return fail(tat + format(": target state %u is out of range", t.to()));
       if (t.from() == t.to()) return fail(tat + ": a state cannot transition to itself");
-      if (!finite(t.duration()) || t.duration() < 0.0f) return fail(tat + ": duration must be finite and >= 0");
-      if (!finite(t.exit_time())) return fail(tat + ": exit time is not finite");
+      if (!time_ok(t.duration())) return fail(tat + ": duration must be finite and in [0, 1e6] s");
+      if (!finite(t.exit_time()) || t.exit_time() > kMaxSeconds) return fail(tat + ": exit time must be finite and <= 1e6");
       if (static_cast<unsigned>(t.mode()) > static_cast<unsigned>(fb::TransitionMode::MAX))
         return fail(tat + format(": unknown blend mode %u", static_cast<unsigned>(t.mode())));
       if (Status st = check_condition(t, tat); !st) return st;
