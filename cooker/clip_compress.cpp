@@ -885,6 +885,7 @@ Result<CompressedClip> compress_clip(const SourceClip& clip, const SourceSkeleto
   const uint64_t raw = 10ull * sizeof(float) * joints * frames;
   out.raw_bytes = static_cast<uint32_t>(std::min<uint64_t>(raw, std::numeric_limits<uint32_t>::max()));
   out.has_root_motion = clip.has_root_motion;
+  out.events = clip.events;
   out.root_motion = clip.root_motion;
 
   const double unit = std::isfinite(metres_per_unit) && metres_per_unit > 0.0f ? metres_per_unit : 1.0;

@@ -61,6 +61,7 @@ struct CompressedClip {
                                               // overhead excluded
   bool has_root_motion = false;
   SourceRootMotion root_motion;
+  std::vector<SourceEvent> events;            // copied from the source clip
 };
 
 /// Compresses one clip of `skeleton`. metres_per_unit converts the tolerances to source units.

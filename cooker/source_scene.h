@@ -65,6 +65,12 @@ struct SourceRootMotion {
   uint8_t up_axis = 1;                   // 0 x, 1 y, 2 z
 };
 
+/// A named marker at a time on a clip (sidecar JSON or graph file; see docs/GRAPH.md).
+struct SourceEvent {
+  std::string name;
+  float time = 0.0f;                     // seconds, in [0, duration]
+};
+
 struct SourceClip {
   std::string name;
   float duration = 0.0f;                 // seconds
@@ -72,6 +78,7 @@ struct SourceClip {
   std::vector<SourceTrack> tracks;       // sorted by joint, one per animated joint
   bool has_root_motion = false;
   SourceRootMotion root_motion;          // when has_root_motion
+  std::vector<SourceEvent> events;       // sorted by time
 };
 
 enum class TextureRole : uint8_t { Diffuse = 0, Normal = 1, Specular = 2 };

@@ -121,8 +121,100 @@ Offset<fb::Clip> write_clip(FlatBufferBuilder& fbb, const CompressedClip& clip, 
   const auto compression = fb::CreateClipCompression(fbb, clip.tolerance, clip.probe_distance, clip.max_error,
                                                      clip.mean_error, clip.worst_joint, clip.raw_bytes);
   const auto root_motion = clip.has_root_motion ? write_root_motion(fbb, clip.root_motion) : Offset<fb::RootMotion>();
+  std::vector<Offset<fb::ClipEvent>> events;
+  for (const SourceEvent& e : clip.events) {
+    const auto event_name = fbb.CreateString(e.name);
+    events.push_back(fb::CreateClipEvent(fbb, event_name, e.time));
+  }
+  const auto events_v = fbb.CreateVector(events);
   return fb::CreateClip(fbb, name, clip.grid.duration(), clip.grid.sample_rate, clip.grid.frame_count, skeleton_hash,
-                        joint_count, constants_v, animated_v, key_frames_v, key_values_v, compression, root_motion);
+                        joint_count, constants_v, animated_v, key_frames_v, key_values_v, compression, root_motion,
+                        events_v);
+}
+
+Offset<fb::Node> write_node(FlatBufferBuilder& fbb, const NodeDef& node) {
+  const auto name = fbb.CreateString(node.name);
+  fb::NodeData type = fb::NodeData::NONE;
+  Offset<void> data;
+  if (const auto* c = std::get_if<ClipNodeDef>(&node.kind)) {
+    type = fb::NodeData::ClipNode;
+    data = fb::CreateClipNode(fbb, c->clip, c->rate, c->rate_parameter, c->loop, c->start_offset).Union();
+  } else if (const auto* a = std::get_if<BlendAlphaDef>(&node.kind)) {
+    type = fb::NodeData::BlendAlphaNode;
+    data = fb::CreateBlendAlphaNode(fbb, a->a, a->b, a->alpha_parameter).Union();
+  } else if (const auto* s = std::get_if<SelectDef>(&node.kind)) {
+    type = fb::NodeData::SelectNode;
+    const auto children = fbb.CreateVector(s->children);
+    data = fb::CreateSelectNode(fbb, s->parameter, children, s->blend_time).Union();
+  } else if (const auto* l = std::get_if<LayeredDef>(&node.kind)) {
+    type = fb::NodeData::LayeredBlendNode;
+    std::vector<Offset<fb::Layer>> layers;
+    for (const LayerDef& layer : l->layers) {
+      std::vector<fb::MaskEntry> mask;
+      for (const MaskEntryDef& m : layer.mask) mask.emplace_back(m.joint, m.depth);
+      const auto mask_v = fbb.CreateVectorOfStructs(mask);
+      layers.push_back(fb::CreateLayer(fbb, layer.node, mask_v, layer.weight, layer.weight_parameter,
+                                       layer.blend_time, layer.mesh_space_rotation));
+    }
+    const auto layers_v = fbb.CreateVector(layers);
+    data = fb::CreateLayeredBlendNode(fbb, l->base, layers_v).Union();
+  } else if (const auto* b = std::get_if<BlendSpaceDef>(&node.kind)) {
+    type = fb::NodeData::BlendSpaceNode;
+    std::vector<fb::BlendSample> samples;
+    for (const BlendSampleDef& smp : b->samples) samples.emplace_back(smp.clip, smp.x, smp.y);
+    const auto samples_v = fbb.CreateVectorOfStructs(samples);
+    data = fb::CreateBlendSpaceNode(fbb, b->x_parameter, b->y_parameter, samples_v, b->rate, b->loop).Union();
+  } else if (const auto* d = std::get_if<AdditiveDef>(&node.kind)) {
+    type = fb::NodeData::AdditiveNode;
+    data = fb::CreateAdditiveNode(fbb, d->base, d->additive, d->weight, d->weight_parameter).Union();
+  } else if (const auto* m = std::get_if<StateMachineRefDef>(&node.kind)) {
+    type = fb::NodeData::StateMachineNode;
+    data = fb::CreateStateMachineNode(fbb, m->machine).Union();
+  }
+  return fb::CreateNode(fbb, name, type, data);
+}
+
+Offset<fb::StateMachine> write_machine(FlatBufferBuilder& fbb, const StateMachineDef& machine) {
+  const auto name = fbb.CreateString(machine.name);
+  std::vector<Offset<fb::State>> states;
+  for (const StateDef& st : machine.states) {
+    const auto state_name = fbb.CreateString(st.name);
+    states.push_back(fb::CreateState(fbb, state_name, st.node, st.restart));
+  }
+  const auto states_v = fbb.CreateVector(states);
+  std::vector<Offset<fb::Transition>> transitions;
+  for (const TransitionDef& t : machine.transitions) {
+    std::vector<fb::ConditionInstr> condition;
+    for (const CondInstr& c : t.condition)
+      condition.emplace_back(static_cast<fb::ConditionOp>(c.op), c.parameter, c.value);
+    const auto condition_v = fbb.CreateVectorOfStructs(condition);
+    transitions.push_back(fb::CreateTransition(fbb, t.from, t.to, condition_v, t.exit_time, t.duration,
+                                               static_cast<fb::TransitionMode>(t.mode)));
+  }
+  const auto transitions_v = fbb.CreateVector(transitions);
+  return fb::CreateStateMachine(fbb, name, states_v, machine.entry, transitions_v);
+}
+
+Offset<fb::Graph> write_graph(FlatBufferBuilder& fbb, const GraphDef& graph) {
+  const auto name = fbb.CreateString(graph.name);
+  std::vector<Offset<fb::Parameter>> parameters;
+  for (const GraphParameter& p : graph.parameters) {
+    const auto param_name = fbb.CreateString(p.name);
+    const auto values = p.enum_values.empty() ? Offset<Vector<Offset<flatbuffers::String>>>()
+                                              : fbb.CreateVectorOfStrings(p.enum_values);
+    parameters.push_back(fb::CreateParameter(fbb, param_name, static_cast<fb::ParameterType>(p.type), p.default_value,
+                                             p.min_value, p.max_value, values));
+  }
+  const auto parameters_v = fbb.CreateVector(parameters);
+  const auto clips_v = fbb.CreateVectorOfStrings(graph.clips);
+  std::vector<Offset<fb::Node>> nodes;
+  for (const NodeDef& node : graph.nodes) nodes.push_back(write_node(fbb, node));
+  const auto nodes_v = fbb.CreateVector(nodes);
+  std::vector<Offset<fb::StateMachine>> machines;
+  for (const StateMachineDef& machine : graph.machines) machines.push_back(write_machine(fbb, machine));
+  const auto machines_v = fbb.CreateVector(machines);
+  return fb::CreateGraph(fbb, name, graph.skeleton_hash, graph.joint_count, parameters_v, clips_v, nodes_v,
+                         machines_v, graph.root);
 }
 
 Offset<fb::Material> write_material(FlatBufferBuilder& fbb, const SourceMaterial& material) {
@@ -183,8 +275,12 @@ std::vector<uint8_t> write_ossa(const SourceScene& scene, std::span<const Cooked
   const auto options_text = fbb.CreateString(provenance.options);
   const auto prov = fb::CreateProvenance(fbb, source_name, provenance.source_hash, cooker_version, options_text);
 
+  std::vector<Offset<fb::Graph>> graph_offsets;
+  for (const GraphDef& graph : options.graphs) graph_offsets.push_back(write_graph(fbb, graph));
+  const auto graphs_v = graph_offsets.empty() ? Offset<Vector<Offset<fb::Graph>>>() : fbb.CreateVector(graph_offsets);
+
   const auto root = fb::CreateFile(fbb, kFormatVersion, scene.metres_per_unit, skeleton, meshes_v, clips_v,
-                                   materials_v, prov);
+                                   materials_v, prov, graphs_v);
   fb::FinishFileBuffer(fbb, root);
   return std::vector<uint8_t>(fbb.GetBufferPointer(), fbb.GetBufferPointer() + fbb.GetSize());
 }

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "cooker/clip_compress.h"
+#include "cooker/graph_def.h"
 #include "cooker/mesh_build.h"
 #include "cooker/source_scene.h"
 
@@ -24,6 +25,7 @@ struct WriteProvenance {
 
 struct WriteOptions {
   bool include_skeleton = true;  // false for clip-only files cooked against --skeleton
+  std::span<const GraphDef> graphs;  // animation graphs (a character cooked from a graph file)
 };
 
 /// The skeleton hash of a SourceSkeleton (format/hash.h's skeleton_hash over its names/parents).

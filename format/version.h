@@ -7,7 +7,7 @@
 #include <cstdint>
 
 namespace ossa {
-inline constexpr uint32_t kFormatVersion = 2;  // 2: compressed clips (ClipCompression, RootMotion)
-inline constexpr const char* kCookerVersion = "ossa-cook 0.2.0";
+inline constexpr uint32_t kFormatVersion = 3;  // 2: compressed clips; 3: animation graphs, clip events
+inline constexpr const char* kCookerVersion = "ossa-cook 0.3.0";
 inline constexpr const char* kFileIdentifier = "OSSA";
 }  // namespace ossa

@@ -359,7 +359,8 @@ void make_additive(ConstPoseSpan pose, ConstPoseSpan reference, PoseSpan out_add
   // Translation differences and scale ratios: element-wise over tx|ty|tz and sx|sy|sz.
   const size_t s = kSx * stride;
   elementwise(p, r, o, 3 * stride, [](float pv, float rv) { return pv - rv; });
-  elementwise(p + s, r + s, o + s, 3 * stride, [](float pv, float rv) { return pv / rv; });
+  // A zero reference scale has no ratio; 1 (no scale change) keeps the result finite.
+  elementwise(p + s, r + s, o + s, 3 * stride, [](float pv, float rv) { return rv != 0.0f ? pv / rv : 1.0f; });
   // conj(r) * q: w = rw qw + rv.qv, v = rw qv - qw rv - rv x qv.
   const size_t rot = kRx * stride, s1 = stride, s2 = 2 * stride, s3 = 3 * stride;
   for (size_t first = 0; first < stride; first += kLanes) {

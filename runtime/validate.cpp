@@ -54,6 +54,13 @@ std::string label(const char* kind, size_t index, const flatbuffers::String* nam
 
 bool finite3(const fb::Vec3& v) { return std::isfinite(v.x()) && std::isfinite(v.y()) && std::isfinite(v.z()); }
 
+/// Pose values (translations, scales) are bounded so that blending, layering and adding poses —
+/// differences, weighted sums, ratios — stay finite: a finite but astronomically large value
+/// (a flipped exponent bit) would overflow there. 1e7 source units is 100 km in centimetres.
+constexpr float kMaxPoseValue = 1e7f;
+bool bounded(float v) { return std::isfinite(v) && std::fabs(v) <= kMaxPoseValue; }
+bool bounded3(const fb::Vec3& v) { return bounded(v.x()) && bounded(v.y()) && bounded(v.z()); }
+
 bool finite4(const fb::Quat& q) {
   return std::isfinite(q.x()) && std::isfinite(q.y()) && std::isfinite(q.z()) && std::isfinite(q.w());
 }
@@ -191,6 +198,10 @@ class Validator {
       for (flatbuffers::uoffset_t i = 0; i < materials->size(); ++i)
         if (Status st = check_material(*materials->Get(i), i); !st) return st;
     }
+    if (const auto* graphs = file_.graphs()) {
+      for (flatbuffers::uoffset_t i = 0; i < graphs->size(); ++i)
+        if (Status st = validate_graph(*graphs->Get(i), i, name_, budget_); !st) return st;
+    }
     return {};
   }
 
@@ -251,11 +262,11 @@ class Validator {
           return fail(where, jl() + format(" has parent %d, must be -1 (the first joint is a root)", parent));
         return fail(where, jl() + format(" has parent %d, must be -1 or < %zu (parents come first)", parent, i));
       }
-      if (!finite3(*s.bind_translations()->Get(idx)))
+      if (!bounded3(*s.bind_translations()->Get(idx)))
         return fail(where, jl() + ": bind translation is not finite");
       if (!normalizable(*s.bind_rotations()->Get(idx)))
         return fail(where, jl() + ": bind rotation is not a finite, non-zero quaternion");
-      if (!finite3(*s.bind_scales()->Get(idx))) return fail(where, jl() + ": bind scale is not finite");
+      if (!bounded3(*s.bind_scales()->Get(idx))) return fail(where, jl() + ": bind scale is not finite (or beyond 1e7)");
       if (!finite_matrix(*s.inverse_bind()->Get(idx)))
         return fail(where, jl() + ": inverse bind matrix is not finite");
     }
@@ -502,8 +513,8 @@ class Validator {
       }
       if (ch.channel() == fb::Channel::Rotation) {
         if (!normalizable(ch.value())) return fail(where, cl() + ": value is not a finite, non-zero quaternion");
-      } else if (!std::isfinite(ch.value().x()) || !std::isfinite(ch.value().y()) || !std::isfinite(ch.value().z())) {
-        return fail(where, cl() + ": value is not finite");
+      } else if (!bounded(ch.value().x()) || !bounded(ch.value().y()) || !bounded(ch.value().z())) {
+        return fail(where, cl() + ": value is not finite (or beyond 1e7)");
       }
     }
 
@@ -585,8 +596,8 @@ class Validator {
       const float los[3] = {lo.x(), lo.y(), lo.z()}, exs[3] = {ex.x(), ex.y(), ex.z()};
       if (bits != kRawFloatBits) {
         for (int i = 0; i < 3; ++i) {
-          if (!std::isfinite(los[i]) || !std::isfinite(exs[i]) || !(exs[i] >= 0.0f) || !std::isfinite(los[i] + exs[i]))
-            return fail(where, cl() + format(": range min %s extent %s must be finite with extents >= 0",
+          if (!bounded(los[i]) || !bounded(exs[i]) || !(exs[i] >= 0.0f) || !bounded(los[i] + exs[i]))
+            return fail(where, cl() + format(": range min %s extent %s must be finite (within 1e7) with extents >= 0",
                                            vec3_text(lo).c_str(), vec3_text(ex).c_str()));
           if (rotation && (los[i] < -kRotationComponentLimit || los[i] + exs[i] > kRotationComponentLimit))
             return fail(where, cl() + format(": rotation range min %s extent %s leaves [-1, 1]", vec3_text(lo).c_str(),
@@ -600,7 +611,7 @@ class Validator {
           float v[3];
           std::memcpy(v, raw + 12ull * i, sizeof v);
           for (int j = 0; j < 3; ++j) {
-            if (!std::isfinite(v[j])) return fail(where, cl() + format(": raw key %u is not finite", i));
+            if (!bounded(v[j])) return fail(where, cl() + format(": raw key %u is not finite (or beyond 1e7)", i));
             if (rotation && std::fabs(v[j]) > kRotationComponentLimit)
               return fail(where, cl() + format(": raw rotation key %u component %g leaves [-1, 1]", i, v[j]));
           }
@@ -620,6 +631,23 @@ class Validator {
         const auto idx = static_cast<flatbuffers::uoffset_t>(i);
         if (!finite3(*rm->translations()->Get(idx)) || !std::isfinite(rm->yaws()->Get(idx)))
           return fail(where, format("root motion frame %zu is not finite", i));
+      }
+    }
+
+    // Events: named, finite, inside the clip, sorted by time (the graph's event scan relies on it).
+    if (const auto* events = c.events()) {
+      if (!spend(static_cast<uint64_t>(events->size()) * 8)) return over_budget(where);
+      float previous = 0.0f;
+      for (flatbuffers::uoffset_t i = 0; i < events->size(); ++i) {
+        const fb::ClipEvent& e = *events->Get(i);
+        if (view_of(e.name()).empty()) return fail(where, format("event %u has an empty name", i));
+        const float t = e.time();
+        if (!std::isfinite(t) || t < 0.0f || t > duration)
+          return fail(where, format("event %u '%s' at %g s lies outside the clip [0, %g s]", i,
+                                    detail::printable(view_of(e.name())).c_str(), t, duration));
+        if (t < previous) return fail(where, format("event %u at %g s comes before event %u's %g s: not sorted", i, t,
+                                                    i - 1, previous));
+        previous = t;
       }
     }
     return {};

@@ -15,7 +15,8 @@
 // normalizable; root motion one finite sample
 // per frame. Runs after verification; never reads out of bounds.
 //
-// Also checked, because a reader relies on them: metres_per_unit finite and > 0; joint names
+// Also checked, because a reader relies on them: pose values (bind translations and scales,
+// clip constants, ranges and raw keys) within 1e7 so pose arithmetic cannot overflow; metres_per_unit finite and > 0; joint names
 // non-empty; bind pose and inverse binds finite, rotations normalizable (also for keys); vertex
 // stride a multiple of 4 and attribute offsets aligned to their component size (so CPU decoding
 // reads aligned data); Joints uses an integer format and nothing else does; Position has >= 3
@@ -41,5 +42,13 @@ namespace ossa {
 /// which a file without shared vectors never does. 0 = no bound (trusted callers only).
 /// verify_buffer passes it. Vertex/index/texture data must be 16-byte aligned in memory.
 Status validate_file(const fb::File& file, std::string_view name, size_t buffer_size = 0);
+
+/// The graph checks (validate_graph.cpp), run by validate_file for each of File.graphs: every index
+/// in range (parameters, clips, joints, nodes, machines, states), parameter types fit their uses,
+/// nodes children first with one referrer each and at most kMaxGraphDepth levels deep, each
+/// machine played by one node, finite numbers, sane durations, conditions well formed with a stack
+/// of at most 16. `budget` (bytes of vector data still allowed to be scanned) is charged.
+inline constexpr uint32_t kMaxGraphDepth = 64;
+Status validate_graph(const fb::Graph& graph, size_t index, std::string_view name, uint64_t& budget);
 
 }  // namespace ossa

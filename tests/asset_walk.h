@@ -9,7 +9,9 @@
 // first broken promise as text (empty when all hold) rather than using GoogleTest, because the
 // libFuzzer target includes it too. Header-only: the fuzz target is built from one source file.
 // Every accepted clip is also played once through sample() at a few times (looping, clamped,
-// nlerp, slerp), so the fuzzer proves the sampler never reads outside a validated file.
+// nlerp, slerp), so the fuzzer proves the sampler never reads outside a validated file; every
+// accepted graph that binds (its clips may legitimately be missing) is played for a few updates
+// with every parameter and trigger set, so the evaluator is proven the same way.
 #pragma once
 #include <algorithm>
 #include <cmath>
@@ -27,6 +29,7 @@
 #include "format/vertex_format.h"
 #include "format/version.h"
 #include "runtime/asset.h"
+#include "runtime/graph.h"
 #include "runtime/pose.h"
 #include "runtime/sample.h"
 
@@ -48,6 +51,7 @@ class AssetWalker {
     for (size_t i = 0; i < asset_.mesh_count(); ++i) mesh(i);
     for (size_t i = 0; i < asset_.clip_count(); ++i) clip(i);
     for (size_t i = 0; i < asset_.material_count(); ++i) material(i);
+    for (size_t i = 0; i < graph_count(asset_); ++i) graph(i);
     if (const fb::Provenance* p = asset_.file().provenance()) {
       text(p->source_name(), "provenance.source_name");
       text(p->cooker_version(), "provenance.cooker_version");
@@ -355,6 +359,35 @@ class AssetWalker {
           sum_ += word;
         }
       }
+    }
+  }
+
+  void graph(size_t i) {
+    const fb::Graph& g = *asset_.file().graphs()->Get(static_cast<flatbuffers::uoffset_t>(i));
+    const std::string where = "graph " + std::to_string(i);
+    text(g.name(), where + ".name");
+    auto def = GraphDefinition::create(asset_, g.name()->string_view());
+    if (!def.ok()) return;  // e.g. a clip it names is not in this file: an error, not a broken promise
+    auto inst = GraphInstance::create(*def, 4);
+    if (!inst.ok()) return fail(where, "binds but cannot be instantiated: " + inst.error().message);
+    const float steps[] = {0.0f, 0.016f, 0.5f, 0.033f, 3.7f, 0.016f, 0.25f, 0.016f};
+    for (size_t k = 0; k < std::size(steps); ++k) {
+      for (size_t p = 0; p < def->parameter_count(); ++p) {
+        const int idx = static_cast<int>(p);
+        const float v = static_cast<float>((k * 7 + p * 3) % 5) * 0.75f;
+        inst->set_float(idx, v);
+        inst->set_int(idx, static_cast<int>(k % 4));
+        inst->set_bool(idx, (k + p) % 2 == 0);
+        inst->set_enum(idx, static_cast<int>(k % 2));
+        if (k % 3 == 0) inst->set_trigger(idx);
+      }
+      inst->update(steps[k]);
+      const ConstPoseSpan pose = inst->pose();
+      for (uint32_t j = 0; j < pose.joint_count; ++j)
+        for (uint32_t c = 0; c < kPoseComponents; ++c)
+          if (!std::isfinite(pose[PoseComponent(c)][j])) return fail(where, "update produced a non-finite pose");
+      for (const GraphEvent& e : inst->events()) touch(e.name, where + " event name");
+      for (size_t m = 0; m < def->machine_count(); ++m) sum_ += static_cast<uint64_t>(inst->machine_status(m).current);
     }
   }
 

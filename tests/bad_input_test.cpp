@@ -192,8 +192,22 @@ size_t referenced_size(const std::vector<uint8_t>& bytes) {
   return n;
 }
 
-TEST(DamagedBytes, EveryTruncationRejected) {
-  const std::vector<uint8_t> bytes = make_valid_file();
+/// The file every damage test starts from: the default, and the variant with an animation graph
+/// and clip events (whose accepted damaged forms are also played through the graph evaluator).
+std::vector<uint8_t> damage_base(bool graph) {
+  if (!graph) return make_valid_file();
+  for (const auto& [name, spec] : valid_variants())
+    if (name == "graph") return make_valid_file(spec);
+  return {};
+}
+
+class DamagedBytes : public ::testing::TestWithParam<bool> {};
+INSTANTIATE_TEST_SUITE_P(File, DamagedBytes, ::testing::Values(false, true),
+                         [](const ::testing::TestParamInfo<bool>& p) { return p.param ? "WithGraph" : "Default"; });
+
+TEST_P(DamagedBytes, EveryTruncationRejected) {
+  const std::vector<uint8_t> bytes = damage_base(GetParam());
+  ASSERT_FALSE(bytes.empty());
   const size_t complete = referenced_size(bytes);
   std::vector<size_t> lengths;
   for (size_t n = 0; n <= std::min<size_t>(bytes.size(), 512); ++n) lengths.push_back(n);
@@ -214,7 +228,7 @@ TEST(DamagedBytes, EveryTruncationRejected) {
   EXPECT_TRUE(failures.empty()) << failures.size() << " failures, first: " << failures.front();
 }
 
-TEST(DamagedBytes, TruncatedFileOnDiskRejected) {
+TEST(DamagedFile, TruncatedFileOnDiskRejected) {
   const std::vector<uint8_t> bytes = make_valid_file();
   const std::filesystem::path dir = make_temp_dir("bad_input");
   for (size_t n : {size_t{1}, size_t{7}, size_t{8}, size_t{64}, bytes.size() / 2, referenced_size(bytes) - 1}) {
@@ -225,8 +239,9 @@ TEST(DamagedBytes, TruncatedFileOnDiskRejected) {
 }
 
 // Every byte, several masks: accepted (then safe to walk) or rejected with a message; never UB.
-TEST(DamagedBytes, EveryByteFlipped) {
-  const std::vector<uint8_t> bytes = make_valid_file();
+TEST_P(DamagedBytes, EveryByteFlipped) {
+  const std::vector<uint8_t> bytes = damage_base(GetParam());
+  ASSERT_FALSE(bytes.empty());
   std::vector<std::string> failures;
   size_t accepted = 0, refused = 0;
   for (size_t offset = 0; offset < bytes.size(); ++offset) {
@@ -253,7 +268,7 @@ TEST(DamagedBytes, EveryByteFlipped) {
   std::printf("flips: %zu accepted, %zu rejected\n", accepted, refused);
 }
 
-TEST(DamagedBytes, RandomBytesRejected) {
+TEST(DamagedFile, RandomBytesRejected) {
   std::mt19937 rng(20240601);  // fixed seed: reproducible
   for (int round = 0; round < 200; ++round) {
     std::vector<uint8_t> bytes(8 + rng() % 4096);
@@ -265,7 +280,7 @@ TEST(DamagedBytes, RandomBytesRejected) {
 
 // FlatBuffers tables form a DAG: one big index vector reached through thousands of mesh entries
 // must not cost thousands of scans (validate.h: the checks bound their work by the buffer size).
-TEST(DamagedBytes, SharedTablesDoNotMultiplyWork) {
+TEST(DamagedFile, SharedTablesDoNotMultiplyWork) {
   flatbuffers::FlatBufferBuilder fbb;
   const std::vector<fb::VertexAttribute> layout = {{fb::VertexSemantic::Position, fb::VertexFormat::Float32x3, 0}};
   const std::vector<uint8_t> vertices(3 * 12, 0);

@@ -279,9 +279,65 @@ flatbuffers::Offset<fb::Clip> write_clip(flatbuffers::FlatBufferBuilder& fbb, co
     const auto yaws = fbb.CreateVector(c.root_motion->yaws);
     root_motion = fb::CreateRootMotion(fbb, translations, yaws, c.root_motion->up_axis);
   }
+  std::vector<flatbuffers::Offset<fb::ClipEvent>> events;
+  for (const auto& [event_name, time] : c.events) events.push_back(fb::CreateClipEventDirect(fbb, event_name.c_str(), time));
+  const auto event_vector = events.empty() ? 0 : fbb.CreateVector(events);
   return fb::CreateClip(fbb, name, c.duration_value(), c.sample_rate, c.frame_count,
                         c.skeleton_hash.value_or(skeleton_hash), joints, constant_vector, animated_vector, frame_vector,
-                        value_vector, compression, root_motion);
+                        value_vector, compression, root_motion, event_vector);
+}
+
+/// The synthetic graph (SyntheticSpec::graph): every node kind, parameter type and transition mode.
+flatbuffers::Offset<fb::Graph> write_graph(flatbuffers::FlatBufferBuilder& fbb, const std::string& clip,
+                                           uint64_t skeleton_hash, uint16_t joint_count) {
+  using PT = fb::ParameterType;
+  std::vector<flatbuffers::Offset<fb::Parameter>> params;
+  params.push_back(fb::CreateParameterDirect(fbb, "speed", PT::Float, 1.0f, 0.0f, 4.0f));
+  params.push_back(fb::CreateParameterDirect(fbb, "flag", PT::Bool));
+  params.push_back(fb::CreateParameterDirect(fbb, "go", PT::Trigger));
+  std::vector<flatbuffers::Offset<flatbuffers::String>> values = {fbb.CreateString("a"), fbb.CreateString("b")};
+  params.push_back(fb::CreateParameter(fbb, fbb.CreateString("mode"), PT::Enum, 0.0f, -3.4e38f, 3.4e38f,
+                                       fbb.CreateVector(values)));
+  params.push_back(fb::CreateParameterDirect(fbb, "count", PT::Int, 0.0f, 0.0f, 3.0f));
+  const auto node = [&](fb::NodeData type, flatbuffers::Offset<void> data) {
+    return fb::CreateNode(fbb, fbb.CreateString(""), type, data);
+  };
+  std::vector<flatbuffers::Offset<fb::Node>> nodes;
+  nodes.push_back(node(fb::NodeData::ClipNode, fb::CreateClipNode(fbb, 0, 1.0f, 0).Union()));              // 0
+  nodes.push_back(node(fb::NodeData::ClipNode, fb::CreateClipNode(fbb, 0, -1.0f, -1, false).Union()));     // 1
+  nodes.push_back(node(fb::NodeData::BlendAlphaNode, fb::CreateBlendAlphaNode(fbb, 0, 1, 0).Union()));    // 2
+  const std::vector<fb::BlendSample> samples = {{0, 0.0f, 0.0f}, {0, 2.0f, 0.0f}};
+  nodes.push_back(node(fb::NodeData::BlendSpaceNode,
+                       fb::CreateBlendSpaceNode(fbb, 0, -1, fbb.CreateVectorOfStructs(samples)).Union()));  // 3
+  const std::vector<uint16_t> children = {2, 3};
+  nodes.push_back(node(fb::NodeData::SelectNode, fb::CreateSelectNode(fbb, 3, fbb.CreateVector(children), 0.2f).Union()));  // 4
+  nodes.push_back(node(fb::NodeData::ClipNode, fb::CreateClipNode(fbb, 0, 1.0f, -1, true, 0.5f).Union()));  // 5
+  nodes.push_back(node(fb::NodeData::AdditiveNode, fb::CreateAdditiveNode(fbb, 4, 5, 0.5f).Union()));      // 6
+  nodes.push_back(node(fb::NodeData::ClipNode, fb::CreateClipNode(fbb, 0).Union()));                       // 7
+  nodes.push_back(node(fb::NodeData::StateMachineNode, fb::CreateStateMachineNode(fbb, 0).Union()));       // 8
+  nodes.push_back(node(fb::NodeData::ClipNode, fb::CreateClipNode(fbb, 0).Union()));                       // 9
+  const std::vector<fb::MaskEntry> mask = {{1, -1}};
+  std::vector<flatbuffers::Offset<fb::Layer>> layers = {
+      fb::CreateLayer(fbb, 9, fbb.CreateVectorOfStructs(mask), 1.0f, 1, 0.1f, true)};
+  nodes.push_back(node(fb::NodeData::LayeredBlendNode, fb::CreateLayeredBlendNode(fbb, 8, fbb.CreateVector(layers)).Union()));  // 10
+
+  using Op = fb::ConditionOp;
+  const std::vector<fb::ConditionInstr> go = {{Op::Trigger, 2, 0.0f}};
+  // (speed > 1 && !flag) || count == 2
+  const std::vector<fb::ConditionInstr> back = {{Op::Greater, 0, 1.0f}, {Op::Bool, 1, 0.0f}, {Op::Not, 0, 0.0f},
+                                                {Op::And, 0, 0.0f},     {Op::Equal, 4, 2.0f}, {Op::Or, 0, 0.0f}};
+  const std::vector<fb::ConditionInstr> flag = {{Op::Bool, 1, 0.0f}};
+  std::vector<flatbuffers::Offset<fb::Transition>> transitions = {
+      fb::CreateTransition(fbb, 0, 1, fbb.CreateVectorOfStructs(go), -1.0f, 0.2f, fb::TransitionMode::Crossfade),
+      fb::CreateTransition(fbb, 1, 0, fbb.CreateVectorOfStructs(back), 0.5f, 0.3f, fb::TransitionMode::SyncCrossfade),
+      fb::CreateTransition(fbb, -1, 0, fbb.CreateVectorOfStructs(flag), -1.0f, 0.1f, fb::TransitionMode::Inertialize)};
+  std::vector<flatbuffers::Offset<fb::State>> states = {fb::CreateStateDirect(fbb, "s0", 6, true),
+                                                        fb::CreateStateDirect(fbb, "s1", 7, false)};
+  std::vector<flatbuffers::Offset<fb::StateMachine>> machines = {
+      fb::CreateStateMachine(fbb, fbb.CreateString("m"), fbb.CreateVector(states), 0, fbb.CreateVector(transitions))};
+  std::vector<flatbuffers::Offset<flatbuffers::String>> clips = {fbb.CreateString(clip)};
+  return fb::CreateGraph(fbb, fbb.CreateString("g"), skeleton_hash, joint_count, fbb.CreateVector(params),
+                         fbb.CreateVector(clips), fbb.CreateVector(nodes), fbb.CreateVector(machines), 10);
 }
 
 flatbuffers::Offset<fb::Material> write_material(flatbuffers::FlatBufferBuilder& fbb, const SyntheticMaterial& m) {
@@ -430,6 +486,11 @@ std::vector<std::pair<std::string, SyntheticSpec>> valid_variants() {
   spec.meshes.push_back(spec.meshes[0]);
   spec.meshes[1].name = "head";
   out.emplace_back("two-meshes", spec);
+  spec = {};
+  spec.graph = true;
+  spec.clips[0].events = {{"start", 0.0f}, {"step", 0.25f}, {"step", 0.75f}, {"end", 1.0f}};
+  out.emplace_back("graph", spec);
+
   return out;
 }
 
@@ -469,9 +530,12 @@ std::vector<uint8_t> make_valid_file(const SyntheticSpec& spec) {
     provenance = fb::CreateProvenanceDirect(fbb, "synthetic.gltf", hash_bytes(source, sizeof source - 1),
                                             kCookerVersion, "synthetic");
   }
+  std::vector<flatbuffers::Offset<fb::Graph>> graphs;
+  if (spec.graph && !spec.clips.empty()) graphs.push_back(write_graph(fbb, spec.clips[0].name, hash, joint_count));
   const auto root = fb::CreateFileDirect(fbb, spec.version, spec.metres_per_unit, skeleton,
                                          spec.meshes.empty() ? nullptr : &meshes, spec.clips.empty() ? nullptr : &clips,
-                                         spec.materials.empty() ? nullptr : &materials, provenance);
+                                         spec.materials.empty() ? nullptr : &materials, provenance,
+                                         graphs.empty() ? nullptr : &graphs);
   std::string identifier = spec.identifier;
   identifier.resize(4, ' ');
   fbb.Finish(root, identifier.c_str());

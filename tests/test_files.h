@@ -130,6 +130,8 @@ struct SyntheticClip {
   std::optional<SyntheticRootMotion> root_motion;
   /// Write empty channel vectors instead of leaving the fields out.
   bool write_empty_channels = false;
+  /// Clip events (name, seconds), written when not empty.
+  std::vector<std::pair<std::string, float>> events;
 
   float duration_value() const { return duration.value_or(static_cast<float>(frame_count - 1) / sample_rate); }
 
@@ -170,6 +172,9 @@ struct SyntheticSpec {
   std::vector<SyntheticClip> clips = {SyntheticClip{}};
   std::vector<SyntheticMaterial> materials = {SyntheticMaterial{}};
   bool provenance = true;
+  /// Add an animation graph "g" over the skeleton and the first clip using every node kind, every
+  /// parameter type, nested conditions and each transition mode (needs the default skeleton).
+  bool graph = false;
 
   static uint32_t default_version();  // kFormatVersion
 };
@@ -181,7 +186,7 @@ std::vector<uint8_t> make_valid_file(const SyntheticSpec& spec = {});
 /// Valid files of different shapes, by name: default, uint32-indices, float32-layout (16-bit joint
 /// slots), static-mesh (no skeleton), clip-only, empty-channels (plus a clip without channels),
 /// single-frame (a 1-frame clip of constants), root-motion, low-bits (1- and 3-bit keys), drop-y
-/// (a rotation storing x, z, w in 19 bits), two-meshes. For suites that must not over-fit the default, and for seeding fuzz corpora.
+/// (a rotation storing x, z, w in 19 bits), two-meshes, graph (an animation graph and clip events). For suites that must not over-fit the default, and for seeding fuzz corpora.
 std::vector<std::pair<std::string, SyntheticSpec>> valid_variants();
 
 /// A 16-byte aligned copy of some bytes: what verify_buffer expects, and what a std::vector

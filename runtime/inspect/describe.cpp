@@ -120,7 +120,7 @@ json describe_clip(const ClipView& clip, const SkeletonView& skeleton, float met
     static const char* const kAxes[] = {"x", "y", "z"};
     root_motion = json{{"up_axis", rm->up_axis() <= 2 ? kAxes[rm->up_axis()] : "?"}};
   }
-  return json{{"name", std::string(clip.name())},
+  json out{{"name", std::string(clip.name())},
               {"duration", round6(clip.duration())},
               {"sample_rate", round6(clip.sample_rate())},
               {"frame_count", clip.frame_count()},
@@ -134,6 +134,88 @@ json describe_clip(const ClipView& clip, const SkeletonView& skeleton, float met
               {"bytes", clip_bytes(clip)},
               {"compression", describe_compression(clip, skeleton, metres_per_unit)},
               {"root_motion", std::move(root_motion)}};
+  // Only when present, so files without events describe as they did before format v3.
+  if (const auto* events = clip.fb->events(); events && events->size() > 0) {
+    json list = json::array();
+    for (const fb::ClipEvent* e : *events) list.push_back(json{{"name", str(e->name())}, {"time", round6(e->time())}});
+    out["events"] = std::move(list);
+  }
+  return out;
+}
+
+/// A condition program back in infix form, for reading: "speed > 4.5 && !crossed".
+std::string condition_text(const fb::Graph& g, const fb::Transition& t) {
+  const auto* cond = t.condition();
+  if (!cond || cond->size() == 0) return "true";
+  std::vector<std::string> stack;
+  const auto param = [&](uint16_t p) { return str(g.parameters()->Get(p)->name()); };
+  static const char* const kOps[] = {"", "<", "<=", ">", ">=", "==", "!="};
+  for (const fb::ConditionInstr* c : *cond) {
+    const auto op = c->op();
+    if (op == fb::ConditionOp::True) {
+      stack.push_back("true");
+    } else if (op >= fb::ConditionOp::Less && op <= fb::ConditionOp::NotEqual) {
+      const fb::Parameter& p = *g.parameters()->Get(c->parameter());
+      std::string value = format("%g", static_cast<double>(c->value()));
+      if (p.type() == fb::ParameterType::Enum && p.enum_values() && c->value() >= 0.0f &&
+          c->value() < static_cast<float>(p.enum_values()->size()))
+        value = str(p.enum_values()->Get(static_cast<flatbuffers::uoffset_t>(c->value())));
+      stack.push_back(param(c->parameter()) + " " + kOps[static_cast<int>(op)] + " " + value);
+    } else if (op == fb::ConditionOp::Bool || op == fb::ConditionOp::Trigger) {
+      stack.push_back(param(c->parameter()));
+    } else if (op == fb::ConditionOp::Not && !stack.empty()) {
+      stack.back() = "!(" + stack.back() + ")";
+    } else if (stack.size() >= 2) {
+      const std::string b = stack.back();
+      stack.pop_back();
+      stack.back() = "(" + stack.back() + (op == fb::ConditionOp::And ? " && " : " || ") + b + ")";
+    }
+  }
+  return stack.empty() ? "?" : stack.back();
+}
+
+json describe_graph(const fb::Graph& g) {
+  json params = json::array(), machines = json::array();
+  for (const fb::Parameter* p : *g.parameters()) {
+    json item{{"name", str(p->name())}, {"type", fb::EnumNameParameterType(p->type())},
+              {"default", round6(p->default_value())}};
+    if (p->enum_values()) {
+      json values = json::array();
+      for (const flatbuffers::String* v : *p->enum_values()) values.push_back(str(v));
+      item["values"] = std::move(values);
+    }
+    params.push_back(std::move(item));
+  }
+  json kinds = json::object();
+  for (const fb::Node* n : *g.nodes()) {
+    const std::string kind = fb::EnumNameNodeData(n->data_type());
+    kinds[kind] = kinds.value(kind, 0) + 1;
+  }
+  if (const auto* ms = g.machines()) {
+    for (const fb::StateMachine* m : *ms) {
+      json states = json::array(), transitions = json::array();
+      for (const fb::State* st : *m->states()) states.push_back(str(st->name()));
+      if (const auto* ts = m->transitions()) {
+        for (const fb::Transition* t : *ts) {
+          const auto state = [&](int i) { return i < 0 ? std::string("any") : str(m->states()->Get(i)->name()); };
+          json item{{"from", state(t->from())}, {"to", state(t->to())}, {"when", condition_text(g, *t)},
+                    {"duration", round6(t->duration())}, {"mode", fb::EnumNameTransitionMode(t->mode())}};
+          if (t->exit_time() >= 0.0f) item["exit_time"] = round6(t->exit_time());
+          transitions.push_back(std::move(item));
+        }
+      }
+      machines.push_back(json{{"name", str(m->name())},
+                              {"entry", str(m->states()->Get(m->entry())->name())},
+                              {"states", std::move(states)},
+                              {"transitions", std::move(transitions)}});
+    }
+  }
+  json clips = json::array();
+  for (const flatbuffers::String* c : *g.clips()) clips.push_back(str(c));
+  return json{{"name", str(g.name())},        {"skeleton_hash", hex16(g.skeleton_hash())},
+              {"parameters", std::move(params)}, {"clips", std::move(clips)},
+              {"node_count", g.nodes()->size()}, {"nodes", std::move(kinds)},
+              {"machines", std::move(machines)}};
 }
 
 json describe_material(const fb::Material& m) {
@@ -198,7 +280,7 @@ json describe(const Asset& asset, std::string_view file_name) {
   for (size_t i = 0; i < asset.mesh_count(); ++i) meshes.push_back(describe_mesh(asset.mesh(i)));
   for (size_t i = 0; i < asset.clip_count(); ++i) clips.push_back(describe_clip(asset.clip(i), skeleton, file.metres_per_unit()));
   for (size_t i = 0; i < asset.material_count(); ++i) materials.push_back(describe_material(asset.material(i)));
-  return json{{"file", std::string(file_name)},
+  json out{{"file", std::string(file_name)},
               {"file_bytes", asset.bytes().size()},
               // Hash of every byte: goldens and build caches see any change in cooked output, not
               // only changes in the counts and sizes summarised below.
@@ -210,6 +292,12 @@ json describe(const Asset& asset, std::string_view file_name) {
               {"meshes", std::move(meshes)},
               {"clips", std::move(clips)},
               {"materials", std::move(materials)}};
+  if (const auto* graphs = file.graphs(); graphs && graphs->size() > 0) {
+    json list = json::array();
+    for (const fb::Graph* g : *graphs) list.push_back(describe_graph(*g));
+    out["graphs"] = std::move(list);
+  }
+  return out;
 }
 
 std::string describe_text(const json& d) {
@@ -282,6 +370,33 @@ std::string describe_text(const json& d) {
       line("  compression    -");
     }
     line("  root motion    " + (c["root_motion"].is_object() ? "yes, up axis " + text(c["root_motion"]["up_axis"]) : std::string("no")));
+    if (c.contains("events")) {
+      std::string events;
+      for (const json& e : c["events"]) events += (events.empty() ? "" : ", ") + text(e["name"]) + " @" + text(e["time"]);
+      line("  events         " + events);
+    }
+  }
+
+  if (d.contains("graphs")) {
+    for (const json& g : d["graphs"]) {
+      line("");
+      line("graph '" + text(g["name"]) + "': " + text(g["node_count"]) + " nodes, clips " + [&] {
+        std::string c;
+        for (const json& n : g["clips"]) c += (c.empty() ? "" : ", ") + text(n);
+        return c;
+      }());
+      for (const json& p : g["parameters"])
+        line("  parameter      " + text(p["name"]) + " (" + text(p["type"]) + ", default " + text(p["default"]) + ")");
+      for (const json& m : g["machines"]) {
+        std::string states;
+        for (const json& st : m["states"]) states += (states.empty() ? "" : ", ") + text(st);
+        line("  machine        " + text(m["name"]) + ": states " + states + "; entry " + text(m["entry"]));
+        for (const json& t : m["transitions"])
+          line("    " + text(t["from"]) + " -> " + text(t["to"]) + " when " + text(t["when"]) +
+               (t.contains("exit_time") ? ", exit time " + text(t["exit_time"]) : std::string()) + ": " +
+               text(t["mode"]) + " " + text(t["duration"]) + " s");
+      }
+    }
   }
 
   index = 0;

@@ -1,0 +1,130 @@
+// graph_def.h — an animation graph as plain data: what the graph compiler (graph_compile.h) makes
+// from a JSON file and what the writer serializes into the .ossa Graph table (format/ossa.fbs).
+//
+// It mirrors the schema one to one, with indices already resolved (clips, parameters, joints,
+// nodes, states), so serialization is a copy and tests can build graphs in C++ without JSON.
+// Nodes are stored children first: every index a node refers to is smaller than its own.
+#pragma once
+#include <cstdint>
+#include <string>
+#include <variant>
+#include <vector>
+
+namespace ossa::cook {
+
+enum class ParamType : uint8_t { Float = 0, Int = 1, Bool = 2, Enum = 3, Trigger = 4 };
+
+struct GraphParameter {
+  std::string name;
+  ParamType type = ParamType::Float;
+  float default_value = 0.0f;
+  float min_value = -3.4e38f, max_value = 3.4e38f;
+  std::vector<std::string> enum_values;
+};
+
+/// Same numbering as fb::ConditionOp.
+enum class CondOp : uint8_t {
+  True = 0, Less, LessEqual, Greater, GreaterEqual, Equal, NotEqual, Bool, Trigger, Not, And, Or
+};
+
+struct CondInstr {
+  CondOp op = CondOp::True;
+  uint16_t parameter = 0;
+  float value = 0.0f;
+};
+
+struct ClipNodeDef {
+  uint16_t clip = 0;
+  float rate = 1.0f;
+  int16_t rate_parameter = -1;
+  bool loop = true;
+  float start_offset = 0.0f;
+};
+struct BlendAlphaDef {
+  uint16_t a = 0, b = 0;
+  uint16_t alpha_parameter = 0;
+};
+struct SelectDef {
+  uint16_t parameter = 0;
+  std::vector<uint16_t> children;
+  float blend_time = 0.0f;
+};
+struct MaskEntryDef {
+  uint16_t joint = 0;
+  int16_t depth = -1;
+};
+struct LayerDef {
+  uint16_t node = 0;
+  std::vector<MaskEntryDef> mask;
+  float weight = 1.0f;
+  int16_t weight_parameter = -1;
+  float blend_time = 0.0f;
+  bool mesh_space_rotation = false;
+};
+struct LayeredDef {
+  uint16_t base = 0;
+  std::vector<LayerDef> layers;
+};
+struct BlendSampleDef {
+  uint16_t clip = 0;
+  float x = 0.0f, y = 0.0f;
+};
+struct BlendSpaceDef {
+  uint16_t x_parameter = 0;
+  int16_t y_parameter = -1;  // < 0: 1D
+  std::vector<BlendSampleDef> samples;
+  float rate = 1.0f;
+  bool loop = true;
+};
+struct AdditiveDef {
+  uint16_t base = 0, additive = 0;
+  float weight = 1.0f;
+  int16_t weight_parameter = -1;
+};
+struct StateMachineRefDef {
+  uint16_t machine = 0;
+};
+
+using NodeKind = std::variant<ClipNodeDef, BlendAlphaDef, SelectDef, LayeredDef, BlendSpaceDef, AdditiveDef,
+                              StateMachineRefDef>;
+
+struct NodeDef {
+  std::string name;
+  NodeKind kind;
+};
+
+/// Same numbering as fb::TransitionMode.
+enum class TransitionModeDef : uint8_t { Crossfade = 0, SyncCrossfade = 1, Inertialize = 2 };
+
+struct StateDef {
+  std::string name;
+  uint16_t node = 0;
+  bool restart = true;
+};
+struct TransitionDef {
+  int16_t from = -1;  // -1: any state
+  uint16_t to = 0;
+  std::vector<CondInstr> condition;  // RPN; empty = true
+  float exit_time = -1.0f;
+  float duration = 0.0f;
+  TransitionModeDef mode = TransitionModeDef::Crossfade;
+};
+struct StateMachineDef {
+  std::string name;
+  std::vector<StateDef> states;
+  uint16_t entry = 0;
+  std::vector<TransitionDef> transitions;  // priority order
+};
+
+struct GraphDef {
+  std::string name;
+  uint64_t skeleton_hash = 0;
+  uint16_t joint_count = 0;
+  std::vector<GraphParameter> parameters;
+  std::vector<std::string> clips;
+  std::vector<NodeDef> nodes;  // children first
+  std::vector<StateMachineDef> machines;
+  uint16_t root = 0;
+};
+
+}  // namespace ossa::cook

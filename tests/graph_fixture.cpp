@@ -1,0 +1,144 @@
+// graph_fixture.cpp — see graph_fixture.h.
+#include "graph_fixture.h"
+
+#include <cstdio>
+#include <memory>
+
+#include "cooker/import_scene.h"
+#include "cooker/write_ossa.h"
+#include "test_files.h"
+
+namespace ossa::test {
+namespace fs = std::filesystem;
+using namespace ossa::cook;
+
+int PabRig::joint(std::string_view name) const {
+  for (size_t i = 0; i < skeleton.joints.size(); ++i)
+    if (skeleton.joints[i].name == name) return static_cast<int>(i);
+  return -1;
+}
+
+const PabRig* pab_rig() {
+  static const std::unique_ptr<PabRig> rig = []() -> std::unique_ptr<PabRig> {
+    const fs::path dir = source_dir() / "assets" / "Pab";
+    if (!fs::exists(dir / "skeleton.fbx")) return nullptr;
+    auto out = std::make_unique<PabRig>();
+    auto rig_scene = import_scene((dir / "skeleton.fbx").string());
+    if (!rig_scene) {
+      std::fprintf(stderr, "graph fixture: %s\n", rig_scene.error().message.c_str());
+      return nullptr;
+    }
+    out->skeleton = rig_scene->skeleton;
+    out->metres_per_unit = rig_scene->metres_per_unit;
+    ImportOptions options;
+    options.reference = &out->skeleton;
+    for (const char* name : {"walk", "jog", "run", "crossarms"}) {
+      auto scene = import_scene((dir / (std::string(name) + ".fbx")).string(), options);
+      if (!scene || scene->clips.empty()) {
+        std::fprintf(stderr, "graph fixture: %s: %s\n", name, scene ? "no clip" : scene.error().message.c_str());
+        return nullptr;
+      }
+      auto clip = compress_clip(scene->clips[0], out->skeleton, out->metres_per_unit, ClipCompressionOptions{});
+      if (!clip) {
+        std::fprintf(stderr, "graph fixture: %s: %s\n", name, clip.error().message.c_str());
+        return nullptr;
+      }
+      clip->name = name;
+      out->clips.push_back(std::move(*clip));
+    }
+    return out;
+  }();
+  return rig.get();
+}
+
+GraphDef pab_graph(const PabRig& rig, std::string name) {
+  GraphDef g;
+  g.name = std::move(name);
+  g.skeleton_hash = skeleton_hash_of(rig.skeleton);
+  g.joint_count = static_cast<uint16_t>(rig.skeleton.joints.size());
+  for (const CompressedClip& c : rig.clips) g.clips.push_back(c.name);
+  return g;
+}
+
+Result<Asset> make_graph_file(const PabRig& rig, const std::vector<GraphDef>& graphs,
+                              const std::map<std::string, std::vector<SourceEvent>>& events) {
+  SourceScene scene;
+  scene.skeleton = rig.skeleton;
+  scene.metres_per_unit = rig.metres_per_unit;
+  std::vector<CompressedClip> clips = rig.clips;
+  for (CompressedClip& c : clips)
+    if (auto it = events.find(c.name); it != events.end()) c.events = it->second;
+  WriteProvenance provenance;
+  provenance.source_name = "graph_fixture";
+  WriteOptions options;
+  options.graphs = graphs;
+  const std::vector<uint8_t> bytes = write_ossa(scene, {}, clips, provenance, options);
+  return Asset::from_bytes(bytes, "graph_fixture.ossa");
+}
+
+uint16_t add_node(GraphDef& g, NodeKind kind, std::string name) {
+  g.nodes.push_back(NodeDef{std::move(name), std::move(kind)});
+  g.root = static_cast<uint16_t>(g.nodes.size() - 1);
+  return g.root;
+}
+
+uint16_t add_param(GraphDef& g, std::string name, ParamType type, float value, std::vector<std::string> enum_values) {
+  GraphParameter p;
+  p.name = std::move(name);
+  p.type = type;
+  p.default_value = value;
+  p.enum_values = std::move(enum_values);
+  g.parameters.push_back(std::move(p));
+  return static_cast<uint16_t>(g.parameters.size() - 1);
+}
+
+uint16_t clip_node(GraphDef& g, uint16_t clip, float rate, bool loop) {
+  ClipNodeDef c;
+  c.clip = clip;
+  c.rate = rate;
+  c.loop = loop;
+  return add_node(g, c, g.clips[clip]);
+}
+
+GraphDef pab_sample_graph(const PabRig& rig) {
+  GraphDef g = pab_graph(rig, "pab");
+  const uint16_t speed = add_param(g, "speed", ParamType::Float, 1.2f);
+  g.parameters[speed].min_value = 0.0f;
+  g.parameters[speed].max_value = 6.0f;
+  const uint16_t crossed = add_param(g, "crossed_arms", ParamType::Bool, 0.0f);
+  const uint16_t stop = add_param(g, "stop", ParamType::Trigger);
+
+  BlendSpaceDef move;
+  move.x_parameter = speed;
+  move.samples = {{kWalk, 1.2f, 0.0f}, {kJog, 2.6f, 0.0f}, {kRun, 4.0f, 0.0f}};
+  const uint16_t move_node = add_node(g, move, "move");
+  const uint16_t sprint_node = clip_node(g, kRun, 1.3f);
+  const uint16_t pose_node = clip_node(g, kCrossarms);
+
+  StateMachineDef sm;
+  sm.name = "locomotion";
+  sm.states = {{"move", move_node, true}, {"sprint", sprint_node, true}, {"pose", pose_node, true}};
+  sm.entry = 0;
+  TransitionDef to_sprint{0, 1, {{CondOp::Greater, speed, 4.5f}}, -1.0f, 0.4f, TransitionModeDef::SyncCrossfade};
+  TransitionDef to_move{1, 0, {{CondOp::LessEqual, speed, 4.2f}}, -1.0f, 0.3f, TransitionModeDef::Crossfade};
+  TransitionDef to_pose{-1, 2, {{CondOp::Trigger, stop, 0.0f}}, -1.0f, 0.25f, TransitionModeDef::Inertialize};
+  TransitionDef from_pose{2, 0, {{CondOp::Greater, speed, 0.2f}}, 0.5f, 0.3f, TransitionModeDef::Inertialize};
+  sm.transitions = {to_pose, to_sprint, to_move, from_pose};
+  g.machines.push_back(sm);
+  const uint16_t machine = add_node(g, StateMachineRefDef{0}, "locomotion");
+
+  const uint16_t arms = clip_node(g, kCrossarms);
+  LayeredDef layered;
+  layered.base = machine;
+  LayerDef layer;
+  layer.node = arms;
+  layer.mask = {{static_cast<uint16_t>(std::max(0, rig.joint("Spine"))), -1}};
+  layer.weight_parameter = static_cast<int16_t>(crossed);
+  layer.blend_time = 0.3f;
+  layer.mesh_space_rotation = true;
+  layered.layers = {layer};
+  add_node(g, layered, "upper_body");
+  return g;
+}
+
+}  // namespace ossa::test

@@ -1,0 +1,52 @@
+// graph_fixture.h — graph files for runtime tests and benchmarks, built in C++ (cooker/graph_def.h)
+// around Pab's real clips, so the tests pin the evaluator without depending on the JSON compiler.
+//
+// pab_rig() imports assets/Pab once per process: the 67-joint skeleton and the walk, jog, run and
+// crossarms clips bound to it, compressed with the default tolerance. make_graph_file() writes one
+// .ossa holding that skeleton, the clips (with any events given) and the graphs, through the same
+// writer ossa-cook uses, and opens it with the runtime's verified loader.
+#pragma once
+#include <map>
+#include <string>
+#include <vector>
+
+#include "cooker/clip_compress.h"
+#include "cooker/graph_def.h"
+#include "cooker/source_scene.h"
+#include "runtime/asset.h"
+
+namespace ossa::test {
+
+struct PabRig {
+  cook::SourceSkeleton skeleton;
+  float metres_per_unit = 0.01f;
+  std::vector<cook::CompressedClip> clips;  // walk, jog, run, crossarms
+  int joint(std::string_view name) const;   // -1 when absent
+};
+
+/// Null when assets/Pab is missing or fails to import (the message is printed).
+const PabRig* pab_rig();
+
+/// Clip index in PabRig::clips / GraphDef::clips order.
+enum PabClip : uint16_t { kWalk = 0, kJog = 1, kRun = 2, kCrossarms = 3 };
+
+/// A graph over Pab's rig with the four clips named walk, jog, run, crossarms (indices PabClip).
+cook::GraphDef pab_graph(const PabRig& rig, std::string name = "test");
+
+/// Writes rig + clips (events added per clip name) + graphs and loads it. Errors carry the
+/// validator's message (for tests of invalid graphs).
+Result<Asset> make_graph_file(const PabRig& rig, const std::vector<cook::GraphDef>& graphs,
+                              const std::map<std::string, std::vector<cook::SourceEvent>>& events = {});
+
+// Small builders: append a node, return its index.
+uint16_t add_node(cook::GraphDef& g, cook::NodeKind kind, std::string name = "");
+uint16_t add_param(cook::GraphDef& g, std::string name, cook::ParamType type, float value = 0.0f,
+                   std::vector<std::string> enum_values = {});
+uint16_t clip_node(cook::GraphDef& g, uint16_t clip, float rate = 1.0f, bool loop = true);
+
+/// The Pab sample graph's shape, built in C++ (as assets/Pab/pab.graph.json describes it): layered
+/// crossarms over a locomotion machine with a 1D walk/jog/run blend space, a sprint state and a
+/// standing pose, using every transition mode. Parameters: speed, crossed_arms, stop.
+cook::GraphDef pab_sample_graph(const PabRig& rig);
+
+}  // namespace ossa::test
