@@ -248,6 +248,72 @@ TEST_F(Viewer, WindowModeWithPanelRunsAndCaptures) {
 }
 
 // ---------------------------------------------------------------------------------------------
+// --graph: the Pab sample graph (tests/viewer_graph_file.cpp) drives arnaud.ossa.
+
+class ViewerGraph : public Viewer {
+ protected:
+  std::string files() const {
+    return quote(cooked("Pab/arnaud.ossa").string()) + " " + quote((viewer_cooked_dir() / "pab-graph.ossa").string());
+  }
+  Image render_graph(const std::string& tag, const std::string& extra) {
+    const fs::path png = dir_ / (tag + ".png");
+    const CommandResult r = run_viewer(files() + " --graph pab --no-grid --size 192x192 --time 1 --screenshot " +
+                                       quote(png.string()) + " " + extra);
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    return load_png(png);
+  }
+};
+
+TEST_F(ViewerGraph, ParametersChangeThePose) {
+  const Image walk = render_graph("walk", "");  // speed's default, 1.2: the walk sample
+  const Image sprint = render_graph("sprint", "--set speed=4.8");  // past 4.5: the sprint state
+  const Image arms = render_graph("arms", "--set crossed_arms=true");  // the crossarms layer
+  const Image stop = render_graph("stop", "--set stop");  // trigger: the standing pose state
+  const Image bind = render_graph("bind", "--bind-pose");
+  EXPECT_GT(coverage(walk), 0.02);
+  EXPECT_GT(compare(walk, bind, kPixelThreshold).differing, kMinDifferingPosed) << "the graph does not move the mesh";
+  EXPECT_GT(compare(walk, sprint, kPixelThreshold).differing, kMinDifferingPosed) << "speed does not reach the pose";
+  EXPECT_GT(compare(walk, arms, kPixelThreshold).differing, kMinDifferingPosed) << "crossed_arms does not layer";
+  EXPECT_GT(compare(walk, stop, kPixelThreshold).differing, kMinDifferingPosed) << "stop does not change state";
+}
+
+TEST_F(ViewerGraph, RendersDeterministicallyAndAgreesWithCpuSkinning) {
+  const Image a = render_graph("a", "--set speed=3");
+  const Image b = render_graph("b", "--set speed=3");
+  const Image cpu = render_graph("cpu", "--set speed=3 --cpu-skinning");
+  EXPECT_EQ(compare(a, b, 0).max_channel, 0) << "the same graph inputs gave another image";
+  EXPECT_LT(compare(a, cpu, kPixelThreshold).differing, kMaxDifferingSame);
+}
+
+TEST_F(ViewerGraph, UnknownGraphOrParameterIsNamed) {
+  const CommandResult graph = run_viewer(files() + " --graph walkies --frames 1");
+  EXPECT_NE(graph.exit_code, 0);
+  EXPECT_NE(graph.err.find("walkies"), std::string::npos) << graph.err;
+  EXPECT_NE(graph.err.find("'pab' (pab-graph.ossa)"), std::string::npos) << graph.err;
+
+  const CommandResult parameter = run_viewer(files() + " --graph pab --set sped=2 --frames 1");
+  EXPECT_NE(parameter.exit_code, 0);
+  EXPECT_NE(parameter.err.find("sped"), std::string::npos) << parameter.err;
+  EXPECT_NE(parameter.err.find("speed, crossed_arms, stop"), std::string::npos) << parameter.err;
+
+  const CommandResult value = run_viewer(files() + " --graph pab --set speed=fast --frames 1");
+  EXPECT_NE(value.exit_code, 0);
+  EXPECT_NE(value.err.find("fast"), std::string::npos) << value.err;
+
+  const CommandResult no_graph = run_viewer(quote(cooked("Fox/Fox.ossa").string()) + " --graph pab --frames 1");
+  EXPECT_NE(no_graph.exit_code, 0);
+  EXPECT_NE(no_graph.err.find("graphs: none"), std::string::npos) << no_graph.err;
+}
+
+TEST_F(ViewerGraph, WindowModeShowsTheGraphPanel) {
+  const fs::path png = dir_ / "window.png";
+  const CommandResult r = run_viewer(files() + " --graph pab --crowd 3 --size 640x400 --window-frames 3 --screenshot " +
+                                     quote(png.string()));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(load_png(png).width, 640);
+}
+
+// ---------------------------------------------------------------------------------------------
 // Failures: non-zero exit, and a message naming the file.
 
 TEST_F(Viewer, CorruptFileIsRefusedByName) {

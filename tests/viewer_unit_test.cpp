@@ -15,6 +15,9 @@
 #include "test_files.h"
 #include "viewer/bounds.h"
 #include "viewer/camera.h"
+#include "viewer/gl.h"
+#include "viewer/graph_driver.h"
+#include "viewer/graph_keys.h"
 #include "viewer/options.h"
 #include "viewer/scene.h"
 
@@ -179,6 +182,85 @@ TEST(ViewerScene, RefusesWithTheFileNamed) {
   EXPECT_FALSE(add_clip_file(*ok, walk));
   EXPECT_EQ(ok->clips.size(), clips) << "a refused file leaves the scene as it was";
   EXPECT_EQ(ok->assets.size(), 1u);
+}
+
+// ---------------------------------------------------------------------------------------------
+// The graph as pose source: the Pab sample graph file from the fixture (viewer_graph_file.cpp).
+
+Result<Scene> pab_graph_scene() {
+  const fs::path graph = fs::path(test::env_or("OSSA_VIEWER_COOKED", OSSA_TEST_VIEWER_COOKED_DIR)) / "pab-graph.ossa";
+  return load_scene(std::vector<std::string>{cooked("Pab/arnaud.ossa").string(), graph.string()});
+}
+
+TEST(ViewerGraph, ParametersSetFromText) {
+  Result<Scene> scene = pab_graph_scene();
+  ASSERT_TRUE(scene) << scene.error().message;
+  Result<GraphDriver> g = make_graph_driver(*scene, "pab", 3);
+  ASSERT_TRUE(g) << g.error().message;
+  ASSERT_EQ(g->instances.size(), 3u);
+  const int speed = graph_parameter(*g, "speed"), arms = graph_parameter(*g, "crossed_arms"), stop = graph_parameter(*g, "stop");
+  ASSERT_GE(speed, 0);
+  ASSERT_GE(arms, 0);
+  ASSERT_GE(stop, 0);
+  EXPECT_TRUE(set_graph_parameter(*g, "speed", "3.5"));
+  EXPECT_TRUE(set_graph_parameter(*g, "crossed_arms", "true"));
+  EXPECT_TRUE(set_graph_parameter(*g, "stop", "1"));
+  for (const GraphInstance& i : g->instances) {  // every crowd instance gets the value
+    EXPECT_FLOAT_EQ(i.value(speed), 3.5f);
+    EXPECT_FLOAT_EQ(i.value(arms), 1.0f);
+    EXPECT_FLOAT_EQ(i.value(stop), 1.0f);
+  }
+  EXPECT_TRUE(set_graph_parameter(*g, "speed", "99"));  // clamped to the parameter's range
+  EXPECT_FLOAT_EQ(g->instances[0].value(speed), 6.0f);
+  EXPECT_FALSE(set_graph_parameter(*g, "speed", "fast"));
+  EXPECT_FALSE(set_graph_parameter(*g, "velocity", "1"));
+  // Crowd instances are spread in time: their poses differ.
+  update_graph(*g, 0.1f);
+  const ConstPoseSpan a = g->instances[0].pose(), b = g->instances[1].pose();
+  bool differ = false;
+  for (uint32_t k = 0; k < a.stride * kPoseComponents && !differ; ++k) differ = a.base[k] != b.base[k];
+  EXPECT_TRUE(differ);
+}
+
+TEST(ViewerGraph, UnknownGraphListsTheGraphs) {
+  Result<Scene> scene = pab_graph_scene();
+  ASSERT_TRUE(scene) << scene.error().message;
+  Result<GraphDriver> g = make_graph_driver(*scene, "locomotion", 1);
+  ASSERT_FALSE(g);
+  EXPECT_NE(g.error().message.find("'pab' (pab-graph.ossa)"), std::string::npos) << g.error().message;
+}
+
+TEST(ViewerGraph, KeysDriveThePabSampleParameters) {
+  Result<Scene> scene = pab_graph_scene();
+  ASSERT_TRUE(scene) << scene.error().message;
+  Result<GraphDriver> g = make_graph_driver(*scene, "pab", 1);
+  ASSERT_TRUE(g) << g.error().message;
+  const int speed = graph_parameter(*g, "speed"), arms = graph_parameter(*g, "crossed_arms"), stop = graph_parameter(*g, "stop");
+  GraphKeys keys;
+  set_graph_value(*g, speed, 0.0f);
+  drive_graph_keys(*g, keys, 1.0f);
+  EXPECT_FLOAT_EQ(g->instances[0].value(speed), 0.0f) << "keys own speed only once W was pressed";
+
+  EXPECT_TRUE(graph_key(*g, keys, GLFW_KEY_W, GLFW_PRESS));
+  drive_graph_keys(*g, keys, 0.2f);
+  EXPECT_NEAR(g->instances[0].value(speed), 0.6f, 1e-5f) << "eased at 3 units/s";
+  drive_graph_keys(*g, keys, 1.0f);
+  EXPECT_FLOAT_EQ(g->instances[0].value(speed), 1.2f) << "W: the walk sample";
+  EXPECT_TRUE(graph_key(*g, keys, GLFW_KEY_LEFT_SHIFT, GLFW_PRESS));
+  drive_graph_keys(*g, keys, 2.0f);
+  EXPECT_FLOAT_EQ(g->instances[0].value(speed), 4.0f) << "Shift+W: the run sample";
+
+  EXPECT_FLOAT_EQ(g->instances[0].value(stop), 0.0f);
+  EXPECT_TRUE(graph_key(*g, keys, GLFW_KEY_W, GLFW_RELEASE));
+  EXPECT_FLOAT_EQ(g->instances[0].value(stop), 1.0f) << "releasing W fires stop";
+  drive_graph_keys(*g, keys, 2.0f);
+  EXPECT_FLOAT_EQ(g->instances[0].value(speed), 0.0f);
+
+  EXPECT_TRUE(graph_key(*g, keys, GLFW_KEY_C, GLFW_PRESS));
+  EXPECT_FLOAT_EQ(g->instances[0].value(arms), 1.0f);
+  EXPECT_TRUE(graph_key(*g, keys, GLFW_KEY_C, GLFW_PRESS));
+  EXPECT_FLOAT_EQ(g->instances[0].value(arms), 0.0f);
+  EXPECT_FALSE(graph_key(*g, keys, GLFW_KEY_X, GLFW_PRESS));
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 // animation.cpp — see animation.h.
 #include "viewer/animation.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <utility>
@@ -75,6 +76,7 @@ float clip_duration(const Scene& scene, const Animator& animator) { return durat
 void advance(const Scene& scene, Animator& animator, float dt) {
   Playback& p = animator.playback;
   if (!p.playing) return;
+  if (animator.graph && animator.use_graph && !p.bind_pose) animator.graph_dt += dt * std::max(p.speed, 0.0f);
   if (p.clip >= 0) p.time = advance_time(p.time, dt, p.speed, duration_of(scene, p.clip), p.loop);
   if (p.fade < 1.0f) {
     p.from_time = advance_time(p.from_time, dt, p.speed, duration_of(scene, p.from_clip), true);
@@ -91,10 +93,21 @@ void set_time(const Scene& scene, Animator& animator, float time) {
 void produce_local_poses(const Scene& scene, Animator& animator, PoseTimings& timings) {
   const Playback& p = animator.playback;
   if (scene.joint_count() == 0) return;
-  if (p.bind_pose || p.clip < 0) {
+  if (p.bind_pose || (p.clip < 0 && !(animator.graph && animator.use_graph))) {
     const auto t0 = Clock::now();
     for (AnimInstance& inst : animator.instances) set_bind_pose(scene.skeleton(), inst.local);
     timings.sample_ms += ms_since(t0);
+    return;
+  }
+  if (animator.graph && animator.use_graph) {
+    const auto t0 = Clock::now();
+    GraphDriver& g = *animator.graph;
+    update_graph(g, animator.graph_dt);
+    animator.graph_dt = 0.0f;
+    for (size_t i = 0; i < animator.instances.size() && i < g.instances.size(); ++i) {
+      copy_pose(g.instances[i].pose(), animator.instances[i].local);
+    }
+    timings.graph_ms += ms_since(t0);
     return;
   }
   const ClipView clip = scene.clips[static_cast<size_t>(p.clip)].clip;

@@ -1,11 +1,10 @@
 // animation.h — what moves the character: clip playback for one or many instances, and the one
 // per-frame step that produces their local poses.
 //
-// produce_local_poses is the viewer's single "where does this frame's pose come from" point: today
-// it samples the selected clip (cross-fading for a moment after the clip changes) or writes the
-// bind pose; an animation graph plugs in here as a third source that updates a graph instance
-// per character and writes its output pose. Everything after it (local -> model, palettes,
-// drawing) does not care where the pose came from.
+// produce_local_poses is the viewer's single "where does this frame's pose come from" point: it
+// writes the bind pose, samples the selected clip (cross-fading for a moment after the clip
+// changes), or updates an animation graph (graph_driver.h) and copies its output pose.
+// Everything after it (local -> model, palettes, drawing) does not care where the pose came from.
 //
 // A crowd is N instances of the same character playing the same clip at different phases; each
 // has its own sampling caches (runtime/sample.h: one cache per clip and playing instance) and pose
@@ -19,6 +18,7 @@
 #include "format/result.h"
 #include "runtime/pose.h"
 #include "runtime/sample.h"
+#include "viewer/graph_driver.h"
 #include "viewer/scene.h"
 
 namespace ossa::view {
@@ -47,6 +47,9 @@ struct AnimInstance {
 struct Animator {
   Playback playback;
   std::vector<AnimInstance> instances;
+  std::unique_ptr<GraphDriver> graph;  // --graph: one graph instance per AnimInstance
+  bool use_graph = false;              // the graph drives the poses (else the clip list does)
+  float graph_dt = 0.0f;               // time advance() banked for the next graph update
 };
 
 /// Instances with bind-pose storage and phases spread over the clip (instance i starts i * 0.618
@@ -61,7 +64,7 @@ Status select_clip(const Scene& scene, Animator& animator, int clip, bool crossf
 float clip_duration(const Scene& scene, const Animator& animator);
 
 /// Moves time by dt * speed when playing (wrapping or clamping as playback.loop says) and the
-/// cross-fade by dt.
+/// cross-fade by dt; banks dt * max(speed, 0) for the graph (graphs only run forwards).
 void advance(const Scene& scene, Animator& animator, float dt);
 
 /// Sets the clip time (scrub, --time): wrapped or clamped into the clip.
@@ -70,10 +73,12 @@ void set_time(const Scene& scene, Animator& animator, float time);
 struct PoseTimings {
   double sample_ms = 0.0;  // sampling clips
   double blend_ms = 0.0;   // blending (cross-fade) and local -> model
+  double graph_ms = 0.0;   // graph updates (their sampling and blending are inside)
 };
 
-/// This frame's local pose of every instance: the bind pose, the selected clip sampled at each
-/// instance's time, or the cross-fade of the previous and the selected clip. Allocation-free.
+/// This frame's local pose of every instance: the bind pose, the graph's output, the selected
+/// clip sampled at each instance's time, or the cross-fade of the previous and the selected clip.
+/// Allocation-free (but for the graph's event log).
 void produce_local_poses(const Scene& scene, Animator& animator, PoseTimings& timings);
 
 /// Local -> model matrices of every instance (AnimInstance::model). Allocation-free.

@@ -49,12 +49,36 @@ Status open_loaded_scene(App& app, Scene scene, size_t crowd, float aspect) {
   app.scene = std::move(scene);
   app.messages = std::move(warnings);
   app.animator = Animator{};
+  // Keep playing the graph by name if the new files have it; otherwise back to clips.
+  bool has_graph = false;
+  for (const Asset& a : app.scene.assets) has_graph = has_graph || (!app.graph_name.empty() && find_graph(a, app.graph_name));
+  if (!has_graph) app.graph_name.clear();
   return set_crowd(app, crowd, aspect);
+}
+
+Status use_graph(App& app, const std::string& name) {
+  Result<GraphDriver> g = make_graph_driver(app.scene, name, app.animator.instances.size());
+  if (!g) return g.error();
+  app.animator.graph = std::make_unique<GraphDriver>(std::move(*g));
+  app.animator.use_graph = true;
+  app.animator.graph_dt = 0.0f;
+  app.graph_name = name;
+  return {};
 }
 
 Status set_crowd(App& app, size_t crowd, float aspect) {
   const Playback previous = app.animator.playback;
   const bool had_clip = !app.animator.instances.empty();
+  // A graph's parameter values survive a crowd change (triggers are one-shot and do not).
+  std::vector<std::pair<int, float>> graph_values;
+  const bool used_graph = app.animator.use_graph;
+  if (app.animator.graph && !app.animator.graph->instances.empty()) {
+    const GraphDriver& g = *app.animator.graph;
+    for (size_t p = 0; p < g.definition->parameter_count(); ++p) {
+      if (g.definition->parameter_type(p) == fb::ParameterType::Trigger) continue;
+      graph_values.emplace_back(static_cast<int>(p), g.instances.front().value(static_cast<int>(p)));
+    }
+  }
   app.crowd = crowd == 0 ? 1 : crowd;
   app.animator = make_animator(app.scene, app.crowd);
 
@@ -88,6 +112,11 @@ Status set_crowd(App& app, size_t crowd, float aspect) {
     p.loop = previous.loop;
     p.bind_pose = previous.bind_pose;
   }
+  if (!app.graph_name.empty()) {
+    if (Status s = use_graph(app, app.graph_name); !s) return s;
+    for (const auto& [index, value] : graph_values) set_graph_value(*app.animator.graph, index, value);
+    app.animator.use_graph = used_graph || graph_values.empty();
+  }
   return {};
 }
 
@@ -115,6 +144,7 @@ Status step_and_render(App& app, float dt, int width, int height, FrameTimings& 
   compute_model_poses(app.scene, app.animator, pose);
   timings.sample_ms += pose.sample_ms;
   timings.blend_ms += pose.blend_ms;
+  timings.graph_ms += pose.graph_ms;
 
   // Follow instance 0's root over the ground, so a clip that travels stays in view.
   const auto& model = app.animator.instances.front().model;

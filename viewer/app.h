@@ -40,6 +40,7 @@ struct App {
   glm::vec3 root_bind{0.0f};       // instance 0's root in the bind pose
   glm::vec3 follow_applied{0.0f};  // how far follow has moved the camera target so far
   std::vector<std::string> messages;  // warnings and errors for the panel / stderr
+  std::string graph_name;          // --graph: re-instantiated when the crowd or the files change
 };
 
 /// Replaces the scene with `paths` (scene.h load_scene), uploads it, builds the crowd and frames
@@ -59,6 +60,10 @@ Status open_or_add(App& app, std::span<const std::string> paths, float aspect);
 
 /// Points the camera at app.framing from app.angles.
 void frame_camera(App& app, float aspect);
+
+/// Instantiates graph `name` (graph_driver.h) for every instance and lets it drive the poses.
+/// Errors name the files (the App keeps its previous pose source then).
+Status use_graph(App& app, const std::string& name);
 
 /// Selects a clip by index (-1: none) with an optional cross-fade.
 Status play_clip(App& app, int clip, bool crossfade);

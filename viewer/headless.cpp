@@ -47,9 +47,20 @@ Status render_headless(const ViewerOptions& o) {
 
   Playback& p = app.animator.playback;
   p.playing = true;  // --paused means nothing here: frames step 1/60 s towards --time
-  // N frames 1/60 s apart, the last at --time: start (N - 1) steps earlier.
-  const float rate = o.speed != 0.0f ? o.speed : 1.0f;
-  p.time = advance_time(p.time, -kFrameStep * static_cast<float>(o.frames - 1), rate, clip_duration(app.scene, app.animator), p.loop);
+  const bool graph = app.animator.use_graph && app.animator.graph;
+  if (graph) {
+    // A graph cannot seek: play --time seconds of it in 1/60 s steps, then the frames follow on.
+    PoseTimings ignored;
+    for (float t = 0.0f; t + 0.5f * kFrameStep < o.time; t += kFrameStep) {
+      advance(app.scene, app.animator, kFrameStep);
+      produce_local_poses(app.scene, app.animator, ignored);
+    }
+  } else {
+    // N frames 1/60 s apart, the last at --time: start (N - 1) steps earlier.
+    const float rate = o.speed != 0.0f ? o.speed : 1.0f;
+    p.time = advance_time(p.time, -kFrameStep * static_cast<float>(o.frames - 1), rate,
+                          clip_duration(app.scene, app.animator), p.loop);
+  }
 
   Result<Offscreen> target = create_offscreen(o.width, o.height, o.msaa);
   if (!target) return Error{name + ": " + target.error().message};
@@ -58,8 +69,12 @@ Status render_headless(const ViewerOptions& o) {
   FrameTimings total;
   for (int f = 0; f < o.frames; ++f) {
     bind_offscreen(*target);
-    if (f == o.frames - 1) set_time(app.scene, app.animator, o.time);  // exactly --time, no drift
-    if (Status s = step_and_render(app, f == 0 || f == o.frames - 1 ? 0.0f : kFrameStep, o.width, o.height, total); !s) return s;
+    float dt = f == 0 ? 0.0f : kFrameStep;
+    if (!graph && f == o.frames - 1) {
+      set_time(app.scene, app.animator, o.time);  // exactly --time, no drift
+      dt = 0.0f;
+    }
+    if (Status s = step_and_render(app, dt, o.width, o.height, total); !s) return s;
     if (Status s = check_gl("drawing frame " + std::to_string(f)); !s) return Error{name + ": " + s.message()};
     if (f == 0 && o.first_frame_time) {
       glFinish();
@@ -77,8 +92,9 @@ Status render_headless(const ViewerOptions& o) {
     const double n = o.frames;
     std::printf("framed (%g %g %g) .. (%g %g %g)\n", app.framing.min.x, app.framing.min.y, app.framing.min.z,
                 app.framing.max.x, app.framing.max.y, app.framing.max.z);
-    std::printf("frames %d  sample %.3f ms  blend %.3f ms  skin %.3f ms  draw %.3f ms  gpu %.3f ms (per frame)\n",
-                o.frames, total.sample_ms / n, total.blend_ms / n, total.skin_ms / n, total.draw_ms / n, total.gpu_ms / n);
+    std::printf("frames %d  sample %.3f ms  blend %.3f ms  graph %.3f ms  skin %.3f ms  draw %.3f ms  gpu %.3f ms (per frame)\n",
+                o.frames, total.sample_ms / n, total.blend_ms / n, total.graph_ms / n, total.skin_ms / n,
+                total.draw_ms / n, total.gpu_ms / n);
   }
   destroy_offscreen(*target);
   release_scene(app.renderer);

@@ -17,6 +17,7 @@
 
 #include "viewer/app.h"
 #include "viewer/gl_util.h"
+#include "viewer/graph_keys.h"
 #include "viewer/setup.h"
 #include "viewer/snapshot.h"
 #include "viewer/ui.h"
@@ -27,6 +28,7 @@ namespace {
 
 struct InputState {
   App* app = nullptr;
+  GraphKeys graph_keys;
   float aspect = 1.0f;
   bool orbiting = false, panning = false;
   double last_x = 0.0, last_y = 0.0;
@@ -43,10 +45,12 @@ void step_clip(App& app, int direction) {
 }
 
 void on_key(GLFWwindow* w, int key, int /*scancode*/, int action, int /*mods*/) {
-  if (action != GLFW_PRESS && action != GLFW_REPEAT) return;
-  if (ImGui::GetCurrentContext() && ImGui::GetIO().WantCaptureKeyboard) return;
+  // Releases always reach the graph keys (a key let go over the panel must not stay held).
+  if (action != GLFW_RELEASE && ImGui::GetCurrentContext() && ImGui::GetIO().WantCaptureKeyboard) return;
   InputState& in = input_of(w);
   App& app = *in.app;
+  if (app.animator.graph && app.animator.use_graph && graph_key(*app.animator.graph, in.graph_keys, key, action)) return;
+  if (action == GLFW_RELEASE) return;
   Playback& p = app.animator.playback;
   switch (key) {
     case GLFW_KEY_SPACE: p.playing = !p.playing; break;
@@ -161,11 +165,13 @@ int run_interactive(const ViewerOptions& o) {
     ImGui_ImplGlfw_NewFrame();
     ImGui::NewFrame();
     draw_panels(app, ui, input.aspect);
+    if (ui.graph_slider_touched) input.graph_keys.driving = false;
     ImGui::Render();
 
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     FrameTimings timings;
     const float dt = static_cast<float>(std::min(frame_ms, 100.0) / 1000.0);  // no leaps after a stall
+    if (app.animator.graph && app.animator.use_graph) drive_graph_keys(*app.animator.graph, input.graph_keys, dt);
     if (Status s = step_and_render(app, dt, fb_width, fb_height, timings); !s) ui.status = s.message();
     record_frame(ui, timings, frame_ms);
     ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());

@@ -45,6 +45,9 @@ ParsedOptions parse_options(int argc, const char* const* argv) {
   app.add_option("--screenshot", o.screenshot, "headless: write the last frame to this PNG");
   app.add_flag("--first-frame-time", o.first_frame_time, "print first-frame-ms once the first frame is finished");
   app.add_flag("--stats", o.stats, "headless: print the average frame-time split");
+  app.add_option("--graph", o.graph, "drive the character with the animation graph of this name");
+  app.add_option("--set", o.set, "graph parameter start value, NAME=VALUE (a trigger: NAME); repeatable")
+      ->needs("--graph");
   app.add_option("--window-frames", o.window_frames, "window mode: exit after N frames (--screenshot captures the window)")
       ->check(CLI::Range(1, 1000000));
   try {

@@ -4,12 +4,15 @@
 //             [--bind-pose] [--cpu-skinning] [--crowd N] [--wireframe] [--skeleton] [--no-grid]
 //             [--yaw DEG] [--pitch DEG] [--size WxH] [--msaa N]
 //             [--frames N] [--screenshot OUT.png] [--first-frame-time] [--stats]
-//             [--window-frames N]
+//             [--window-frames N] [--graph NAME [--set PARAM=VALUE ...]]
 //
 // With --frames or --screenshot the viewer runs headless (hidden window, offscreen framebuffer):
 // it renders N frames 1/60 s apart ending at --time, writes the last one as a PNG, and exits.
 // --window-frames N runs the window mode (panel included) for N frames and exits, writing the
 // window's last frame to --screenshot if given: how the interactive path is tested.
+// --graph NAME drives the character with an animation graph found in any of the files; --set
+// gives its parameters start values (a trigger is fired by naming it: --set stop). A graph cannot
+// seek, so headless --time T plays T seconds of the graph in 1/60 s steps before the N frames.
 // Parsing is separate from running so tests and the bench can build command lines with the same
 // names.
 #pragma once
@@ -41,6 +44,8 @@ struct ViewerOptions {
   bool first_frame_time = false;  // print "first-frame-ms X" (since main) once the first frame is finished
   bool stats = false;           // headless: print the frame-time split
   int window_frames = 0;        // window mode: exit after this many frames (0: when closed)
+  std::string graph;            // drive the character with this graph
+  std::vector<std::string> set; // graph parameter start values, "name=value" (or "trigger")
 
   bool headless() const { return window_frames == 0 && (frames > 0 || !screenshot.empty()); }
 };

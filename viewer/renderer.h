@@ -34,7 +34,7 @@ struct ViewToggles {
 /// Milliseconds spent in each stage of a frame (CPU time; gpu_ms from a timer query, a frame
 /// late, 0 until available).
 struct FrameTimings {
-  double sample_ms = 0, blend_ms = 0, skin_ms = 0, draw_ms = 0, gpu_ms = 0;
+  double sample_ms = 0, blend_ms = 0, graph_ms = 0, skin_ms = 0, draw_ms = 0, gpu_ms = 0;
 };
 
 struct LineVertex {

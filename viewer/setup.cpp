@@ -28,6 +28,15 @@ Status setup_app(App& app, Scene scene, const ViewerOptions& o, float aspect) {
     }
     if (Status s = play_clip(app, c, false); !s) return s;
   }
+  if (!o.graph.empty()) {
+    if (Status s = use_graph(app, o.graph); !s) return s;
+    for (const std::string& assignment : o.set) {
+      const size_t eq = assignment.find('=');
+      const std::string parameter = assignment.substr(0, eq);
+      const std::string value = eq == std::string::npos ? "1" : assignment.substr(eq + 1);
+      if (Status s = set_graph_parameter(*app.animator.graph, parameter, value); !s) return Error{name + ": " + s.message()};
+    }
+  }
   Playback& p = app.animator.playback;
   p.bind_pose = o.bind_pose;
   p.speed = o.speed;

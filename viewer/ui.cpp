@@ -2,6 +2,7 @@
 #include "viewer/ui.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <filesystem>
 #include <vector>
 
@@ -56,6 +57,113 @@ void view_panel(App& app, UiState& ui, float aspect) {
   }
 }
 
+const char* node_kind(const fb::Node& n) { return fb::EnumNameNodeData(n.data_type()); }
+
+void graph_parameters(GraphDriver& g, UiState& ui) {
+  const GraphDefinition& d = *g.definition;
+  const GraphInstance& first = g.instances.front();
+  for (size_t i = 0; i < d.parameter_count(); ++i) {
+    const int p = static_cast<int>(i);
+    const fb::Parameter& param = *d.graph().parameters()->Get(static_cast<flatbuffers::uoffset_t>(i));
+    const std::string label = std::string(d.parameter_name(i));
+    const float lo = param.min_value(), hi = param.max_value();
+    const bool bounded = lo > -1e6f && hi < 1e6f && lo < hi;
+    float v = first.value(p);
+    switch (d.parameter_type(i)) {
+      case fb::ParameterType::Float: {
+        const bool changed = bounded ? ImGui::SliderFloat(label.c_str(), &v, lo, hi) : ImGui::DragFloat(label.c_str(), &v, 0.01f);
+        if (changed) {
+          set_graph_value(g, p, v);
+          if (label == "speed") ui.graph_slider_touched = true;
+        }
+        break;
+      }
+      case fb::ParameterType::Int: {
+        int n = static_cast<int>(v);
+        const bool changed = bounded ? ImGui::SliderInt(label.c_str(), &n, static_cast<int>(lo), static_cast<int>(hi))
+                                     : ImGui::DragInt(label.c_str(), &n);
+        if (changed) set_graph_value(g, p, static_cast<float>(n));
+        break;
+      }
+      case fb::ParameterType::Bool: {
+        bool b = v != 0.0f;
+        if (ImGui::Checkbox(label.c_str(), &b)) set_graph_value(g, p, b ? 1.0f : 0.0f);
+        break;
+      }
+      case fb::ParameterType::Enum: {
+        std::vector<const char*> names;
+        if (param.enum_values() != nullptr) {
+          for (const flatbuffers::String* e : *param.enum_values()) names.push_back(e->c_str());
+        }
+        int n = static_cast<int>(v);
+        if (!names.empty() && ImGui::Combo(label.c_str(), &n, names.data(), static_cast<int>(names.size()))) {
+          set_graph_value(g, p, static_cast<float>(n));
+        }
+        break;
+      }
+      case fb::ParameterType::Trigger:
+        if (ImGui::Button(label.c_str())) fire_graph_trigger(g, p);
+        ImGui::SameLine();
+        ImGui::TextDisabled(v != 0.0f ? "(trigger, set)" : "(trigger)");
+        break;
+    }
+  }
+}
+
+void graph_status(const GraphDriver& g) {
+  const GraphDefinition& d = *g.definition;
+  const GraphInstance& first = g.instances.front();
+  for (size_t m = 0; m < d.machine_count(); ++m) {
+    const MachineStatus st = first.machine_status(m);
+    const auto state = [&](int s) { return s >= 0 ? std::string(d.state_name(m, static_cast<size_t>(s))) : std::string("-"); };
+    ImGui::Text("%.*s: %s", static_cast<int>(d.machine_name(m).size()), d.machine_name(m).data(), state(st.current).c_str());
+    if (st.previous >= 0) {
+      ImGui::Text("  from %s  %.2f / %.2f s", state(st.previous).c_str(), st.elapsed, st.duration);
+      ImGui::ProgressBar(st.weight, ImVec2(-1.0f, 0.0f), "transition weight");
+    }
+    if (st.inertial_remaining > 0.0f) ImGui::Text("  inertializing: %.2f s left", st.inertial_remaining);
+  }
+  ImGui::TextDisabled("nodes with weight");
+  for (size_t n = 0; n < d.node_count(); ++n) {
+    const float w = first.node_weight(n);
+    if (w <= 0.0f) continue;
+    const fb::Node& node = *d.graph().nodes()->Get(static_cast<flatbuffers::uoffset_t>(n));
+    char overlay[96];
+    std::snprintf(overlay, sizeof overlay, "%s (%s) %.2f", node.name() && node.name()->size() ? node.name()->c_str() : "-",
+                  node_kind(node), w);
+    ImGui::ProgressBar(w, ImVec2(-1.0f, 0.0f), overlay);
+  }
+  ImGui::TextDisabled("events");
+  for (const std::string& e : g.recent_events) ImGui::TextUnformatted(e.c_str());
+}
+
+void graph_panel(App& app, UiState& ui) {
+  Animator& a = app.animator;
+  if (!a.graph) {
+    bool any = false;
+    for (const Asset& asset : app.scene.assets) {
+      const auto* graphs = asset.file().graphs();
+      if (graphs == nullptr) continue;
+      for (const fb::Graph* g : *graphs) {
+        any = true;
+        if (ImGui::Button(("play graph '" + g->name()->str() + "'").c_str())) {
+          if (Status s = use_graph(app, g->name()->str()); !s) ui.status = s.message();
+        }
+      }
+    }
+    if (!any) ImGui::TextDisabled("no graph in the files opened (open one with --graph NAME)");
+    return;
+  }
+  ImGui::Checkbox("graph drives the character", &a.use_graph);
+  if (a.graph->instances.empty()) return;
+  ImGui::Text("graph '%s'", a.graph->name.c_str());
+  graph_parameters(*a.graph, ui);
+  ImGui::PushStyleColor(ImGuiCol_Text, ImGui::GetStyleColorVec4(ImGuiCol_TextDisabled));
+  ImGui::TextWrapped("keys: W walk, Shift+W run, release W: stop, C: crossed arms");
+  ImGui::PopStyleColor();
+  graph_status(*a.graph);
+}
+
 void stats_panel(const App& app, const UiState& ui) {
   const SceneCounts c = count(app.scene);
   ImGui::Text("joints %zu   meshes %zu   instances %zu", c.joints, c.meshes, app.crowd);
@@ -63,6 +171,7 @@ void stats_panel(const App& app, const UiState& ui) {
   const FrameTimings& t = ui.smoothed;
   ImGui::Text("frame %.2f ms (%.0f fps)", ui.frame_ms, ui.frame_ms > 0 ? 1000.0 / ui.frame_ms : 0.0);
   ImGui::Text("sample %.3f  blend %.3f  skin %.3f ms", t.sample_ms, t.blend_ms, t.skin_ms);
+  if (app.animator.graph && app.animator.use_graph) ImGui::Text("graph update %.3f ms (sampling and blending)", t.graph_ms);
   ImGui::Text("draw %.3f ms (CPU)   GPU %.3f ms", t.draw_ms, t.gpu_ms);
 }
 
@@ -82,6 +191,7 @@ void open_panel(App& app, UiState& ui, float aspect) {
 void record_frame(UiState& ui, const FrameTimings& f, double frame_ms) {
   smooth(ui.smoothed.sample_ms, f.sample_ms);
   smooth(ui.smoothed.blend_ms, f.blend_ms);
+  smooth(ui.smoothed.graph_ms, f.graph_ms);
   smooth(ui.smoothed.skin_ms, f.skin_ms);
   smooth(ui.smoothed.draw_ms, f.draw_ms);
   if (f.gpu_ms > 0.0) smooth(ui.smoothed.gpu_ms, f.gpu_ms);
@@ -90,10 +200,12 @@ void record_frame(UiState& ui, const FrameTimings& f, double frame_ms) {
 
 void draw_panels(App& app, UiState& ui, float aspect) {
   ImGui::SetNextWindowPos(ImVec2(10, 10), ImGuiCond_FirstUseEver);
-  ImGui::SetNextWindowSize(ImVec2(360, 0), ImGuiCond_FirstUseEver);
+  ImGui::SetNextWindowSize(ImVec2(380, 0), ImGuiCond_FirstUseEver);
   const std::string title = std::filesystem::path(app.scene.paths.front()).filename().string() + "###ossa";
   ImGui::Begin(title.c_str());
-  if (ImGui::CollapsingHeader("Clips", ImGuiTreeNodeFlags_DefaultOpen)) clips_panel(app, ui);
+  ui.graph_slider_touched = false;
+  if (ImGui::CollapsingHeader("Graph", app.animator.graph ? ImGuiTreeNodeFlags_DefaultOpen : 0)) graph_panel(app, ui);
+  if (ImGui::CollapsingHeader("Clips", app.animator.graph ? 0 : ImGuiTreeNodeFlags_DefaultOpen)) clips_panel(app, ui);
   if (ImGui::CollapsingHeader("View", ImGuiTreeNodeFlags_DefaultOpen)) view_panel(app, ui, aspect);
   if (ImGui::CollapsingHeader("Stats", ImGuiTreeNodeFlags_DefaultOpen)) stats_panel(app, ui);
   if (ImGui::CollapsingHeader("Open")) open_panel(app, ui, aspect);

@@ -1,9 +1,10 @@
 // ui.h — the Dear ImGui panels: clip list and playback, view toggles, crowd, stats, open file.
 //
 // Immediate mode: every frame the panels read the App and write back what the user changed, so
-// there is no UI state to keep in sync beyond the text field and the smoothed timings. The panel
-// is where an animation graph's parameters will appear (one widget per parameter) next to the
-// clip list.
+// there is no UI state to keep in sync beyond the text field and the smoothed timings. With a
+// graph, its panel shows one widget per parameter (slider, checkbox, combo, trigger button), each
+// state machine's state and running transition, the weights of the nodes that contributed to the
+// pose, and the events the graph reported.
 #pragma once
 #include <string>
 
@@ -16,6 +17,7 @@ struct UiState {
   FrameTimings smoothed;     // exponential moving average of the per-frame timings
   double frame_ms = 0.0;     // smoothed wall time between frames
   std::string status;        // last error, shown in red until the next success
+  bool graph_slider_touched = false;  // the user moved a graph's `speed` this frame
 };
 
 /// Folds one frame's timings into the smoothed ones.

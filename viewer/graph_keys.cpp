@@ -1,0 +1,51 @@
+// graph_keys.cpp — see graph_keys.h.
+#include "viewer/graph_keys.h"
+
+#include <algorithm>
+
+#include "viewer/gl.h"
+
+namespace ossa::view {
+namespace {
+
+constexpr float kWalkSpeed = 1.2f, kRunSpeed = 4.0f, kEasePerSecond = 3.0f;
+
+}  // namespace
+
+bool graph_key(GraphDriver& graph, GraphKeys& keys, int key, int action) {
+  const bool down = action != GLFW_RELEASE;
+  if (key == GLFW_KEY_LEFT_SHIFT || key == GLFW_KEY_RIGHT_SHIFT) {
+    keys.run = down;
+    return true;
+  }
+  if (key == GLFW_KEY_W && graph_parameter(graph, "speed") >= 0) {
+    if (action == GLFW_PRESS && !keys.driving) {
+      keys.driving = true;
+      keys.speed = graph.instances.empty() ? 0.0f : graph.instances.front().value(graph_parameter(graph, "speed"));
+    }
+    if (action == GLFW_RELEASE && keys.walk) {
+      const int stop = graph_parameter(graph, "stop");
+      if (stop >= 0) fire_graph_trigger(graph, stop);
+    }
+    if (action != GLFW_REPEAT) keys.walk = down;
+    return true;
+  }
+  if (key == GLFW_KEY_C && action == GLFW_PRESS) {
+    const int arms = graph_parameter(graph, "crossed_arms");
+    if (arms < 0 || graph.instances.empty()) return false;
+    set_graph_value(graph, arms, graph.instances.front().value(arms) != 0.0f ? 0.0f : 1.0f);
+    return true;
+  }
+  return false;
+}
+
+void drive_graph_keys(GraphDriver& graph, GraphKeys& keys, float dt) {
+  const int speed = graph_parameter(graph, "speed");
+  if (!keys.driving || speed < 0) return;
+  const float target = keys.walk ? (keys.run ? kRunSpeed : kWalkSpeed) : 0.0f;
+  const float step = kEasePerSecond * dt;
+  keys.speed = keys.speed < target ? std::min(target, keys.speed + step) : std::max(target, keys.speed - step);
+  set_graph_value(graph, speed, keys.speed);
+}
+
+}  // namespace ossa::view
