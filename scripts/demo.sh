@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
-# demo.sh — the main job on the bundled samples: install, build, cook assets/ into cooked/, and
-# print what was cooked. The Pab clips are clip-only files: they are cooked against the cooked Pab
-# skeleton, which is how a game's build would cook a clip library for one rig.
+# demo.sh — the main job on the bundled samples: install, build, cook assets/ into cooked/, print
+# what was cooked, and show it. The Pab clips are clip-only files: they are cooked against the
+# cooked Pab skeleton, which is how a game's build would cook a clip library for one rig.
+# With a display (DISPLAY set, not CI) ossa-view opens on Pab with its clips; otherwise headless
+# screenshots are written to cooked/screenshots/ (under xvfb-run when there is no display).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh
@@ -24,3 +26,19 @@ for f in "$out"/Pab/skeleton.ossa "$out"/Fox/Fox.ossa; do
   echo
 done
 echo "demo: cooked files are in $out/ (inspect any with $bin/ossa-inspect FILE.ossa [--json])"
+
+pab=("$out/Pab/arnaud.ossa" "$out/Pab/walk.ossa" "$out/Pab/jog.ossa" "$out/Pab/run.ossa" "$out/Pab/crossarms.ossa")
+if [ -n "${DISPLAY:-}" ] && [ -z "${CI:-}" ]; then
+  echo "== ossa-view on Pab (close the window to finish)"
+  "$bin/ossa-view" "${pab[@]}"
+else
+  echo "== headless screenshots (no display, or CI)"
+  shots="$out/screenshots"
+  mkdir -p "$shots"
+  xvfb=()
+  [ -n "${DISPLAY:-}" ] || xvfb=(xvfb-run -a -s "-screen 0 1280x1024x24")
+  "${xvfb[@]}" "$bin/ossa-view" "${pab[@]}" --clip walk --time 0.6 --size 960x540 --screenshot "$shots/pab-walk.png"
+  "${xvfb[@]}" "$bin/ossa-view" "$out/Fox/Fox.ossa" --clip Walk --crowd 9 --time 0.3 --size 960x540 --screenshot "$shots/fox-crowd.png"
+  "${xvfb[@]}" "$bin/ossa-view" "$out/CesiumMan/CesiumMan.ossa" --time 0.5 --skeleton --size 960x540 --screenshot "$shots/cesium-man.png"
+  echo "demo: screenshots in $shots/ (with a display, scripts/demo.sh opens the viewer instead)"
+fi
