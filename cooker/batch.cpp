@@ -18,6 +18,12 @@ bool is_source_extension(const fs::path& path) {
   return ext == ".fbx" || ext == ".gltf" || ext == ".glb" || ext == ".dae" || ext == ".bvh" || ext == ".obj";
 }
 
+std::string output_stem(const fs::path& input) {
+  const std::string name = input.filename().string();
+  if (is_graph_file(input)) return name.substr(0, name.size() - std::string_view(".graph.json").size());
+  return input.stem().string();
+}
+
 Result<std::vector<BatchItem>> plan_batch(const std::vector<fs::path>& inputs, const fs::path& out_dir,
                                           const fs::path& root) {
   std::vector<fs::path> files;
@@ -26,7 +32,8 @@ Result<std::vector<BatchItem>> plan_batch(const std::vector<fs::path>& inputs, c
     if (fs::is_directory(input, ec)) {
       std::vector<fs::path> found;
       for (fs::recursive_directory_iterator it(input, ec), end; !ec && it != end; it.increment(ec))
-        if (it->is_regular_file(ec) && is_source_extension(it->path())) found.push_back(it->path());
+        if (it->is_regular_file(ec) && (is_source_extension(it->path()) || is_graph_file(it->path())))
+          found.push_back(it->path());
       if (ec) return Error{input.string() + ": cannot list directory: " + ec.message()};
       std::sort(found.begin(), found.end());
       files.insert(files.end(), found.begin(), found.end());
@@ -47,7 +54,7 @@ Result<std::vector<BatchItem>> plan_batch(const std::vector<fs::path>& inputs, c
         return Error{input.string() + ": is not inside --root " + root.string()};
       sub = rel.parent_path();
     }
-    fs::path output = (out_dir / sub / input.stem()).concat(".ossa").lexically_normal();
+    fs::path output = (out_dir / sub / output_stem(input)).concat(".ossa").lexically_normal();
     auto [it, inserted] = claimed.emplace(output, input);
     if (!inserted)
       return Error{"inputs " + it->second.string() + " and " + input.string() + " would both write " +

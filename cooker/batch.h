@@ -26,8 +26,12 @@ struct BatchItem {
 /// File extensions ossa-cook picks up when an input is a directory (lower case, with the dot).
 bool is_source_extension(const std::filesystem::path& path);
 
-/// Expands directory inputs (recursively, sorted, source extensions only) and maps each input to
-/// OUTDIR/<stem>.ossa, or with `root` to OUTDIR/<path relative to root>/<stem>.ossa. Errors: an
+/// The output name of an input without ".ossa": its stem, or for a graph file `X.graph.json`, X.
+std::string output_stem(const std::filesystem::path& input);
+
+/// Expands directory inputs (recursively, sorted; source extensions and graph files `*.graph.json`
+/// only, so event sidecars and other JSON stay out) and maps each input to OUTDIR/<output_stem>.ossa,
+/// or with `root` to OUTDIR/<path relative to root>/<output_stem>.ossa. Errors: an
 /// input outside `root`, or two inputs mapping to one output (both named). Missing inputs are not
 /// errors here: they fail at cook time as their own record. O(inputs log inputs).
 Result<std::vector<BatchItem>> plan_batch(const std::vector<std::filesystem::path>& inputs,

@@ -1,16 +1,21 @@
-// cook.cpp — one source file to one .ossa file (see cook.h): import, build meshes, write, rename.
+// cook.cpp — one source file to one .ossa file (see cook.h): import, attach sidecar events, build
+// meshes, compress clips, write, rename. Graph files go to cook_graph.cpp, which shares these steps.
 #include "cooker/cook.h"
 
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
+#include <cctype>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <iterator>
 
+#include "cooker/clip_events.h"
+#include "cooker/cook_internal.h"
 #include "cooker/import_scene.h"
 #include "cooker/mesh_build.h"
 #include "cooker/root_motion.h"
@@ -20,6 +25,13 @@
 
 namespace ossa::cook {
 namespace fs = std::filesystem;
+
+bool is_graph_file(const fs::path& path) {
+  std::string name = path.filename().string();
+  std::transform(name.begin(), name.end(), name.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  constexpr std::string_view kSuffix = ".graph.json";
+  return name.size() > kSuffix.size() && name.compare(name.size() - kSuffix.size(), kSuffix.size(), kSuffix) == 0;
+}
 
 std::string CookOptions::canonical() const {
   std::string s = float_vertices ? "vertices=float32" : "vertices=quantized";
@@ -36,7 +48,7 @@ std::string CookOptions::canonical() const {
   return s;
 }
 
-namespace {
+namespace detail {
 
 Result<std::vector<uint8_t>> read_bytes(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);
@@ -46,10 +58,71 @@ Result<std::vector<uint8_t>> read_bytes(const fs::path& path) {
   return bytes;
 }
 
+Result<std::vector<CompressedClip>> cook_clips(SourceScene& scene, const CookOptions& options, CookRecord& record,
+                                               const std::string& label) {
+  if (options.root_motion) {
+    for (SourceClip& clip : scene.clips) {
+      if (Status st = extract_root_motion(clip, scene.skeleton, options.up_axis); !st)
+        return Error{label + ": " + st.message()};
+    }
+  }
+  std::vector<CompressedClip> clips;
+  for (const SourceClip& clip : scene.clips) {
+    auto compressed = compress_clip(clip, scene.skeleton, scene.metres_per_unit, options.clips);
+    if (!compressed) return Error{label + ": " + compressed.error().message};
+    ClipRecord cr;
+    cr.name = compressed->name;
+    cr.joints = static_cast<uint32_t>(scene.skeleton.joints.size());
+    cr.frames = compressed->grid.frame_count;
+    cr.raw_bytes = compressed->raw_bytes;
+    cr.cooked_bytes = compressed->cooked_bytes;
+    cr.max_error_mm = compressed->max_error * scene.metres_per_unit * 1000.0f;
+    cr.mean_error_mm = compressed->mean_error * scene.metres_per_unit * 1000.0f;
+    if (compressed->worst_joint < scene.skeleton.joints.size())
+      cr.worst_joint = scene.skeleton.joints[compressed->worst_joint].name;
+    if (compressed->tolerance > 0.0f && compressed->max_error > compressed->tolerance) {
+      char buf[160];
+      std::snprintf(buf, sizeof buf, "clip '%s': max error %.4f mm exceeds the %.4f mm tolerance", cr.name.c_str(),
+                    static_cast<double>(cr.max_error_mm),
+                    static_cast<double>(compressed->tolerance * scene.metres_per_unit * 1000.0f));
+      record.warnings.push_back(buf);
+    }
+    record.clip_records.push_back(std::move(cr));
+    clips.push_back(std::move(*compressed));
+  }
+  return clips;
+}
+
+bool write_verified(CookRecord& record, const std::vector<uint8_t>& bytes, const fs::path& input,
+                    const fs::path& output) {
+  // The writer's output must pass the same checks every reader makes; a cooker bug is caught here
+  // rather than in a game.
+  if (Status st = verify_buffer(bytes, output.filename().string()); !st) {
+    record.error = input.string() + ": internal error, cooked bytes fail verification: " + st.message();
+    return false;
+  }
+  if (Status st = write_file_atomic(output, bytes); !st) {
+    record.error = st.message();
+    return false;
+  }
+  record.cooked_bytes = bytes.size();
+  return true;
+}
+
+}  // namespace detail
+
+namespace {
+
+using detail::read_bytes;
+
 void cook_into(CookRecord& record, const fs::path& input, const fs::path& output, const CookOptions& options) {
   std::error_code ec;
   if (fs::is_directory(input, ec)) {
     record.error = input.string() + ": is a directory, not a source file";
+    return;
+  }
+  if (is_graph_file(input)) {
+    detail::cook_graph(record, input, output, options);
     return;
   }
   auto source = read_bytes(input);
@@ -67,6 +140,12 @@ void cook_into(CookRecord& record, const fs::path& input, const fs::path& output
     return;
   }
   record.warnings = scene->warnings;
+  // Events authored beside the source (clip_events.h); its bytes count as the source's.
+  auto sidecar = attach_sidecar_events(input, scene->clips);
+  if (!sidecar) {
+    record.error = sidecar.error().message;  // names the sidecar, line and column
+    return;
+  }
 
   MeshOptions mesh_options;
   mesh_options.float_vertices = options.float_vertices;
@@ -77,65 +156,28 @@ void cook_into(CookRecord& record, const fs::path& input, const fs::path& output
     return;
   }
 
-  if (options.root_motion) {
-    for (SourceClip& clip : scene->clips) {
-      if (Status st = extract_root_motion(clip, scene->skeleton, options.up_axis); !st) {
-        record.error = input.string() + ": " + st.message();
-        return;
-      }
-    }
-  }
-  std::vector<CompressedClip> clips;
-  for (const SourceClip& clip : scene->clips) {
-    auto compressed = compress_clip(clip, scene->skeleton, scene->metres_per_unit, options.clips);
-    if (!compressed) {
-      record.error = input.string() + ": " + compressed.error().message;
-      return;
-    }
-    ClipRecord cr;
-    cr.name = compressed->name;
-    cr.joints = static_cast<uint32_t>(scene->skeleton.joints.size());
-    cr.frames = compressed->grid.frame_count;
-    cr.raw_bytes = compressed->raw_bytes;
-    cr.cooked_bytes = compressed->cooked_bytes;
-    cr.max_error_mm = compressed->max_error * scene->metres_per_unit * 1000.0f;
-    cr.mean_error_mm = compressed->mean_error * scene->metres_per_unit * 1000.0f;
-    if (compressed->worst_joint < scene->skeleton.joints.size())
-      cr.worst_joint = scene->skeleton.joints[compressed->worst_joint].name;
-    if (compressed->tolerance > 0.0f && compressed->max_error > compressed->tolerance) {
-      char buf[160];
-      std::snprintf(buf, sizeof buf, "clip '%s': max error %.4f mm exceeds the %.4f mm tolerance", cr.name.c_str(),
-                    static_cast<double>(cr.max_error_mm),
-                    static_cast<double>(compressed->tolerance * scene->metres_per_unit * 1000.0f));
-      record.warnings.push_back(buf);
-    }
-    record.clip_records.push_back(std::move(cr));
-    clips.push_back(std::move(*compressed));
+  auto clips = detail::cook_clips(*scene, options, record, input.string());
+  if (!clips) {
+    record.error = clips.error().message;
+    return;
   }
 
   WriteProvenance provenance;
   provenance.source_name = input.filename().string();
   provenance.source_hash = hash_bytes(source->data(), source->size());
+  if (sidecar->present) {
+    provenance.source_hash = hash_bytes(sidecar->bytes.data(), sidecar->bytes.size(), provenance.source_hash);
+    record.source_bytes += sidecar->bytes.size();
+  }
   provenance.options = options.canonical();
   // A clip-only file binds to its rig by hash and carries no skeleton; a file with meshes always
   // carries the rig its joint palettes index (with --skeleton, the reference's, hash-identical).
   WriteOptions write_options;
   write_options.include_skeleton = options.reference == nullptr || !meshes->empty();
-  const std::vector<uint8_t> bytes = write_ossa(*scene, *meshes, clips, provenance, write_options);
-
-  // The writer's output must pass the same checks every reader makes; a cooker bug is caught here
-  // rather than in a game.
-  if (Status st = verify_buffer(bytes, output.filename().string()); !st) {
-    record.error = input.string() + ": internal error, cooked bytes fail verification: " + st.message();
-    return;
-  }
-  if (Status st = write_file_atomic(output, bytes); !st) {
-    record.error = st.message();
-    return;
-  }
+  const std::vector<uint8_t> bytes = write_ossa(*scene, *meshes, *clips, provenance, write_options);
+  if (!detail::write_verified(record, bytes, input, output)) return;
 
   record.ok = true;
-  record.cooked_bytes = bytes.size();
   record.joints = static_cast<uint32_t>(write_options.include_skeleton ? scene->skeleton.joints.size() : 0);
   record.meshes = static_cast<uint32_t>(meshes->size());
   for (const CookedMesh& m : *meshes) record.submeshes += static_cast<uint32_t>(m.submeshes.size());

@@ -53,8 +53,16 @@ struct CookRecord {
 };
 
 /// Cooks `input` to `output` (parent directories are created). Never throws.
+///
+/// A source file's clips get the events of its sidecar `<stem>.events.json` when there is one
+/// (cooker/clip_events.h; the sidecar's bytes are part of the provenance hash). A graph file
+/// (is_graph_file) cooks into a self-contained character: its rig, meshes, clips and the compiled
+/// graph (docs/GRAPH.md); `reference` is then not used, the graph names its own rig.
 CookRecord cook_file(const std::filesystem::path& input, const std::filesystem::path& output,
                      const CookOptions& options);
+
+/// True for `*.graph.json` (case-insensitive): an animation graph file rather than a source.
+bool is_graph_file(const std::filesystem::path& path);
 
 /// Loads the skeleton of a cooked file (for --skeleton). Errors name the file.
 Result<SourceSkeleton> load_reference_skeleton(const std::filesystem::path& ossa_file);

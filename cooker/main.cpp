@@ -1,4 +1,5 @@
 // main.cpp — the ossa-cook command line: parse options, plan, cook in parallel, report.
+// Inputs are sources (FBX, glTF, ...) and animation graph files (`*.graph.json`, docs/GRAPH.md).
 //
 //   ossa-cook INPUT... -o OUTDIR [--root DIR] [--jobs N] [--report FILE.json]
 //             [--skeleton REF.ossa] [--float-vertices] [--clip-tolerance MM] [--no-clip-compression]
@@ -46,14 +47,16 @@ void print_summary(const std::vector<CookRecord>& records) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"ossa-cook: cook FBX / glTF / GLB / Collada / BVH sources into .ossa files"};
+  CLI::App app{"ossa-cook: cook FBX / glTF / GLB / Collada / BVH sources and animation graph files (*.graph.json) "
+               "into .ossa files"};
   std::vector<std::string> inputs;
   std::string out_dir, root, report_path, skeleton_path;
   unsigned jobs = std::max(1u, std::thread::hardware_concurrency());
   bool float_vertices = false, quiet = false, lossless_clips = false, root_motion = false;
   double clip_tolerance_mm = 0.1;
   std::string up_axis = "y";
-  app.add_option("inputs", inputs, "source files or directories (searched recursively)")->required();
+  app.add_option("inputs", inputs, "source files, graph files (X.graph.json -> X.ossa) or directories (searched recursively)")
+      ->required();
   app.add_option("-o,--output", out_dir, "output directory")->required();
   app.add_option("--root", root, "mirror inputs' paths relative to this directory under the output directory");
   app.add_option("-j,--jobs", jobs, "cook this many files in parallel")->check(CLI::Range(1u, 256u));
@@ -127,8 +130,13 @@ int main(int argc, char** argv) {
   if (!quiet) print_summary(records);
   if (failed > 0) {
     std::fprintf(stderr, "ossa-cook: %zu of %zu inputs failed:\n", failed, records.size());
-    for (const CookRecord& r : records)
-      if (!r.ok) std::fprintf(stderr, "  %s\n", r.error.c_str());
+    for (const CookRecord& r : records) {
+      if (r.ok) continue;
+      std::string indented = r.error;  // graph files report one problem per line
+      for (size_t at = indented.find('\n'); at != std::string::npos; at = indented.find('\n', at + 3))
+        indented.replace(at, 1, "\n  ");
+      std::fprintf(stderr, "  %s\n", indented.c_str());
+    }
     return 1;
   }
   return 0;

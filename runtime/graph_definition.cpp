@@ -127,6 +127,9 @@ Result<GraphDefinition> GraphDefinition::create(const Asset& asset, std::string_
     if (Status st = check_clip_binding(view, d.skeleton, owner->name() + ": clip '" + std::string(clip_name) + "'"); !st)
       return Error{where + ": " + st.message()};
     d.clips.push_back(view);
+    auto prototype = make_sampling_cache(view, d.skeleton);
+    if (!prototype) return Error{where + ": " + prototype.error().message};
+    d.prototypes.push_back(std::move(*prototype));
   }
 
   const auto& nodes = *g->nodes();

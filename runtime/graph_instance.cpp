@@ -58,12 +58,12 @@ Result<GraphInstance> GraphInstance::create(const GraphDefinition& definition, s
     const NodeInfo& info = d.nodes[n];
     if (info.kind == Kind::Clip) {
       const auto* c = static_cast<const fb::ClipNode*>(info.table);
-      auto cache = make_sampling_cache(d.clips[c->clip()], d.skeleton);
+      auto cache = make_sampling_cache(d.clips[c->clip()], d.skeleton, &d.prototypes[c->clip()]);
       if (!cache) return cache.error();
       s->caches.push_back(std::move(*cache));
     } else if (info.kind == Kind::BlendSpace) {
       for (const fb::BlendSample* smp : *static_cast<const fb::BlendSpaceNode*>(info.table)->samples()) {
-        auto cache = make_sampling_cache(d.clips[smp->clip()], d.skeleton);
+        auto cache = make_sampling_cache(d.clips[smp->clip()], d.skeleton, &d.prototypes[smp->clip()]);
         if (!cache) return cache.error();
         s->caches.push_back(std::move(*cache));
       }

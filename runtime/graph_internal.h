@@ -60,6 +60,7 @@ struct GraphDefinition::Impl {
   SkeletonView skeleton;
   uint32_t joints = 0;
   std::vector<ClipView> clips;
+  std::vector<SamplingCache> prototypes;  // one per clip: the fixed values instances share
   std::vector<graph_detail::NodeInfo> nodes;
   std::vector<graph_detail::MachineInfo> machines;
   std::vector<uint16_t> transition_triggers;

@@ -117,6 +117,9 @@ struct SamplingCache::State {
   AlignedFloats block;
   float* k0 = nullptr;
   float* k1 = nullptr;
+  // Source of the fixed (never re-decoded) blocks: k0, or a prototype cache's k0 shared by every
+  // instance playing the clip, so crowds read those values from one hot copy.
+  const float* fixed = nullptr;
   float* start = nullptr;       // per kind: frame of k0
   float* inv_length = nullptr;  // per kind: 1 / (frame of k1 - frame of k0); 0 for fixed channels
   // Per 8-joint block: bit `kind` set when some joint of the block has an animated channel of
@@ -348,6 +351,7 @@ OSSA_INLINE F8 sqrt8(const F8& x) {
 
 struct Lanes {
   const float* k0;
+  const float* fixed;  // where blocks without an animated channel of a kind are copied from
   const float* k1;
   const float* start;
   const float* inv_length;
@@ -372,7 +376,7 @@ void interpolate_nlerp(const Lanes& l, float frame) {
     // it: copy them. Real rigs have few animated translations and scales, and runs of joints
     // (fingers, props) that a clip leaves alone.
     const uint8_t kinds = l.block_kinds[b];
-    const auto copy = [&](size_t c) { store8(out + c * n + j, load8(k0 + c * n + j)); };
+    const auto copy = [&](size_t c) { store8(out + c * n + j, load8(l.fixed + c * n + j)); };
     const auto lerp = [&](size_t c, const F8& wa, const F8& wb) {
       // a * (1 - w) + b * w is exact at both ends (w = 0 gives a, w = 1 gives b).
       store8(out + c * n + j, load8(k0 + c * n + j) * wa + load8(k1 + c * n + j) * wb);
@@ -458,7 +462,8 @@ void interpolate_slerp(const Lanes& l, float frame) {
 
 // ---- public API --------------------------------------------------------------------------------
 
-Result<SamplingCache> make_sampling_cache(const ClipView& clip, const SkeletonView& skeleton) {
+Result<SamplingCache> make_sampling_cache(const ClipView& clip, const SkeletonView& skeleton,
+                                          const SamplingCache* prototype) {
   if (Status st = check_clip_binding(clip, skeleton, "make_sampling_cache"); !st) return st.error();
   auto s = std::make_unique<State>();
   s->clip = clip.fb;
@@ -529,6 +534,10 @@ Result<SamplingCache> make_sampling_cache(const ClipView& clip, const SkeletonVi
     s->tracks[r.first_track + filled[run_index[i]]++] = make_track(animated[i], s->stride);
   }
   forget_cursors(*s);
+  s->fixed = s->k0;
+  if (prototype && prototype->state() && prototype->state()->clip == s->clip &&
+      prototype->state()->joint_count == s->joint_count)
+    s->fixed = prototype->state()->fixed;  // same clip, same rig: identical fixed blocks
   return SamplingCache(std::move(s));
 }
 
@@ -571,7 +580,7 @@ void sample(const ClipView& clip, float time, const SampleOptions& options, Samp
     if (!(frame >= r.enter && frame < r.leave)) move_run(s, r, frame);
 
   // Pass 2: every joint.
-  const Lanes lanes{s.k0, s.k1, s.start, s.inv_length, s.block_kinds.data(), out.base, s.stride};
+  const Lanes lanes{s.k0, s.fixed, s.k1, s.start, s.inv_length, s.block_kinds.data(), out.base, s.stride};
   if (options.rotation == RotationInterpolation::Slerp)
     interpolate_slerp(lanes, frame);
   else

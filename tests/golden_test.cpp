@@ -46,7 +46,7 @@ bool cook(const std::string& args) {
   return r.exit_code == 0;
 }
 
-/// The repo's samples, cooked the way scripts/demo.sh cooks them.
+/// The repo's samples, cooked the way scripts/demo.sh cooks them (the Pab graph into its own tree).
 bool cook_repo_assets(const fs::path& out, int jobs) {
   const fs::path a = ossa::test::source_dir() / "assets";
   const std::string j = " --jobs " + std::to_string(jobs);
@@ -54,7 +54,8 @@ bool cook_repo_assets(const fs::path& out, int jobs) {
               q(a / "RiggedSimple") + " --root " + q(a) + " -o " + q(out) + j) &&
          cook(q(a / "Pab" / "arnaud.fbx") + " " + q(a / "Pab" / "walk.fbx") + " " + q(a / "Pab" / "jog.fbx") + " " +
               q(a / "Pab" / "run.fbx") + " " + q(a / "Pab" / "crossarms.fbx") + " --skeleton " +
-              q(out / "Pab" / "skeleton.ossa") + " --root " + q(a) + " -o " + q(out / "bound") + j);
+              q(out / "Pab" / "skeleton.ossa") + " --root " + q(a) + " -o " + q(out / "bound") + j) &&
+         cook(q(a / "Pab" / "pab.graph.json") + " --root " + q(a) + " -o " + q(out / "graph") + j);
 }
 
 /// Every source in ../shared/assets standalone (Collada into its own tree: Pab has skeleton.fbx and

@@ -1,0 +1,33 @@
+// cook_internal.h — the steps that cooking a source (cook.cpp) and cooking a graph file
+// (cook_graph.cpp) share. Not an API: only those two files include it.
+#pragma once
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "cooker/clip_compress.h"
+#include "cooker/cook.h"
+#include "cooker/source_scene.h"
+#include "format/result.h"
+
+namespace ossa::cook::detail {
+
+/// The whole file. Errors name it.
+Result<std::vector<uint8_t>> read_bytes(const std::filesystem::path& path);
+
+/// Root motion (when the options ask for it) and compression of every clip of `scene`, in order;
+/// adds a ClipRecord per clip and a warning per clip over its tolerance. Errors start with `label`.
+Result<std::vector<CompressedClip>> cook_clips(SourceScene& scene, const CookOptions& options, CookRecord& record,
+                                               const std::string& label);
+
+/// verify_buffer, then write_file_atomic. On success sets record.cooked_bytes; otherwise
+/// record.error, and returns false.
+bool write_verified(CookRecord& record, const std::vector<uint8_t>& bytes, const std::filesystem::path& input,
+                    const std::filesystem::path& output);
+
+/// cook_file for a graph file (cook_graph.cpp).
+void cook_graph(CookRecord& record, const std::filesystem::path& input, const std::filesystem::path& output,
+                const CookOptions& options);
+
+}  // namespace ossa::cook::detail
