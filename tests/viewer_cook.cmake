@@ -1,6 +1,6 @@
 # viewer_cook.cmake — the viewer tests' fixture: cooks the repo's samples the way scripts/demo.sh
-# does (characters, then the Pab clips and mesh against the cooked Pab skeleton), plus float32
-# vertex cooks of the glTF characters, into OUT. Run as
+# does (characters, the Pab clips and mesh against the cooked Pab skeleton, the Pab graph into
+# Pab/pab.ossa), plus float32 vertex cooks of the glTF characters, into OUT. Run as
 #   cmake -DCOOK=ossa-cook -DASSETS=assets -DOUT=dir -P viewer_cook.cmake
 cmake_minimum_required(VERSION 3.25)
 file(REMOVE_RECURSE "${OUT}")
@@ -15,4 +15,5 @@ cook("${ASSETS}/Pab/skeleton.fbx" "${ASSETS}/CesiumMan" "${ASSETS}/Fox" "${ASSET
 cook("${ASSETS}/Pab/arnaud.fbx" "${ASSETS}/Pab/walk.fbx" "${ASSETS}/Pab/jog.fbx" "${ASSETS}/Pab/run.fbx"
      "${ASSETS}/Pab/crossarms.fbx" --skeleton "${OUT}/quantized/Pab/skeleton.ossa" --root "${ASSETS}"
      -o "${OUT}/quantized")
+cook("${ASSETS}/Pab/pab.graph.json" --root "${ASSETS}" -o "${OUT}/quantized")
 cook("${ASSETS}/CesiumMan" "${ASSETS}/Fox" "${ASSETS}/RiggedSimple" --float-vertices --root "${ASSETS}" -o "${OUT}/float")

@@ -248,16 +248,16 @@ TEST_F(Viewer, WindowModeWithPanelRunsAndCaptures) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// --graph: the Pab sample graph (tests/viewer_graph_file.cpp) drives arnaud.ossa.
+// --graph: the Pab sample graph, cooked from assets/Pab/pab.graph.json into Pab/pab.ossa (rig,
+// meshes, clips with events, graph 'pab': speed 0..7 over walk 1.07 / jog 3.13 / run 5.02, sprint
+// above 5.5, a crossarms pose below 0.05 or on strike_pose, crossed_arms layering the arms).
 
 class ViewerGraph : public Viewer {
  protected:
-  std::string files() const {
-    return quote(cooked("Pab/arnaud.ossa").string()) + " " + quote((viewer_cooked_dir() / "pab-graph.ossa").string());
-  }
+  std::string files() const { return quote(cooked("Pab/pab.ossa").string()); }
   Image render_graph(const std::string& tag, const std::string& extra) {
     const fs::path png = dir_ / (tag + ".png");
-    const CommandResult r = run_viewer(files() + " --graph pab --no-grid --size 192x192 --time 1 --screenshot " +
+    const CommandResult r = run_viewer(files() + " --graph pab --no-grid --size 192x192 --time 2 --screenshot " +
                                        quote(png.string()) + " " + extra);
     EXPECT_EQ(r.exit_code, 0) << r.err;
     return load_png(png);
@@ -265,16 +265,16 @@ class ViewerGraph : public Viewer {
 };
 
 TEST_F(ViewerGraph, ParametersChangeThePose) {
-  const Image walk = render_graph("walk", "");  // speed's default, 1.2: the walk sample
-  const Image sprint = render_graph("sprint", "--set speed=4.8");  // past 4.5: the sprint state
+  const Image walk = render_graph("walk", "");  // speed's default, 1.07: the walk sample
+  const Image sprint = render_graph("sprint", "--set speed=6.5");  // past 5.5: the sprint state
   const Image arms = render_graph("arms", "--set crossed_arms=true");  // the crossarms layer
-  const Image stop = render_graph("stop", "--set stop");  // trigger: the standing pose state
+  const Image stop = render_graph("stop", "--set strike_pose");  // trigger: the pose state
   const Image bind = render_graph("bind", "--bind-pose");
   EXPECT_GT(coverage(walk), 0.02);
   EXPECT_GT(compare(walk, bind, kPixelThreshold).differing, kMinDifferingPosed) << "the graph does not move the mesh";
   EXPECT_GT(compare(walk, sprint, kPixelThreshold).differing, kMinDifferingPosed) << "speed does not reach the pose";
   EXPECT_GT(compare(walk, arms, kPixelThreshold).differing, kMinDifferingPosed) << "crossed_arms does not layer";
-  EXPECT_GT(compare(walk, stop, kPixelThreshold).differing, kMinDifferingPosed) << "stop does not change state";
+  EXPECT_GT(compare(walk, stop, kPixelThreshold).differing, kMinDifferingPosed) << "strike_pose does not change state";
 }
 
 TEST_F(ViewerGraph, RendersDeterministicallyAndAgreesWithCpuSkinning) {
@@ -289,12 +289,12 @@ TEST_F(ViewerGraph, UnknownGraphOrParameterIsNamed) {
   const CommandResult graph = run_viewer(files() + " --graph walkies --frames 1");
   EXPECT_NE(graph.exit_code, 0);
   EXPECT_NE(graph.err.find("walkies"), std::string::npos) << graph.err;
-  EXPECT_NE(graph.err.find("'pab' (pab-graph.ossa)"), std::string::npos) << graph.err;
+  EXPECT_NE(graph.err.find("'pab' (pab.ossa)"), std::string::npos) << graph.err;
 
   const CommandResult parameter = run_viewer(files() + " --graph pab --set sped=2 --frames 1");
   EXPECT_NE(parameter.exit_code, 0);
   EXPECT_NE(parameter.err.find("sped"), std::string::npos) << parameter.err;
-  EXPECT_NE(parameter.err.find("speed, crossed_arms, stop"), std::string::npos) << parameter.err;
+  EXPECT_NE(parameter.err.find("speed, crossed_arms, strike_pose"), std::string::npos) << parameter.err;
 
   const CommandResult value = run_viewer(files() + " --graph pab --set speed=fast --frames 1");
   EXPECT_NE(value.exit_code, 0);

@@ -138,6 +138,16 @@ TEST(ViewerBounds, BindPoseBoundsMatchTheMeshWhereSkinAndRigAgree) {
   EXPECT_NEAR(b.size().x, 1.14f, 0.02f);
 }
 
+TEST(ViewerBounds, AMeshMergedFromTwoMeshSpacesIsClippedToTheSkeleton) {
+  // pab.ossa's one mesh joins a Z-up and a Y-up body: its cooked box spans ~1.8 m on every axis.
+  Result<Asset> a = Asset::open(cooked("Pab/pab.ossa").string());
+  ASSERT_TRUE(a) << a.error().message;
+  const Box b = bind_pose_bounds(*a, bind_model(a->skeleton()));
+  EXPECT_GT(b.size().y, 180.0f);  // 1.83 m tall, in centimetres
+  EXPECT_LT(b.size().y, 210.0f);
+  EXPECT_LT(b.size().z, 0.4f * b.size().y) << "a standing character is not as deep as it is tall";
+}
+
 TEST(ViewerBounds, SlotsPlacedByAnotherBindPoseDoNotInflateTheBox) {
   // Pab's mesh was skinned with its fingers posed unlike the rig's bind pose: those slots place
   // the mesh box elsewhere. The box must follow the slots that agree (the T-pose, 1.73 m span).
@@ -185,12 +195,10 @@ TEST(ViewerScene, RefusesWithTheFileNamed) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// The graph as pose source: the Pab sample graph file from the fixture (viewer_graph_file.cpp).
+// The graph as pose source: Pab's sample graph, cooked from assets/Pab/pab.graph.json by the
+// fixture (speed 0..7 over walk 1.07 / jog 3.13 / run 5.02; crossed_arms; strike_pose).
 
-Result<Scene> pab_graph_scene() {
-  const fs::path graph = fs::path(test::env_or("OSSA_VIEWER_COOKED", OSSA_TEST_VIEWER_COOKED_DIR)) / "pab-graph.ossa";
-  return load_scene(std::vector<std::string>{cooked("Pab/arnaud.ossa").string(), graph.string()});
-}
+Result<Scene> pab_graph_scene() { return load_scene(std::vector<std::string>{cooked("Pab/pab.ossa").string()}); }
 
 TEST(ViewerGraph, ParametersSetFromText) {
   Result<Scene> scene = pab_graph_scene();
@@ -198,20 +206,21 @@ TEST(ViewerGraph, ParametersSetFromText) {
   Result<GraphDriver> g = make_graph_driver(*scene, "pab", 3);
   ASSERT_TRUE(g) << g.error().message;
   ASSERT_EQ(g->instances.size(), 3u);
-  const int speed = graph_parameter(*g, "speed"), arms = graph_parameter(*g, "crossed_arms"), stop = graph_parameter(*g, "stop");
+  const int speed = graph_parameter(*g, "speed"), arms = graph_parameter(*g, "crossed_arms"),
+            stop = graph_parameter(*g, "strike_pose");
   ASSERT_GE(speed, 0);
   ASSERT_GE(arms, 0);
   ASSERT_GE(stop, 0);
   EXPECT_TRUE(set_graph_parameter(*g, "speed", "3.5"));
   EXPECT_TRUE(set_graph_parameter(*g, "crossed_arms", "true"));
-  EXPECT_TRUE(set_graph_parameter(*g, "stop", "1"));
+  EXPECT_TRUE(set_graph_parameter(*g, "strike_pose", ""));
   for (const GraphInstance& i : g->instances) {  // every crowd instance gets the value
     EXPECT_FLOAT_EQ(i.value(speed), 3.5f);
     EXPECT_FLOAT_EQ(i.value(arms), 1.0f);
     EXPECT_FLOAT_EQ(i.value(stop), 1.0f);
   }
   EXPECT_TRUE(set_graph_parameter(*g, "speed", "99"));  // clamped to the parameter's range
-  EXPECT_FLOAT_EQ(g->instances[0].value(speed), 6.0f);
+  EXPECT_FLOAT_EQ(g->instances[0].value(speed), 7.0f);
   EXPECT_FALSE(set_graph_parameter(*g, "speed", "fast"));
   EXPECT_FALSE(set_graph_parameter(*g, "velocity", "1"));
   // Crowd instances are spread in time: their poses differ.
@@ -227,7 +236,7 @@ TEST(ViewerGraph, UnknownGraphListsTheGraphs) {
   ASSERT_TRUE(scene) << scene.error().message;
   Result<GraphDriver> g = make_graph_driver(*scene, "locomotion", 1);
   ASSERT_FALSE(g);
-  EXPECT_NE(g.error().message.find("'pab' (pab-graph.ossa)"), std::string::npos) << g.error().message;
+  EXPECT_NE(g.error().message.find("'pab' (pab.ossa)"), std::string::npos) << g.error().message;
 }
 
 TEST(ViewerGraph, KeysDriveThePabSampleParameters) {
@@ -235,7 +244,10 @@ TEST(ViewerGraph, KeysDriveThePabSampleParameters) {
   ASSERT_TRUE(scene) << scene.error().message;
   Result<GraphDriver> g = make_graph_driver(*scene, "pab", 1);
   ASSERT_TRUE(g) << g.error().message;
-  const int speed = graph_parameter(*g, "speed"), arms = graph_parameter(*g, "crossed_arms"), stop = graph_parameter(*g, "stop");
+  const int speed = graph_parameter(*g, "speed"), arms = graph_parameter(*g, "crossed_arms");
+  const KeySpeeds speeds = key_speeds(*g);
+  EXPECT_FLOAT_EQ(speeds.walk, 1.07f) << "the walk sample of the blend space on speed";
+  EXPECT_FLOAT_EQ(speeds.run, 5.02f) << "its run sample";
   GraphKeys keys;
   set_graph_value(*g, speed, 0.0f);
   drive_graph_keys(*g, keys, 1.0f);
@@ -245,16 +257,20 @@ TEST(ViewerGraph, KeysDriveThePabSampleParameters) {
   drive_graph_keys(*g, keys, 0.2f);
   EXPECT_NEAR(g->instances[0].value(speed), 0.6f, 1e-5f) << "eased at 3 units/s";
   drive_graph_keys(*g, keys, 1.0f);
-  EXPECT_FLOAT_EQ(g->instances[0].value(speed), 1.2f) << "W: the walk sample";
+  EXPECT_FLOAT_EQ(g->instances[0].value(speed), 1.07f) << "W: the walk sample";
   EXPECT_TRUE(graph_key(*g, keys, GLFW_KEY_LEFT_SHIFT, GLFW_PRESS));
   drive_graph_keys(*g, keys, 2.0f);
-  EXPECT_FLOAT_EQ(g->instances[0].value(speed), 4.0f) << "Shift+W: the run sample";
+  EXPECT_FLOAT_EQ(g->instances[0].value(speed), 5.02f) << "Shift+W: the run sample";
 
-  EXPECT_FLOAT_EQ(g->instances[0].value(stop), 0.0f);
   EXPECT_TRUE(graph_key(*g, keys, GLFW_KEY_W, GLFW_RELEASE));
-  EXPECT_FLOAT_EQ(g->instances[0].value(stop), 1.0f) << "releasing W fires stop";
-  drive_graph_keys(*g, keys, 2.0f);
+  drive_graph_keys(*g, keys, 1.0f);
+  EXPECT_NEAR(g->instances[0].value(speed), 2.02f, 1e-4f) << "releasing W eases speed down";
+  drive_graph_keys(*g, keys, 1.0f);
   EXPECT_FLOAT_EQ(g->instances[0].value(speed), 0.0f);
+  // Below 0.05 the sample graph strikes its pose.
+  update_graph(*g, 0.1f);
+  const MachineStatus st = g->instances[0].machine_status(0);
+  EXPECT_EQ(g->definition->state_name(0, static_cast<size_t>(st.current)), "pose");
 
   EXPECT_TRUE(graph_key(*g, keys, GLFW_KEY_C, GLFW_PRESS));
   EXPECT_FLOAT_EQ(g->instances[0].value(arms), 1.0f);

@@ -1,6 +1,7 @@
 // bounds.cpp — see bounds.h.
 #include "viewer/bounds.h"
 
+#include <algorithm>
 #include <cstring>
 #include <vector>
 
@@ -29,7 +30,8 @@ Box joint_bounds(std::span<const glm::mat4> model) {
 }
 
 Box bind_pose_bounds(const Asset& asset, std::span<const glm::mat4> model) {
-  Box box = joint_bounds(model);
+  const Box joints_box = joint_bounds(model);
+  Box box;
   for (size_t i = 0; i < asset.mesh_count(); ++i) {
     const MeshView mesh = asset.mesh(i);
     const fb::Vec3* lo = mesh.fb->bounds_min();
@@ -69,6 +71,18 @@ Box bind_pose_bounds(const Asset& asset, std::span<const glm::mat4> model) {
       if (alike(placement[best], placement[b])) add_box(box, placement[b], l, h);
     }
   }
+  if (joints_box.empty()) return box;
+  const float margin = 0.1f * glm::length(joints_box.size());
+  if (!box.empty() && margin > 0.0f) {
+    for (int a = 0; a < 3; ++a) {
+      const float lo = joints_box.min[a] - margin, hi = joints_box.max[a] + margin;
+      if (box.max[a] - box.min[a] <= 1.5f * (hi - lo)) continue;
+      box.min[a] = std::max(box.min[a], lo);
+      box.max[a] = std::min(box.max[a], hi);
+      if (box.min[a] > box.max[a]) box.min[a] = box.max[a] = 0.5f * (lo + hi);
+    }
+  }
+  box.add(joints_box);
   return box;
 }
 

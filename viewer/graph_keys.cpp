@@ -8,9 +8,26 @@
 namespace ossa::view {
 namespace {
 
-constexpr float kWalkSpeed = 1.2f, kRunSpeed = 4.0f, kEasePerSecond = 3.0f;
+constexpr float kEasePerSecond = 3.0f;
 
 }  // namespace
+
+KeySpeeds key_speeds(const GraphDriver& graph) {
+  KeySpeeds k;
+  const int speed = graph_parameter(graph, "speed");
+  if (speed < 0) return k;
+  for (const fb::Node* node : *graph.definition->graph().nodes()) {
+    const fb::BlendSpaceNode* b = node->data_as_BlendSpaceNode();
+    if (b == nullptr || b->x_parameter() != speed || b->samples()->size() < 2) continue;
+    float lo = b->samples()->Get(0)->x(), hi = lo;
+    for (const fb::BlendSample* smp : *b->samples()) {
+      lo = std::min(lo, smp->x());
+      hi = std::max(hi, smp->x());
+    }
+    return KeySpeeds{lo, hi};
+  }
+  return k;
+}
 
 bool graph_key(GraphDriver& graph, GraphKeys& keys, int key, int action) {
   const bool down = action != GLFW_RELEASE;
@@ -22,10 +39,6 @@ bool graph_key(GraphDriver& graph, GraphKeys& keys, int key, int action) {
     if (action == GLFW_PRESS && !keys.driving) {
       keys.driving = true;
       keys.speed = graph.instances.empty() ? 0.0f : graph.instances.front().value(graph_parameter(graph, "speed"));
-    }
-    if (action == GLFW_RELEASE && keys.walk) {
-      const int stop = graph_parameter(graph, "stop");
-      if (stop >= 0) fire_graph_trigger(graph, stop);
     }
     if (action != GLFW_REPEAT) keys.walk = down;
     return true;
@@ -42,7 +55,8 @@ bool graph_key(GraphDriver& graph, GraphKeys& keys, int key, int action) {
 void drive_graph_keys(GraphDriver& graph, GraphKeys& keys, float dt) {
   const int speed = graph_parameter(graph, "speed");
   if (!keys.driving || speed < 0) return;
-  const float target = keys.walk ? (keys.run ? kRunSpeed : kWalkSpeed) : 0.0f;
+  const KeySpeeds k = key_speeds(graph);
+  const float target = keys.walk ? (keys.run ? k.run : k.walk) : 0.0f;
   const float step = kEasePerSecond * dt;
   keys.speed = keys.speed < target ? std::min(target, keys.speed + step) : std::max(target, keys.speed - step);
   set_graph_value(graph, speed, keys.speed);

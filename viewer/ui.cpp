@@ -159,7 +159,7 @@ void graph_panel(App& app, UiState& ui) {
   ImGui::Text("graph '%s'", a.graph->name.c_str());
   graph_parameters(*a.graph, ui);
   ImGui::PushStyleColor(ImGuiCol_Text, ImGui::GetStyleColorVec4(ImGuiCol_TextDisabled));
-  ImGui::TextWrapped("keys: W walk, Shift+W run, release W: stop, C: crossed arms");
+  ImGui::TextWrapped("keys: W walk, Shift+W run (release to stop), C crossed arms");
   ImGui::PopStyleColor();
   graph_status(*a.graph);
 }
