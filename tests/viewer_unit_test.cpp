@@ -64,6 +64,15 @@ TEST(ViewerOptions, ScreenshotMeansHeadlessOneFrame) {
   EXPECT_FALSE(parse({"a.ossa"}).options->headless());
 }
 
+TEST(ViewerOptions, GraphValuesTakeOneArgumentEach) {
+  const ParsedOptions p = parse({"--graph", "pab", "--set", "speed=3", "--set", "strike_pose", "pab.ossa", "walk.ossa"});
+  ASSERT_TRUE(p.options);
+  EXPECT_EQ(p.options->graph, "pab");
+  EXPECT_EQ(p.options->set, (std::vector<std::string>{"speed=3", "strike_pose"}));
+  EXPECT_EQ(p.options->files, (std::vector<std::string>{"pab.ossa", "walk.ossa"}));
+  EXPECT_EQ(parse({"a.ossa", "--set", "speed=3"}).exit_code, 2) << "--set needs --graph";
+}
+
 TEST(ViewerOptions, UsageErrorsExitWithTwo) {
   EXPECT_FALSE(parse({}).options);
   EXPECT_EQ(parse({}).exit_code, 2);  // no file

@@ -47,7 +47,8 @@ ParsedOptions parse_options(int argc, const char* const* argv) {
   app.add_flag("--stats", o.stats, "headless: print the average frame-time split");
   app.add_option("--graph", o.graph, "drive the character with the animation graph of this name");
   app.add_option("--set", o.set, "graph parameter start value, NAME=VALUE (a trigger: NAME); repeatable")
-      ->needs("--graph");
+      ->needs("--graph")
+      ->allow_extra_args(false);  // one value per --set: the files may follow
   app.add_option("--window-frames", o.window_frames, "window mode: exit after N frames (--screenshot captures the window)")
       ->check(CLI::Range(1, 1000000));
   try {
