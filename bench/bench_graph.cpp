@@ -154,7 +154,7 @@ int main(int argc, char** argv) {
   Params p;
   p.speed = def->find_parameter("speed");
   p.crossed = def->find_parameter("crossed_arms");
-  p.stop = def->find_parameter("stop");
+  p.stop = def->find_parameter("strike_pose");
   std::printf("graph '%s' of %s: %u joints, %zu nodes, %zu state machines, %zu clips; %d frames of %.1f ms\n",
               graph_name.c_str(), file.c_str(), def->joint_count(), def->node_count(), def->machine_count(),
               def->clip_count(), frames, 1000.0 * kDt);
