@@ -138,7 +138,7 @@ int main(int argc, char** argv) {
     cooked_dir = dir;
   }
   auto asset = Asset::open(file);
-  if (!cooked_dir.empty()) fs::remove_all(cooked_dir);  // a file this small is read, not mapped
+  if (!cooked_dir.empty()) fs::remove_all(cooked_dir);  // the Asset holds the bytes (read, or mapped: unlinking keeps them)
   if (!asset) {
     std::fprintf(stderr, "ossa-bench-graph: %s\n", asset.error().message.c_str());
     return 1;
