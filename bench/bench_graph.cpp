@@ -124,17 +124,21 @@ int main(int argc, char** argv) {
       return 2;
     }
   }
+  fs::path cooked_dir;
   if (file.empty()) {
     const fs::path source = fs::path(OSSA_BENCH_SOURCE_DIR) / "assets" / "Pab" / "pab.graph.json";
     const fs::path dir = fs::temp_directory_path() / ("ossa-bench-graph-" + std::to_string(::getpid()));
     const cook::CookRecord r = cook::cook_file(source, dir / "pab.ossa", cook::CookOptions{});
     if (!r.ok) {
+      fs::remove_all(dir);
       std::fprintf(stderr, "ossa-bench-graph: %s\n", r.error.c_str());
       return 1;
     }
     file = (dir / "pab.ossa").string();
+    cooked_dir = dir;
   }
   auto asset = Asset::open(file);
+  if (!cooked_dir.empty()) fs::remove_all(cooked_dir);  // the Asset holds the bytes (read, or mapped: unlinking keeps them)
   if (!asset) {
     std::fprintf(stderr, "ossa-bench-graph: %s\n", asset.error().message.c_str());
     return 1;
@@ -154,7 +158,7 @@ int main(int argc, char** argv) {
   Params p;
   p.speed = def->find_parameter("speed");
   p.crossed = def->find_parameter("crossed_arms");
-  p.stop = def->find_parameter("stop");
+  p.stop = def->find_parameter("strike_pose");
   std::printf("graph '%s' of %s: %u joints, %zu nodes, %zu state machines, %zu clips; %d frames of %.1f ms\n",
               graph_name.c_str(), file.c_str(), def->joint_count(), def->node_count(), def->machine_count(),
               def->clip_count(), frames, 1000.0 * kDt);

@@ -106,6 +106,11 @@ void cook_graph(CookRecord& record, const fs::path& input, const fs::path& outpu
     return;
   }
   character.clips.clear();  // only the clips the graph names are cooked
+  if (!manifest->skeleton_meshes) {  // the rig alone: its source's own body is not the character's
+    character.meshes.clear();
+    character.materials.clear();
+    character.vertices_over_4_influences = 0;
+  }
   const SourceSkeleton rig = character.skeleton;
   ImportOptions against_rig;
   against_rig.reference = &rig;

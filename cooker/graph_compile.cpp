@@ -74,7 +74,18 @@ void read_manifest(Checker& check, const Value& root, GraphManifest& out) {
 
   if (const Value* skeleton = root.find("skeleton")) {
     out.skeleton_pos = skeleton->pos;
-    check.expect_name(*skeleton, "\"skeleton\" (the rig's source file)", &out.skeleton);
+    if (skeleton->is(Type::Object)) {
+      // {"source": "rig.fbx", "meshes": false}: the rig without the meshes its source carries.
+      check.expect_keys(*skeleton, {"source", "meshes"}, "\"skeleton\"");
+      if (const Value* source = skeleton->find("source"))
+        check.expect_name(*source, "\"skeleton\" \"source\" (the rig's source file)", &out.skeleton);
+      else
+        check.error(skeleton->pos, "\"skeleton\" needs a \"source\": the rig's source file");
+      if (const Value* meshes = skeleton->find("meshes"); meshes && check.expect(*meshes, Type::Bool, "\"meshes\""))
+        out.skeleton_meshes = meshes->boolean;
+    } else {
+      check.expect_name(*skeleton, "\"skeleton\" (the rig's source file)", &out.skeleton);
+    }
   } else {
     check.error(root.pos, "a graph needs a \"skeleton\": the source file of its rig, relative to the graph file");
   }

@@ -46,6 +46,7 @@ struct GraphManifest {
   std::string name;
   std::string skeleton;  // path relative to the graph file
   json::Pos skeleton_pos;
+  bool skeleton_meshes = true;  // false: {"source": ..., "meshes": false} keeps only the rig
   std::vector<std::string> meshes;
   std::vector<json::Pos> mesh_pos;
   std::vector<GraphClipSource> clips;  // Graph.clips order

@@ -128,6 +128,8 @@ struct SamplingCache::State {
 
   std::vector<Run> runs;
   std::vector<Track> tracks;  // grouped by run
+  // What move_run reads: tracks, or a prototype's (identical: they depend on the clip and rig only).
+  const Track* track_data = nullptr;
 };
 
 SamplingCache::SamplingCache() = default;
@@ -255,7 +257,7 @@ inline uint32_t find_pair(const Run& r, float frame) {
 /// per channel when it moved forward by one (k1 becomes k0), both keys otherwise.
 void move_run(State& s, Run& r, float frame) {
   const uint32_t k = find_pair(r, frame);
-  const Track* t = s.tracks.data() + r.first_track;
+  const Track* t = s.track_data + r.first_track;
   const Track* end = t + r.track_count;
   const uint8_t* stream = s.stream;
   float* k0 = s.k0;
@@ -535,9 +537,16 @@ Result<SamplingCache> make_sampling_cache(const ClipView& clip, const SkeletonVi
   }
   forget_cursors(*s);
   s->fixed = s->k0;
+  s->track_data = s->tracks.data();
   if (prototype && prototype->state() && prototype->state()->clip == s->clip &&
-      prototype->state()->joint_count == s->joint_count)
-    s->fixed = prototype->state()->fixed;  // same clip, same rig: identical fixed blocks
+      prototype->state()->joint_count == s->joint_count) {
+    // Same clip, same rig: identical fixed blocks and decode records. Only the cursors and the
+    // decoded key pairs stay per instance.
+    s->fixed = prototype->state()->fixed;
+    s->track_data = prototype->state()->track_data;
+    s->tracks.clear();
+    s->tracks.shrink_to_fit();
+  }
   return SamplingCache(std::move(s));
 }
 

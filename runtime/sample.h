@@ -49,8 +49,9 @@ class SamplingCache {
 /// Allocates and primes a cache for playing `clip` on `skeleton` (bind values for channels the
 /// clip leaves out). Error when the clip's skeleton hash or joint count is not the skeleton's.
 /// `prototype` (optional): a cache of the same clip and rig, never used for sampling, that must
-/// outlive this one; the values that never change (constant and bind channels) are then read from
-/// it, so many characters playing one clip share them in cache. O(joints + animated channels).
+/// outlive this one; what never changes (constant and bind channels, and each animated channel's
+/// decode record) is then read from it, so many characters playing one clip share it in cache and
+/// each cache keeps only its cursors and decoded key pairs. O(joints + animated channels).
 Result<SamplingCache> make_sampling_cache(const ClipView& clip, const SkeletonView& skeleton,
                                           const SamplingCache* prototype = nullptr);
 

@@ -807,6 +807,28 @@ TEST_F(GraphCompile, ManifestListsWhatToImport) {
   ASSERT_FALSE(mb.ok());
   EXPECT_HAS(mb.error().message, "g.json:1:44: \"skeleton\" (the rig's source file) must be a string, not a number");
   EXPECT_HAS(mb.error().message, "g.json:1:62: clip 'w' needs a \"source\" file");
+
+  // The object form: the rig without its source's meshes.
+  auto rig_only = ossa::cook::json::parse(
+      "{\"ossa_graph\": 1, \"name\": \"n\", \"skeleton\": {\"source\": \"s.fbx\", \"meshes\": false},\n"
+      " \"clips\": {\"w\": \"w.fbx\"}, \"root\": {\"clip\": \"w\"}}",
+      "g.json");
+  ASSERT_TRUE(rig_only.ok());
+  auto mr = read_graph_manifest(*rig_only);
+  ASSERT_TRUE(mr.ok()) << mr.error().message;
+  EXPECT_EQ(mr->skeleton, "s.fbx");
+  EXPECT_FALSE(mr->skeleton_meshes);
+  EXPECT_TRUE(m->skeleton_meshes) << "the string form keeps the source's meshes";
+  auto bad_rig = ossa::cook::json::parse(
+      "{\"ossa_graph\": 1, \"name\": \"n\", \"skeleton\": {\"meshes\": \"no\", \"mesh\": 1},\n"
+      " \"clips\": {\"w\": \"w.fbx\"}, \"root\": {\"clip\": \"w\"}}",
+      "g.json");
+  ASSERT_TRUE(bad_rig.ok());
+  auto mbr = read_graph_manifest(*bad_rig);
+  ASSERT_FALSE(mbr.ok());
+  EXPECT_HAS(mbr.error().message, "g.json:1:44: \"skeleton\" needs a \"source\"");
+  EXPECT_HAS(mbr.error().message, "\"meshes\" must be a boolean");
+  EXPECT_HAS(mbr.error().message, "unknown key \"mesh\"");
 }
 
 }  // namespace

@@ -100,45 +100,4 @@ uint16_t clip_node(GraphDef& g, uint16_t clip, float rate, bool loop) {
   return add_node(g, c, g.clips[clip]);
 }
 
-GraphDef pab_sample_graph(const PabRig& rig) {
-  GraphDef g = pab_graph(rig, "pab");
-  const uint16_t speed = add_param(g, "speed", ParamType::Float, 1.2f);
-  g.parameters[speed].min_value = 0.0f;
-  g.parameters[speed].max_value = 6.0f;
-  const uint16_t crossed = add_param(g, "crossed_arms", ParamType::Bool, 0.0f);
-  const uint16_t stop = add_param(g, "stop", ParamType::Trigger);
-
-  BlendSpaceDef move;
-  move.x_parameter = speed;
-  move.samples = {{kWalk, 1.2f, 0.0f}, {kJog, 2.6f, 0.0f}, {kRun, 4.0f, 0.0f}};
-  const uint16_t move_node = add_node(g, move, "move");
-  const uint16_t sprint_node = clip_node(g, kRun, 1.3f);
-  const uint16_t pose_node = clip_node(g, kCrossarms);
-
-  StateMachineDef sm;
-  sm.name = "locomotion";
-  sm.states = {{"move", move_node, true}, {"sprint", sprint_node, true}, {"pose", pose_node, true}};
-  sm.entry = 0;
-  TransitionDef to_sprint{0, 1, {{CondOp::Greater, speed, 4.5f}}, -1.0f, 0.4f, TransitionModeDef::SyncCrossfade};
-  TransitionDef to_move{1, 0, {{CondOp::LessEqual, speed, 4.2f}}, -1.0f, 0.3f, TransitionModeDef::Crossfade};
-  TransitionDef to_pose{-1, 2, {{CondOp::Trigger, stop, 0.0f}}, -1.0f, 0.25f, TransitionModeDef::Inertialize};
-  TransitionDef from_pose{2, 0, {{CondOp::Greater, speed, 0.2f}}, 0.5f, 0.3f, TransitionModeDef::Inertialize};
-  sm.transitions = {to_pose, to_sprint, to_move, from_pose};
-  g.machines.push_back(sm);
-  const uint16_t machine = add_node(g, StateMachineRefDef{0}, "locomotion");
-
-  const uint16_t arms = clip_node(g, kCrossarms);
-  LayeredDef layered;
-  layered.base = machine;
-  LayerDef layer;
-  layer.node = arms;
-  layer.mask = {{static_cast<uint16_t>(std::max(0, rig.joint("Spine"))), -1}};
-  layer.weight_parameter = static_cast<int16_t>(crossed);
-  layer.blend_time = 0.3f;
-  layer.mesh_space_rotation = true;
-  layered.layers = {layer};
-  add_node(g, layered, "upper_body");
-  return g;
-}
-
 }  // namespace ossa::test

@@ -44,9 +44,4 @@ uint16_t add_param(cook::GraphDef& g, std::string name, cook::ParamType type, fl
                    std::vector<std::string> enum_values = {});
 uint16_t clip_node(cook::GraphDef& g, uint16_t clip, float rate = 1.0f, bool loop = true);
 
-/// The Pab sample graph's shape, built in C++ (as assets/Pab/pab.graph.json describes it): layered
-/// crossarms over a locomotion machine with a 1D walk/jog/run blend space, a sprint state and a
-/// standing pose, using every transition mode. Parameters: speed, crossed_arms, stop.
-cook::GraphDef pab_sample_graph(const PabRig& rig);
-
 }  // namespace ossa::test
