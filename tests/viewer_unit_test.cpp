@@ -147,14 +147,30 @@ TEST(ViewerBounds, BindPoseBoundsMatchTheMeshWhereSkinAndRigAgree) {
   EXPECT_NEAR(b.size().x, 1.14f, 0.02f);
 }
 
-TEST(ViewerBounds, AMeshMergedFromTwoMeshSpacesIsClippedToTheSkeleton) {
-  // pab.ossa's one mesh joins a Z-up and a Y-up body: its cooked box spans ~1.8 m on every axis.
-  Result<Asset> a = Asset::open(cooked("Pab/pab.ossa").string());
-  ASSERT_TRUE(a) << a.error().message;
-  const Box b = bind_pose_bounds(*a, bind_model(a->skeleton()));
-  EXPECT_GT(b.size().y, 180.0f);  // 1.83 m tall, in centimetres
-  EXPECT_LT(b.size().y, 210.0f);
-  EXPECT_LT(b.size().z, 0.4f * b.size().y) << "a standing character is not as deep as it is tall";
+Box synthetic_bounds(const test::SyntheticSpec& spec) {
+  const std::vector<uint8_t> bytes = test::make_valid_file(spec);
+  Result<Asset> a = Asset::from_bytes(bytes, "synthetic.ossa");
+  EXPECT_TRUE(a) << a.error().message;
+  return a ? bind_pose_bounds(*a, bind_model(a->skeleton())) : Box{};
+}
+
+TEST(ViewerBounds, AnImplausiblyDeepMeshBoxIsClippedToTheSkeleton) {
+  // The synthetic rig (joints over x 0..0.5, y 0..2, z 0) and its 1 x 2 x 0.2 grid of vertices:
+  // an ordinary mesh keeps its exact box.
+  test::SyntheticSpec spec;
+  const Box plain = synthetic_bounds(spec);
+  EXPECT_NEAR(plain.min.x, -0.5f, 1e-3f);
+  EXPECT_NEAR(plain.max.x, 0.5f, 1e-3f);
+  EXPECT_NEAR(plain.size().y, 2.0f, 1e-3f);
+  EXPECT_NEAR(plain.size().z, 0.2f, 1e-3f);
+  // A mesh box 4 units deep over a flat skeleton (what merging meshes cooked in different axis
+  // conventions gives): depth clipped to the joints' extent +- 10 % of their diagonal (0.206).
+  test::SyntheticVertex far = spec.meshes[0].vertices[0];
+  far.position = fb::Vec3(0.0f, 1.0f, 4.0f);
+  spec.meshes[0].vertices.push_back(far);
+  const Box clipped = synthetic_bounds(spec);
+  EXPECT_NEAR(clipped.max.z, 0.206f, 2e-3f);
+  EXPECT_NEAR(clipped.size().y, 2.0f, 1e-3f) << "axes of plausible extent are kept";
 }
 
 TEST(ViewerBounds, SlotsPlacedByAnotherBindPoseDoNotInflateTheBox) {

@@ -8,8 +8,8 @@
 // slots carry other matrices, and a union over every slot framed a box 2.4 times too wide. The
 // box therefore goes through the matrices of the largest group of slots that agree (corners
 // within 1 % of the box diagonal), which is the mesh's actual placement. A mesh's box is also a
-// union over what was merged into it: pab.ossa's one mesh joins skeleton.fbx's body (Z-up in its
-// mesh space) and arnaud.fbx's (Y-up), so its box covers 1.8 m in every axis. So, with a
+// union over what was merged into it: when pab.ossa still held skeleton.fbx's body (Z-up in its
+// mesh space) merged with arnaud.fbx's (Y-up), its box covered 1.8 m in every axis. So, with a
 // skeleton, an axis on which the mesh box is implausibly larger than the joints' extent (more than
 // 1.5x the joints' extent grown by 10 % of the joints' diagonal on each side) is clipped to that
 // grown extent. Ordinary meshes (a big-headed CesiumMan, a cylinder around a bone chain) stay
