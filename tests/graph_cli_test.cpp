@@ -116,7 +116,7 @@ TEST_F(PabGraph, CooksIntoACharacterThatLoads) {
   ASSERT_EQ(layered->layers()->size(), 1u);
   const ossa::fb::Layer& layer = *layered->layers()->Get(0);
   ASSERT_EQ(layer.mask()->size(), 1u);
-  EXPECT_EQ(layer.mask()->Get(0)->joint(), find_joint(sk, "Spine"));
+  EXPECT_EQ(layer.mask()->Get(0)->joint(), find_joint(sk, "Spine1"));
   EXPECT_EQ(layer.mask()->Get(0)->depth(), -1);
   EXPECT_EQ(layer.weight_parameter(), 1);
   EXPECT_TRUE(layer.mesh_space_rotation());
