@@ -142,12 +142,25 @@ Result<GraphDefinition> GraphDefinition::create(const Asset& asset, std::string_
     info.floats = d.float_count;
     info.caches = d.cache_count;
     switch (node.data_type()) {
-      case fb::NodeData::ClipNode:
+      case fb::NodeData::ClipNode: {
         info.kind = Kind::Clip;
-        info.table = node.data_as_ClipNode();
+        const auto* c = node.data_as_ClipNode();
+        info.table = c;
         d.float_count += 1;  // time
         d.cache_count += 1;
+        if (c->rate() == 0.0f && c->rate_parameter() < 0) {
+          const ClipView& clip = d.clips[c->clip()];
+          auto cache = make_sampling_cache(clip, d.skeleton);
+          if (!cache) return Error{where + ": " + cache.error().message};
+          Pose pose(d.joints);
+          SampleOptions options;
+          options.loop = c->loop();
+          sample(clip, std::clamp(c->start_offset(), 0.0f, clip.duration()), options, *cache, pose);
+          info.held = static_cast<int32_t>(d.held.size());
+          d.held.push_back(std::move(pose));
+        }
         break;
+      }
       case fb::NodeData::BlendAlphaNode:
         info.kind = Kind::BlendAlpha;
         info.table = node.data_as_BlendAlphaNode();
@@ -240,7 +253,7 @@ Result<GraphDefinition> GraphDefinition::create(const Asset& asset, std::string_
 
   d.bind = Pose(d.joints);
   set_bind_pose(d.skeleton, d.bind);
-  d.scratch_depth = scratch_needed(d, g->root());
+  d.scratch_depth = 1 + scratch_needed(d, g->root());  // poses[0]: the root evaluates there
   return GraphDefinition(std::move(impl));
 }
 

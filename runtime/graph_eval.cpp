@@ -86,6 +86,7 @@ float clip_rate(const State& s, const fb::ClipNode& c) {
 }
 
 void evaluate_clip(State& s, uint16_t n, const NodeInfo& info, const Advance& advance, bool dominant, PoseSpan out) {
+  if (info.held >= 0) return copy_pose(s.def->held[static_cast<size_t>(info.held)], out);  // time never moves
   const auto& c = *static_cast<const fb::ClipNode*>(info.table);
   const ClipView& clip = s.def->clips[c.clip()];
   float& time = s.floats[info.floats];

@@ -6,6 +6,11 @@
 
 #include "runtime/graph_internal.h"
 
+#include <cstring>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 namespace ossa {
 using namespace graph_detail;
 
@@ -36,6 +41,22 @@ std::unique_ptr<GraphScratch::Buffers> make_buffers(const GraphDefinition::Impl&
 
 }  // namespace
 
+namespace graph_detail {
+
+void stream_pose(ConstPoseSpan from, PoseSpan to) {
+  const size_t n = static_cast<size_t>(kPoseComponents) * to.stride;
+#if defined(__SSE2__)
+  if (reinterpret_cast<uintptr_t>(from.base) % 16 == 0 && reinterpret_cast<uintptr_t>(to.base) % 16 == 0 &&
+      from.stride == to.stride) {
+    for (size_t i = 0; i < n; i += 4) _mm_stream_ps(to.base + i, _mm_load_ps(from.base + i));
+    return;  // update() fences once, after every stream of the frame
+  }
+#endif
+  std::memcpy(to.base, from.base, n * sizeof(float));
+}
+
+}  // namespace graph_detail
+
 GraphScratch::GraphScratch(std::unique_ptr<Buffers> b) : buffers_(std::move(b)) {}
 GraphScratch::GraphScratch(GraphScratch&&) noexcept = default;
 GraphScratch& GraphScratch::operator=(GraphScratch&&) noexcept = default;
@@ -56,7 +77,9 @@ Result<GraphInstance> GraphInstance::create(const GraphDefinition& definition, s
   s->caches.reserve(d.cache_count);
   for (size_t n = 0; n < d.nodes.size(); ++n) {
     const NodeInfo& info = d.nodes[n];
-    if (info.kind == Kind::Clip) {
+    if (info.kind == Kind::Clip && info.held >= 0) {
+      s->caches.emplace_back();  // keeps cache indices; a held pose is never sampled
+    } else if (info.kind == Kind::Clip) {
       const auto* c = static_cast<const fb::ClipNode*>(info.table);
       auto cache = make_sampling_cache(d.clips[c->clip()], d.skeleton, &d.prototypes[c->clip()]);
       if (!cache) return cache.error();
@@ -160,7 +183,15 @@ void GraphInstance::update(float dt, GraphScratch::Buffers& buffers) {
   std::fill(s.node_weights.begin(), s.node_weights.end(), 0.0f);
   Advance advance;
   advance.dt = dt;
-  evaluate(s, s.def->graph->root(), advance, 1.0f, true, s.output, 0);
+  // The root evaluates into scratch (hot) and the result streams into the instance's output.
+  PoseSpan root = buffers.poses[0].span();
+  evaluate(s, s.def->graph->root(), advance, 1.0f, true, root, 1);
+  stream_pose(root, s.output);
+#if defined(__SSE2__)
+  // Streaming stores are weakly ordered: fence them so that whatever the host uses to hand this
+  // character to another thread (even a plain release store) publishes the pose and histories.
+  _mm_sfence();
+#endif
   s.scratch = nullptr;
 }
 

@@ -28,6 +28,7 @@ struct NodeInfo {
   uint32_t caches = 0;          // first sampling cache (clip: 1, blend space: one per sample)
   uint32_t aux = 0;             // layered: first mask (Impl::masks); blend space: 2D space index
   uint16_t machine = 0;         // Machine: index into Impl::machines
+  int32_t held = -1;            // Clip with rate 0 and no rate parameter: index into Impl::held
 };
 
 /// A transition's condition and the triggers it consumes, decoded.
@@ -68,9 +69,12 @@ struct GraphDefinition::Impl {
   std::vector<graph_detail::LayerJoints> layer_joints;  // parallel to masks
   std::vector<BlendSpace2D> spaces;
   Pose bind;                       // the rig's bind pose, for additive deltas
+  /// Poses of held clips (rate 0, no rate parameter: a pose that never moves), sampled once here
+  /// and shared by every instance instead of being sampled by each, every frame.
+  std::vector<Pose> held;
   uint32_t float_count = 0;        // size of State::floats
   uint32_t cache_count = 0;        // sampling caches per instance
-  uint32_t scratch_depth = 0;      // scratch poses one evaluation needs at most
+  uint32_t scratch_depth = 0;      // scratch poses one evaluation needs at most, plus the root's
 };
 
 namespace graph_detail {
@@ -160,6 +164,13 @@ void evaluate_machine(GraphInstance::State& s, uint16_t n, const Advance& advanc
 void restart_machine(GraphInstance::State& s, uint16_t machine);
 Cycle machine_cycle(const GraphInstance::State& s, uint16_t machine);
 void set_machine_phase(GraphInstance::State& s, uint16_t machine, float p);
+
+/// Copies a pose with streaming stores (graph_instance.cpp): for destinations that are written
+/// every frame but read later or rarely (an instance's output, a machine's history). With a crowd
+/// those lines are not in cache; writing around the cache saves reading each line first and
+/// leaves the cache to what the next character reads. The caller fences (update() does, once).
+/// O(stride).
+void stream_pose(ConstPoseSpan from, PoseSpan to);
 
 /// Scratch needed by a subtree beyond `out` (graph_definition.cpp computes it once).
 uint32_t scratch_needed(const GraphDefinition::Impl& def, uint16_t n);

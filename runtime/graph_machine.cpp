@@ -292,7 +292,7 @@ void evaluate_machine(State& s, uint16_t n, const Advance& advance, float weight
   // Keep this output for a later capture: the older buffer becomes the newest.
   std::swap(m.last, m.before_last);
   m.before_last_update = m.last_update;
-  copy_pose(out, m.last);
+  stream_pose(out, m.last);
   m.last_update = s.update_counter;
   m.last_dt = advance.dt;
 }
