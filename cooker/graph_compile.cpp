@@ -30,16 +30,6 @@ constexpr double kIntLimit = 16777216.0;  // ints are held as floats: exact up t
 const std::vector<std::string_view> kNodeKinds = {"clip",        "blend",    "select",        "layered",
                                                   "blend_space", "additive", "state_machine", "use"};
 
-const char* type_word(ParamType t) {
-  switch (t) {
-    case ParamType::Float: return "float";
-    case ParamType::Int: return "int";
-    case ParamType::Bool: return "bool";
-    case ParamType::Enum: return "enum";
-    case ParamType::Trigger: return "trigger";
-  }
-  return "?";
-}
 
 std::string a_type(ParamType t) {
   return (t == ParamType::Int || t == ParamType::Enum ? "an " : "a ") + std::string(type_word(t));

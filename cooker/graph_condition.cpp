@@ -24,16 +24,6 @@ bool ident_start(char c) { return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z
 bool ident_char(char c) { return ident_start(c) || (c >= '0' && c <= '9'); }
 bool digit(char c) { return c >= '0' && c <= '9'; }
 
-const char* type_word(ParamType t) {
-  switch (t) {
-    case ParamType::Float: return "float";
-    case ParamType::Int: return "int";
-    case ParamType::Bool: return "bool";
-    case ParamType::Enum: return "enum";
-    case ParamType::Trigger: return "trigger";
-  }
-  return "?";
-}
 
 const char* op_text(CondOp op) {
   switch (op) {
@@ -321,6 +311,17 @@ class ConditionParser {
 };
 
 }  // namespace
+
+const char* type_word(ParamType t) {
+  switch (t) {
+    case ParamType::Float: return "float";
+    case ParamType::Int: return "int";
+    case ParamType::Bool: return "bool";
+    case ParamType::Enum: return "enum";
+    case ParamType::Trigger: return "trigger";
+  }
+  return "?";
+}
 
 ConditionResult compile_condition(std::string_view text, std::span<const GraphParameter> parameters) {
   return ConditionParser(text, parameters).run();

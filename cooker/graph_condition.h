@@ -24,6 +24,9 @@
 
 namespace ossa::cook {
 
+/// "float", "int", "bool", "enum", "trigger": a parameter type as the JSON writes it.
+const char* type_word(ParamType t);
+
 struct ConditionResult {
   bool ok = false;
   std::vector<CondInstr> code;  // RPN, never empty when ok ("true" is [True])

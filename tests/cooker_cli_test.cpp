@@ -19,13 +19,7 @@ std::string cook_cmd() { return (ossa::test::bin_dir() / "ossa-cook").string(); 
 fs::path asset(const char* rel) { return ossa::test::source_dir() / "assets" / rel; }
 std::string q(const fs::path& p) { return "'" + p.string() + "'"; }
 
-size_t count_files(const fs::path& dir) {
-  size_t n = 0;
-  std::error_code ec;
-  for (fs::recursive_directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec))
-    if (it->is_regular_file()) ++n;
-  return n;
-}
+using ossa::test::count_files;
 
 TEST(CookerCli, CooksOneFileThatVerifies) {
   const fs::path out = ossa::test::make_temp_dir("cli-one");

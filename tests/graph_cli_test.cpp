@@ -26,13 +26,7 @@ std::string cook_cmd() { return (ossa::test::bin_dir() / "ossa-cook").string(); 
 fs::path pab(const char* file) { return ossa::test::source_dir() / "assets" / "Pab" / file; }
 std::string q(const fs::path& p) { return "'" + p.string() + "'"; }
 
-size_t count_files(const fs::path& dir) {
-  size_t n = 0;
-  std::error_code ec;
-  for (fs::recursive_directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec))
-    if (it->is_regular_file()) ++n;
-  return n;
-}
+using ossa::test::count_files;
 
 std::string str(const flatbuffers::String* s) { return s ? s->str() : std::string(); }
 

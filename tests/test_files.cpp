@@ -626,4 +626,12 @@ CommandResult run_command(const std::string& command) {
   return result;
 }
 
+size_t count_files(const std::filesystem::path& dir) {
+  size_t n = 0;
+  std::error_code ec;
+  for (std::filesystem::recursive_directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec))
+    if (it->is_regular_file()) ++n;
+  return n;
+}
+
 }  // namespace ossa::test

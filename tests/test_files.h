@@ -221,6 +221,8 @@ std::optional<std::vector<uint8_t>> read_file(const std::filesystem::path& path)
 std::optional<std::string> read_text(const std::filesystem::path& path);
 /// Whole-file write (truncating); false on any failure.
 bool write_file(const std::filesystem::path& path, std::span<const uint8_t> bytes);
+/// Regular files below dir, recursively (0 when it does not exist).
+size_t count_files(const std::filesystem::path& dir);
 bool write_file(const std::filesystem::path& path, std::string_view text);
 
 struct CommandResult {
