@@ -71,9 +71,11 @@ Result<GraphInstance> GraphInstance::create(const GraphDefinition& definition, s
   auto s = std::make_unique<State>();
   s->def = &d;
   s->owner = &definition;
-  s->params.resize(d.graph->parameters()->size());
-  s->floats.assign(d.float_count, 0.0f);
-  s->node_weights.assign(d.nodes.size(), 0.0f);
+  const size_t param_count = d.graph->parameters()->size();
+  s->values.assign(param_count + d.float_count + d.nodes.size(), 0.0f);
+  s->params = std::span<float>(s->values.data(), param_count);
+  s->floats = std::span<float>(s->values.data() + param_count, d.float_count);
+  s->node_weights = std::span<float>(s->values.data() + param_count + d.float_count, d.nodes.size());
   s->caches.reserve(d.cache_count);
   for (size_t n = 0; n < d.nodes.size(); ++n) {
     const NodeInfo& info = d.nodes[n];

@@ -8,6 +8,7 @@
 // NodeInfo offsets: no per-node allocations, nothing allocated by update().
 #pragma once
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -118,9 +119,11 @@ struct GraphScratch::Buffers {
 struct GraphInstance::State {
   const GraphDefinition::Impl* def = nullptr;
   const GraphDefinition* owner = nullptr;
-  std::vector<float> params;
-  std::vector<float> floats;        // node variable state
-  std::vector<float> node_weights;  // per node, last update
+  // One allocation for the per-frame scalars (a crowd pays one cache miss for them, not three):
+  std::vector<float> values;
+  std::span<float> params;          // parameter values
+  std::span<float> floats;          // node variable state
+  std::span<float> node_weights;    // per node, last update
   std::vector<SamplingCache> caches;
   std::unique_ptr<GraphScratch::Buffers> own_scratch;  // null when made to share a GraphScratch
   GraphScratch::Buffers* scratch = nullptr;  // during update(): the buffers in use

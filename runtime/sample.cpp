@@ -42,6 +42,8 @@
 #include <limits>
 #include <map>
 #include <new>
+#include <span>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -125,8 +127,12 @@ struct SamplingCache::State {
   // Per 8-joint block: bit `kind` set when some joint of the block has an animated channel of
   // that kind. Pass 2 interpolates only those; the rest never change and are copied.
   std::vector<uint8_t> block_kinds;
+  const uint8_t* kinds = nullptr;  // block_kinds, or a prototype's
 
-  std::vector<Run> runs;
+  // The runs live at the end of `block` (after the floats): one allocation holds everything a
+  // sample touches per instance, so a crowd pays one cache miss per clip instead of three.
+  Run* runs = nullptr;
+  uint32_t run_count = 0;
   std::vector<Track> tracks;  // grouped by run
   // What move_run reads: tracks, or a prototype's (identical: they depend on the clip and rig only).
   const Track* track_data = nullptr;
@@ -144,7 +150,7 @@ using State = SamplingCache::State;
 
 void forget_cursors(State& s) {
   // An empty range: the next sample's range test fails for every run, whatever the frame.
-  for (Run& r : s.runs) {
+  for (Run& r : std::span<Run>(s.runs, s.run_count)) {
     r.cursor = kNoCursor;
     r.enter = kInf;
     r.leave = -kInf;
@@ -474,7 +480,30 @@ Result<SamplingCache> make_sampling_cache(const ClipView& clip, const SkeletonVi
   s->stride = pose_stride(s->joint_count);
   s->last_frame = static_cast<float>(clip.frame_count() - 1);
   const size_t stride = s->stride;
-  s->block = AlignedFloats((2 * kPoseComponents + 6) * stride);
+  // Runs: channels that address the same key-frame range share one, in order of first use;
+  // tracks are grouped by run.
+  s->block_kinds.assign(s->stride / kPoseLanes, 0);
+  std::vector<Run> runs;
+  const auto animated = clip.animated();
+  std::map<std::pair<uint32_t, uint32_t>, uint32_t> run_of;  // (first_key, key_count) -> run
+  std::vector<uint32_t> run_index(animated.size());
+  for (size_t i = 0; i < animated.size(); ++i) {
+    const fb::AnimatedChannel& a = animated[i];
+    const auto [it, added] = run_of.emplace(std::make_pair(a.first_key(), a.key_count()),
+                                            static_cast<uint32_t>(runs.size()));
+    if (added) {
+      Run r;
+      r.frames = clip.key_frames().data() + a.first_key();
+      r.key_count = a.key_count();
+      runs.push_back(r);
+    }
+    run_index[i] = it->second;
+    ++runs[it->second].track_count;
+    s->block_kinds[a.joint() / kPoseLanes] |= static_cast<uint8_t>(1u << static_cast<uint32_t>(a.channel()));
+  }
+  // Floats first (a multiple of 8 floats: the runs start 32-byte aligned), then the runs.
+  const size_t floats = (2 * kPoseComponents + 6) * stride;
+  s->block = AlignedFloats(floats + (runs.size() * sizeof(Run) + sizeof(float) - 1) / sizeof(float));
   s->k0 = s->block.data;
   s->k1 = s->k0 + kPoseComponents * stride;
   s->start = s->k1 + kPoseComponents * stride;
@@ -504,48 +533,36 @@ Result<SamplingCache> make_sampling_cache(const ClipView& clip, const SkeletonVi
     set_fixed(*s, c.joint(), kind, v);
   }
 
-  // Runs: channels that address the same key-frame range share one, in order of first use;
-  // tracks are grouped by run.
-  s->block_kinds.assign(s->stride / kPoseLanes, 0);
-  const auto animated = clip.animated();
-  std::map<std::pair<uint32_t, uint32_t>, uint32_t> run_of;  // (first_key, key_count) -> run
-  std::vector<uint32_t> run_index(animated.size());
-  for (size_t i = 0; i < animated.size(); ++i) {
-    const fb::AnimatedChannel& a = animated[i];
-    const auto [it, added] = run_of.emplace(std::make_pair(a.first_key(), a.key_count()),
-                                            static_cast<uint32_t>(s->runs.size()));
-    if (added) {
-      Run r;
-      r.frames = clip.key_frames().data() + a.first_key();
-      r.key_count = a.key_count();
-      s->runs.push_back(r);
-    }
-    run_index[i] = it->second;
-    ++s->runs[it->second].track_count;
-    s->block_kinds[a.joint() / kPoseLanes] |= static_cast<uint8_t>(1u << static_cast<uint32_t>(a.channel()));
-  }
   uint32_t next = 0;
-  for (Run& r : s->runs) {
+  for (Run& r : runs) {
     r.first_track = next;
     next += r.track_count;
   }
+  static_assert(std::is_trivially_copyable_v<Run>);
+  s->runs = reinterpret_cast<Run*>(s->block.data + floats);
+  s->run_count = static_cast<uint32_t>(runs.size());
+  if (!runs.empty()) std::memcpy(static_cast<void*>(s->runs), runs.data(), runs.size() * sizeof(Run));
   s->tracks.resize(animated.size());
-  std::vector<uint32_t> filled(s->runs.size(), 0);
+  std::vector<uint32_t> filled(runs.size(), 0);
   for (size_t i = 0; i < animated.size(); ++i) {
-    const Run& r = s->runs[run_index[i]];
+    const Run& r = runs[run_index[i]];
     s->tracks[r.first_track + filled[run_index[i]]++] = make_track(animated[i], s->stride);
   }
   forget_cursors(*s);
   s->fixed = s->k0;
   s->track_data = s->tracks.data();
+  s->kinds = s->block_kinds.data();
   if (prototype && prototype->state() && prototype->state()->clip == s->clip &&
       prototype->state()->joint_count == s->joint_count) {
     // Same clip, same rig: identical fixed blocks and decode records. Only the cursors and the
     // decoded key pairs stay per instance.
     s->fixed = prototype->state()->fixed;
     s->track_data = prototype->state()->track_data;
+    s->kinds = prototype->state()->kinds;
     s->tracks.clear();
     s->tracks.shrink_to_fit();
+    s->block_kinds.clear();
+    s->block_kinds.shrink_to_fit();
   }
   return SamplingCache(std::move(s));
 }
@@ -585,11 +602,11 @@ void sample(const ClipView& clip, float time, const SampleOptions& options, Samp
   if (std::fabs(frame - nearest) <= 1e-5f * (1.0f + nearest)) frame = nearest;
 
   // Pass 1: runs whose cached pair no longer covers the frame.
-  for (Run& r : s.runs)
+  for (Run& r : std::span<Run>(s.runs, s.run_count))
     if (!(frame >= r.enter && frame < r.leave)) move_run(s, r, frame);
 
   // Pass 2: every joint.
-  const Lanes lanes{s.k0, s.fixed, s.k1, s.start, s.inv_length, s.block_kinds.data(), out.base, s.stride};
+  const Lanes lanes{s.k0, s.fixed, s.k1, s.start, s.inv_length, s.kinds, out.base, s.stride};
   if (options.rotation == RotationInterpolation::Slerp)
     interpolate_slerp(lanes, frame);
   else
