@@ -57,9 +57,6 @@ std::span<const T> scalar_span(const flatbuffers::Vector<T>* v) {
   return {v->data(), v->size()};
 }
 
-std::string_view view_of(const flatbuffers::String* s) {
-  return s ? std::string_view(s->c_str(), s->size()) : std::string_view();
-}
 
 Error error(std::string_view name, const std::string& what) { return Error{std::string(name) + ": " + what}; }
 
@@ -264,7 +261,7 @@ size_t SkeletonView::joint_count() const { return fb ? fb->joint_names()->size()
 
 std::string_view SkeletonView::joint_name(size_t joint) const {
   if (joint >= joint_count()) return {};
-  return view_of(fb->joint_names()->Get(static_cast<flatbuffers::uoffset_t>(joint)));
+  return flatbuffers::GetStringView(fb->joint_names()->Get(static_cast<flatbuffers::uoffset_t>(joint)));
 }
 
 std::span<const int16_t> SkeletonView::parents() const { return fb ? scalar_span(fb->parents()) : std::span<const int16_t>(); }
@@ -285,13 +282,13 @@ uint64_t SkeletonView::hash() const { return fb ? fb->hash() : 0; }
 int SkeletonView::find_joint(std::string_view name) const {
   const size_t n = joint_count();
   for (size_t i = 0; i < n; ++i)
-    if (view_of(fb->joint_names()->Get(static_cast<flatbuffers::uoffset_t>(i))) == name) return static_cast<int>(i);
+    if (flatbuffers::GetStringView(fb->joint_names()->Get(static_cast<flatbuffers::uoffset_t>(i))) == name) return static_cast<int>(i);
   return -1;
 }
 
 // ---- MeshView ----------------------------------------------------------------------------------
 
-std::string_view MeshView::name() const { return view_of(fb->name()); }
+std::string_view MeshView::name() const { return flatbuffers::GetStringView(fb->name()); }
 uint32_t MeshView::vertex_count() const { return fb->vertex_count(); }
 uint32_t MeshView::vertex_stride() const { return fb->vertex_stride(); }
 std::span<const fb::VertexAttribute> MeshView::layout() const { return struct_span(fb->layout()); }
@@ -315,7 +312,7 @@ std::span<const fb::Mat4> MeshView::inverse_bind() const { return struct_span(fb
 
 // ---- ClipView ----------------------------------------------------------------------------------
 
-std::string_view ClipView::name() const { return view_of(fb->name()); }
+std::string_view ClipView::name() const { return flatbuffers::GetStringView(fb->name()); }
 float ClipView::duration() const { return fb->duration(); }
 float ClipView::sample_rate() const { return fb->sample_rate(); }
 uint32_t ClipView::frame_count() const { return fb->frame_count(); }

@@ -16,17 +16,14 @@ using namespace graph_detail;
 
 namespace {
 
-std::string_view view_of(const flatbuffers::String* s) { return s ? std::string_view(s->c_str(), s->size()) : ""; }
 
 const fb::Clip* find_clip(const Asset& asset, std::string_view name) {
   const auto* clips = asset.file().clips();
   if (!clips) return nullptr;
   for (const fb::Clip* c : *clips)
-    if (view_of(c->name()) == name) return c;
+    if (flatbuffers::GetStringView(c->name()) == name) return c;
   return nullptr;
 }
-
-uint32_t max3(uint32_t a, uint32_t b, uint32_t c) { return std::max(a, std::max(b, c)); }
 
 }  // namespace
 
@@ -39,7 +36,7 @@ const fb::Graph* find_graph(const Asset& asset, std::string_view name) {
   const auto* graphs = asset.file().graphs();
   if (!graphs) return nullptr;
   for (const fb::Graph* g : *graphs)
-    if (view_of(g->name()) == name) return g;
+    if (flatbuffers::GetStringView(g->name()) == name) return g;
   return nullptr;
 }
 
@@ -77,7 +74,7 @@ uint32_t scratch_needed(const GraphDefinition::Impl& def, uint16_t n) {
     case Kind::Machine: {
       uint32_t need = 0;
       for (const fb::State* st : *def.machines[info.machine].fb->states())
-        need = max3(need, 1 + scratch_needed(def, st->node()), 0);
+        need = std::max(need, 1 + scratch_needed(def, st->node()));
       return need;
     }
   }
@@ -98,13 +95,12 @@ Result<GraphDefinition> GraphDefinition::create(const Asset& asset, std::string_
   if (!g) {
     std::string names;
     if (const auto* graphs = asset.file().graphs())
-      for (const fb::Graph* other : *graphs) names += (names.empty() ? "" : ", ") + std::string(view_of(other->name()));
+      for (const fb::Graph* other : *graphs) names += (names.empty() ? "" : ", ") + std::string(flatbuffers::GetStringView(other->name()));
     return Error{asset.name() + ": no graph named '" + std::string(graph_name) + "'" +
                  (names.empty() ? " (the file has no graphs)" : " (graphs: " + names + ")")};
   }
   auto impl = std::make_unique<Impl>();
   Impl& d = *impl;
-  d.asset = &asset;
   d.graph = g;
   d.skeleton = asset.skeleton();
   if (d.skeleton.empty()) return Error{where + ": the file has no skeleton to play the graph on"};
@@ -114,7 +110,7 @@ Result<GraphDefinition> GraphDefinition::create(const Asset& asset, std::string_
 
   // Clips by name: this file first, then the extra clip files in order.
   for (const flatbuffers::String* name : *g->clips()) {
-    const std::string_view clip_name = view_of(name);
+    const std::string_view clip_name = flatbuffers::GetStringView(name);
     const fb::Clip* found = find_clip(asset, clip_name);
     const Asset* owner = &asset;
     for (size_t k = 0; !found && k < more_clips.size(); ++k) {
@@ -205,6 +201,11 @@ Result<GraphDefinition> GraphDefinition::create(const Asset& asset, std::string_
         const uint32_t count = t->samples()->size();
         d.float_count += 1 + count;  // phase, then the sample weights
         d.cache_count += count;
+        info.samples = static_cast<uint32_t>(d.sample_x.size());
+        for (const fb::BlendSample* smp : *t->samples()) {
+          d.sample_x.push_back(smp->x());
+          d.sample_duration.push_back(d.clips[smp->clip()].duration());
+        }
         if (t->y_parameter() >= 0) {
           std::vector<glm::vec2> points;
           for (const fb::BlendSample* smp : *t->samples()) points.emplace_back(smp->x(), smp->y());
@@ -263,7 +264,7 @@ uint32_t GraphDefinition::joint_count() const { return impl_->joints; }
 size_t GraphDefinition::parameter_count() const { return impl_->graph->parameters()->size(); }
 std::string_view GraphDefinition::parameter_name(size_t i) const {
   if (i >= parameter_count()) return {};
-  return view_of(impl_->graph->parameters()->Get(static_cast<flatbuffers::uoffset_t>(i))->name());
+  return flatbuffers::GetStringView(impl_->graph->parameters()->Get(static_cast<flatbuffers::uoffset_t>(i))->name());
 }
 fb::ParameterType GraphDefinition::parameter_type(size_t i) const {
   if (i >= parameter_count()) return fb::ParameterType::Float;
@@ -276,14 +277,14 @@ int GraphDefinition::find_parameter(std::string_view name) const {
 }
 size_t GraphDefinition::machine_count() const { return impl_->machines.size(); }
 std::string_view GraphDefinition::machine_name(size_t i) const {
-  return i < machine_count() ? view_of(impl_->machines[i].fb->name()) : std::string_view();
+  return i < machine_count() ? flatbuffers::GetStringView(impl_->machines[i].fb->name()) : std::string_view();
 }
 size_t GraphDefinition::state_count(size_t machine) const {
   return machine < machine_count() ? impl_->machines[machine].fb->states()->size() : 0;
 }
 std::string_view GraphDefinition::state_name(size_t machine, size_t state) const {
   if (state >= state_count(machine)) return {};
-  return view_of(impl_->machines[machine].fb->states()->Get(static_cast<flatbuffers::uoffset_t>(state))->name());
+  return flatbuffers::GetStringView(impl_->machines[machine].fb->states()->Get(static_cast<flatbuffers::uoffset_t>(state))->name());
 }
 size_t GraphDefinition::node_count() const { return impl_->nodes.size(); }
 size_t GraphDefinition::clip_count() const { return impl_->clips.size(); }

@@ -109,42 +109,24 @@ void evaluate_clip(State& s, uint16_t n, const NodeInfo& info, const Advance& ad
 /// Fills the sample weights (floats after the phase) from the parameters; returns the sample count.
 uint32_t blend_space_weights(State& s, const NodeInfo& info) {
   const auto& b = *static_cast<const fb::BlendSpaceNode*>(info.table);
-  const auto& samples = *b.samples();
-  const uint32_t count = samples.size();
-  float* w = &s.floats[info.floats + 1];
+  const uint32_t count = b.samples()->size();
+  const std::span<float> w(&s.floats[info.floats + 1], count);
   const float x = std::clamp(s.params[b.x_parameter()], -kMaxCoordinate, kMaxCoordinate);
   if (b.y_parameter() < 0) {
-    // 1D: the two neighbours of x among the sorted sample positions (validated strictly increasing).
-    for (uint32_t i = 0; i < count; ++i) w[i] = 0.0f;
-    if (count == 1 || x <= samples.Get(0)->x()) {
-      w[0] = 1.0f;
-    } else if (x >= samples.Get(count - 1)->x()) {
-      w[count - 1] = 1.0f;
-    } else {
-      uint32_t hi = 1;
-      while (samples.Get(hi)->x() < x) ++hi;
-      const float x0 = samples.Get(hi - 1)->x(), x1 = samples.Get(hi)->x();
-      const float t = (x - x0) / (x1 - x0);
-      w[hi - 1] = 1.0f - t;
-      w[hi] = t;
-    }
+    blend_space_1d_weights(std::span<const float>(&s.def->sample_x[info.samples], count), x, w);
   } else {
     const float y = std::clamp(s.params[static_cast<size_t>(b.y_parameter())], -kMaxCoordinate, kMaxCoordinate);
-    blend_space_2d_weights(s.def->spaces[info.aux], glm::vec2(x, y), std::span<float>(w, count));
+    blend_space_2d_weights(s.def->spaces[info.aux], glm::vec2(x, y), w);
   }
   return count;
 }
 
-/// The blended cycle: weighted mean of the sample clips' durations, over |rate|.
+/// The blended cycle: the synchronized duration of the sample clips at their weights, over |rate|.
 float blend_space_duration(const State& s, const NodeInfo& info) {
   const auto& b = *static_cast<const fb::BlendSpaceNode*>(info.table);
-  const float* w = &s.floats[info.floats + 1];
-  float total = 0.0f, weighted = 0.0f;
-  for (uint32_t i = 0; i < b.samples()->size(); ++i) {
-    total += w[i];
-    weighted += w[i] * s.def->clips[b.samples()->Get(i)->clip()].duration();
-  }
-  const float d = total > 0.0f ? weighted / total : 0.0f;
+  const uint32_t count = b.samples()->size();
+  const float d = synchronized_duration(std::span<const float>(&s.def->sample_duration[info.samples], count),
+                                        std::span<const float>(&s.floats[info.floats + 1], count));
   const float rate = std::fabs(b.rate());
   return rate > 1e-6f ? d / rate : d * 1e6f;
 }
@@ -258,16 +240,6 @@ void evaluate_select(State& s, const NodeInfo& info, const Advance& advance, flo
 }
 
 // ---- layered blend per joint ----
-
-glm::quat rotation_at(ConstPoseSpan p, uint32_t j) {
-  return glm::quat(p[kRw][j], p[kRx][j], p[kRy][j], p[kRz][j]);
-}
-void set_rotation(PoseSpan p, uint32_t j, const glm::quat& q) {
-  p[kRx][j] = q.x;
-  p[kRy][j] = q.y;
-  p[kRz][j] = q.z;
-  p[kRw][j] = q.w;
-}
 
 glm::quat nlerp(const glm::quat& a, glm::quat b, float t) {
   if (glm::dot(a, b) < 0.0f) b = -b;

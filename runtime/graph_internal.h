@@ -28,6 +28,7 @@ struct NodeInfo {
   uint32_t floats = 0;          // offset of this node's variable state in State::floats
   uint32_t caches = 0;          // first sampling cache (clip: 1, blend space: one per sample)
   uint32_t aux = 0;             // layered: first mask (Impl::masks); blend space: 2D space index
+  uint32_t samples = 0;         // blend space: first entry in Impl::sample_x / sample_duration
   uint16_t machine = 0;         // Machine: index into Impl::machines
   int32_t held = -1;            // Clip with rate 0 and no rate parameter: index into Impl::held
 };
@@ -57,7 +58,6 @@ struct LayerJoints {
 namespace ossa {
 
 struct GraphDefinition::Impl {
-  const Asset* asset = nullptr;
   const fb::Graph* graph = nullptr;
   SkeletonView skeleton;
   uint32_t joints = 0;
@@ -69,6 +69,8 @@ struct GraphDefinition::Impl {
   std::vector<std::vector<float>> masks;               // one per layer (joint weights)
   std::vector<graph_detail::LayerJoints> layer_joints;  // parallel to masks
   std::vector<BlendSpace2D> spaces;
+  std::vector<float> sample_x;         // blend-space sample positions (1D: sorted), per node in order
+  std::vector<float> sample_duration;  // their clips' durations
   Pose bind;                       // the rig's bind pose, for additive deltas
   /// Poses of held clips (rate 0, no rate parameter: a pose that never moves), sampled once here
   /// and shared by every instance instead of being sampled by each, every frame.
@@ -167,6 +169,16 @@ void evaluate_machine(GraphInstance::State& s, uint16_t n, const Advance& advanc
 void restart_machine(GraphInstance::State& s, uint16_t machine);
 Cycle machine_cycle(const GraphInstance::State& s, uint16_t machine);
 void set_machine_phase(GraphInstance::State& s, uint16_t machine, float p);
+
+inline glm::quat rotation_at(ConstPoseSpan p, uint32_t j) {
+  return glm::quat(p[kRw][j], p[kRx][j], p[kRy][j], p[kRz][j]);
+}
+inline void set_rotation(PoseSpan p, uint32_t j, const glm::quat& q) {
+  p[kRx][j] = q.x;
+  p[kRy][j] = q.y;
+  p[kRz][j] = q.z;
+  p[kRw][j] = q.w;
+}
 
 /// Copies a pose with streaming stores (graph_instance.cpp): for destinations that are written
 /// every frame but read later or rarely (an instance's output, a machine's history). With a crowd

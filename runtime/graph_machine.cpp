@@ -115,8 +115,6 @@ glm::vec3 rotation_vector(glm::quat q) {
   return v * (2.0f * std::atan2(s, q.w) / s);
 }
 
-glm::quat rotation_at(ConstPoseSpan p, uint32_t j) { return glm::quat(p[kRw][j], p[kRx][j], p[kRy][j], p[kRz][j]); }
-
 /// Starts an offset that carries the last output into `now` (this frame's pose before offsets).
 void capture_offset(State& s, MachineState& m, ConstPoseSpan now, float duration) {
   const uint32_t joints = s.def->joints;
@@ -154,11 +152,7 @@ void apply_offset(const State& s, const MachineState& m, PoseSpan out) {
     if (cr.x0 > 0.0f) {
       const float x = quintic(cr, t);
       if (x == 0.0f) continue;
-      const glm::quat q = glm::angleAxis(x, cr.direction) * rotation_at(out, j);
-      out[kRx][j] = q.x;
-      out[kRy][j] = q.y;
-      out[kRz][j] = q.z;
-      out[kRw][j] = q.w;
+      set_rotation(out, j, glm::angleAxis(x, cr.direction) * rotation_at(out, j));
     }
   }
 }

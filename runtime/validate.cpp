@@ -41,14 +41,11 @@ size_t count_of(const V* v) {
   return v ? v->size() : 0;
 }
 
-std::string_view view_of(const flatbuffers::String* s) {
-  return s ? std::string_view(s->c_str(), s->size()) : std::string_view();
-}
 
 /// "mesh 2 'Body'", or "mesh 2" when unnamed.
 std::string label(const char* kind, size_t index, const flatbuffers::String* name) {
   std::string out = format("%s %zu", kind, index);
-  if (name && name->size() != 0) out += " '" + detail::printable(view_of(name)) + "'";
+  if (name && name->size() != 0) out += " '" + detail::printable(flatbuffers::GetStringView(name)) + "'";
   return out;
 }
 
@@ -224,7 +221,7 @@ class Validator {
   std::string joint_label(size_t joint) const {
     std::string out = format("joint %zu", joint);
     if (skeleton_ && joint < joint_count_) {
-      const auto name = view_of(skeleton_->joint_names()->Get(static_cast<flatbuffers::uoffset_t>(joint)));
+      const auto name = flatbuffers::GetStringView(skeleton_->joint_names()->Get(static_cast<flatbuffers::uoffset_t>(joint)));
       out += " '" + detail::printable(name) + "'";
     }
     return out;
@@ -252,7 +249,7 @@ class Validator {
     names.reserve(n);
     for (size_t i = 0; i < n; ++i) {
       const auto idx = static_cast<flatbuffers::uoffset_t>(i);
-      const std::string_view name = view_of(s.joint_names()->Get(idx));
+      const std::string_view name = flatbuffers::GetStringView(s.joint_names()->Get(idx));
       if (name.empty()) return fail(where, format("joint %zu has an empty name", i));
       names.push_back(name);
       const auto jl = [&] { return format("joint %zu '%s'", i, detail::printable(name).c_str()); };
@@ -640,11 +637,11 @@ class Validator {
       float previous = 0.0f;
       for (flatbuffers::uoffset_t i = 0; i < events->size(); ++i) {
         const fb::ClipEvent& e = *events->Get(i);
-        if (view_of(e.name()).empty()) return fail(where, format("event %u has an empty name", i));
+        if (flatbuffers::GetStringView(e.name()).empty()) return fail(where, format("event %u has an empty name", i));
         const float t = e.time();
         if (!std::isfinite(t) || t < 0.0f || t > duration)
           return fail(where, format("event %u '%s' at %g s lies outside the clip [0, %g s]", i,
-                                    detail::printable(view_of(e.name())).c_str(), t, duration));
+                                    detail::printable(flatbuffers::GetStringView(e.name())).c_str(), t, duration));
         if (t < previous) return fail(where, format("event %u at %g s comes before event %u's %g s: not sorted", i, t,
                                                     i - 1, previous));
         previous = t;
@@ -673,7 +670,7 @@ class Validator {
       if (static_cast<unsigned>(t.role()) > static_cast<unsigned>(fb::TextureRole::MAX))
         return fail(where, format("texture %u has unknown role %u", k, static_cast<unsigned>(t.role())));
       const size_t data_size = count_of(t.data());
-      if (data_size == 0 && view_of(t.path()).empty())
+      if (data_size == 0 && flatbuffers::GetStringView(t.path()).empty())
         return fail(where, format("texture %u (%s) has neither embedded data nor a path", k,
                                   fb::EnumNameTextureRole(t.role())));
       if (data_size != 0 && reinterpret_cast<uintptr_t>(t.data()->Data()) % 16 != 0)

@@ -21,14 +21,13 @@ namespace {
 
 using detail::format;
 
-std::string_view view_of(const flatbuffers::String* s) { return s ? std::string_view(s->c_str(), s->size()) : ""; }
 
 class GraphChecker {
  public:
   GraphChecker(const fb::Graph& g, size_t index, std::string_view name, uint64_t& budget)
       : g_(g), budget_(budget) {
     where_ = std::string(name) + ": " + format("graph %zu", index);
-    if (!view_of(g.name()).empty()) where_ += " '" + detail::printable(view_of(g.name())) + "'";
+    if (!flatbuffers::GetStringView(g.name()).empty()) where_ += " '" + detail::printable(flatbuffers::GetStringView(g.name())) + "'";
   }
 
   Status run() {
@@ -45,7 +44,7 @@ class GraphChecker {
     for (size_t i = 0; i < param_count_; ++i)
       if (Status st = check_parameter(i); !st) return st;
     for (size_t i = 0; i < clip_count_; ++i)
-      if (view_of(g_.clips()->Get(static_cast<flatbuffers::uoffset_t>(i))).empty())
+      if (flatbuffers::GetStringView(g_.clips()->Get(static_cast<flatbuffers::uoffset_t>(i))).empty())
         return fail(format("clip %zu has an empty name", i));
     referrers_.assign(node_count_, 0);
     depth_.assign(node_count_, 1);
@@ -76,7 +75,7 @@ class GraphChecker {
   }
   std::string param_label(size_t p) const {
     return format("parameter %zu '%s'", p,
-                  detail::printable(view_of(g_.parameters()->Get(static_cast<flatbuffers::uoffset_t>(p))->name())).c_str());
+                  detail::printable(flatbuffers::GetStringView(g_.parameters()->Get(static_cast<flatbuffers::uoffset_t>(p))->name())).c_str());
   }
 
   /// A parameter reference of one of the allowed types (optional: -1 allowed).
@@ -94,7 +93,7 @@ class GraphChecker {
   Status check_parameter(size_t i) {
     const fb::Parameter& p = *g_.parameters()->Get(static_cast<flatbuffers::uoffset_t>(i));
     const std::string at = param_label(i);
-    if (view_of(p.name()).empty()) return fail(format("parameter %zu has an empty name", i));
+    if (flatbuffers::GetStringView(p.name()).empty()) return fail(format("parameter %zu has an empty name", i));
     if (static_cast<unsigned>(p.type()) > static_cast<unsigned>(fb::ParameterType::MAX))
       return fail(at + format(" has unknown type %u", static_cast<unsigned>(p.type())));
     const float v = p.default_value(), lo = p.min_value(), hi = p.max_value();
@@ -251,10 +250,10 @@ class GraphChecker {
   Status check_machine(size_t m) {
     const fb::StateMachine& sm = *g_.machines()->Get(static_cast<flatbuffers::uoffset_t>(m));
     std::string at = format("state machine %zu", m);
-    if (!view_of(sm.name()).empty()) at += " '" + detail::printable(view_of(sm.name())) + "'";
+    if (!flatbuffers::GetStringView(sm.name()).empty()) at += " '" + detail::printable(flatbuffers::GetStringView(sm.name())) + "'";
     const size_t states = sm.states()->size();
     for (size_t k = 0; k < states; ++k)
-      if (view_of(sm.states()->Get(static_cast<flatbuffers::uoffset_t>(k))->name()).empty())
+      if (flatbuffers::GetStringView(sm.states()->Get(static_cast<flatbuffers::uoffset_t>(k))->name()).empty())
         return fail(at + format(": state %zu has an empty name", k));
     if (sm.entry() >= states) return fail(at + format(": entry state %u is out of range (%zu states)", sm.entry(), states));
     const auto* transitions = sm.transitions();
