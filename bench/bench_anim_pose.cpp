@@ -24,8 +24,8 @@
 #include <glm/gtc/quaternion.hpp>
 
 #include "bench_fixture.h"
-#include "runtime/pose.h"
-#include "runtime/pose_ops.h"
+#include <ossa/anim/pose.h>
+#include <ossa/anim/pose_ops.h>
 
 namespace {
 

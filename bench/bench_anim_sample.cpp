@@ -26,10 +26,10 @@
 #include <glm/glm.hpp>
 
 #include "bench_fixture.h"
-#include "runtime/pose.h"
-#include "runtime/pose_ops.h"
-#include "runtime/sample.h"
-#include "runtime/skinning.h"
+#include <ossa/anim/pose.h>
+#include <ossa/anim/pose_ops.h>
+#include <ossa/anim/sample.h>
+#include <ossa/skinning/skinning.h>
 
 namespace {
 

@@ -24,9 +24,9 @@
 #include <string>
 #include <vector>
 
-#include "cooker/clip_compress.h"
+#include "cooker/clip/clip_compress.h"
 #include "cooker/cook.h"
-#include "cooker/import_scene.h"
+#include "cooker/import/import_scene.h"
 
 namespace fs = std::filesystem;
 using namespace ossa::cook;

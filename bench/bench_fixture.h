@@ -4,7 +4,7 @@
 // with default options (the compression a game would ship), and the arnaud skinned mesh. These are
 // the assets the ozz-animation figures were measured on, so results compare directly.
 #pragma once
-#include "runtime/asset.h"
+#include <ossa/loader/asset.h>
 
 namespace ossa::bench {
 

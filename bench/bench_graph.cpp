@@ -30,7 +30,7 @@
 #include <vector>
 
 #include "cooker/cook.h"
-#include "runtime/graph.h"
+#include <ossa/graph/graph.h>
 
 namespace fs = std::filesystem;
 using namespace ossa;

@@ -25,8 +25,8 @@
 #include <assimp/scene.h>
 
 #include "cooker/cook.h"
-#include "cooker/import_scene.h"
-#include "runtime/asset.h"
+#include "cooker/import/import_scene.h"
+#include <ossa/loader/asset.h>
 
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;

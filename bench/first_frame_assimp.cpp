@@ -18,7 +18,7 @@
 #include <glm/gtc/type_ptr.hpp>
 #include <stb_image.h>
 
-#include "cooker/import_scene.h"
+#include "cooker/import/import_scene.h"
 #include "viewer/bounds.h"
 #include "viewer/camera.h"
 #include "viewer/gl_util.h"

@@ -14,14 +14,14 @@
 #include <fstream>
 #include <iterator>
 
-#include "cooker/clip_events.h"
+#include "cooker/clip/clip_events.h"
 #include "cooker/cook_internal.h"
-#include "cooker/import_scene.h"
-#include "cooker/mesh_build.h"
-#include "cooker/root_motion.h"
-#include "cooker/write_ossa.h"
-#include "format/hash.h"
-#include "runtime/asset.h"
+#include "cooker/import/import_scene.h"
+#include "cooker/mesh/mesh_build.h"
+#include "cooker/clip/root_motion.h"
+#include "cooker/write/write_ossa.h"
+#include <ossa/format/hash.h>
+#include <ossa/loader/asset.h>
 
 namespace ossa::cook {
 namespace fs = std::filesystem;
@@ -93,6 +93,25 @@ Result<std::vector<CompressedClip>> cook_clips(SourceScene& scene, const CookOpt
   return clips;
 }
 
+void count_scene(CookRecord& record, const SourceScene& scene) {
+  record.joints = static_cast<uint32_t>(scene.skeleton.joints.size());
+  record.clips = static_cast<uint32_t>(scene.clips.size());
+  record.materials = static_cast<uint32_t>(scene.materials.size());
+  uint32_t textures = 0;
+  for (const SourceMaterial& m : scene.materials) textures += static_cast<uint32_t>(m.textures.size());
+  record.textures = textures;
+  record.vertices_over_4_influences = scene.vertices_over_4_influences;
+}
+
+void count_meshes(CookRecord& record, const std::vector<CookedMesh>& meshes, const MeshBuildStats& stats) {
+  record.meshes = static_cast<uint32_t>(meshes.size());
+  uint32_t submeshes = 0;
+  for (const CookedMesh& m : meshes) submeshes += static_cast<uint32_t>(m.submeshes.size());
+  record.submeshes = submeshes;
+  record.vertices = stats.cooked_vertices;
+  record.triangles = stats.triangles;
+}
+
 bool write_verified(CookRecord& record, const std::vector<uint8_t>& bytes, const fs::path& input,
                     const fs::path& output) {
   // The writer's output must pass the same checks every reader makes; a cooker bug is caught here
@@ -113,6 +132,8 @@ bool write_verified(CookRecord& record, const std::vector<uint8_t>& bytes, const
 
 namespace {
 
+using detail::count_meshes;
+using detail::count_scene;
 using detail::read_bytes;
 
 void cook_into(CookRecord& record, const fs::path& input, const fs::path& output, const CookOptions& options) {
@@ -140,12 +161,14 @@ void cook_into(CookRecord& record, const fs::path& input, const fs::path& output
     return;
   }
   record.warnings = scene->warnings;
+  count_scene(record, *scene);
   // Events authored beside the source (clip_events.h); its bytes count as the source's.
   auto sidecar = attach_sidecar_events(input, scene->clips);
   if (!sidecar) {
     record.error = sidecar.error().message;  // names the sidecar, line and column
     return;
   }
+  if (sidecar->present) record.source_bytes += sidecar->bytes.size();
 
   MeshOptions mesh_options;
   mesh_options.float_vertices = options.float_vertices;
@@ -155,6 +178,7 @@ void cook_into(CookRecord& record, const fs::path& input, const fs::path& output
     record.error = input.string() + ": " + meshes.error().message;
     return;
   }
+  count_meshes(record, *meshes, stats);
 
   auto clips = detail::cook_clips(*scene, options, record, input.string());
   if (!clips) {
@@ -165,10 +189,8 @@ void cook_into(CookRecord& record, const fs::path& input, const fs::path& output
   WriteProvenance provenance;
   provenance.source_name = input.filename().string();
   provenance.source_hash = hash_bytes(source->data(), source->size());
-  if (sidecar->present) {
+  if (sidecar->present)
     provenance.source_hash = hash_bytes(sidecar->bytes.data(), sidecar->bytes.size(), provenance.source_hash);
-    record.source_bytes += sidecar->bytes.size();
-  }
   provenance.options = options.canonical();
   // A clip-only file binds to its rig by hash and carries no skeleton; a file with meshes always
   // carries the rig its joint palettes index (with --skeleton, the reference's, hash-identical).
@@ -178,15 +200,7 @@ void cook_into(CookRecord& record, const fs::path& input, const fs::path& output
   if (!detail::write_verified(record, bytes, input, output)) return;
 
   record.ok = true;
-  record.joints = static_cast<uint32_t>(write_options.include_skeleton ? scene->skeleton.joints.size() : 0);
-  record.meshes = static_cast<uint32_t>(meshes->size());
-  for (const CookedMesh& m : *meshes) record.submeshes += static_cast<uint32_t>(m.submeshes.size());
-  record.vertices = stats.cooked_vertices;
-  record.triangles = stats.triangles;
-  record.clips = static_cast<uint32_t>(scene->clips.size());
-  record.materials = static_cast<uint32_t>(scene->materials.size());
-  for (const SourceMaterial& m : scene->materials) record.textures += static_cast<uint32_t>(m.textures.size());
-  record.vertices_over_4_influences = scene->vertices_over_4_influences;
+  if (!write_options.include_skeleton) record.joints = 0;  // the file carries no rig of its own
 }
 
 }  // namespace

@@ -7,12 +7,13 @@
 #pragma once
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
-#include "cooker/clip_compress.h"
-#include "cooker/source_scene.h"
-#include "format/result.h"
+#include "cooker/clip/clip_compress.h"
+#include "cooker/import/source_scene.h"
+#include <ossa/format/result.h>
 
 namespace ossa::cook {
 
@@ -37,25 +38,33 @@ struct ClipRecord {
   std::string worst_joint;
 };
 
-/// One line of the --report file.
+/// One line of the --report file (docs/schemas/ossa-cook-report.schema.json).
+///
+/// A failed cook keeps what it learnt before it stopped: the counts are filled in as each stage
+/// finishes (an empty optional: that stage was not reached), source_bytes counts what was read,
+/// seconds is always set. `output` is where the file goes; only a record with `ok` has written it
+/// (report_json names it only then), and cooked_bytes is 0 otherwise.
 struct CookRecord {
   std::string input;
   std::string output;
   bool ok = false;
   std::string error;                  // when !ok: "<input>: what is wrong"
   std::vector<std::string> warnings;
-  uint32_t joints = 0, meshes = 0, submeshes = 0, vertices = 0, triangles = 0, clips = 0,
-           materials = 0, textures = 0;
-  uint32_t vertices_over_4_influences = 0;
-  uint64_t source_bytes = 0, cooked_bytes = 0;
+  // Known after import: joints (of the imported rig; when ok, of the file's skeleton: 0 for a
+  // clip-only file cooked against --skeleton), clips, materials, textures, vertices over 4 influences.
+  std::optional<uint32_t> joints, clips, materials, textures, vertices_over_4_influences;
+  // Known once meshes are built.
+  std::optional<uint32_t> meshes, submeshes, vertices, triangles;
+  uint64_t source_bytes = 0;          // every file read: the source, its sidecar, a graph's sources
+  uint64_t cooked_bytes = 0;          // the written file (ok only)
   double seconds = 0.0;
-  std::vector<ClipRecord> clip_records;
+  std::vector<ClipRecord> clip_records;  // one per clip compressed before any failure
 };
 
 /// Cooks `input` to `output` (parent directories are created). Never throws.
 ///
 /// A source file's clips get the events of its sidecar `<stem>.events.json` when there is one
-/// (cooker/clip_events.h; the sidecar's bytes are part of the provenance hash). A graph file
+/// (cooker/clip/clip_events.h; the sidecar's bytes are part of the provenance hash). A graph file
 /// (is_graph_file) cooks into a self-contained character: its rig, meshes, clips and the compiled
 /// graph (docs/GRAPH.md); `reference` is then not used, the graph names its own rig.
 CookRecord cook_file(const std::filesystem::path& input, const std::filesystem::path& output,

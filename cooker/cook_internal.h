@@ -6,10 +6,11 @@
 #include <string>
 #include <vector>
 
-#include "cooker/clip_compress.h"
+#include "cooker/clip/clip_compress.h"
 #include "cooker/cook.h"
-#include "cooker/source_scene.h"
-#include "format/result.h"
+#include "cooker/import/source_scene.h"
+#include "cooker/mesh/mesh_build.h"
+#include <ossa/format/result.h>
 
 namespace ossa::cook::detail {
 
@@ -20,6 +21,13 @@ Result<std::vector<uint8_t>> read_bytes(const std::filesystem::path& path);
 /// adds a ClipRecord per clip and a warning per clip over its tolerance. Errors start with `label`.
 Result<std::vector<CompressedClip>> cook_clips(SourceScene& scene, const CookOptions& options, CookRecord& record,
                                                const std::string& label);
+
+/// The counts a record knows once the scene is imported: joints, clips, materials, textures,
+/// vertices over 4 influences (set before later stages run, so a failure keeps them).
+void count_scene(CookRecord& record, const SourceScene& scene);
+
+/// The counts a record knows once the meshes are built: meshes, submeshes, vertices, triangles.
+void count_meshes(CookRecord& record, const std::vector<CookedMesh>& meshes, const MeshBuildStats& stats);
 
 /// verify_buffer, then write_file_atomic. On success sets record.cooked_bytes; otherwise
 /// record.error, and returns false.

@@ -10,7 +10,12 @@ PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev libimgui-dev libepoxy-dev
   xvfb xauth libgl1-mesa-dri libglx-mesa0 mesa-utils
   clang libclang-rt-14-dev
+  python3 python3-jsonschema
+  g++-mingw-w64-x86-64-posix wine64
 )
+# g++-mingw-w64-x86-64-posix + wine64: the Windows stage of scripts/test.sh cross-builds the runtime
+# and its suites with MinGW-w64 (cmake/toolchains/mingw-w64-x86_64.cmake) and runs them under Wine;
+# GoogleTest's sources for that build come with libgtest-dev (/usr/src/googletest).
 
 missing=()
 for p in "${PACKAGES[@]}"; do

@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # test.sh — install, build (warnings as errors), and run every test through CTest: the main suite,
 # the bad-input suite again under AddressSanitizer + UBSan, and the loader fuzzer for a bounded time
-# (when clang is present). The main suite runs last so its CTest summary is the closing line.
+# (when clang is present), the runtime alone with only FlatBuffers and GLM, the runtime and its suites
+# cross-built for Windows and run under Wine, and the main suite (which includes the install +
+# out-of-tree consumer test). The main suite runs last so its CTest summary is the closing line.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh
@@ -20,6 +22,29 @@ if command -v clang++ >/dev/null; then
 else
   echo "== fuzz build skipped: clang++ not found"
 fi
+
+echo "== runtime-only build: FlatBuffers and GLM (GoogleTest for its suites), every other package hidden"
+# CMAKE_DISABLE_FIND_PACKAGE_X makes find_package(X) fail as if X were not installed, so this proves
+# -DOSSA_RUNTIME_ONLY=ON needs nothing else without uninstalling anything.
+hidden=()
+for p in assimp OpenMesh meshoptimizer CLI11 nlohmann_json PkgConfig benchmark glfw3; do
+  hidden+=("-DCMAKE_DISABLE_FIND_PACKAGE_$p=ON")
+done
+cmake -S . -B build-runtime -G Ninja --no-warn-unused-cli -DOSSA_RUNTIME_ONLY=ON -DOSSA_WERROR=ON "${hidden[@]}" >/dev/null
+cmake --build build-runtime -j "$jobs"
+ctest --test-dir build-runtime --output-on-failure -j "$jobs"
+
+echo "== Windows: runtime + its suites cross-built with MinGW-w64, run under Wine"
+# The runtime's portability check: the same runtime-only build for x86_64 Windows (PE, no ifunc, no
+# POSIX), every runtime suite run under a headless Wine (one WINEPREFIX in build-win, created on the
+# first run; cmake/toolchains/wine-run.sh). Each test has a CTest TIMEOUT, and the stage is bounded
+# as a whole so a stuck Wine cannot hold CI.
+launcher=()
+if command -v ccache >/dev/null; then launcher=(-DCMAKE_C_COMPILER_LAUNCHER=ccache -DCMAKE_CXX_COMPILER_LAUNCHER=ccache); fi
+cmake -S . -B build-win -G Ninja -DCMAKE_TOOLCHAIN_FILE=cmake/toolchains/mingw-w64-x86_64.cmake \
+  -DOSSA_RUNTIME_ONLY=ON -DOSSA_WERROR=ON -DOSSA_BUILD_BENCH=OFF "${launcher[@]}" >/dev/null
+timeout 900 cmake --build build-win -j "$jobs"
+timeout 300 ctest --test-dir build-win --output-on-failure -j "$jobs" --timeout 60
 
 echo "== main build and suite"
 cmake -S . -B build -G Ninja -DOSSA_WERROR=ON >/dev/null

@@ -2,12 +2,12 @@
 // layout exactly as it is stored in the .ossa file.
 //
 // The viewer binds the file's vertex bytes with glVertexAttribPointer straight from the layout
-// table (format/vertex_format.h), so GL itself does the unorm / snorm / half-float decoding and
+// table (ossa/format/vertex_format.h), so GL itself does the unorm / snorm / half-float decoding and
 // attribute locations equal fb::VertexSemantic values (Position 0 ... Weights 6):
 //  - position: Unorm16x4 (normalized into [0, 1] inside the mesh bounds) or Float32x3. The
 //    de-quantizing affine D = translate(position_offset) * scale(position_scale) is folded into
-//    every palette matrix on the CPU (runtime/skinning.h), so both cases are palette * (p.xyz, 1).
-//  - normal: Snorm16x2 octahedral (decoded here, as format/vertex_codec.h) or Float32x3 xyz.
+//    every palette matrix on the CPU (ossa/skinning/skinning.h), so both cases are palette * (p.xyz, 1).
+//  - normal: Snorm16x2 octahedral (decoded here, as ossa/format/vertex_codec.h) or Float32x3 xyz.
 //    Directions must not see D's per-axis scale, so they are multiplied by u_direction_prescale
 //    (1 / position_scale; 1 for float layouts) before the palette, exactly as skin_cpu does:
 //    palette3x3 * (n / s) = (model * inverse_bind)3x3 * n.

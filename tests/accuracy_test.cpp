@@ -31,11 +31,11 @@
 #include <glm/gtc/type_ptr.hpp>
 
 #include "cooker/cook.h"
-#include "cooker/import_scene.h"
-#include "format/vertex_codec.h"
-#include "runtime/asset.h"
-#include "runtime/pose.h"
-#include "runtime/sample.h"
+#include "cooker/import/import_scene.h"
+#include <ossa/format/vertex_codec.h>
+#include <ossa/loader/asset.h>
+#include <ossa/anim/pose.h>
+#include <ossa/anim/sample.h>
 #include "test_files.h"
 
 namespace fs = std::filesystem;

@@ -2,9 +2,9 @@
 // made by accepting it, for tests that feed the loader hostile bytes (bad_input_test, fuzz_load).
 //
 // "Accepted" must mean "safe to use without further checks": every span and name lies inside the
-// asset's own bytes, and every invariant listed in runtime/validate.h holds. walk_asset touches
+// asset's own bytes, and every invariant listed in ossa/loader/validate.h holds. walk_asset touches
 // every byte the views expose (so ASan sees any read past the buffer) and checks those invariants
-// independently of runtime/validate.cpp, reading raw values only through bounds it has itself
+// independently of runtime/loader/validate.cpp, reading raw values only through bounds it has itself
 // established, so a loader that accepts a bad file is reported instead of trusted. It returns the
 // first broken promise as text (empty when all hold) rather than using GoogleTest, because the
 // libFuzzer target includes it too. Header-only: the fuzz target is built from one source file.
@@ -17,6 +17,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <limits>
 #include <span>
 #include <string>
 #include <string_view>
@@ -25,13 +26,13 @@
 
 #include <flatbuffers/flatbuffers.h>
 
-#include "format/hash.h"
-#include "format/vertex_format.h"
-#include "format/version.h"
-#include "runtime/asset.h"
-#include "runtime/graph.h"
-#include "runtime/pose.h"
-#include "runtime/sample.h"
+#include <ossa/format/hash.h>
+#include <ossa/format/vertex_format.h>
+#include <ossa/version.h>
+#include <ossa/loader/asset.h>
+#include <ossa/graph/graph.h>
+#include <ossa/anim/pose.h>
+#include <ossa/anim/sample.h>
 
 namespace ossa::test {
 
@@ -257,8 +258,13 @@ class AssetWalker {
         return fail(where, "constant value not finite");
       if (ch.channel() == fb::Channel::Rotation) {
         if (!std::isfinite(ch.value().w())) return fail(where, "rotation constant not finite");
-        const double x = ch.value().x(), y = ch.value().y(), z = ch.value().z(), w = ch.value().w();
-        if (!(x * x + y * y + z * z + w * w > 1e-30)) return fail(where, "zero rotation constant");
+        // validate.h promises "normalizable": a squared norm, in float as the sampler computes it,
+        // that neither underflows below FLT_MIN nor overflows (a double sum > 1e-30 was stricter
+        // than that promise, and the fuzzer found constants between the two).
+        const float x = ch.value().x(), y = ch.value().y(), z = ch.value().z(), w = ch.value().w();
+        const float n2 = x * x + y * y + z * z + w * w;
+        if (!(n2 >= std::numeric_limits<float>::min() && n2 <= std::numeric_limits<float>::max()))
+          return fail(where, "zero rotation constant");
       }
     }
     for (size_t k = 0; k < animated.size(); ++k) {

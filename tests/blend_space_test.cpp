@@ -1,4 +1,4 @@
-// blend_space_test.cpp — blend-space weights (runtime/blend_space.h): 1D and 2D weights sum to 1,
+// blend_space_test.cpp — blend-space weights (ossa/anim/blend_space.h): 1D and 2D weights sum to 1,
 // are exact at the samples, interpolate linearly / barycentrically, clamp or project outside, the
 // 2D triangulation is Delaunay and rejects degenerate input, evaluation does not allocate, and
 // clips scaled to the synchronized duration stay in phase.
@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "runtime/blend_space.h"
+#include <ossa/anim/blend_space.h>
 #include "allocation_counter.h"
 
 

@@ -1,8 +1,8 @@
-// clip_compress_test.cpp — clip compression (cooker/clip_compress.h) on real and synthetic clips.
+// clip_compress_test.cpp — clip compression (cooker/clip/clip_compress.h) on real and synthetic clips.
 //
 // What a user relies on: the error bound holds, and it is what an independent measurement finds
-// (this file decodes the packed keys itself with format/clip_codec.h, rebuilds model space in
-// double and measures the probe points, sharing no code with cooker/clip_error.cpp); channels are
+// (this file decodes the packed keys itself with ossa/format/clip_codec.h, rebuilds model space in
+// double and measures the probe points, sharing no code with cooker/clip/clip_error.cpp); channels are
 // classified as the format says (bind values omitted, constants stored once); lossless mode
 // reproduces every frame; rotations drop a component that keeps them precise (a half turn
 // compresses without the raw-float escape); a tighter tolerance costs bytes and a looser one saves
@@ -27,14 +27,14 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/quaternion.hpp>
 
-#include "cooker/batch.h"
-#include "cooker/clip_compress.h"
+#include "cooker/cli/batch.h"
+#include "cooker/clip/clip_compress.h"
 #include "cooker/cook.h"
-#include "cooker/import_scene.h"
-#include "cooker/write_ossa.h"
-#include "format/clip_codec.h"
-#include "format/ossa_generated.h"
-#include "runtime/asset.h"
+#include "cooker/import/import_scene.h"
+#include "cooker/write/write_ossa.h"
+#include <ossa/format/clip_codec.h>
+#include <ossa/format/ossa_generated.h>
+#include <ossa/loader/asset.h>
 
 namespace {
 

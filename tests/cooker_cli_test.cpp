@@ -7,7 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "runtime/asset.h"
+#include <ossa/loader/asset.h>
 #include "test_files.h"
 
 namespace fs = std::filesystem;

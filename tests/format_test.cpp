@@ -7,9 +7,9 @@
 #include <string_view>
 #include <vector>
 
-#include "format/hash.h"
-#include "format/vertex_codec.h"
-#include "format/vertex_format.h"
+#include <ossa/format/hash.h>
+#include <ossa/format/vertex_codec.h>
+#include <ossa/format/vertex_format.h>
 
 namespace {
 

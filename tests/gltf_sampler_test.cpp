@@ -1,8 +1,8 @@
 // gltf_sampler_test.cpp — glTF STEP / LINEAR / CUBICSPLINE samplers are honoured by the importer.
 //
 // Assimp 5.2.5 hands STEP and CUBICSPLINE keys over as if they were LINEAR; the importer reads the
-// samplers from the file itself (cooker/gltf_samplers.h) and resamples those channels on the clip's
-// frame grid (cooker/import_clips.cpp). These tests check the SourceScene the importer returns:
+// samplers from the file itself (cooker/import/gltf_samplers.h) and resamples those channels on the clip's
+// frame grid (cooker/import/import_clips.cpp). These tests check the SourceScene the importer returns:
 //   - interpolation_test.gltf (Khronos sample, ../shared/assets; skipped with a notice when
 //   absent):
 //     every grid frame of each STEP / CUBICSPLINE channel equals the glTF sampler evaluated here,
@@ -27,9 +27,9 @@
 #include <glm/gtc/quaternion.hpp>
 #include <nlohmann/json.hpp>
 
-#include "cooker/clip_grid.h"
-#include "cooker/gltf_samplers.h"
-#include "cooker/import_scene.h"
+#include "cooker/clip/clip_grid.h"
+#include "cooker/import/gltf_samplers.h"
+#include "cooker/import/import_scene.h"
 #include "test_files.h"
 
 namespace fs = std::filesystem;

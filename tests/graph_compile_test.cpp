@@ -1,5 +1,5 @@
-// graph_compile_test.cpp — the graph compiler (cooker/graph_compile.h) and its condition language
-// (cooker/graph_condition.h): valid graphs give the expected GraphDef (node order, indices, RPN,
+// graph_compile_test.cpp — the graph compiler (cooker/graph/graph_compile.h) and its condition language
+// (cooker/graph/graph_condition.h): valid graphs give the expected GraphDef (node order, indices, RPN,
 // sorted transitions, merged events); every kind of mistake is refused with a message that starts
 // with `file:line:col:` at the value at fault.
 #include <gtest/gtest.h>
@@ -9,9 +9,9 @@
 #include <string>
 #include <vector>
 
-#include "cooker/graph_compile.h"
-#include "cooker/graph_condition.h"
-#include "cooker/write_ossa.h"
+#include "cooker/graph/graph_compile.h"
+#include "cooker/graph/graph_condition.h"
+#include "cooker/write/write_ossa.h"
 
 namespace {
 

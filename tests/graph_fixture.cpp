@@ -4,8 +4,8 @@
 #include <cstdio>
 #include <memory>
 
-#include "cooker/import_scene.h"
-#include "cooker/write_ossa.h"
+#include "cooker/import/import_scene.h"
+#include "cooker/write/write_ossa.h"
 #include "test_files.h"
 
 namespace ossa::test {

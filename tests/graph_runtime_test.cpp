@@ -1,4 +1,4 @@
-// graph_runtime_test.cpp — the animation graph evaluator (runtime/graph.h) on Pab's real clips:
+// graph_runtime_test.cpp — the animation graph evaluator (ossa/graph/graph.h) on Pab's real clips:
 // transition weights, poses against hand-made blends, no pop at switches (measured in model
 // space), synchronized phases, interruptions, triggers, nested machines, exit times across loops,
 // events, determinism and allocation-free updates. Graphs are built in C++ (graph_fixture.h).
@@ -17,9 +17,9 @@
 #include "cooker/cook.h"
 #include "test_files.h"
 #include "graph_fixture.h"
-#include "runtime/graph.h"
-#include "runtime/pose_ops.h"
-#include "runtime/sample.h"
+#include <ossa/graph/graph.h>
+#include <ossa/anim/pose_ops.h>
+#include <ossa/anim/sample.h>
 
 namespace ossa {
 namespace {

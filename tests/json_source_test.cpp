@@ -1,4 +1,4 @@
-// json_source_test.cpp — the position-keeping JSON reader (cooker/json_source.h): values and
+// json_source_test.cpp — the position-keeping JSON reader (cooker/json/json_source.h): values and
 // their positions, strictness (each RFC 8259 violation named at its line and column), and
 // robustness: every truncation and many byte mutations of a valid file parse or fail cleanly.
 #include <gtest/gtest.h>
@@ -6,8 +6,8 @@
 #include <cstdint>
 #include <string>
 
-#include "cooker/json_check.h"
-#include "cooker/json_source.h"
+#include "cooker/json/json_check.h"
+#include "cooker/json/json_source.h"
 
 namespace json = ossa::cook::json;
 

@@ -18,15 +18,15 @@
 #include <string>
 #include <vector>
 
-#include "cooker/clip_compress.h"
-#include "cooker/mesh_build.h"
-#include "cooker/write_ossa.h"
-#include "format/clip_codec.h"
-#include "format/hash.h"
-#include "format/vertex_codec.h"
-#include "format/vertex_format.h"
-#include "format/version.h"
-#include "runtime/asset.h"
+#include "cooker/clip/clip_compress.h"
+#include "cooker/mesh/mesh_build.h"
+#include "cooker/write/write_ossa.h"
+#include <ossa/format/clip_codec.h>
+#include <ossa/format/hash.h>
+#include <ossa/format/vertex_codec.h>
+#include <ossa/format/vertex_format.h>
+#include <ossa/version.h>
+#include <ossa/loader/asset.h>
 
 namespace {
 

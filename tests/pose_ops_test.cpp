@@ -24,9 +24,9 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/quaternion.hpp>
 
-#include "runtime/asset.h"
-#include "runtime/pose.h"
-#include "runtime/pose_ops.h"
+#include <ossa/loader/asset.h>
+#include <ossa/anim/pose.h>
+#include <ossa/anim/pose_ops.h>
 #include "test_files.h"
 
 namespace {
@@ -596,6 +596,28 @@ TEST(Additive, RoundTripAndWeights) {
   EXPECT_NEAR(std::abs(glm::dot(th.rotation, about_z(40.0f))), 1.0f, 1e-6f);
   EXPECT_NEAR(th.translation.x, 3.0f, 1e-6f);
   EXPECT_NEAR(th.scale.x, 4.0f, 1e-6f);  // 2 * lerp(1, 3, 0.5)
+}
+
+TEST(Additive, TinyReferenceScalesAndDeepStacksStayFinite) {
+  // A denormal reference scale (the loader accepts any scale within +-1e7, zero and denormals
+  // included) has a ratio beyond float range; stacking additive layers multiplies scales again.
+  // Every result must stay finite and within the loader's bound of 1e7. (Found by fuzz_load.)
+  Pose pose(1), reference(1), delta(1), out(1);
+  ossa::set_transform(pose, 0, {glm::vec3(1e7f, -1e7f, 0), about_z(30.0f), glm::vec3(1e7f, 1.0f, -1e7f)});
+  ossa::set_transform(reference, 0, {glm::vec3(-1e7f, 1e7f, 0), about_z(0.0f), glm::vec3(1e-40f, 0.0f, 1e-38f)});
+  ossa::make_additive(pose, reference, delta);
+  const Transform td = ossa::get_transform(delta, 0);
+  EXPECT_EQ(td.scale.x, 1e7f);   // clamped ratio
+  EXPECT_EQ(td.scale.y, 1.0f);   // zero reference: no change
+  EXPECT_EQ(td.scale.z, -1e7f);  // clamped, sign kept
+  ossa::copy_pose(pose, out);
+  for (int layer = 0; layer < 40; ++layer) ossa::add(out, delta, 8.0f, out);
+  const Transform t = ossa::get_transform(out, 0);
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_TRUE(std::isfinite(t.translation[c]) && std::abs(t.translation[c]) <= 1e7f) << t.translation[c];
+    EXPECT_TRUE(std::isfinite(t.scale[c]) && std::abs(t.scale[c]) <= 1e7f) << t.scale[c];
+  }
+  EXPECT_NEAR(glm::length(t.rotation), 1.0f, 1e-5f);
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -1,4 +1,4 @@
-// root_motion_test.cpp — root motion from cook to host (cooker/root_motion.h, runtime/root_motion.h).
+// root_motion_test.cpp — root motion from cook to host (cooker/clip/root_motion.h, ossa/anim/root_motion.h).
 //
 // Cook side: on a synthetic clip whose root runs 1.5 turns round a circle while turning with it
 // (plus height bob, pitch/roll wobble, a constant tilt like a Z-up rig folded into Y-up, and a
@@ -22,13 +22,13 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/quaternion.hpp>
 
-#include "cooker/clip_grid.h"
+#include "cooker/clip/clip_grid.h"
 #include "cooker/cook.h"
-#include "cooker/root_motion.h"
-#include "runtime/asset.h"
-#include "runtime/pose.h"
-#include "runtime/root_motion.h"
-#include "runtime/sample.h"
+#include "cooker/clip/root_motion.h"
+#include <ossa/loader/asset.h>
+#include <ossa/anim/pose.h>
+#include <ossa/anim/root_motion.h>
+#include <ossa/anim/sample.h>
 #include "test_files.h"
 #include "allocation_counter.h"
 
@@ -65,7 +65,7 @@ struct Placement {
   double yaw = 0.0;
 };
 
-/// What a host does each frame (the convention runtime/root_motion.h documents), written with
+/// What a host does each frame (the convention ossa/anim/root_motion.h documents), written with
 /// glm so it does not share code with the implementation under test.
 void apply(Placement& p, const RootMotionDelta& d, int up) {
   p.position += glm::angleAxis(p.yaw, axis(up)) * glm::dvec3(d.translation);

@@ -1,6 +1,6 @@
-// sample_test.cpp — the clip sampler (runtime/sample.h) against an independent reference.
+// sample_test.cpp — the clip sampler (ossa/anim/sample.h) against an independent reference.
 //
-// The reference here decodes keys with format/clip_codec.h and interpolates them the slow, obvious
+// The reference here decodes keys with ossa/format/clip_codec.h and interpolates them the slow, obvious
 // way (linear search for the key pair, double precision, lerp / nlerp with the shortest-arc sign
 // fix / slerp), so the tests hold the cached SoA sampler to what the format says a clip means:
 //   - at frame times sampling reproduces the decoded keys; between keys it is their interpolation;
@@ -25,10 +25,10 @@
 #include <glm/gtc/quaternion.hpp>
 
 #include "cooker/cook.h"
-#include "format/clip_codec.h"
-#include "runtime/asset.h"
-#include "runtime/pose.h"
-#include "runtime/sample.h"
+#include <ossa/format/clip_codec.h>
+#include <ossa/loader/asset.h>
+#include <ossa/anim/pose.h>
+#include <ossa/anim/sample.h>
 #include "test_files.h"
 
 namespace ossa {

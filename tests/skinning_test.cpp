@@ -40,10 +40,10 @@
 #include <glm/gtc/quaternion.hpp>
 
 #include "cooker/cook.h"
-#include "format/vertex_codec.h"
-#include "format/vertex_format.h"
-#include "runtime/asset.h"
-#include "runtime/skinning.h"
+#include <ossa/format/vertex_codec.h>
+#include <ossa/format/vertex_format.h>
+#include <ossa/loader/asset.h>
+#include <ossa/skinning/skinning.h>
 #include "test_files.h"
 
 namespace fs = std::filesystem;

@@ -3,11 +3,6 @@
 // to write files the cooker never would.
 #include "test_files.h"
 
-#include <fcntl.h>
-#include <spawn.h>
-#include <sys/wait.h>
-#include <unistd.h>
-
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
@@ -15,6 +10,8 @@
 #include <cstring>
 #include <fstream>
 #include <iterator>
+#include <new>
+#include <random>
 #include <utility>
 
 #include <flatbuffers/flatbuffers.h>
@@ -23,13 +20,11 @@
 #include <glm/gtc/quaternion.hpp>
 #include <glm/gtc/type_ptr.hpp>
 
-#include "format/clip_codec.h"
-#include "format/hash.h"
-#include "format/vertex_codec.h"
-#include "format/vertex_format.h"
-#include "format/version.h"
-
-extern char** environ;
+#include <ossa/format/clip_codec.h>
+#include <ossa/format/hash.h>
+#include <ossa/format/vertex_codec.h>
+#include <ossa/format/vertex_format.h>
+#include <ossa/version.h>
 
 // Fallbacks when the environment does not say (a binary run by hand, or a CTest registration
 // that lost the variables): tests/CMakeLists.txt may define these at compile time.
@@ -543,15 +538,14 @@ std::vector<uint8_t> make_valid_file(const SyntheticSpec& spec) {
 }
 
 AlignedBytes::AlignedBytes(std::span<const uint8_t> bytes) : size_(bytes.size()) {
-  // posix_memalign, not aligned_alloc: it takes the exact size, so AddressSanitizer reports a
-  // read one byte past the end instead of letting it land in rounding slack.
-  void* p = nullptr;
-  if (posix_memalign(&p, 16, bytes.empty() ? 1 : bytes.size()) != 0) std::abort();
-  data_ = static_cast<uint8_t*>(p);
+  // Aligned operator new with the exact size (not aligned_alloc, which rounds up and which MinGW
+  // lacks), so AddressSanitizer reports a read one byte past the end instead of letting it land
+  // in rounding slack.
+  data_ = static_cast<uint8_t*>(::operator new(bytes.empty() ? 1 : bytes.size(), std::align_val_t{16}));
   if (!bytes.empty()) std::memcpy(data_, bytes.data(), bytes.size());
 }
 
-AlignedBytes::~AlignedBytes() { std::free(data_); }
+AlignedBytes::~AlignedBytes() { ::operator delete(data_, std::align_val_t{16}); }
 
 // ---------------------------------------------------------------------------------------------
 
@@ -566,10 +560,20 @@ std::filesystem::path shared_assets() { return env_or("OSSA_SHARED_ASSETS", OSSA
 
 std::filesystem::path make_temp_dir(std::string_view prefix) {
   const std::filesystem::path root = env_or("OSSA_TEST_TMP", OSSA_TEST_TMP_DIR);
-  std::filesystem::create_directories(root);
-  std::string pattern = (root / (std::string(prefix) + "-XXXXXX")).string();
-  if (mkdtemp(pattern.data()) == nullptr) return {};
-  return pattern;
+  std::error_code ec;
+  std::filesystem::create_directories(root, ec);
+  // mkdtemp is POSIX-only; create_directory reports whether it made the directory, which gives the
+  // same exclusive creation on every platform.
+  static std::mt19937_64 rng{std::random_device{}()};
+  static constexpr char kChars[] = "abcdefghijklmnopqrstuvwxyz0123456789";
+  for (int attempt = 0; attempt < 100; ++attempt) {
+    std::string name = std::string(prefix) + "-";
+    for (int i = 0; i < 6; ++i) name += kChars[rng() % (sizeof(kChars) - 1)];
+    const std::filesystem::path dir = root / name;
+    if (std::filesystem::create_directory(dir, ec)) return dir;
+    if (ec) return {};
+  }
+  return {};
 }
 
 std::optional<std::vector<uint8_t>> read_file(const std::filesystem::path& path) {
@@ -595,35 +599,6 @@ bool write_file(const std::filesystem::path& path, std::span<const uint8_t> byte
 
 bool write_file(const std::filesystem::path& path, std::string_view text) {
   return write_file(path, std::span<const uint8_t>(reinterpret_cast<const uint8_t*>(text.data()), text.size()));
-}
-
-CommandResult run_command(const std::string& command) {
-  CommandResult result;
-  const std::filesystem::path dir = make_temp_dir("cmd");
-  if (dir.empty()) return result;
-  const std::string out_path = (dir / "stdout").string(), err_path = (dir / "stderr").string();
-
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, STDIN_FILENO, "/dev/null", O_RDONLY, 0);
-  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  std::string sh = "/bin/sh", dash_c = "-c", cmd = command;
-  char* argv[] = {sh.data(), dash_c.data(), cmd.data(), nullptr};
-  pid_t pid = 0;
-  const int spawned = posix_spawn(&pid, "/bin/sh", &actions, nullptr, argv, environ);
-  posix_spawn_file_actions_destroy(&actions);
-  if (spawned == 0) {
-    int status = 0;
-    while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
-    }
-    result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : WIFSIGNALED(status) ? 128 + WTERMSIG(status) : -1;
-  }
-  result.out = read_text(out_path).value_or("");
-  result.err = read_text(err_path).value_or("");
-  std::error_code ignored;
-  std::filesystem::remove_all(dir, ignored);
-  return result;
 }
 
 size_t count_files(const std::filesystem::path& dir) {

@@ -25,7 +25,7 @@
 #include <utility>
 #include <vector>
 
-#include "format/ossa_generated.h"
+#include <ossa/format/ossa_generated.h>
 
 namespace ossa::test {
 
@@ -85,7 +85,7 @@ struct SyntheticConstant {
 };
 
 /// An animated channel given by its key frames and decoded-to-be values; make_valid_file packs
-/// them with format/clip_codec.h (range-reduced to `bits`, or raw floats for bits == 32). The
+/// them with ossa/format/clip_codec.h (range-reduced to `bits`, or raw floats for bits == 32). The
 /// optional fields override what is derived, which is how defects are written.
 struct SyntheticAnimated {
   uint16_t joint = 0;
@@ -230,7 +230,7 @@ struct CommandResult {
   std::string out;
   std::string err;
 };
-/// Runs `/bin/sh -c command` with stdout and stderr captured (through temporary files, so a
+/// (test_process.cpp) Runs `/bin/sh -c command` with stdout and stderr captured (through temporary files, so a
 /// chatty tool cannot dead-lock on a full pipe) and waits for it.
 CommandResult run_command(const std::string& command);
 

@@ -374,6 +374,31 @@ TEST_F(Viewer, BadSizeIsAUsageError) {
   const CommandResult r = run_viewer(quote(cooked("Fox/Fox.ossa").string()) + " --size 640by480 --frames 1");
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("--size"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("run 'ossa-view --help'"), std::string::npos) << r.err;
+}
+
+// -q / -v (runtime/tools/cli/cli.h) on a rendered scene. The synthetic file's normal map is a path
+// that does not exist, so a plain run warns that it was left out.
+TEST_F(Viewer, QuietHidesWarningsVerboseNamesTheContext) {
+  const fs::path file = dir_ / "synthetic.ossa";
+  ASSERT_TRUE(write_file(file, make_valid_file()));
+  const std::string args = quote(file.string()) + " --size 64x64 --frames 1";
+
+  const CommandResult normal = run_viewer(args);
+  ASSERT_EQ(normal.exit_code, 0) << normal.err;
+  EXPECT_NE(normal.err.find("warning: "), std::string::npos) << normal.err;
+  EXPECT_NE(normal.err.find("left out"), std::string::npos) << normal.err;
+
+  const CommandResult quiet = run_viewer(args + " -q");
+  ASSERT_EQ(quiet.exit_code, 0) << quiet.err;
+  EXPECT_TRUE(quiet.err.empty()) << quiet.err;
+  EXPECT_TRUE(quiet.out.empty()) << quiet.out;
+
+  const CommandResult verbose = run_viewer(args + " --verbose");
+  ASSERT_EQ(verbose.exit_code, 0) << verbose.err;
+  EXPECT_NE(verbose.err.find("OpenGL "), std::string::npos) << verbose.err;
+  EXPECT_NE(verbose.err.find("4 joints, 1 meshes"), std::string::npos) << verbose.err;
+  EXPECT_NE(verbose.err.find("left out"), std::string::npos) << "-v keeps the warnings: " << verbose.err;
 }
 
 }  // namespace

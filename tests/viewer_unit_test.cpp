@@ -10,8 +10,8 @@
 
 #include <glm/glm.hpp>
 
-#include "runtime/pose.h"
-#include "runtime/pose_ops.h"
+#include <ossa/anim/pose.h>
+#include <ossa/anim/pose_ops.h>
 #include "test_files.h"
 #include "viewer/bounds.h"
 #include "viewer/camera.h"

@@ -6,7 +6,7 @@
 #include <cmath>
 #include <utility>
 
-#include "runtime/pose_ops.h"
+#include <ossa/anim/pose_ops.h>
 
 namespace ossa::view {
 namespace {

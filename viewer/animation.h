@@ -7,7 +7,7 @@
 // Everything after it (local -> model, palettes, drawing) does not care where the pose came from.
 //
 // A crowd is N instances of the same character playing the same clip at different phases; each
-// has its own sampling caches (runtime/sample.h: one cache per clip and playing instance) and pose
+// has its own sampling caches (ossa/anim/sample.h: one cache per clip and playing instance) and pose
 // storage, allocated when a clip is selected, never per frame.
 #pragma once
 #include <cstddef>
@@ -15,9 +15,9 @@
 
 #include <glm/glm.hpp>
 
-#include "format/result.h"
-#include "runtime/pose.h"
-#include "runtime/sample.h"
+#include <ossa/format/result.h>
+#include <ossa/anim/pose.h>
+#include <ossa/anim/sample.h>
 #include "viewer/graph_driver.h"
 #include "viewer/scene.h"
 

@@ -12,7 +12,7 @@
 
 #include <glm/glm.hpp>
 
-#include "format/result.h"
+#include <ossa/format/result.h>
 #include "viewer/animation.h"
 #include "viewer/bounds.h"
 #include "viewer/camera.h"

@@ -20,7 +20,7 @@
 
 #include <glm/glm.hpp>
 
-#include "runtime/asset.h"
+#include <ossa/loader/asset.h>
 
 namespace ossa::view {
 

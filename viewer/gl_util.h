@@ -7,7 +7,7 @@
 #include <string>
 #include <string_view>
 
-#include "format/result.h"
+#include <ossa/format/result.h>
 #include "viewer/gl.h"
 
 namespace ossa::view {

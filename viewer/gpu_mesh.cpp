@@ -4,7 +4,7 @@
 #include <cstdint>
 #include <string>
 
-#include "format/vertex_format.h"
+#include <ossa/format/vertex_format.h>
 
 namespace ossa::view {
 namespace {

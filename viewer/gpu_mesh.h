@@ -1,7 +1,7 @@
 // gpu_mesh.h — a cooked mesh on the GPU: buffers made straight from the file's bytes.
 //
 // create_gpu_mesh hands MeshView::vertex_bytes() and index_bytes() to glBufferData as they are
-// and sets one attribute pointer per layout entry from format/vertex_format.h's table (location =
+// and sets one attribute pointer per layout entry from ossa/format/vertex_format.h's table (location =
 // fb::VertexSemantic, integer formats through glVertexAttribIPointer). Nothing is decoded,
 // converted or copied on the CPU: the skinned vertex shader reads the quantized layout itself.
 //
@@ -15,8 +15,8 @@
 
 #include <glm/glm.hpp>
 
-#include "format/result.h"
-#include "runtime/asset.h"
+#include <ossa/format/result.h>
+#include <ossa/loader/asset.h>
 #include "viewer/gl.h"
 
 namespace ossa::view {

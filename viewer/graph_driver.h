@@ -15,9 +15,9 @@
 #include <string_view>
 #include <vector>
 
-#include "format/result.h"
-#include "runtime/graph.h"
-#include "runtime/pose.h"
+#include <ossa/format/result.h>
+#include <ossa/graph/graph.h>
+#include <ossa/anim/pose.h>
 #include "viewer/scene.h"
 
 namespace ossa::view {

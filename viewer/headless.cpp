@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <string>
 
+#include "runtime/tools/cli/cli.h"
 #include "viewer/app.h"
 #include "viewer/gl_util.h"
 #include "viewer/offscreen.h"
@@ -17,13 +18,9 @@ namespace {
 
 constexpr float kFrameStep = 1.0f / 60.0f;
 
-int fail(const std::string& message) {
-  std::fprintf(stderr, "ossa-view: %s\n", message.c_str());
-  return 1;
-}
-
-/// The whole run, with errors as values; run_headless turns them into the exit status.
-Status render_headless(const ViewerOptions& o) {
+/// The whole run, with errors as values; run_headless turns them into the exit status. A window
+/// that cannot be made (no display, no GL 3.3) sets `cannot_run`: nothing could be tried then.
+Status render_headless(const ViewerOptions& o, bool& cannot_run) {
   const auto start = std::chrono::steady_clock::now();
   const std::string& name = o.files.front();
   // Open the files first: a bad file is reported as such even where no display exists.
@@ -35,7 +32,10 @@ Status render_headless(const ViewerOptions& o) {
   wo.height = 64;
   wo.visible = false;
   Result<Window> window = create_window(wo);
-  if (!window) return Error{name + ": " + window.error().message};
+  if (!window) {
+    cannot_run = true;
+    return Error{name + ": " + window.error().message};
+  }
   if (Status s = check_gl("creating the context"); !s) return Error{name + ": " + s.message()};
 
   Result<Renderer> renderer = create_renderer();
@@ -105,8 +105,11 @@ Status render_headless(const ViewerOptions& o) {
 }  // namespace
 
 int run_headless(const ViewerOptions& options) {
-  const Status s = render_headless(options);
-  return s ? 0 : fail(s.message());
+  bool cannot_run = false;
+  const Status s = render_headless(options, cannot_run);
+  if (s) return cli::kExitOk;
+  std::fprintf(stderr, "ossa-view: %s\n", s.message().c_str());
+  return cannot_run ? cli::kExitUsage : cli::kExitFailed;
 }
 
 }  // namespace ossa::view

@@ -10,7 +10,8 @@
 
 namespace ossa::view {
 
-/// Returns the process exit status: 0, or 1 after printing "ossa-view: <what failed>" to stderr.
+/// Returns the process exit status (options.h): 0; or after printing "ossa-view: <what failed>" to
+/// stderr, 2 when no window could be made, 1 for any other failure.
 int run_headless(const ViewerOptions& options);
 
 }  // namespace ossa::view

@@ -15,6 +15,7 @@
 #include <backends/imgui_impl_glfw.h>
 #include <backends/imgui_impl_opengl3.h>
 
+#include "runtime/tools/cli/cli.h"
 #include "viewer/app.h"
 #include "viewer/gl_util.h"
 #include "viewer/graph_keys.h"
@@ -111,7 +112,10 @@ int run_interactive(const ViewerOptions& o) {
   wo.samples = o.msaa > 1 ? o.msaa : 0;
   wo.title = "ossa-view — " + o.files.front();
   Result<Window> window = create_window(wo);
-  if (!window) return fail(o.files.front() + ": " + window.error().message);
+  if (!window) {
+    fail(o.files.front() + ": " + window.error().message);
+    return cli::kExitUsage;  // no display: the viewer cannot run at all
+  }
   GLFWwindow* w = window->get();
   glfwSwapInterval(1);
 

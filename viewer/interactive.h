@@ -4,8 +4,8 @@
 
 namespace ossa::view {
 
-/// Runs until the window is closed. Returns the exit status (1 after printing why the window or
-/// the files could not be opened).
+/// Runs until the window is closed. Returns the exit status (options.h): 2 after printing why no
+/// window could be made, 1 after printing why the files could not be opened or shown.
 int run_interactive(const ViewerOptions& options);
 
 }  // namespace ossa::view

@@ -10,7 +10,7 @@
 
 #include <glm/glm.hpp>
 
-#include "runtime/asset.h"
+#include <ossa/loader/asset.h>
 #include "viewer/gl.h"
 
 namespace ossa::view {

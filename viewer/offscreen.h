@@ -7,7 +7,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "format/result.h"
+#include <ossa/format/result.h>
 #include "viewer/gl.h"
 
 namespace ossa::view {

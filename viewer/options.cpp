@@ -1,11 +1,10 @@
-// options.cpp — see options.h. CLI11 (as ossa-cook uses) does the parsing; its exceptions stay
-// inside this file.
+// options.cpp — see options.h. CLI11 does the parsing through runtime/tools/cli (the conventions
+// every ossa tool shares); its exceptions stay inside that library.
 #include "viewer/options.h"
 
 #include <charconv>
-#include <cstdio>
 
-#include <CLI/CLI.hpp>
+#include "runtime/tools/cli/cli.h"
 
 namespace ossa::view {
 
@@ -22,7 +21,9 @@ std::optional<std::pair<int, int>> parse_size(const std::string& text) {
 }
 
 ParsedOptions parse_options(int argc, const char* const* argv) {
-  CLI::App app{"ossa-view: look at cooked .ossa characters and play their clips (GLFW + OpenGL 3.3)"};
+  cli::Command command("ossa-view", "ossa-view: look at cooked .ossa characters and play their clips (GLFW + OpenGL 3.3)",
+                       "when the files could not be shown (a file refused, a name not found, a GL error)");
+  CLI::App& app = command.app();
   ViewerOptions o;
   std::string size;
   bool no_grid = false;
@@ -51,18 +52,12 @@ ParsedOptions parse_options(int argc, const char* const* argv) {
       ->allow_extra_args(false);  // one value per --set: the files may follow
   app.add_option("--window-frames", o.window_frames, "window mode: exit after N frames (--screenshot captures the window)")
       ->check(CLI::Range(1, 1000000));
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);  // prints the help, or the error and a hint
-    return {std::nullopt, code == 0 ? 0 : 2};  // one usage-error status, as ossa-cook documents
-  }
+  if (const auto exit_now = command.parse(argc, argv)) return {std::nullopt, *exit_now};
+  o.quiet = command.quiet();
+  o.verbose = command.verbose();
   if (!size.empty()) {
     const auto wh = parse_size(size);
-    if (!wh) {
-      std::fprintf(stderr, "--size: expected WxH with both in 1..16384, got '%s'\n", size.c_str());
-      return {std::nullopt, 2};
-    }
+    if (!wh) return {std::nullopt, command.usage_error("--size: expected WxH with both in 1..16384, got '" + size + "'")};
     o.width = wh->first;
     o.height = wh->second;
   }

@@ -5,6 +5,7 @@
 //             [--yaw DEG] [--pitch DEG] [--size WxH] [--msaa N]
 //             [--frames N] [--screenshot OUT.png] [--first-frame-time] [--stats]
 //             [--window-frames N] [--graph NAME [--set PARAM=VALUE ...]]
+//             [-q | -v] [--version] [--help]
 //
 // With --frames or --screenshot the viewer runs headless (hidden window, offscreen framebuffer):
 // it renders N frames 1/60 s apart ending at --time, writes the last one as a PNG, and exits.
@@ -13,8 +14,13 @@
 // --graph NAME drives the character with an animation graph found in any of the files; --set
 // gives its parameters start values (a trigger is fired by naming it: --set stop). A graph cannot
 // seek, so headless --time T plays T seconds of the graph in 1/60 s steps before the N frames.
-// Parsing is separate from running so tests and the bench can build command lines with the same
-// names.
+// -q prints only errors (no warnings such as a texture left out); -v adds the OpenGL version and
+// renderer and what was loaded. Parsing is separate from running so tests and the bench can build
+// command lines with the same names.
+//
+// Exit status (runtime/tools/cli/cli.h): 0 success; 1 the files could not be shown (a file refused,
+// a clip / graph / parameter not found, a GL error, the screenshot not written); 2 usage error, or
+// no OpenGL 3.3 window can be made (no display).
 #pragma once
 #include <optional>
 #include <string>
@@ -46,12 +52,14 @@ struct ViewerOptions {
   int window_frames = 0;        // window mode: exit after this many frames (0: when closed)
   std::string graph;            // drive the character with this graph
   std::vector<std::string> set; // graph parameter start values, "name=value" (or "trigger")
+  bool quiet = false;           // -q: errors only
+  bool verbose = false;         // -v: GL information and what was loaded
 
   bool headless() const { return window_frames == 0 && (frames > 0 || !screenshot.empty()); }
 };
 
-/// The parsed options, or the exit status to end with right away (help printed: 0; a usage
-/// error printed with the usage: 2).
+/// The parsed options, or the exit status to end with right away (help or version printed: 0; a
+/// usage error printed: 2).
 struct ParsedOptions {
   std::optional<ViewerOptions> options;
   int exit_code = 0;

@@ -6,7 +6,7 @@
 #include <cmath>
 #include <cstdint>
 
-#include "runtime/skinning.h"
+#include <ossa/skinning/skinning.h>
 #include "viewer/gl_util.h"
 #include "viewer/shader_sources.h"
 

@@ -1,7 +1,7 @@
 // renderer.h — draws a scene: skinned meshes (GPU or CPU skinning), skeleton overlay, grid.
 //
 // Per frame the CPU work is per joint, never per vertex (on the GPU path): each instance's model
-// matrices become palettes (runtime/skinning.h, with the bind matrices prepared once per mesh),
+// matrices become palettes (ossa/skinning/skinning.h, with the bind matrices prepared once per mesh),
 // the palettes of every instance and mesh go into one texture buffer, and each submesh is drawn
 // once for all instances with glDrawElementsInstanced. The --cpu-skinning path instead runs
 // skin_cpu per instance and streams the skinned floats into the mesh's CPU vertex array; it draws
@@ -14,7 +14,7 @@
 
 #include <glm/glm.hpp>
 
-#include "format/result.h"
+#include <ossa/format/result.h>
 #include "viewer/animation.h"
 #include "viewer/bounds.h"
 #include "viewer/camera.h"

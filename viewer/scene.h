@@ -2,7 +2,7 @@
 //
 // `ossa-view arnaud.ossa walk.ossa run.ossa`: the first file with a mesh is the character; every
 // other file contributes its clips, which must be cooked for the character's skeleton (clip-only
-// files carry no skeleton and bind by skeleton hash, runtime/asset.h check_clip_binding). Assets
+// files carry no skeleton and bind by skeleton hash, ossa/loader/asset.h check_clip_binding). Assets
 // are kept open for the scene's lifetime: clip views, mesh views and the sampling caches point
 // into their bytes (an Asset's bytes do not move when the Asset does, so a vector of them is fine).
 #pragma once
@@ -11,8 +11,8 @@
 #include <string>
 #include <vector>
 
-#include "format/result.h"
-#include "runtime/asset.h"
+#include <ossa/format/result.h>
+#include <ossa/loader/asset.h>
 
 namespace ossa::view {
 

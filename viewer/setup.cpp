@@ -6,6 +6,8 @@
 
 #include <glm/gtc/constants.hpp>
 
+#include "viewer/window.h"
+
 namespace ossa::view {
 
 Status setup_app(App& app, Scene scene, const ViewerOptions& o, float aspect) {
@@ -17,7 +19,15 @@ Status setup_app(App& app, Scene scene, const ViewerOptions& o, float aspect) {
   app.toggles.skeleton = o.skeleton;
   app.toggles.grid = o.grid;
   if (Status s = open_loaded_scene(app, std::move(scene), o.crowd, aspect); !s) return s;
-  for (const std::string& w : app.messages) std::fprintf(stderr, "ossa-view: warning: %s\n", w.c_str());
+  if (!o.quiet)
+    for (const std::string& w : app.messages) std::fprintf(stderr, "ossa-view: warning: %s\n", w.c_str());
+  if (o.verbose) {
+    const SceneCounts c = count(app.scene);
+    std::fprintf(stderr, "ossa-view: %s\n", gl_description().c_str());
+    std::fprintf(stderr, "ossa-view: %s: %zu joints, %zu meshes, %zu vertices, %zu triangles; %zu clips from %zu files\n",
+                 name.c_str(), c.joints, c.meshes, c.vertices, c.triangles, app.scene.clips.size(),
+                 app.scene.assets.size());
+  }
 
   if (!o.clip.empty()) {
     const int c = find_clip(app.scene, o.clip);

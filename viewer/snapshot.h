@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "format/result.h"
+#include <ossa/format/result.h>
 
 namespace ossa::view {
 

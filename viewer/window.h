@@ -7,7 +7,7 @@
 #pragma once
 #include <string>
 
-#include "format/result.h"
+#include <ossa/format/result.h>
 #include "viewer/gl.h"
 
 namespace ossa::view {

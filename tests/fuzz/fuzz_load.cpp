@@ -3,7 +3,7 @@
 // Each input goes through both entry points (verify_buffer over a 16-byte aligned copy, which is
 // what its contract asks for, and Asset::from_bytes); they must agree. An accepted input is then
 // walked by tests/asset_walk.h, which reads every byte the views expose and re-checks the
-// invariants of runtime/validate.h, so the fuzzer finds not only out-of-bounds reads (ASan) and
+// invariants of ossa/loader/validate.h, so the fuzzer finds not only out-of-bounds reads (ASan) and
 // UB (UBSan) but also files the validator wrongly lets through (abort with the broken promise).
 //
 // Build: CC=clang CXX=clang++ cmake -DOSSA_FUZZ=ON ...; seeds: tests/fuzz/make_corpus.cpp.
@@ -15,7 +15,7 @@
 #include <span>
 #include <string>
 
-#include "runtime/asset.h"
+#include <ossa/loader/asset.h>
 #include "tests/asset_walk.h"
 
 namespace {

@@ -1,0 +1,59 @@
+// batch.h — many inputs to many outputs: plan the output paths, cook in parallel, report.
+//
+// Planning happens before any cooking so that a batch with two inputs mapping to one output is
+// refused whole (nothing is written), while a batch whose inputs merely fail goes on to the end:
+// each failure is a record, the others are cooked. Records come back in input order whatever the
+// number of threads, so reports are stable and outputs are identical for any --jobs.
+#pragma once
+#include <cstddef>
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "cooker/cook.h"
+#include <ossa/format/result.h>
+
+namespace ossa::cook {
+
+struct BatchItem {
+  std::filesystem::path input;
+  std::filesystem::path output;
+};
+
+/// File extensions ossa-cook picks up when an input is a directory (lower case, with the dot).
+bool is_source_extension(const std::filesystem::path& path);
+
+/// The output name of an input without ".ossa": its stem, or for a graph file `X.graph.json`, X.
+std::string output_stem(const std::filesystem::path& input);
+
+/// Expands directory inputs (recursively, sorted; source extensions and graph files `*.graph.json`
+/// only, so event sidecars and other JSON stay out) and maps each input to OUTDIR/<output_stem>.ossa,
+/// or with `root` to OUTDIR/<path relative to root>/<output_stem>.ossa. Errors: an
+/// input outside `root`, or two inputs mapping to one output (both named). Missing inputs are not
+/// errors here: they fail at cook time as their own record. O(inputs log inputs).
+Result<std::vector<BatchItem>> plan_batch(const std::vector<std::filesystem::path>& inputs,
+                                          const std::filesystem::path& out_dir,
+                                          const std::filesystem::path& root);
+
+/// Called after each item finishes, from the worker thread, serialized by the batch.
+using BatchProgress = std::function<void(size_t done, size_t total, const CookRecord& record)>;
+
+/// Cooks every item on `jobs` threads (>= 1). Returns one record per item, in item order.
+std::vector<CookRecord> run_batch(const std::vector<BatchItem>& items, const CookOptions& options,
+                                  unsigned jobs, const BatchProgress& progress);
+
+/// The --report document's "schema" and "schema_version": docs/schemas/ossa-cook-report.schema.json
+/// describes it (docs/JSON.md). The version moves only on an incompatible change (a field removed,
+/// renamed or given another meaning or type); an added optional field keeps it.
+inline constexpr const char* kReportSchema = "ossa-cook-report";
+inline constexpr int kReportSchemaVersion = 1;
+
+/// The --report document: schema name and version, cooker version, options, totals and one record
+/// per input. A failed record carries its error and the counts known before the failure, and no
+/// "output" or "cooked_bytes": nothing was written for it.
+nlohmann::ordered_json report_json(const std::vector<CookRecord>& records, const CookOptions& options);
+
+}  // namespace ossa::cook

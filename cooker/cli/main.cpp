@@ -1,0 +1,178 @@
+// main.cpp — the ossa-cook command line: parse options, plan, cook in parallel, report.
+// Inputs are sources (FBX, glTF, ...) and animation graph files (`*.graph.json`, docs/GRAPH.md).
+//
+//   ossa-cook INPUT... -o OUTDIR [--root DIR] [--jobs N] [--report FILE.json]
+//             [--skeleton REF.ossa] [--float-vertices] [--clip-tolerance MM] [--no-clip-compression]
+//             [--root-motion] [--up-axis x|y|z] [-q | -v] [--version] [--help]
+//
+// Exit status (runtime/tools/cli/cli.h): 0 when every input cooked; 1 when any failed (the rest
+// are still cooked) or the report could not be written; 2 for a usage error or a plan that cannot
+// be carried out (nothing is written then).
+//
+// Output: failures always (stderr). Without -q, a progress line per input and the number of
+// warnings (stderr) and a table of what was cooked (stdout). -v adds the options in effect, every
+// input's warnings, time and sizes, one line per clip (frames, error, ratio) and the total time.
+// Warnings are not printed one by one by default: importing the samples alone gives dozens of
+// lines (dropped cameras, matched joint names) that would bury the failures. The --report document is docs/schemas/ossa-cook-report.schema.json (docs/JSON.md).
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "cooker/cli/batch.h"
+#include "cooker/cook.h"
+#include "runtime/tools/cli/cli.h"
+
+namespace fs = std::filesystem;
+using namespace ossa::cook;
+
+namespace {
+
+std::string human_bytes(uint64_t n) {
+  char buf[32];
+  if (n >= 1u << 20) std::snprintf(buf, sizeof buf, "%.2f MiB", static_cast<double>(n) / (1 << 20));
+  else if (n >= 1u << 10) std::snprintf(buf, sizeof buf, "%.1f KiB", static_cast<double>(n) / (1 << 10));
+  else std::snprintf(buf, sizeof buf, "%llu B", static_cast<unsigned long long>(n));
+  return buf;
+}
+
+void print_summary(const std::vector<CookRecord>& records) {
+  std::printf("%-40s %7s %7s %9s %6s %12s %12s\n", "output", "joints", "meshes", "vertices", "clips", "source",
+              "cooked");
+  for (const CookRecord& r : records) {
+    if (!r.ok) continue;
+    std::printf("%-40s %7u %7u %9u %6u %12s %12s\n", r.output.c_str(), r.joints.value_or(0), r.meshes.value_or(0),
+                r.vertices.value_or(0), r.clips.value_or(0), human_bytes(r.source_bytes).c_str(),
+                human_bytes(r.cooked_bytes).c_str());
+  }
+}
+
+/// -v: what one input took and what compression achieved on each of its clips.
+void print_details(const CookRecord& r) {
+  std::fprintf(stderr, "  %s: %.1f ms, source %s", r.input.c_str(), r.seconds * 1e3, human_bytes(r.source_bytes).c_str());
+  if (r.ok) std::fprintf(stderr, ", cooked %s", human_bytes(r.cooked_bytes).c_str());
+  std::fprintf(stderr, "\n");
+  for (const ClipRecord& c : r.clip_records)
+    std::fprintf(stderr, "    clip '%s': %u frames, %u joints, max error %.4f mm (mean %.4f mm, at '%s'), %u -> %u bytes (%.1f:1)\n",
+                 c.name.c_str(), c.frames, c.joints, static_cast<double>(c.max_error_mm),
+                 static_cast<double>(c.mean_error_mm), c.worst_joint.c_str(), c.raw_bytes, c.cooked_bytes,
+                 c.cooked_bytes > 0 ? static_cast<double>(c.raw_bytes) / c.cooked_bytes : 0.0);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const auto start = std::chrono::steady_clock::now();
+  ossa::cli::Command command("ossa-cook",
+                             "ossa-cook: cook FBX / glTF / GLB / Collada / BVH sources and animation graph files "
+                             "(*.graph.json) into .ossa files",
+                             "when any input failed to cook (the others are still cooked)");
+  CLI::App& app = command.app();
+  std::vector<std::string> inputs;
+  std::string out_dir, root, report_path, skeleton_path;
+  unsigned jobs = std::max(1u, std::thread::hardware_concurrency());
+  bool float_vertices = false, lossless_clips = false, root_motion = false;
+  double clip_tolerance_mm = 0.1;
+  std::string up_axis = "y";
+  app.add_option("inputs", inputs, "source files, graph files (X.graph.json -> X.ossa) or directories (searched recursively)")
+      ->required();
+  app.add_option("-o,--output", out_dir, "output directory")->required();
+  app.add_option("--root", root, "mirror inputs' paths relative to this directory under the output directory");
+  app.add_option("-j,--jobs", jobs, "cook this many files in parallel")->check(CLI::Range(1u, 256u));
+  app.add_option("--report", report_path, "write a JSON record per input to this file (docs/JSON.md)");
+  app.add_option("--skeleton", skeleton_path, "cook clip-only files against this cooked skeleton (.ossa)");
+  app.add_flag("--float-vertices", float_vertices, "store vertices as float32 instead of quantized");
+  app.add_option("--clip-tolerance", clip_tolerance_mm,
+                 "largest model-space error of any joint, in millimetres at 10 cm from it (default 0.1)")
+      ->check(CLI::Range(1e-6, 1e4));
+  app.add_flag("--no-clip-compression", lossless_clips, "keep every clip key exact (raw floats at every frame)");
+  app.add_flag("--root-motion", root_motion, "extract root translation and yaw from clips into a root-motion track");
+  app.add_option("--up-axis", up_axis, "up axis for --root-motion")->check(CLI::IsMember({"x", "y", "z"}));
+  if (const auto exit_now = command.parse(argc, argv)) return *exit_now;
+  const bool quiet = command.quiet(), verbose = command.verbose();
+
+  CookOptions options;
+  options.float_vertices = float_vertices;
+  options.clips.enabled = !lossless_clips;
+  options.clips.tolerance_metres = static_cast<float>(clip_tolerance_mm / 1000.0);
+  options.root_motion = root_motion;
+  options.up_axis = static_cast<uint8_t>(up_axis == "x" ? 0 : up_axis == "z" ? 2 : 1);
+  SourceSkeleton reference;
+  if (!skeleton_path.empty()) {
+    auto loaded = load_reference_skeleton(skeleton_path);
+    if (!loaded) {
+      std::fprintf(stderr, "ossa-cook: --skeleton %s\n", loaded.error().message.c_str());
+      return ossa::cli::kExitUsage;
+    }
+    reference = std::move(*loaded);
+    options.reference = &reference;
+    options.reference_name = fs::path(skeleton_path).filename().string();
+  }
+
+  std::vector<fs::path> input_paths(inputs.begin(), inputs.end());
+  auto plan = plan_batch(input_paths, out_dir, root);
+  if (!plan) {
+    std::fprintf(stderr, "ossa-cook: %s\n", plan.error().message.c_str());
+    return ossa::cli::kExitUsage;
+  }
+  if (plan->empty()) {
+    std::fprintf(stderr, "ossa-cook: no source files found in the inputs given\n");
+    return ossa::cli::kExitUsage;
+  }
+  if (verbose)
+    std::fprintf(stderr, "ossa-cook: %zu inputs, %u jobs, options %s\n", plan->size(), jobs,
+                 options.canonical().c_str());
+
+  // -v writes a block per input, which a progress line rewritten in place would tear.
+  const bool tty = ::isatty(STDERR_FILENO) != 0 && !verbose;
+  size_t warnings = 0;  // progress calls are serialized by the batch
+  auto progress = [&](size_t done, size_t total, const CookRecord& r) {
+    warnings += r.warnings.size();
+    if (!r.ok) {
+      std::fprintf(stderr, "%s[%zu/%zu] FAILED %s\n", tty ? "\r\033[K" : "", done, total, r.error.c_str());
+    } else if (!quiet) {
+      if (tty) std::fprintf(stderr, "\r\033[K[%zu/%zu] %s", done, total, r.input.c_str());
+      else std::fprintf(stderr, "[%zu/%zu] %s -> %s\n", done, total, r.input.c_str(), r.output.c_str());
+    }
+    if (verbose) {
+      for (const std::string& w : r.warnings) std::fprintf(stderr, "warning: %s: %s\n", r.input.c_str(), w.c_str());
+      print_details(r);
+    }
+    if (tty && done == total && !quiet) std::fprintf(stderr, "\n");
+    std::fflush(stderr);
+  };
+  const std::vector<CookRecord> records = run_batch(*plan, options, jobs, progress);
+
+  size_t failed = 0;
+  for (const CookRecord& r : records) failed += r.ok ? 0 : 1;
+  if (!report_path.empty()) {
+    const std::string text = report_json(records, options).dump(2) + "\n";
+    if (ossa::Status st = write_file_atomic(report_path, std::vector<uint8_t>(text.begin(), text.end())); !st) {
+      std::fprintf(stderr, "ossa-cook: report: %s\n", st.message().c_str());
+      return ossa::cli::kExitFailed;
+    }
+  }
+  if (!quiet) print_summary(records);
+  if (!quiet && !verbose && warnings > 0)
+    std::fprintf(stderr, "ossa-cook: %zu warning%s (-v prints them; --report records them)\n", warnings,
+                 warnings == 1 ? "" : "s");
+  if (verbose)
+    std::fprintf(stderr, "ossa-cook: %zu inputs in %.0f ms\n", records.size(),
+                 std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+  if (failed > 0) {
+    std::fprintf(stderr, "ossa-cook: %zu of %zu inputs failed:\n", failed, records.size());
+    for (const CookRecord& r : records) {
+      if (r.ok) continue;
+      std::string indented = r.error;  // graph files report one problem per line
+      for (size_t at = indented.find('\n'); at != std::string::npos; at = indented.find('\n', at + 3))
+        indented.replace(at, 1, "\n  ");
+      std::fprintf(stderr, "  %s\n", indented.c_str());
+    }
+    return ossa::cli::kExitFailed;
+  }
+  return ossa::cli::kExitOk;
+}

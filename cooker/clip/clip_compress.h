@@ -1,0 +1,73 @@
+// clip_compress.h — SourceClip -> compressed channels with a stated, measured error bound.
+//
+// Each channel is resampled on the clip's frame grid (clip_grid.h), classified as bind (equal to
+// the skeleton's bind value within tolerance: stored as nothing), constant (one value) or animated;
+// animated channels lose the keys that linear interpolation can rebuild, then get the fewest bits
+// per component (range-reduced, ossa/format/clip_codec.h) that keep the model-space error of every joint
+// under the tolerance. The error is measured, as the animation-compression literature does, as the
+// displacement of probe points at a fixed distance from each joint along its three axes, in model
+// space, accumulated down the hierarchy, over every joint at every frame; the compressor verifies
+// the final result against the source and tightens until the bound holds.
+#pragma once
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "cooker/clip/clip_grid.h"
+#include "cooker/import/source_scene.h"
+#include <ossa/format/result.h>
+
+namespace ossa::cook {
+
+struct ClipCompressionOptions {
+  bool enabled = true;              // false: lossless (bind/constant only when bit-equal, every
+                                    // other channel raw floats at every frame)
+  float tolerance_metres = 0.0001f; // 0.1 mm ...
+  float probe_metres = 0.1f;        // ... at 10 cm
+};
+
+struct CompressedConstant {
+  uint16_t joint = 0;
+  uint8_t channel = 0;              // fb::Channel
+  float value[4] = {0, 0, 0, 0};
+};
+
+struct CompressedAnimated {
+  uint16_t joint = 0;
+  uint8_t channel = 0;
+  uint8_t bits = 0;                 // 1..kMaxQuantBits (19) or 32
+  uint8_t dropped = 3;              // rotations: the component not stored (ossa/format/clip_codec.h)
+  uint32_t first_key = 0;
+  uint32_t key_count = 0;
+  uint32_t bit_offset = 0;
+  float range_min[3] = {0, 0, 0};
+  float range_extent[3] = {0, 0, 0};
+};
+
+/// A clip as the writer serializes it (format/ossa.fbs, Clip).
+struct CompressedClip {
+  std::string name;
+  FrameGrid grid;
+  std::vector<CompressedConstant> constants;  // sorted by (joint, channel)
+  std::vector<CompressedAnimated> animated;   // sorted by (joint, channel)
+  std::vector<uint16_t> key_frames;
+  std::vector<uint8_t> key_values;            // padded (ossa/format/clip_codec.h)
+  // What was measured, in source units.
+  float tolerance = 0.0f, probe_distance = 0.0f, max_error = 0.0f, mean_error = 0.0f;
+  uint16_t worst_joint = 0;
+  uint32_t raw_bytes = 0;                     // 10 floats * joints * frames
+  uint32_t cooked_bytes = 0;                  // the clip's vectors as stored: constants, animated,
+                                              // key_frames, key_values (padding included); tables'
+                                              // overhead excluded
+  bool has_root_motion = false;
+  SourceRootMotion root_motion;
+  std::vector<SourceEvent> events;            // copied from the source clip
+};
+
+/// Compresses one clip of `skeleton`. metres_per_unit converts the tolerances to source units.
+/// Errors name the clip (e.g. more frames than kMaxFrames). Deterministic.
+/// Cost: O(frames * joints * iterations) for the error verification.
+Result<CompressedClip> compress_clip(const SourceClip& clip, const SourceSkeleton& skeleton,
+                                     float metres_per_unit, const ClipCompressionOptions& options);
+
+}  // namespace ossa::cook

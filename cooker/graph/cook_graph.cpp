@@ -1,0 +1,221 @@
+// cook_graph.cpp — a graph file (`*.graph.json`, docs/GRAPH.md) cooked into one self-contained
+// character: the rig and meshes of its "skeleton" source, the meshes of its "meshes" sources
+// bound to that rig, its clips (each from its source, bound to the rig, renamed to the graph's
+// name for it, with events) and the compiled graph.
+//
+// Every source is imported as `ossa-cook --skeleton` would import it against the rig
+// (ImportOptions::reference), so clips authored on a superset rig (Pab's clips carry an extra
+// "Bip01 Footsteps" joint) bind by joint name. A source used by several clip entries is imported
+// once. The provenance hash covers the graph file's bytes and then every file it read (sources and
+// their event sidecars) in the order first read, so a build cache invalidates when any changes.
+// Messages about a source start with the graph file's position of the entry naming it and then
+// carry the source's own message (which names the source).
+#include <map>
+#include <span>
+
+#include "cooker/clip/clip_events.h"
+#include "cooker/cook_internal.h"
+#include "cooker/graph/graph_compile.h"
+#include "cooker/import/import_scene.h"
+#include "cooker/json/json_source.h"
+#include "cooker/mesh/mesh_build.h"
+#include "cooker/write/write_ossa.h"
+#include <ossa/format/hash.h>
+
+namespace ossa::cook::detail {
+namespace fs = std::filesystem;
+
+namespace {
+
+/// What the graph reads besides itself, folded into one hash.
+struct SourceTally {
+  uint64_t hash = kFnvOffset;
+  uint64_t bytes = 0;
+  void add(const std::vector<uint8_t>& data) {
+    const uint64_t size = data.size();
+    hash = hash_bytes(&size, sizeof size, hash);  // sizes too, so concatenations cannot collide
+    hash = hash_bytes(data.data(), data.size(), hash);
+    bytes += data.size();
+  }
+};
+
+struct GraphCook {
+  CookRecord& record;
+  const fs::path& input;
+  fs::path dir;
+  SourceTally tally;
+  std::map<fs::path, SourceScene> clip_sources;  // imported against the rig, by path
+
+  bool fail(json::Pos pos, const std::string& what) {
+    record.error = json::where(input.string(), pos) + what;
+    return false;
+  }
+
+  fs::path resolve(const std::string& relative) const { return (dir / relative).lexically_normal(); }
+
+  /// Hashes and counts bytes read (the record keeps the count even if a later step fails).
+  void add(const std::vector<uint8_t>& bytes) {
+    tally.add(bytes);
+    record.source_bytes = tally.bytes;
+  }
+
+  /// Reads the file for the hash, then imports it. Errors name the graph entry and the source.
+  bool import(const fs::path& path, json::Pos pos, const ImportOptions& options, SourceScene* out) {
+    std::error_code ec;
+    if (!fs::is_regular_file(path, ec)) return fail(pos, path.string() + ": no such source file");
+    auto bytes = read_bytes(path);
+    if (!bytes) return fail(pos, bytes.error().message);
+    add(*bytes);
+    auto scene = import_scene(path.string(), options);
+    if (!scene) return fail(pos, scene.error().message);
+    for (const std::string& w : scene->warnings) record.warnings.push_back(path.filename().string() + ": " + w);
+    *out = std::move(*scene);
+    return true;
+  }
+};
+
+}  // namespace
+
+void cook_graph(CookRecord& record, const fs::path& input, const fs::path& output, const CookOptions& options_in) {
+  // The graph names its rig; --skeleton (meant for the batch's clip files) does not apply.
+  CookOptions options = options_in;
+  if (options.reference != nullptr)
+    record.warnings.push_back("--skeleton is not used for a graph file: its \"skeleton\" names the rig");
+  options.reference = nullptr;
+  options.reference_name.clear();
+
+  auto text = read_bytes(input);
+  if (!text) {
+    record.error = text.error().message;
+    return;
+  }
+  GraphCook cook{record, input, input.parent_path(), {}, {}};
+  cook.tally.hash = hash_bytes(text->data(), text->size());
+  cook.tally.bytes = text->size();
+  record.source_bytes = text->size();
+  auto doc = json::parse(std::string_view(reinterpret_cast<const char*>(text->data()), text->size()), input.string());
+  if (!doc) {
+    record.error = doc.error().message;
+    return;
+  }
+  auto manifest = read_graph_manifest(*doc);
+  if (!manifest) {
+    record.error = manifest.error().message;
+    return;
+  }
+
+  // The rig, and its meshes.
+  SourceScene character;
+  if (!cook.import(cook.resolve(manifest->skeleton), manifest->skeleton_pos, {}, &character)) return;
+  if (character.skeleton.joints.empty()) {
+    cook.fail(manifest->skeleton_pos,
+              cook.resolve(manifest->skeleton).string() + ": has no skeleton for the graph to animate");
+    return;
+  }
+  character.clips.clear();  // only the clips the graph names are cooked
+  if (!manifest->skeleton_meshes) {  // the rig alone: its source's own body is not the character's
+    character.meshes.clear();
+    character.materials.clear();
+    character.vertices_over_4_influences = 0;
+  }
+  const SourceSkeleton rig = character.skeleton;
+  record.joints = static_cast<uint32_t>(rig.joints.size());
+  ImportOptions against_rig;
+  against_rig.reference = &rig;
+
+  // Mesh sources bound to the rig: their meshes and materials appended, material indices moved.
+  for (size_t m = 0; m < manifest->meshes.size(); ++m) {
+    const fs::path path = cook.resolve(manifest->meshes[m]);
+    SourceScene part;
+    if (!cook.import(path, manifest->mesh_pos[m], against_rig, &part)) return;
+    if (part.meshes.empty()) record.warnings.push_back(path.filename().string() + ": has no mesh");
+    if (part.metres_per_unit != character.metres_per_unit)
+      record.warnings.push_back(
+          path.filename().string() +
+          ": its unit differs from the skeleton source's; its meshes are kept in their own units");
+    const auto offset = static_cast<uint32_t>(character.materials.size());
+    for (SourceMesh& mesh : part.meshes) {
+      mesh.material += offset;
+      character.meshes.push_back(std::move(mesh));
+    }
+    for (SourceMaterial& material : part.materials) character.materials.push_back(std::move(material));
+    character.vertices_over_4_influences += part.vertices_over_4_influences;
+  }
+
+  // Clips: each from its source (imported once, with its event sidecar), renamed.
+  GraphContext context;
+  context.skeleton = &rig;
+  for (const GraphClipSource& entry : manifest->clips) {
+    const fs::path path = cook.resolve(entry.source);
+    auto it = cook.clip_sources.find(path);
+    if (it == cook.clip_sources.end()) {
+      SourceScene scene;
+      if (!cook.import(path, entry.pos, against_rig, &scene)) return;
+      auto sidecar = attach_sidecar_events(path, scene.clips);
+      if (!sidecar) {
+        cook.fail(entry.pos, sidecar.error().message);
+        return;
+      }
+      if (sidecar->present) cook.add(sidecar->bytes);
+      it = cook.clip_sources.emplace(path, std::move(scene)).first;
+    }
+    const std::vector<SourceClip>& available = it->second.clips;
+    const SourceClip* picked = nullptr;
+    for (const SourceClip& c : available)
+      if (entry.source_clip.empty() || c.name == entry.source_clip) {
+        picked = &c;
+        break;
+      }
+    if (!picked) {
+      std::string names;
+      for (const SourceClip& c : available) names += (names.empty() ? "'" : ", '") + c.name + "'";
+      cook.fail(entry.pos,
+                "clip '" + entry.name + "': " + path.string() +
+                    (available.empty() ? " has no animation"
+                                       : " has no clip named '" + entry.source_clip + "' (its clips: " + names + ")"));
+      return;
+    }
+    SourceClip clip = *picked;
+    clip.name = entry.name;
+    context.clips.push_back({clip.name, event_duration(clip), clip.events});
+    character.clips.push_back(std::move(clip));
+  }
+  count_scene(record, character);
+
+  auto compiled = compile_graph(*doc, context);
+  if (!compiled) {
+    record.error = compiled.error().message;
+    return;
+  }
+  for (size_t c = 0; c < character.clips.size(); ++c) character.clips[c].events = compiled->clip_events[c];
+  for (const std::string& w : compiled->warnings) record.warnings.push_back(w);
+
+  MeshOptions mesh_options;
+  mesh_options.float_vertices = options.float_vertices;
+  MeshBuildStats stats;
+  auto meshes = build_meshes(character, mesh_options, &stats, &record.warnings);
+  if (!meshes) {
+    record.error = input.string() + ": " + meshes.error().message;
+    return;
+  }
+  count_meshes(record, *meshes, stats);
+  auto clips = cook_clips(character, options, record, input.string());
+  if (!clips) {
+    record.error = clips.error().message;
+    return;
+  }
+
+  WriteProvenance provenance;
+  provenance.source_name = input.filename().string();
+  provenance.source_hash = cook.tally.hash;
+  provenance.options = options.canonical();
+  WriteOptions write_options;
+  write_options.include_skeleton = true;
+  write_options.graphs = std::span<const GraphDef>(&compiled->graph, 1);
+  const std::vector<uint8_t> bytes = write_ossa(character, *meshes, *clips, provenance, write_options);
+  if (!write_verified(record, bytes, input, output)) return;
+
+  record.ok = true;
+}
+
+}  // namespace ossa::cook::detail

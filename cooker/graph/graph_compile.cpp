@@ -1,0 +1,1033 @@
+// graph_compile.cpp — graph JSON -> GraphDef (graph_compile.h; the format is docs/GRAPH.md).
+//
+// One pass over the document with a Checker collecting every problem. A function that reads a
+// part returns what it built or a "failed" mark (-1 for an index); its parent then emits nothing
+// but still reads its other parts, so their problems are reported too. Since any problem fails
+// the whole compile, a partly built GraphDef is never returned.
+#include "cooker/graph/graph_compile.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "cooker/clip/clip_events.h"
+#include "cooker/graph/graph_condition.h"
+#include "cooker/json/json_check.h"
+#include "cooker/write/write_ossa.h"
+#include <ossa/anim/blend_space.h>
+
+namespace ossa::cook {
+namespace {
+
+using json::Checker;
+using json::Member;
+using json::Pos;
+using json::Type;
+using json::Value;
+
+constexpr double kFloatMax = 3.4e38;      // Parameter.min_value / max_value defaults
+constexpr double kIntLimit = 16777216.0;  // ints are held as floats: exact up to 2^24
+const std::vector<std::string_view> kNodeKinds = {"clip",        "blend",    "select",        "layered",
+                                                  "blend_space", "additive", "state_machine", "use"};
+
+
+std::string a_type(ParamType t) {
+  return (t == ParamType::Int || t == ParamType::Enum ? "an " : "a ") + std::string(type_word(t));
+}
+
+std::string quoted(const std::vector<std::string>& names) {
+  std::string out;
+  for (const std::string& n : names) out += (out.empty() ? "'" : ", '") + n + "'";
+  return out;
+}
+
+std::string number_text(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+
+/// The shape of the top level and the import entries (shared by read_graph_manifest and
+/// compile_graph, so both report the same problems).
+void read_manifest(Checker& check, const Value& root, GraphManifest& out) {
+  if (!check.expect(root, Type::Object, "a graph file")) return;
+  check.expect_keys(root, {"ossa_graph", "name", "skeleton", "meshes", "clips", "parameters", "nodes", "root"},
+                    "a graph file");
+  const Value* version = root.find("ossa_graph");
+  if (!version) {
+    check.error(root.pos, "not a graph file: \"ossa_graph\": 1 is missing");
+  } else if (!version->is(Type::Number) || version->number != 1.0) {
+    check.error(version->pos, "\"ossa_graph\" must be 1 (the only version this cooker reads)");
+  }
+  if (const Value* name = root.find("name")) check.expect_name(*name, "\"name\"", &out.name);
+  else check.error(root.pos, "a graph needs a \"name\" (what a game asks the file for)");
+
+  if (const Value* skeleton = root.find("skeleton")) {
+    out.skeleton_pos = skeleton->pos;
+    if (skeleton->is(Type::Object)) {
+      // {"source": "rig.fbx", "meshes": false}: the rig without the meshes its source carries.
+      check.expect_keys(*skeleton, {"source", "meshes"}, "\"skeleton\"");
+      if (const Value* source = skeleton->find("source"))
+        check.expect_name(*source, "\"skeleton\" \"source\" (the rig's source file)", &out.skeleton);
+      else
+        check.error(skeleton->pos, "\"skeleton\" needs a \"source\": the rig's source file");
+      if (const Value* meshes = skeleton->find("meshes"); meshes && check.expect(*meshes, Type::Bool, "\"meshes\""))
+        out.skeleton_meshes = meshes->boolean;
+    } else {
+      check.expect_name(*skeleton, "\"skeleton\" (the rig's source file)", &out.skeleton);
+    }
+  } else {
+    check.error(root.pos, "a graph needs a \"skeleton\": the source file of its rig, relative to the graph file");
+  }
+  if (const Value* meshes = root.find("meshes"); meshes && check.expect(*meshes, Type::Array, "\"meshes\"")) {
+    for (const Value& m : meshes->items) {
+      std::string path;
+      if (!check.expect_name(m, "a \"meshes\" entry (a source file)", &path)) continue;
+      out.meshes.push_back(std::move(path));
+      out.mesh_pos.push_back(m.pos);
+    }
+  }
+
+  const Value* clips = root.find("clips");
+  if (!clips) {
+    check.error(root.pos, "a graph needs \"clips\": {\"<clip name>\": \"<source file>\", ...}");
+    return;
+  }
+  if (!check.expect(*clips, Type::Object, "\"clips\"")) return;
+  if (clips->members.size() > kMaxGraphClips)
+    check.error(clips->pos, "more than " + std::to_string(kMaxGraphClips) + " clips");
+  for (const Member& m : clips->members) {
+    GraphClipSource c;
+    c.name = m.key;
+    c.pos = m.value.pos;
+    if (m.key.empty()) check.error(m.key_pos, "a clip name must not be empty");
+    if (m.value.is(Type::String)) {
+      check.expect_name(m.value, "clip '" + m.key + "' (its source file)", &c.source);
+    } else if (check.expect(m.value, Type::Object, "clip '" + m.key + "' (a source file, or {\"source\": ...})")) {
+      check.expect_keys(m.value, {"source", "clip", "events"}, "clip '" + m.key + "'");
+      if (const Value* source = m.value.find("source")) check.expect_name(*source, "\"source\"", &c.source);
+      else check.error(m.value.pos, "clip '" + m.key + "' needs a \"source\" file");
+      if (const Value* pick = m.value.find("clip"))
+        check.expect_name(*pick, "\"clip\" (a clip name in the source)", &c.source_clip);
+      if (const Value* events = m.value.find("events")) check.expect(*events, Type::Array, "\"events\"");
+    }
+    out.clips.push_back(std::move(c));
+  }
+}
+
+class GraphCompiler {
+ public:
+  GraphCompiler(const json::Document& doc, const GraphContext& context) : check_(doc), ctx_(context) {}
+
+  Result<CompiledGraph> run() {
+    const Value& root = check_.doc().root;
+    GraphManifest manifest;
+    read_manifest(check_, root, manifest);
+    if (!root.is(Type::Object)) return Error{check_.message()};
+    g_.name = manifest.name;
+    read_skeleton();
+    read_clips(root, manifest);
+    read_parameters(root.find("parameters"));
+    read_named_nodes(root.find("nodes"));
+
+    const Value* root_node = root.find("root");
+    int index = -1;
+    if (!root_node) check_.error(root.pos, "a graph needs a \"root\" node");
+    else index = node(*root_node, "");
+    if (index >= 0) g_.root = static_cast<uint16_t>(index);
+    check_unused();
+    if (!check_.ok()) return Error{check_.message()};
+
+    CompiledGraph out;
+    out.graph = std::move(g_);
+    out.clip_events = std::move(clip_events_);
+    out.warnings = std::move(warnings_);
+    return out;
+  }
+
+ private:
+  Checker check_;
+  const GraphContext& ctx_;
+  GraphDef g_;
+  std::vector<std::vector<SourceEvent>> clip_events_;
+  std::vector<float> clip_duration_;
+  std::vector<bool> clip_used_;
+  std::vector<Pos> clip_pos_;
+  std::vector<bool> param_bad_;  // a parameter already reported: its uses are not checked again
+  std::vector<std::string> warnings_;
+
+  struct Named {
+    const Member* member = nullptr;
+    size_t uses = 0;
+  };
+  std::vector<Named> named_;
+  std::vector<std::string> use_stack_;
+  size_t visits_ = 0;
+  bool too_many_ = false;
+  bool checking_unused_ = false;  // the node limit then only bounds the work, it is no error
+  uint32_t depth_ = 0;
+
+  void warn(Pos pos, const std::string& what) { warnings_.push_back(json::where(check_.doc().file, pos) + what); }
+
+  // ---- small readers -----------------------------------------------------------------------
+
+  bool read_float(const Value& v, const std::string& what, float* out, double lo = -kFloatMax, double hi = kFloatMax) {
+    double d = 0.0;
+    if (!check_.expect_number(v, what, &d)) return false;
+    if (d < lo || d > hi) {
+      if (hi >= kFloatMax && lo > -kFloatMax)
+        return check_.error(v.pos, what + " must be >= " + number_text(lo) + ", not " + number_text(d));
+      return check_.error(
+          v.pos, what + " must be within [" + number_text(lo) + ", " + number_text(hi) + "], not " + number_text(d));
+    }
+    *out = static_cast<float>(d);
+    return true;
+  }
+
+  bool read_bool(const Value& v, const std::string& what, bool* out) {
+    if (!check_.expect(v, Type::Bool, what)) return false;
+    *out = v.boolean;
+    return true;
+  }
+
+  /// A parameter named by the string v, of one of the allowed types; -1 (reported) otherwise.
+  int parameter(const Value& v, std::initializer_list<ParamType> allowed, const std::string& role) {
+    if (!check_.expect(v, Type::String, role + " (a parameter name)")) return -1;
+    int index = -1;
+    for (size_t p = 0; p < g_.parameters.size(); ++p)
+      if (g_.parameters[p].name == v.string) index = static_cast<int>(p);
+    if (index < 0) {
+      std::vector<std::string> names;
+      for (const GraphParameter& p : g_.parameters) names.push_back(p.name);
+      const std::string hint = json::closest_name(v.string, names);
+      check_.error(v.pos,
+                   "unknown parameter '" + v.string + "' in " + role +
+                       (hint.empty() ? "" : " (did you mean '" + hint + "'?)") +
+                       (names.empty() ? "; the graph declares no \"parameters\"" : "; parameters: " + quoted(names)));
+      return -1;
+    }
+    if (param_bad_[static_cast<size_t>(index)]) return -1;
+    const ParamType type = g_.parameters[static_cast<size_t>(index)].type;
+    if (std::find(allowed.begin(), allowed.end(), type) != allowed.end()) return index;
+    std::string want;  // "float", "float or bool", "bool, int or enum"
+    size_t listed = 0;
+    for (ParamType t : allowed) {
+      if (listed > 0) want += listed + 1 == allowed.size() ? " or " : ", ";
+      want += type_word(t);
+      ++listed;
+    }
+    check_.error(v.pos, "parameter '" + v.string + "' is " + a_type(type) + "; " + role + " needs " +
+                            (*allowed.begin() == ParamType::Int || *allowed.begin() == ParamType::Enum ? "an " : "a ") +
+                            want + " parameter");
+    return -1;
+  }
+
+  /// A clip named by the string v; -1 (reported) otherwise.
+  int clip(const Value& v, const std::string& role) {
+    if (!check_.expect(v, Type::String, role + " (a clip name)")) return -1;
+    for (size_t c = 0; c < g_.clips.size(); ++c) {
+      if (g_.clips[c] == v.string) {
+        clip_used_[c] = true;
+        return static_cast<int>(c);
+      }
+    }
+    const std::string hint = json::closest_name(v.string, g_.clips);
+    check_.error(v.pos, "unknown clip '" + v.string + "'" + (hint.empty() ? "" : " (did you mean '" + hint + "'?)") +
+                            (g_.clips.empty() ? "; \"clips\" declares none" : "; clips: " + quoted(g_.clips)));
+    return -1;
+  }
+
+  /// A required member; reports its absence.
+  const Value* required(const Value& object, std::string_view key, const std::string& what) {
+    const Value* v = object.find(key);
+    if (!v) check_.error(object.pos, what + " needs \"" + std::string(key) + "\"");
+    return v;
+  }
+
+  // ---- top level ---------------------------------------------------------------------------
+
+  void read_skeleton() {
+    const SourceSkeleton* sk = ctx_.skeleton;
+    if (!sk || sk->joints.empty()) {
+      check_.error(check_.doc().root.pos, "the graph's skeleton has no joints");
+      return;
+    }
+    if (sk->joints.size() > 65535) {
+      check_.error(check_.doc().root.pos, "the skeleton has more than 65535 joints");
+      return;
+    }
+    g_.skeleton_hash = skeleton_hash_of(*sk);
+    g_.joint_count = static_cast<uint16_t>(sk->joints.size());
+  }
+
+  void read_clips(const Value& root, const GraphManifest& manifest) {
+    const Value* clips = root.find("clips");
+    for (const GraphClipSource& entry : manifest.clips) {
+      g_.clips.push_back(entry.name);
+      clip_used_.push_back(false);
+      clip_pos_.push_back(entry.pos);
+      const GraphClipInfo* info = nullptr;
+      for (const GraphClipInfo& c : ctx_.clips)
+        if (c.name == entry.name) info = &c;
+      std::vector<SourceEvent> events;
+      float duration = 0.0f;
+      if (!info) {
+        check_.error(entry.pos, "clip '" + entry.name + "' was not imported");
+      } else {
+        duration = info->duration;
+        events = info->events;
+        const Value* value = clips ? clips->find(entry.name) : nullptr;
+        const Value* list = value && value->is(Type::Object) ? value->find("events") : nullptr;
+        if (list && list->is(Type::Array))
+          read_event_list(check_, *list, duration, "clip '" + entry.name + "'", events);
+        sort_events(events);
+      }
+      clip_events_.push_back(std::move(events));
+      clip_duration_.push_back(duration);
+    }
+  }
+
+  void read_parameters(const Value* params) {
+    if (!params || !check_.expect(*params, Type::Object, "\"parameters\"")) return;
+    if (params->members.size() > kMaxGraphParameters)
+      check_.error(params->pos, "more than " + std::to_string(kMaxGraphParameters) + " parameters");
+    for (const Member& m : params->members) {
+      GraphParameter p;
+      p.name = m.key;
+      const bool ok = read_parameter(m, p);
+      g_.parameters.push_back(std::move(p));
+      param_bad_.push_back(!ok);
+    }
+  }
+
+  bool read_parameter(const Member& m, GraphParameter& p) {
+    const std::string what = "parameter '" + m.key + "'";
+    bool ok = true;
+    if (!is_condition_identifier(m.key))
+      ok = check_.error(m.key_pos, "parameter name '" + m.key +
+                                       "' must be an identifier (letters, digits and '_', not starting with a digit, "
+                                       "not true/false/and/or/not) so conditions can name it");
+    const Value& v = m.value;
+    if (!check_.expect(v, Type::Object, what)) return false;
+    const Value* type = v.find("type");
+    static const std::vector<std::string_view> kTypes = {"float", "int", "bool", "enum", "trigger"};
+    if (!type) return check_.error(v.pos, what + " needs a \"type\": float, int, bool, enum or trigger");
+    if (!check_.expect(*type, Type::String, "\"type\"")) return false;
+    const auto found = std::find(kTypes.begin(), kTypes.end(), type->string);
+    if (found == kTypes.end()) {
+      const std::string hint = json::closest_name(type->string, kTypes);
+      return check_.error(type->pos, "unknown parameter type '" + type->string + "'" +
+                                         (hint.empty() ? "" : " (did you mean '" + hint + "'?)") +
+                                         "; types: float, int, bool, enum, trigger");
+    }
+    p.type = static_cast<ParamType>(found - kTypes.begin());
+    const Value* def = v.find("default");
+    switch (p.type) {
+      case ParamType::Float:
+      case ParamType::Int: {
+        const bool is_int = p.type == ParamType::Int;
+        ok &= check_.expect_keys(v, {"type", "default", "min", "max"}, what);
+        double lo = -kFloatMax, hi = kFloatMax, d = 0.0;
+        const double limit = is_int ? kIntLimit : kFloatMax;
+        const auto read = [&](const char* key, double* out) {
+          const Value* x = v.find(key);
+          if (!x) return true;
+          if (!check_.expect_number(*x, what + " \"" + key + "\"", out)) return false;
+          if (is_int && *out != std::floor(*out))
+            return check_.error(x->pos, what + " \"" + key + "\" must be a whole number");
+          if (std::abs(*out) > limit)
+            return check_.error(x->pos, what + " \"" + key + "\" must be within +-" + number_text(limit));
+          return true;
+        };
+        const bool min_ok = read("min", &lo);
+        const bool max_ok = read("max", &hi);
+        const bool have_range = min_ok && max_ok;
+        ok &= have_range;
+        if (have_range && lo > hi) {
+          ok = check_.error(v.find("min")->pos,
+                            what + ": min " + number_text(lo) + " is greater than max " + number_text(hi));
+        } else if (have_range) {
+          d = std::clamp(0.0, lo, hi);  // no default: 0, or the range's nearest end
+          if (def && !read("default", &d)) {
+            ok = false;
+          } else if (def && (d < lo || d > hi)) {
+            ok = check_.error(def->pos, what + ": default " + number_text(d) + " is outside [min, max] = [" +
+                                            number_text(lo) + ", " + number_text(hi) + "]");
+          }
+        }
+        p.min_value = static_cast<float>(lo);
+        p.max_value = static_cast<float>(hi);
+        p.default_value = static_cast<float>(d);
+        return ok;
+      }
+      case ParamType::Bool:
+        ok &= check_.expect_keys(v, {"type", "default"}, what);
+        if (def) {
+          bool b = false;
+          ok &= read_bool(*def, what + " \"default\"", &b);
+          p.default_value = b ? 1.0f : 0.0f;
+        }
+        return ok;
+      case ParamType::Trigger: return check_.expect_keys(v, {"type"}, what) && ok;
+      case ParamType::Enum: {
+        ok &= check_.expect_keys(v, {"type", "values", "default"}, what);
+        const Value* values = v.find("values");
+        if (!values) return check_.error(v.pos, what + " needs \"values\": [\"<name>\", ...]");
+        if (!check_.expect(*values, Type::Array, what + " \"values\"")) return false;
+        if (values->items.empty()) return check_.error(values->pos, what + " needs at least one value");
+        if (values->items.size() > 65535) return check_.error(values->pos, what + " has more than 65535 values");
+        for (const Value& name : values->items) {
+          if (!check_.expect(name, Type::String, "an enum value")) {
+            ok = false;
+            continue;
+          }
+          if (!is_condition_identifier(name.string)) {
+            ok = check_.error(name.pos, "enum value '" + name.string +
+                                            "' must be an identifier (letters, digits and '_', not starting with a "
+                                            "digit, not true/false/and/or/not) so conditions can name it");
+          } else if (std::find(p.enum_values.begin(), p.enum_values.end(), name.string) != p.enum_values.end()) {
+            ok = check_.error(name.pos, what + ": value '" + name.string + "' is listed twice");
+          }
+          p.enum_values.push_back(name.string);
+        }
+        if (def && check_.expect(*def, Type::String, what + " \"default\" (one of its values)")) {
+          const auto at = std::find(p.enum_values.begin(), p.enum_values.end(), def->string);
+          if (at == p.enum_values.end())
+            ok = check_.error(def->pos, what + ": default '" + def->string + "' is not one of its values (" +
+                                            quoted(p.enum_values) + ")");
+          else p.default_value = static_cast<float>(at - p.enum_values.begin());
+        } else if (def) {
+          ok = false;
+        }
+        return ok;
+      }
+    }
+    return false;
+  }
+
+  void read_named_nodes(const Value* nodes) {
+    if (!nodes || !check_.expect(*nodes, Type::Object, "\"nodes\" (named nodes)")) return;
+    for (const Member& m : nodes->members) {
+      if (m.key.empty()) check_.error(m.key_pos, "a named node's name must not be empty");
+      named_.push_back({&m, 0});
+    }
+  }
+
+  /// Named nodes no "use" reached and declared clips no node plays are warnings; the former are
+  /// still compiled (and thrown away) so their problems are reported.
+  void check_unused() {
+    for (Named& n : named_) {
+      if (n.uses > 0) continue;
+      warn(n.member->key_pos, "named node '" + n.member->key + "' is never used");
+      const size_t nodes = g_.nodes.size(), machines = g_.machines.size();
+      visits_ = 0;
+      too_many_ = false;
+      checking_unused_ = true;
+      use_stack_ = {n.member->key};
+      ++n.uses;
+      (void)node(n.member->value, n.member->key);
+      use_stack_.clear();
+      g_.nodes.resize(nodes);
+      g_.machines.resize(machines);
+    }
+    checking_unused_ = false;
+    for (size_t c = 0; c < clip_used_.size(); ++c)
+      if (!clip_used_[c]) warn(clip_pos_[c], "clip '" + g_.clips[c] + "' is declared but no node plays it");
+  }
+
+  // ---- nodes ---------------------------------------------------------------------------------
+
+  int emit(std::string name, NodeKind kind) {
+    g_.nodes.push_back({std::move(name), std::move(kind)});
+    return static_cast<int>(g_.nodes.size() - 1);
+  }
+
+  /// Compiles the node written at v (and its subtree) and returns its index, or -1.
+  int node(const Value& v, const std::string& default_name) {
+    if (too_many_) return -1;
+    if (!check_.expect(v, Type::Object, "a node")) return -1;
+    const Member* kind = nullptr;
+    for (const Member& m : v.members) {
+      if (std::find(kNodeKinds.begin(), kNodeKinds.end(), m.key) == kNodeKinds.end()) continue;
+      if (kind) {
+        check_.error(m.key_pos,
+                     "a node is exactly one kind, but this one has both \"" + kind->key + "\" and \"" + m.key + "\"");
+        return -1;
+      }
+      kind = &m;
+    }
+    if (!kind) {
+      if (check_.expect_keys(
+              v, {"clip", "blend", "select", "layered", "blend_space", "additive", "state_machine", "use", "name"},
+              "a node"))
+        check_.error(v.pos,
+                     "a node needs one of the keys clip, blend, select, layered, blend_space, additive, "
+                     "state_machine, use");
+      return -1;
+    }
+    // Every node but a use (which stands for the node it copies) becomes one output node.
+    if (kind->key != "use" && ++visits_ > kMaxGraphNodes) {
+      too_many_ = true;
+      if (!checking_unused_)
+        check_.error(v.pos, "the graph has more than " + std::to_string(kMaxGraphNodes) +
+                                " nodes (each {\"use\"} of a named node is a copy of it)");
+      return -1;
+    }
+    if (depth_ >= kMaxNodeDepth) {
+      check_.error(v.pos, "nodes nested deeper than " + std::to_string(kMaxNodeDepth) + " levels");
+      return -1;
+    }
+    std::string name = default_name;
+    if (const Value* n = v.find("name")) {
+      if (!check_.expect(*n, Type::String, "a node's \"name\"")) return -1;
+      name = n->string;
+    }
+    ++depth_;
+    int index = -1;
+    const std::string& k = kind->key;
+    if (k == "clip") index = clip_node(v, name);
+    else if (k == "blend") index = blend_node(v, name);
+    else if (k == "select") index = select_node(v, name);
+    else if (k == "layered") index = layered_node(v, name);
+    else if (k == "blend_space") index = blend_space_node(v, name);
+    else if (k == "additive") index = additive_node(v, name);
+    else if (k == "state_machine") index = machine_node(v, name);
+    else index = use_node(v, name, v.find("name") != nullptr);
+    --depth_;
+    return index;
+  }
+
+  int use_node(const Value& v, const std::string& name, bool named_here) {
+    check_.expect_keys(v, {"use", "name"}, "a use");
+    const Value& target = *v.find("use");
+    if (!check_.expect(target, Type::String, "\"use\" (a named node)")) return -1;
+    Named* found = nullptr;
+    for (Named& n : named_)
+      if (n.member->key == target.string) found = &n;
+    if (!found) {
+      std::vector<std::string> names;
+      for (const Named& n : named_) names.push_back(n.member->key);
+      const std::string hint = json::closest_name(target.string, names);
+      return check_.error(target.pos,
+                          "unknown named node '" + target.string + "'" +
+                              (hint.empty() ? "" : " (did you mean '" + hint + "'?)") +
+                              (names.empty() ? "; the graph has no \"nodes\"" : "; named nodes: " + quoted(names))),
+             -1;
+    }
+    if (std::find(use_stack_.begin(), use_stack_.end(), target.string) != use_stack_.end()) {
+      std::string chain;
+      for (auto it = std::find(use_stack_.begin(), use_stack_.end(), target.string); it != use_stack_.end(); ++it)
+        chain += *it + " -> ";
+      check_.error(target.pos, "named nodes use each other in a cycle: " + chain + target.string);
+      return -1;
+    }
+    ++found->uses;
+    use_stack_.push_back(target.string);
+    const int index = node(found->member->value, named_here ? name : target.string);
+    use_stack_.pop_back();
+    return index;
+  }
+
+  int clip_node(const Value& v, const std::string& name) {
+    check_.expect_keys(v, {"clip", "rate", "rate_parameter", "loop", "start", "name"}, "a clip node");
+    ClipNodeDef c;
+    bool ok = true;
+    const int index = clip(*v.find("clip"), "a clip node");
+    ok &= index >= 0;
+    if (const Value* r = v.find("rate")) ok &= read_float(*r, "\"rate\"", &c.rate);
+    if (const Value* p = v.find("rate_parameter")) {
+      const int param = parameter(*p, {ParamType::Float}, "\"rate_parameter\"");
+      ok &= param >= 0;
+      c.rate_parameter = static_cast<int16_t>(param);
+    }
+    if (const Value* l = v.find("loop")) ok &= read_bool(*l, "\"loop\"", &c.loop);
+    if (const Value* s = v.find("start"); s && index >= 0) {
+      const double duration = clip_duration_[static_cast<size_t>(index)];
+      double t = 0.0;
+      if (!check_.expect_number(*s, "\"start\" (seconds)", &t)) {
+        ok = false;
+      } else if (t < 0.0 || t > duration + kEventTimeSlack) {
+        ok = check_.error(s->pos, "\"start\" " + number_text(t) + " s is outside clip '" +
+                                      g_.clips[static_cast<size_t>(index)] + "' [0, " + number_text(duration) + " s]");
+      } else {
+        c.start_offset = static_cast<float>(std::min(t, duration));
+      }
+    }
+    if (!ok) return -1;
+    c.clip = static_cast<uint16_t>(index);
+    return emit(name, c);
+  }
+
+  int blend_node(const Value& v, const std::string& name) {
+    check_.expect_keys(v, {"blend", "alpha", "name"}, "a blend node");
+    BlendAlphaDef b;
+    const Value& inputs = *v.find("blend");
+    bool ok = true;
+    int alpha = -1;
+    if (const Value* a = required(v, "alpha", "a blend node"))
+      alpha = parameter(*a, {ParamType::Float}, "a blend's \"alpha\"");
+    ok &= alpha >= 0;
+    if (!check_.expect(inputs, Type::Array, "\"blend\" ([A, B])")) return -1;
+    if (inputs.items.size() != 2) {
+      check_.error(inputs.pos, "\"blend\" takes exactly 2 nodes [A, B], not " + std::to_string(inputs.items.size()));
+      ok = false;
+    }
+    std::vector<int> children;
+    for (const Value& child : inputs.items) children.push_back(node(child, ""));
+    for (int c : children) ok &= c >= 0;
+    if (!ok) return -1;
+    b.a = static_cast<uint16_t>(children[0]);
+    b.b = static_cast<uint16_t>(children[1]);
+    b.alpha_parameter = static_cast<uint16_t>(alpha);
+    return emit(name, b);
+  }
+
+  int select_node(const Value& v, const std::string& name) {
+    check_.expect_keys(v, {"select", "children", "blend_time", "name"}, "a select node");
+    SelectDef s;
+    bool ok = true;
+    const int param = parameter(*v.find("select"), {ParamType::Bool, ParamType::Int, ParamType::Enum}, "a select node");
+    ok &= param >= 0;
+    if (const Value* t = v.find("blend_time")) ok &= read_float(*t, "\"blend_time\"", &s.blend_time, 0.0);
+    const Value* children = required(v, "children", "a select node");
+    if (!children) return -1;
+    if (!children->is(Type::Array) && !children->is(Type::Object)) {
+      check_.expect(*children, Type::Array, "\"children\"");
+      return -1;
+    }
+    if (param < 0) {  // still report the children's problems
+      for (const Value& c : children->items) node(c, "");
+      for (const Member& m : children->members) node(m.value, "");
+      return -1;
+    }
+    const GraphParameter& p = g_.parameters[static_cast<size_t>(param)];
+    std::vector<std::string> labels;  // the value names, when the parameter has them
+    if (p.type == ParamType::Bool) labels = {"false", "true"};
+    if (p.type == ParamType::Enum) labels = p.enum_values;
+
+    std::vector<int> out;
+    if (children->is(Type::Array)) {
+      for (const Value& c : children->items) out.push_back(node(c, ""));
+      const size_t n = children->items.size();
+      if (p.type == ParamType::Int && n == 0) {
+        ok = check_.error(children->pos, "a select on int '" + p.name + "' needs at least one child");
+      } else if (p.type != ParamType::Int && n != labels.size()) {
+        ok = check_.error(children->pos, "a select on " + std::string(type_word(p.type)) + " '" + p.name +
+                                             "' needs exactly " + std::to_string(labels.size()) +
+                                             " children, one per value in the order " + quoted(labels) + ", not " +
+                                             std::to_string(n));
+      }
+    } else {
+      if (p.type == ParamType::Int) {
+        for (const Member& m : children->members) node(m.value, "");
+        check_.error(children->pos, "a select on int '" + p.name + "' takes its children as an array");
+        return -1;
+      }
+      out.assign(labels.size(), -1);
+      std::vector<bool> given(labels.size(), false);
+      for (const Member& m : children->members) {
+        const auto at = std::find(labels.begin(), labels.end(), m.key);
+        const int child = node(m.value, "");
+        if (at == labels.end()) {
+          ok = check_.error(m.key_pos, "'" + m.key + "' is not a value of " + std::string(type_word(p.type)) + " '" +
+                                           p.name + "' (values: " + quoted(labels) + ")");
+          continue;
+        }
+        const size_t slot = static_cast<size_t>(at - labels.begin());
+        given[slot] = true;
+        out[slot] = child;
+      }
+      for (size_t i = 0; i < labels.size(); ++i)
+        if (!given[i])
+          ok = check_.error(children->pos, "a select on '" + p.name + "' has no child for '" + labels[i] + "'");
+    }
+    for (int c : out) ok &= c >= 0;
+    if (!ok) return -1;
+    s.parameter = static_cast<uint16_t>(param);
+    for (int c : out) s.children.push_back(static_cast<uint16_t>(c));
+    return emit(name, std::move(s));
+  }
+
+  int joint(const Value& v) {
+    if (!check_.expect(v, Type::String, "a mask's \"joint\"")) return -1;
+    if (!ctx_.skeleton) return -1;
+    const auto& joints = ctx_.skeleton->joints;
+    for (size_t j = 0; j < joints.size(); ++j)
+      if (joints[j].name == v.string) return static_cast<int>(j);
+    std::vector<std::string> names;
+    for (const SourceJoint& j : joints) names.push_back(j.name);
+    const std::string hint = json::closest_name(v.string, names);
+    return check_.error(v.pos,
+                        "unknown joint '" + v.string + "' in a mask" +
+                            (hint.empty() ? " (joint names are case-sensitive)" : " (did you mean '" + hint + "'?)")),
+           -1;
+  }
+
+  int layered_node(const Value& v, const std::string& name) {
+    check_.expect_keys(v, {"layered", "layers", "name"}, "a layered node");
+    LayeredDef l;
+    const int base = node(*v.find("layered"), "");
+    bool ok = base >= 0;
+    const Value* layers = required(v, "layers", "a layered node");
+    if (!layers || !check_.expect(*layers, Type::Array, "\"layers\"")) return -1;
+    if (layers->items.empty())
+      ok = check_.error(layers->pos, "\"layers\" is empty: a layered node needs at least one layer");
+    for (const Value& lv : layers->items) {
+      if (!check_.expect(lv, Type::Object, "a layer")) {
+        ok = false;
+        continue;
+      }
+      check_.expect_keys(lv, {"node", "mask", "weight", "weight_parameter", "blend_time", "mesh_space_rotation"},
+                         "a layer");
+      LayerDef layer;
+      const Value* n = required(lv, "node", "a layer");
+      const int child = n ? node(*n, "") : -1;
+      ok &= child >= 0;
+      layer.node = static_cast<uint16_t>(std::max(child, 0));
+      const Value* mask = required(lv, "mask", "a layer");
+      if (!mask || !check_.expect(*mask, Type::Array, "\"mask\" ([{\"joint\": ...}, ...])")) {
+        ok = false;
+      } else {
+        if (mask->items.empty()) ok = check_.error(mask->pos, "\"mask\" is empty: a layer needs at least one joint");
+        for (const Value& e : mask->items) {
+          if (!check_.expect(e, Type::Object, "a mask entry ({\"joint\": ..., \"depth\": ...})")) {
+            ok = false;
+            continue;
+          }
+          check_.expect_keys(e, {"joint", "depth"}, "a mask entry");
+          MaskEntryDef entry;
+          const Value* jv = required(e, "joint", "a mask entry");
+          const int j = jv ? joint(*jv) : -1;
+          ok &= j >= 0;
+          entry.joint = static_cast<uint16_t>(std::max(j, 0));
+          if (const Value* d = e.find("depth")) {
+            long long depth = -1;
+            ok &= check_.expect_integer(*d, "a mask's \"depth\" (-1: all descendants)", -1, 32767, &depth);
+            entry.depth = static_cast<int16_t>(depth);
+          }
+          layer.mask.push_back(entry);
+        }
+      }
+      if (const Value* w = lv.find("weight")) ok &= read_float(*w, "a layer's \"weight\"", &layer.weight, 0.0, 1.0);
+      if (const Value* p = lv.find("weight_parameter")) {
+        const int param = parameter(*p, {ParamType::Float, ParamType::Bool}, "a layer's \"weight_parameter\"");
+        ok &= param >= 0;
+        layer.weight_parameter = static_cast<int16_t>(param);
+      }
+      if (const Value* t = lv.find("blend_time"))
+        ok &= read_float(*t, "a layer's \"blend_time\"", &layer.blend_time, 0.0);
+      if (const Value* m = lv.find("mesh_space_rotation"))
+        ok &= read_bool(*m, "\"mesh_space_rotation\"", &layer.mesh_space_rotation);
+      l.layers.push_back(std::move(layer));
+    }
+    if (!ok) return -1;
+    l.base = static_cast<uint16_t>(base);
+    return emit(name, std::move(l));
+  }
+
+  int blend_space_node(const Value& v, const std::string& name) {
+    check_.expect_keys(v, {"blend_space", "y", "samples", "rate", "loop", "name"}, "a blend space");
+    BlendSpaceDef b;
+    const int x = parameter(*v.find("blend_space"), {ParamType::Float}, "a blend space's x (\"blend_space\")");
+    bool ok = x >= 0;
+    const Value* yv = v.find("y");
+    if (yv) {
+      const int y = parameter(*yv, {ParamType::Float}, "a blend space's \"y\"");
+      ok &= y >= 0;
+      b.y_parameter = static_cast<int16_t>(y);
+    }
+    if (const Value* r = v.find("rate")) ok &= read_float(*r, "\"rate\"", &b.rate);
+    if (const Value* l = v.find("loop")) ok &= read_bool(*l, "\"loop\"", &b.loop);
+    const Value* samples = required(v, "samples", "a blend space");
+    if (!samples || !check_.expect(*samples, Type::Array, "\"samples\"")) return -1;
+    const bool two_d = yv != nullptr;
+    std::vector<Pos> where;  // each sample's position, for the checks across samples
+    for (const Value& s : samples->items) {
+      if (!check_.expect(s, Type::Object, "a sample ({\"clip\": ..., \"x\": ...})")) {
+        ok = false;
+        continue;
+      }
+      check_.expect_keys(s, {"clip", "x", "y"}, "a blend-space sample");
+      BlendSampleDef sample;
+      const Value* c = required(s, "clip", "a sample");
+      const int ci = c ? clip(*c, "a sample") : -1;
+      ok &= ci >= 0;
+      sample.clip = static_cast<uint16_t>(std::max(ci, 0));
+      const Value* sx = required(s, "x", "a sample");
+      ok &= sx && read_float(*sx, "a sample's \"x\"", &sample.x);
+      const Value* sy = s.find("y");
+      if (two_d && !sy) ok = check_.error(s.pos, "a sample of a 2D blend space needs \"y\"");
+      if (!two_d && sy) ok = check_.error(sy->pos, "\"y\" given but the blend space has no \"y\" parameter (1D)");
+      if (two_d && sy) ok &= read_float(*sy, "a sample's \"y\"", &sample.y);
+      b.samples.push_back(sample);
+      where.push_back(s.pos);
+    }
+    if (!ok) return -1;
+    const auto label = [&](size_t i) { return "'" + g_.clips[b.samples[i].clip] + "'"; };
+    if (!two_d) {
+      if (b.samples.size() < 2)
+        return check_.error(samples->pos, "a 1D blend space needs at least 2 samples (one clip is a clip node)"), -1;
+      std::vector<size_t> order(b.samples.size());
+      for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+      std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t c) { return b.samples[a].x < b.samples[c].x; });
+      for (size_t i = 1; i < order.size(); ++i) {
+        if (b.samples[order[i]].x == b.samples[order[i - 1]].x) {
+          const size_t later = std::max(order[i], order[i - 1]), earlier = std::min(order[i], order[i - 1]);
+          ok = check_.error(where[later], "samples " + label(earlier) + " and " + label(later) + " have the same x (" +
+                                              number_text(b.samples[later].x) + ")");
+        }
+      }
+      std::vector<BlendSampleDef> sorted;
+      for (size_t i : order) sorted.push_back(b.samples[i]);
+      b.samples = std::move(sorted);
+    } else {
+      if (b.samples.size() < 3)
+        return check_.error(samples->pos, "a 2D blend space needs at least 3 samples, not all on one line"), -1;
+      for (size_t i = 0; i < b.samples.size(); ++i)
+        for (size_t j = 0; j < i; ++j)
+          if (b.samples[i].x == b.samples[j].x && b.samples[i].y == b.samples[j].y)
+            ok = check_.error(where[i], "samples " + label(j) + " and " + label(i) + " are at the same point (" +
+                                            number_text(b.samples[i].x) + ", " + number_text(b.samples[i].y) + ")");
+      if (ok) {
+        // The runtime's own triangulation decides what it can use (collinear, near-duplicates).
+        std::vector<glm::vec2> points;
+        for (const BlendSampleDef& s : b.samples) points.emplace_back(s.x, s.y);
+        if (auto space = make_blend_space_2d(points); !space) ok = check_.error(samples->pos, space.error().message);
+      }
+    }
+    if (!ok) return -1;
+    b.x_parameter = static_cast<uint16_t>(x);
+    return emit(name, std::move(b));
+  }
+
+  int additive_node(const Value& v, const std::string& name) {
+    check_.expect_keys(v, {"additive", "add", "weight", "weight_parameter", "name"}, "an additive node");
+    AdditiveDef a;
+    const int base = node(*v.find("additive"), "");
+    bool ok = base >= 0;
+    const Value* add = required(v, "add", "an additive node");
+    const int added = add ? node(*add, "") : -1;
+    ok &= added >= 0;
+    if (const Value* w = v.find("weight")) ok &= read_float(*w, "\"weight\"", &a.weight);
+    if (const Value* p = v.find("weight_parameter")) {
+      const int param = parameter(*p, {ParamType::Float, ParamType::Bool}, "\"weight_parameter\"");
+      ok &= param >= 0;
+      a.weight_parameter = static_cast<int16_t>(param);
+    }
+    if (!ok) return -1;
+    a.base = static_cast<uint16_t>(base);
+    a.additive = static_cast<uint16_t>(added);
+    return emit(name, a);
+  }
+
+  // ---- state machines ------------------------------------------------------------------------
+
+  int machine_node(const Value& v, const std::string& name) {
+    check_.expect_keys(v, {"state_machine", "name"}, "a state machine node");
+    const Value& m = *v.find("state_machine");
+    if (!check_.expect(m, Type::Object, "\"state_machine\"")) return -1;
+    check_.expect_keys(m, {"name", "entry", "states", "transitions"}, "a state machine");
+    if (g_.machines.size() >= 65535) return check_.error(m.pos, "more than 65535 state machines"), -1;
+    const size_t machine_index = g_.machines.size();
+    g_.machines.emplace_back();  // reserved now: machines are numbered in the order they are met
+    StateMachineDef sm;
+    bool ok = true;
+    if (const Value* n = required(m, "name", "a state machine"))
+      ok &= check_.expect_name(*n, "a state machine's \"name\"", &sm.name);
+    else ok = false;
+    const std::string label = sm.name.empty() ? std::string("the state machine") : "state machine '" + sm.name + "'";
+
+    std::vector<Pos> state_pos;
+    const Value* states = required(m, "states", "a state machine");
+    if (states && check_.expect(*states, Type::Object, "\"states\" ({\"<state>\": {\"node\": ...}, ...})")) {
+      if (states->members.empty()) ok = check_.error(states->pos, label + " has no states");
+      if (states->members.size() > 32767)
+        ok = check_.error(states->pos, label + " has more than 32767 states");  // Transition.from is int16
+      for (const Member& s : states->members) {
+        StateDef st;
+        st.name = s.key;
+        if (s.key == "any")
+          ok = check_.error(s.key_pos, "'any' is reserved for transitions from any state; rename the state");
+        if (s.key.empty()) ok = check_.error(s.key_pos, "a state name must not be empty");
+        if (check_.expect(s.value, Type::Object, "state '" + s.key + "' ({\"node\": ..., \"restart\": ...})")) {
+          check_.expect_keys(s.value, {"node", "restart"}, "a state");
+          const Value* n = required(s.value, "node", "state '" + s.key + "'");
+          const int child = n ? node(*n, "") : -1;
+          ok &= child >= 0;
+          st.node = static_cast<uint16_t>(std::max(child, 0));
+          if (const Value* r = s.value.find("restart")) ok &= read_bool(*r, "\"restart\"", &st.restart);
+        } else {
+          ok = false;
+        }
+        sm.states.push_back(std::move(st));
+        state_pos.push_back(s.key_pos);
+      }
+    } else {
+      ok = false;
+    }
+    const auto state_index = [&](const std::string& s) {
+      for (size_t i = 0; i < sm.states.size(); ++i)
+        if (sm.states[i].name == s) return static_cast<int>(i);
+      return -1;
+    };
+    const auto unknown_state = [&](const Value& at, const std::string& what) {
+      std::vector<std::string> names;
+      for (const StateDef& s : sm.states) names.push_back(s.name);
+      const std::string hint = json::closest_name(at.string, names);
+      return check_.error(at.pos, what + " '" + at.string + "' is not a state of " + label +
+                                      (hint.empty() ? "" : " (did you mean '" + hint + "'?)") +
+                                      "; states: " + quoted(names));
+    };
+
+    bool entry_ok = false;
+    if (const Value* e = m.find("entry")) {
+      if (check_.expect(*e, Type::String, "\"entry\" (a state name)")) {
+        const int entry = state_index(e->string);
+        if (entry < 0) ok = unknown_state(*e, "the entry state");
+        else sm.entry = static_cast<uint16_t>(entry), entry_ok = true;
+      } else {
+        ok = false;
+      }
+    } else {
+      ok = check_.error(m.pos, label + " needs an \"entry\" state");
+    }
+
+    std::vector<long long> priorities;
+    bool transitions_ok = true;
+    if (const Value* ts = m.find("transitions"); ts && check_.expect(*ts, Type::Array, "\"transitions\"")) {
+      for (const Value& t : ts->items) {
+        TransitionDef tr;
+        long long priority = 0;
+        if (transition(t, state_index, unknown_state, tr, priority)) {
+          sm.transitions.push_back(std::move(tr));
+          priorities.push_back(priority);
+        } else {
+          transitions_ok = false;
+        }
+      }
+    } else if (ts) {
+      transitions_ok = false;
+    }
+    ok &= transitions_ok;
+
+    // Stable sort by priority: lower first, file order among equals.
+    std::vector<size_t> order(sm.transitions.size());
+    for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+    std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return priorities[a] < priorities[b]; });
+    std::vector<TransitionDef> sorted;
+    for (size_t i : order) sorted.push_back(std::move(sm.transitions[i]));
+    sm.transitions = std::move(sorted);
+
+    // Every state must be reachable from the entry (only meaningful once every transition read).
+    if (entry_ok && transitions_ok) {
+      std::vector<bool> reached(sm.states.size(), false);
+      std::vector<size_t> stack = {sm.entry};
+      reached[sm.entry] = true;
+      for (const TransitionDef& t : sm.transitions)  // "any" leaves every state, the entry included
+        if (t.from < 0 && !reached[t.to]) reached[t.to] = true, stack.push_back(t.to);
+      while (!stack.empty()) {
+        const size_t s = stack.back();
+        stack.pop_back();
+        for (const TransitionDef& t : sm.transitions)
+          if (t.from == static_cast<int>(s) && !reached[t.to]) reached[t.to] = true, stack.push_back(t.to);
+      }
+      for (size_t s = 0; s < sm.states.size(); ++s)
+        if (!reached[s])
+          ok = check_.error(state_pos[s], "state '" + sm.states[s].name + "' of " + label +
+                                              " cannot be reached: no transition leads to it from the entry state '" +
+                                              sm.states[sm.entry].name + "'");
+    }
+    if (!ok) return -1;
+    g_.machines[machine_index] = std::move(sm);
+    return emit(name, StateMachineRefDef{static_cast<uint16_t>(machine_index)});
+  }
+
+  template <class StateIndex, class UnknownState>
+  bool transition(const Value& t, const StateIndex& state_index, const UnknownState& unknown_state, TransitionDef& out,
+                  long long& priority) {
+    if (!check_.expect(t, Type::Object, "a transition")) return false;
+    check_.expect_keys(t, {"from", "to", "when", "exit_time", "duration", "mode", "priority"}, "a transition");
+    bool ok = true;
+    if (const Value* from = required(t, "from", "a transition (a state name or \"any\")")) {
+      if (!check_.expect(*from, Type::String, "\"from\"")) {
+        ok = false;
+      } else if (from->string == "any") {
+        out.from = -1;
+      } else {
+        const int s = state_index(from->string);
+        if (s < 0) ok = unknown_state(*from, "\"from\"");
+        out.from = static_cast<int16_t>(s);
+      }
+    } else {
+      ok = false;
+    }
+    if (const Value* to = required(t, "to", "a transition")) {
+      if (!check_.expect(*to, Type::String, "\"to\"")) {
+        ok = false;
+      } else {
+        const int s = state_index(to->string);
+        if (s < 0) ok = unknown_state(*to, "\"to\"");
+        out.to = static_cast<uint16_t>(std::max(s, 0));
+      }
+    } else {
+      ok = false;
+    }
+    if (const Value* when = t.find("when")) {
+      if (check_.expect(*when, Type::String, "\"when\" (a condition)")) {
+        ConditionResult c = compile_condition(when->string, g_.parameters);
+        if (!c.ok) {
+          ok = check_.error_in_string(*when, c.error_offset, c.error);
+        } else {
+          for (const CondInstr& instr : c.code)  // a parameter already reported wrong is not re-checked
+            if (instr.op != CondOp::True && instr.op < CondOp::Not && param_bad_[instr.parameter]) ok = false;
+          out.condition = std::move(c.code);
+        }
+      } else {
+        ok = false;
+      }
+    }
+    if (const Value* e = t.find("exit_time")) {
+      ok &= read_float(*e, "\"exit_time\" (normalized time of the source state; leave it out for none)", &out.exit_time,
+                       0.0);
+    }
+    if (const Value* d = t.find("duration")) ok &= read_float(*d, "\"duration\" (seconds)", &out.duration, 0.0);
+    if (const Value* mode = t.find("mode")) {
+      static const std::vector<std::string_view> kModes = {"crossfade", "sync_crossfade", "inertialize"};
+      if (!check_.expect(*mode, Type::String, "\"mode\"")) {
+        ok = false;
+      } else if (const auto at = std::find(kModes.begin(), kModes.end(), mode->string); at != kModes.end()) {
+        out.mode = static_cast<TransitionModeDef>(at - kModes.begin());
+      } else {
+        const std::string hint = json::closest_name(mode->string, kModes);
+        ok = check_.error(mode->pos, "unknown transition mode '" + mode->string + "'" +
+                                         (hint.empty() ? "" : " (did you mean '" + hint + "'?)") +
+                                         "; modes: crossfade, sync_crossfade, inertialize");
+      }
+    }
+    if (const Value* p = t.find("priority"))
+      ok &= check_.expect_integer(*p, "\"priority\" (lower is checked first)", -1000000000, 1000000000, &priority);
+    return ok;
+  }
+};
+
+}  // namespace
+
+Result<GraphManifest> read_graph_manifest(const json::Document& doc) {
+  Checker check(doc);
+  GraphManifest out;
+  read_manifest(check, doc.root, out);
+  if (!check.ok()) return Error{check.message()};
+  return out;
+}
+
+Result<CompiledGraph> compile_graph(const json::Document& doc, const GraphContext& context) {
+  return GraphCompiler(doc, context).run();
+}
+
+Result<CompiledGraph> compile_graph(std::string_view text, std::string file, const GraphContext& context) {
+  auto doc = json::parse(text, std::move(file));
+  if (!doc) return doc.error();
+  return compile_graph(*doc, context);
+}
+
+}  // namespace ossa::cook

@@ -1,0 +1,765 @@
+// import_clips.cpp — Assimp animations -> per-joint T/R/S keys in seconds, one clip per aiAnimation.
+//
+// A joint's local transform is the product of the nodes in its chain (import_rig.cpp): usually
+// just the joint's node, but also the `$AssimpFbx$` helpers above it, the nodes above the root, or
+// in clip-only cooking the nodes the reference lacks. Keys are therefore produced two ways:
+//   - copied: only the joint's own node is animated and the static part above it is identity or a
+//     similarity (uniform scale, rotation, translation), which maps T, R and S keys one by one.
+//     Source keys and their times survive exactly, which the compression stage's error bound and
+//     round-trip tests rely on. This is every asset in the test set.
+//   - resampled: otherwise the chain's product is evaluated (linear / slerp between each channel's
+//     source keys, as Assimp's own evaluator does) at the union of the chain's key times and
+//     decomposed. Between those times the product of interpolations is not the interpolation of the
+//     product, so this is exact at the keys and approximate in between; the keys are the source's.
+// Then times become seconds, strictly increasing and inside [0, duration], rotations unit and on
+// the previous key's hemisphere.
+//
+// glTF STEP and CUBICSPLINE samplers: Assimp 5.2.5 hands their keys over as if they were LINEAR
+// (STEP values as plain keys, CUBICSPLINE reduced to the value of each [in-tangent, value,
+// out-tangent] triple), so both would be interpolated linearly. For a glTF source the samplers
+// are read from the file itself (gltf_samplers.h) and each such channel's node keys are replaced,
+// before anything above runs, by the source curve evaluated at every frame of the clip's grid and
+// at its own key times. Folding into chains, the copy/resample choice and the final conversion
+// then treat them like any other keys, and the compressor, which samples the grid, sees exactly
+// the source's curve at every frame: a STEP holds until the frame at (or after) the next key time,
+// a spline is the spline. Between frames the runtime interpolates linearly, so the grid rate
+// decides how close that comes to the source; see resampling_rate() for the choice.
+#include <algorithm>
+#include <cmath>
+#include <iterator>
+#include <map>
+#include <optional>
+#include <set>
+
+#include <assimp/scene.h>
+
+#include "cooker/clip/clip_grid.h"
+#include "cooker/import/gltf_samplers.h"
+#include "cooker/import/import_internal.h"
+
+namespace ossa::cook::detail {
+namespace {
+
+/// One node's keys, sorted by time, non-finite ones removed. Times in ticks.
+struct NodeKeys {
+  std::vector<double> tt, rt, st;
+  std::vector<glm::dvec3> tv, sv;
+  std::vector<glm::dquat> rv;
+  bool any() const { return !tt.empty() || !rt.empty() || !st.empty(); }
+};
+
+bool finite3(const aiVector3D& v) {
+  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
+
+template <class Key, class Value, class Convert>
+void take_keys(const Key* keys, unsigned count, std::vector<double>* times, std::vector<Value>* values,
+               Convert convert, size_t* dropped) {
+  std::vector<std::pair<double, Value>> pairs;
+  pairs.reserve(count);
+  for (unsigned i = 0; keys && i < count; ++i) {
+    bool ok = std::isfinite(keys[i].mTime);
+    Value v{};
+    if (ok) ok = convert(keys[i].mValue, &v);
+    if (ok) {
+      pairs.emplace_back(keys[i].mTime, v);
+    } else {
+      ++*dropped;
+    }
+  }
+  std::stable_sort(pairs.begin(), pairs.end(),
+                   [](const auto& a, const auto& b) { return a.first < b.first; });
+  for (const auto& [t, v] : pairs) {
+    times->push_back(t);
+    values->push_back(v);
+  }
+}
+
+NodeKeys extract_keys(const aiNodeAnim& ch, size_t* dropped) {
+  NodeKeys k;
+  auto vec = [](const aiVector3D& a, glm::dvec3* out) {
+    if (!finite3(a)) return false;
+    *out = glm::dvec3(a.x, a.y, a.z);
+    return true;
+  };
+  auto quat = [](const aiQuaternion& a, glm::dquat* out) {
+    const glm::dquat q(a.w, a.x, a.y, a.z);
+    const double len = glm::length(q);
+    if (!std::isfinite(len) || len < 1e-12) return false;
+    *out = q / len;
+    return true;
+  };
+  take_keys(ch.mPositionKeys, ch.mNumPositionKeys, &k.tt, &k.tv, vec, dropped);
+  take_keys(ch.mRotationKeys, ch.mNumRotationKeys, &k.rt, &k.rv, quat, dropped);
+  take_keys(ch.mScalingKeys, ch.mNumScalingKeys, &k.st, &k.sv, vec, dropped);
+  return k;
+}
+
+/// Index of the segment [i-1, i] holding t, and the blend factor; clamps outside the keys.
+size_t segment(const std::vector<double>& times, double t, double* f) {
+  const size_t i = static_cast<size_t>(std::upper_bound(times.begin(), times.end(), t) - times.begin());
+  if (i == 0) {
+    *f = 0.0;
+    return 1;  // caller reads [0] when f == 0
+  }
+  if (i == times.size()) {
+    *f = 1.0;
+    return times.size() - 1;
+  }
+  *f = (t - times[i - 1]) / (times[i] - times[i - 1]);
+  return i;
+}
+
+glm::dvec3 sample(const std::vector<double>& times, const std::vector<glm::dvec3>& values, double t) {
+  if (times.size() == 1) return values[0];
+  double f = 0.0;
+  const size_t i = segment(times, t, &f);
+  if (f <= 0.0) return values[i - 1];
+  return glm::mix(values[i - 1], values[i], f);
+}
+
+glm::dquat sample(const std::vector<double>& times, const std::vector<glm::dquat>& values, double t) {
+  if (times.size() == 1) return values[0];
+  double f = 0.0;
+  const size_t i = segment(times, t, &f);
+  if (f <= 0.0) return values[i - 1];
+  glm::dquat b = values[i];
+  if (glm::dot(values[i - 1], b) < 0.0) b = -b;  // shortest arc
+  return glm::normalize(glm::slerp(values[i - 1], b, f));
+}
+
+/// The node's local transform at tick t: keyed components from its keys, others from its static
+/// transform.
+glm::dmat4 local_at(const Node& node, const NodeKeys* keys, double t) {
+  if (!keys) return node.local;
+  Trs trs = decompose(node.local);
+  if (!keys->tt.empty()) trs.t = sample(keys->tt, keys->tv, t);
+  if (!keys->rt.empty()) trs.r = sample(keys->rt, keys->rv, t);
+  if (!keys->st.empty()) trs.s = sample(keys->st, keys->sv, t);
+  return compose(trs);
+}
+
+/// A track in ticks and double precision, before the final conversion.
+struct RawTrack {
+  std::vector<double> tt, rt, st;
+  std::vector<glm::dvec3> tv, sv;
+  std::vector<glm::dquat> rv;
+};
+
+/// Uniform-scale rotation+translation with positive determinant: maps keys one by one.
+bool as_similarity(const glm::dmat4& f, Trs* out) {
+  const glm::dmat3 a(f);
+  const double s = glm::length(a[0]);
+  if (!(s > 0.0) || glm::determinant(a) <= 0.0) return false;
+  constexpr double kTolerance = 1e-6;  // relative; far below what float keys can tell apart
+  for (int c = 0; c < 3; ++c) {
+    if (std::abs(glm::length(a[c]) - s) > kTolerance * s) return false;
+    for (int d = c + 1; d < 3; ++d) {
+      if (std::abs(glm::dot(a[c], a[d])) > kTolerance * s * s) return false;
+    }
+  }
+  out->t = glm::dvec3(f[3]);
+  out->r = glm::normalize(glm::quat_cast(a / s));
+  out->s = glm::dvec3(s);
+  return true;
+}
+
+RawTrack copy_keys(const NodeKeys& k, const glm::dmat4& prefix) {
+  RawTrack raw{k.tt, k.rt, k.st, k.tv, k.sv, k.rv};
+  if (relative_difference(prefix, glm::dmat4(1.0)) == 0.0) return raw;
+  Trs f;
+  as_similarity(prefix, &f);  // checked by the caller
+  for (auto& v : raw.tv) v = f.t + f.s.x * (f.r * v);
+  for (auto& q : raw.rv) q = glm::normalize(f.r * q);
+  for (auto& v : raw.sv) v = f.s.x * v;
+  return raw;
+}
+
+RawTrack resample_chain(const NodeGraph& graph, const glm::dmat4& prefix,
+                        const std::vector<int>& chain, const std::vector<const NodeKeys*>& keys_of) {
+  std::vector<double> times;
+  bool before_zero = false;
+  for (size_t i = 0; i < chain.size(); ++i) {
+    if (!keys_of[i]) continue;
+    for (const auto* list : {&keys_of[i]->tt, &keys_of[i]->rt, &keys_of[i]->st}) {
+      for (double t : *list) {
+        if (t < 0.0) {
+          before_zero = true;
+        } else {
+          times.push_back(t);
+        }
+      }
+    }
+  }
+  if (before_zero) times.push_back(0.0);  // the clip starts at 0: its value there, not earlier
+  std::sort(times.begin(), times.end());
+  times.erase(std::unique(times.begin(), times.end()), times.end());
+  RawTrack raw;
+  for (double t : times) {
+    glm::dmat4 m = prefix;
+    for (size_t i = 0; i < chain.size(); ++i) m = m * local_at(graph.nodes[chain[i]], keys_of[i], t);
+    const Trs trs = decompose(m);
+    raw.tt.push_back(t);
+    raw.tv.push_back(trs.t);
+    raw.rt.push_back(t);
+    raw.rv.push_back(trs.r);
+    raw.st.push_back(t);
+    raw.sv.push_back(trs.s);
+  }
+  return raw;
+}
+
+bool has_negative_time(const NodeKeys& k) {
+  for (const auto* list : {&k.tt, &k.rt, &k.st}) {
+    if (!list->empty() && list->front() < 0.0) return true;
+  }
+  return false;
+}
+
+RawTrack joint_keys(const NodeGraph& graph, const glm::dmat4& rig_prefix,
+                    const std::vector<int>& chain, const std::vector<const NodeKeys*>& keys_of) {
+  size_t animated = 0;
+  for (const auto* k : keys_of) animated += k ? 1 : 0;
+  const NodeKeys* last = keys_of.back();
+  if (animated == 1 && last && !has_negative_time(*last)) {
+    glm::dmat4 prefix = rig_prefix;
+    for (size_t i = 0; i + 1 < chain.size(); ++i) prefix = prefix * graph.nodes[chain[i]].local;
+    Trs unused;
+    if (relative_difference(prefix, glm::dmat4(1.0)) == 0.0 || as_similarity(prefix, &unused)) {
+      return copy_keys(*last, prefix);
+    }
+  }
+  return resample_chain(graph, rig_prefix, chain, keys_of);
+}
+
+/// Seconds, strictly increasing in float, inside [0, duration]. Returns keys dropped as duplicates.
+template <class In, class Out, class Convert>
+size_t finish_channel(const std::vector<double>& ticks, const std::vector<In>& values, double tps,
+                      float duration, std::vector<float>* times, std::vector<Out>* out,
+                      Convert convert) {
+  size_t duplicates = 0;
+  for (size_t i = 0; i < ticks.size(); ++i) {
+    const float t = std::clamp(static_cast<float>(ticks[i] / tps), 0.0f, duration);
+    if (!times->empty() && t <= times->back()) {
+      ++duplicates;  // same time twice: keep the first, as a linear sampler would reach it first
+      continue;
+    }
+    times->push_back(t);
+    out->push_back(convert(values[i]));
+  }
+  return duplicates;
+}
+
+SourceTrack finish_track(const RawTrack& raw, uint16_t joint, double tps, float duration,
+                         size_t* duplicates) {
+  SourceTrack track;
+  track.joint = joint;
+  auto vec = [](const glm::dvec3& v) { return glm::vec3(v); };
+  auto quat = [](const glm::dquat& q) { return glm::normalize(glm::quat(q)); };
+  *duplicates += finish_channel(raw.tt, raw.tv, tps, duration, &track.translation_times,
+                                &track.translations, vec);
+  *duplicates += finish_channel(raw.rt, raw.rv, tps, duration, &track.rotation_times,
+                                &track.rotations, quat);
+  *duplicates += finish_channel(raw.st, raw.sv, tps, duration, &track.scale_times, &track.scales,
+                                vec);
+  for (size_t i = 1; i < track.rotations.size(); ++i) {
+    if (glm::dot(track.rotations[i - 1], track.rotations[i]) < 0.0f) {
+      track.rotations[i] = -track.rotations[i];
+    }
+  }
+  return track;
+}
+
+/// Keys per second from the most common spacing between keys; 0 when no channel has two keys.
+float estimate_sample_rate(const std::vector<NodeKeys>& keys, double tps) {
+  std::map<long long, std::pair<size_t, double>> buckets;  // spacing in 0.1 µs -> (count, sum)
+  for (const NodeKeys& k : keys) {
+    for (const auto* list : {&k.tt, &k.rt, &k.st}) {
+      for (size_t i = 1; i < list->size(); ++i) {
+        const double d = ((*list)[i] - (*list)[i - 1]) / tps;
+        if (!(d > 0.0)) continue;
+        auto& b = buckets[std::llround(d * 1e7)];
+        ++b.first;
+        b.second += d;
+      }
+    }
+  }
+  const std::pair<size_t, double>* best = nullptr;
+  for (const auto& [spacing, b] : buckets) {
+    if (!best || b.first > best->first) best = &b;  // ties: the smaller spacing, seen first
+  }
+  if (!best) return 0.0f;
+  return static_cast<float>(static_cast<double>(best->first) / best->second);
+}
+
+// ---------------------------------------------------------------------------------------------
+// glTF STEP / CUBICSPLINE samplers
+
+/// The slowest grid that STEP and CUBICSPLINE channels are resampled on. One frame at 60 Hz is one
+/// display frame: a STEP becomes a 16.7 ms ramp at worst (none when its key lies on the grid, see
+/// resampling_rate), and a spline's chord error between frames is h²/8 · |p''| with h = 1/60 s.
+constexpr double kMinResampleRate = 60.0;
+/// Frame rates exporters key at, tried when the clip's own estimate does not hold every key.
+constexpr double kCommonRates[] = {24.0, 25.0, 30.0, 48.0, 50.0, 60.0, 100.0, 120.0};
+
+/// True when every key time (seconds) lies on a grid of `rate` frames per second, to a
+/// thousandth of a frame plus what float key times can hold.
+bool keys_on_grid(const std::vector<double>& times, double rate) {
+  for (double t : times) {
+    const double frame = t * rate;
+    const double slack = 1e-3 + 4.0 * std::abs(frame) * 1.2e-7;  // float times: ~2^-23 relative
+    if (std::abs(frame - std::round(frame)) > slack) return false;
+  }
+  return true;
+}
+
+/// Every key time of a clip, in seconds.
+std::vector<double> key_times(const std::vector<NodeKeys>& keys, double tps) {
+  std::vector<double> times;
+  for (const NodeKeys& k : keys) {
+    for (const auto* list : {&k.tt, &k.rt, &k.st}) {
+      for (double t : *list) times.push_back(t / tps);
+    }
+  }
+  return times;
+}
+
+/// The grid rate for a clip with resampled channels: the smallest multiple of the rate its keys
+/// were made at (the clip's own estimate, else a common frame rate holding every key) that is at
+/// least kMinResampleRate, so every source key, and so every STEP jump, falls on a frame; when no
+/// rate holds them all, max(estimate, kMinResampleRate). Lowered (keeping a multiple where there is
+/// one) when the clip would need more than kMaxFrames frames, never below the estimate.
+float resampling_rate(const std::vector<NodeKeys>& keys, double tps, float estimated,
+                      float duration) {
+  const std::vector<double> times = key_times(keys, tps);
+  double base = 0.0;
+  if (estimated > 0.0f && keys_on_grid(times, estimated)) base = estimated;
+  for (size_t i = 0; base == 0.0 && i < std::size(kCommonRates); ++i) {
+    if (keys_on_grid(times, kCommonRates[i])) base = kCommonRates[i];
+  }
+  double rate = base > 0.0 ? base * std::ceil(kMinResampleRate / base - 1e-9)
+                           : std::max<double>(estimated, kMinResampleRate);
+  const double fit = duration > 0.0f ? static_cast<double>(kMaxFrames - 1) / duration : rate;
+  if (rate > fit) {
+    const double lowered = base > 0.0 && fit >= base ? base * std::floor(fit / base) : fit;
+    rate = std::max<double>(lowered, estimated);
+  }
+  const double whole = std::round(rate);  // 2.4f * 25 is 60.000004: say 60
+  if (std::abs(rate - whole) < 1e-5 * rate) rate = whole;
+  return static_cast<float>(rate);
+}
+
+/// The clip's frame rate: the slowest rate whose grid holds every source key, so that cooking on
+/// that grid (cooker/clip/clip_grid.h) loses no key. The most common key spacing is only a first guess:
+/// Pab's jog keys most channels every 1/15 s but some every 1/30 s, and a BVH's "Frame Time:
+/// 0.0083333" is not exactly 120 Hz. Candidates, slowest first among: the estimate rounded to a
+/// whole rate, the estimate as measured, their multiples up to 8x, and the common exporter rates
+/// and their doubles. When none holds every key (irregular keys), the estimate is kept and the
+/// keys are resampled at the faster of the estimate and the file's own frame rate; *off_grid says
+/// so. FBX and BVH state a frame rate (Assimp's ticks per second: 30 for Pab, 1 / Frame Time for a
+/// BVH); glTF's 1000 ticks per second is a time unit, not a rate, so only rates up to 240 count.
+/// Pab's FBX clips are such a case: Assimp merges each curve's own key times, which lie on no grid,
+/// and the file's 30 fps is what ozz-animation samples them at too. 0 when there is no estimate
+/// (fewer than two keys).
+float clip_sample_rate(const std::vector<double>& times, float estimated, double tps, float duration, bool* off_grid) {
+  *off_grid = false;
+  if (!(estimated > 0.0f)) return 0.0f;
+  const double raw = estimated;
+  const double whole = std::round(raw);
+  const double file_rate = tps > 1.0 && tps <= 240.0 ? tps : 0.0;
+  std::vector<double> candidates;
+  if (file_rate > 0.0) candidates.push_back(file_rate);
+  for (int k = 1; k <= 8; ++k) {
+    if (whole > 0.0) candidates.push_back(whole * k);
+    candidates.push_back(raw * k);
+  }
+  for (double r : kCommonRates) {
+    candidates.push_back(r);
+    candidates.push_back(2.0 * r);
+  }
+  std::stable_sort(candidates.begin(), candidates.end());
+  const double fit = duration > 0.0f ? static_cast<double>(kMaxFrames - 1) / duration : 1e9;
+  for (double r : candidates) {
+    if (r + 1e-9 < raw * 0.999 || r > fit) continue;  // never coarser than the keys' own spacing
+    // A whole rate within a thousandth wins over the measured 23.99997 it was estimated as.
+    const double rounded = std::round(r);
+    if (rounded > 0.0 && std::abs(rounded - r) < 1e-3 * r && keys_on_grid(times, rounded))
+      return static_cast<float>(rounded);
+    if (keys_on_grid(times, r)) return static_cast<float>(r);
+  }
+  *off_grid = true;
+  double rate = std::max(std::abs(raw - whole) < 1e-3 * raw ? whole : raw, file_rate);
+  if (rate > fit) rate = std::max(fit, raw);
+  return static_cast<float>(rate);
+}
+
+/// One channel whose node keys are replaced by its glTF sampler.
+struct GltfFix {
+  int node = -1;  // graph node
+  gltf::TargetPath path = gltf::TargetPath::Other;
+  const gltf::Sampler* sampler = nullptr;
+};
+
+/// Per aiAnimation: the channels to resample, and those kept as Assimp's linear keys, with why.
+struct GltfClip {
+  std::vector<GltfFix> fixes;
+  std::vector<std::string> kept;
+};
+
+/// The file's samplers mapped onto the node graph, one GltfClip per aiAnimation.
+struct GltfSamplers {
+  gltf::Animations file;
+  std::vector<GltfClip> clips;
+};
+
+const char* path_name(gltf::TargetPath p) {
+  switch (p) {
+    case gltf::TargetPath::Translation:
+      return "translation";
+    case gltf::TargetPath::Rotation:
+      return "rotation";
+    case gltf::TargetPath::Scale:
+      return "scale";
+    default:
+      return "other";
+  }
+}
+
+/// glTF node -> graph node (-1 when unmatched). Assimp 5.2.5 builds its tree from the imported
+/// scene (gltf::Animations::scene_roots): the single root node is the aiScene root, several roots
+/// hang in order under a node it adds ("ROOT"), children keep the file's order, and each node is
+/// named as gltf::assimp_node_name says. Walking both trees together and accepting a pair only when
+/// name and child count agree matches nodes by position, which names alone cannot (glTF names
+/// need not be unique), and matches nothing where Assimp's tree differs from the file.
+std::vector<int> match_gltf_nodes(const gltf::Animations& file, const NodeGraph& graph) {
+  std::vector<int> node_of(file.nodes.size(), -1);
+  std::vector<std::vector<int>> children(graph.nodes.size());
+  for (size_t n = 1; n < graph.nodes.size(); ++n) {
+    // Depth-first order gives a node's children increasing indices in their source order.
+    if (graph.nodes[n].parent >= 0) children[graph.nodes[n].parent].push_back(static_cast<int>(n));
+  }
+  std::vector<std::pair<int, int>> pending;  // (glTF node, graph node)
+  if (graph.nodes.empty()) return node_of;
+  if (file.scene_roots.size() == 1) {
+    pending.emplace_back(file.scene_roots[0], 0);
+  } else if (children[0].size() == file.scene_roots.size()) {
+    for (size_t i = 0; i < file.scene_roots.size(); ++i) {
+      pending.emplace_back(file.scene_roots[i], children[0][i]);
+    }
+  }
+  std::vector<bool> used(graph.nodes.size(), false);
+  while (!pending.empty()) {
+    const auto [n, g] = pending.back();
+    pending.pop_back();
+    if (n < 0 || used[g]) continue;
+    const gltf::Node& node = file.nodes[static_cast<size_t>(n)];
+    if (graph.nodes[g].name != gltf::assimp_node_name(file, n) ||
+        children[g].size() != node.children.size()) {
+      continue;
+    }
+    used[g] = true;
+    // A node listed twice (not a tree, against the spec) has two aiNodes: keep the first.
+    if (node_of[static_cast<size_t>(n)] < 0) node_of[static_cast<size_t>(n)] = g;
+    for (size_t c = 0; c < node.children.size(); ++c) {
+      pending.emplace_back(node.children[c], children[g][c]);
+    }
+  }
+  return node_of;
+}
+
+/// Which channels of one glTF animation to resample. Only channels that move a joint (a node on
+/// some joint's chain), that step or curve in a way Assimp's linear keys do not already give, and
+/// whose keys could be read.
+GltfClip plan_gltf_clip(const gltf::Animations& file, const gltf::Animation& anim,
+                        const std::vector<int>& node_of, const NodeGraph& graph,
+                        const std::vector<bool>& on_chain) {
+  GltfClip out;
+  // (node, path): a second channel on the same target is ignored.
+  std::set<std::pair<int, int>> seen;
+  for (const gltf::Channel& ch : anim.channels) {
+    if (ch.node < 0 || ch.sampler < 0 || ch.path == gltf::TargetPath::Other) continue;
+    const gltf::Sampler& s = anim.samplers[static_cast<size_t>(ch.sampler)];
+    if (s.interpolation == gltf::Interpolation::Linear && s.error.empty()) continue;
+    if (!seen.insert({ch.node, static_cast<int>(ch.path)}).second) continue;
+    const std::string name = gltf::assimp_node_name(file, ch.node);
+    const std::string what = "'" + name + "' " + path_name(ch.path);
+    const int g = node_of[static_cast<size_t>(ch.node)];
+    if (g < 0) {
+      // A node of another scene is not imported at all (the rig stage names it); otherwise
+      // Assimp's tree differs from the file's here and the keys cannot be placed with certainty.
+      if (graph.by_name.count(name)) {
+        out.kept.push_back(what + " (Assimp's node tree differs from the file's)");
+      }
+      continue;
+    }
+    if (!on_chain[static_cast<size_t>(g)]) continue;
+    if (!s.error.empty()) {
+      out.kept.push_back(what + " (" + s.error + ")");
+      continue;
+    }
+    if (s.width != (ch.path == gltf::TargetPath::Rotation ? 4 : 3)) {
+      out.kept.push_back(what + " (the sampler's output has " + std::to_string(s.width) +
+                         " components)");
+      continue;
+    }
+    if (graph.resolve(name) != g) {
+      // Channels are bound to nodes by name (collect_keys): with a repeated name Assimp's keys may
+      // sit on another node, so replacing this node's keys could move the wrong one.
+      out.kept.push_back(what + " (the node's name is not unique)");
+      continue;
+    }
+    if (gltf::is_linear_equivalent(s)) continue;
+    out.fixes.push_back({g, ch.path, &s});
+  }
+  return out;
+}
+
+/// Reads the glTF file behind the scene and plans every clip; nullopt (with a warning when the
+/// file has STEP or CUBICSPLINE samplers or cannot be read) when nothing is to be resampled.
+std::optional<GltfSamplers> read_gltf_samplers(const Context& ctx, const NodeGraph& graph,
+                                               const Rig& rig) {
+  Result<gltf::Animations> file = gltf::read_gltf_animations(ctx.path);
+  const std::string fallback = ": STEP and CUBICSPLINE samplers, if any, are interpolated linearly";
+  if (!file) {
+    ctx.warn("glTF samplers not read (" + file.error().message + ")" + fallback);
+    return std::nullopt;
+  }
+  if (!file->any_nonlinear) return std::nullopt;
+  const aiScene& scene = *ctx.scene;
+  if (file->animations.size() != scene.mNumAnimations) {
+    ctx.warn("the file has " + std::to_string(file->animations.size()) + " animations, Assimp " +
+             std::to_string(scene.mNumAnimations) + fallback);
+    return std::nullopt;
+  }
+  GltfSamplers out;
+  out.file = std::move(*file);
+  std::vector<bool> on_chain(graph.nodes.size(), false);
+  for (const auto& chain : rig.chain) {
+    for (int c : chain) on_chain[static_cast<size_t>(c)] = true;
+  }
+  const std::vector<int> node_of = match_gltf_nodes(out.file, graph);
+  out.clips.resize(scene.mNumAnimations);
+  for (unsigned a = 0; a < scene.mNumAnimations; ++a) {
+    const gltf::Animation& anim = out.file.animations[a];
+    if (!scene.mAnimations[a]) continue;
+    if (anim.name != scene.mAnimations[a]->mName.C_Str()) {
+      // Assimp keeps the file's order and names; if not, the animations cannot be paired.
+      out.clips[a].kept.push_back("all (the file's animation " + std::to_string(a) + " is named '" +
+                                  anim.name + "')");
+      continue;
+    }
+    out.clips[a] = plan_gltf_clip(out.file, anim, node_of, graph, on_chain);
+  }
+  return out;
+}
+
+/// Replaces one channel of a node's keys with the sampler evaluated at every frame of the grid and
+/// at its own key times, all inside [0, duration]; times in ticks.
+void resample_gltf_channel(const GltfFix& fix, const FrameGrid& grid, float duration, double tps,
+                           NodeKeys* keys) {
+  const gltf::Sampler& s = *fix.sampler;
+  // A ten-thousandth of a frame: far below any real spacing, far above float rounding of a time.
+  const double snap = 1e-4 / grid.sample_rate;
+  const double end = static_cast<double>(duration) + snap;
+  std::vector<double> times;
+  for (uint32_t f = 0; f < grid.frame_count && grid.time(f) <= end; ++f) {
+    times.push_back(grid.time(f));
+  }
+  for (float t : s.times) {
+    if (t >= 0.0f && t <= duration) times.push_back(t);
+  }
+  std::sort(times.begin(), times.end());
+  std::vector<double> unique;
+  for (double t : times) {
+    if (unique.empty() || t - unique.back() > snap) unique.push_back(t);  // keeps the frame's time
+  }
+  std::vector<double>* out_times = fix.path == gltf::TargetPath::Translation ? &keys->tt
+                                   : fix.path == gltf::TargetPath::Rotation  ? &keys->rt
+                                                                             : &keys->st;
+  out_times->clear();
+  std::vector<glm::dvec3>* out_vec =
+      fix.path == gltf::TargetPath::Translation ? &keys->tv : &keys->sv;
+  if (fix.path == gltf::TargetPath::Rotation) {
+    keys->rv.clear();
+  } else {
+    out_vec->clear();
+  }
+  for (double t : unique) {
+    double v[4] = {0.0, 0.0, 0.0, 0.0};
+    gltf::evaluate(s, t, snap, v);
+    if (fix.path == gltf::TargetPath::Rotation) {
+      const glm::dquat q(v[3], v[0], v[1], v[2]);  // glTF stores (x, y, z, w)
+      const double len = glm::length(q);
+      if (!(len > 0.5)) {
+        continue;  // a spline through zero: no rotation to give, the neighbours hold
+      }
+      keys->rv.push_back(q / len);
+    } else {
+      out_vec->push_back(glm::dvec3(v[0], v[1], v[2]));
+    }
+    out_times->push_back(t * tps);
+  }
+}
+
+double ticks_per_second(const Context& ctx, const aiAnimation& anim) {
+  const double tps = anim.mTicksPerSecond;
+  if (std::isfinite(tps) && tps > 0.0) return tps;
+  // What Assimp's importers mean by 0: glTF keys are in milliseconds (Assimp's glTF2 importer
+  // writes 1000 itself); FBX, Collada and the rest follow Assimp's documented default of 25.
+  const double fallback = ctx.format == SourceFormat::Gltf ? 1000.0 : 25.0;
+  ctx.warn("clip '" + std::string(anim.mName.C_Str()) + "' has no ticks per second, " +
+           std::to_string(static_cast<int>(fallback)) + " assumed");
+  return fallback;
+}
+
+std::string clip_name(const aiAnimation& anim, unsigned index, std::set<std::string>* used) {
+  std::string base = anim.mName.length ? anim.mName.C_Str() : "clip" + std::to_string(index);
+  std::string name = base;
+  for (int n = 2; !used->insert(name).second; ++n) name = base + " (" + std::to_string(n) + ")";
+  return name;
+}
+
+/// Clips to name in the per-file warnings (one line each, however many clips a file has).
+struct ClipSummary {
+  std::vector<std::string> morphs, empty;
+};
+
+std::string join(const std::vector<std::string>& names) {
+  std::string out;
+  for (size_t i = 0; i < names.size(); ++i) out += (i ? ", " : "") + names[i];
+  return out;
+}
+
+/// Every channel's keys, indexed by node; a node animated twice in one clip keeps its first.
+struct ClipKeys {
+  std::vector<NodeKeys> keys;
+  std::vector<int> node_keys;  // per node: index into keys, or -1
+  double end_ticks = 0.0;      // the later of the stated duration and the last key
+  size_t non_finite = 0, twice = 0;
+};
+
+ClipKeys collect_keys(const NodeGraph& graph, const aiAnimation& anim) {
+  ClipKeys out;
+  out.node_keys.assign(graph.nodes.size(), -1);
+  out.end_ticks = std::isfinite(anim.mDuration) ? std::max(0.0, anim.mDuration) : 0.0;
+  for (unsigned c = 0; c < anim.mNumChannels; ++c) {
+    const aiNodeAnim* ch = anim.mChannels[c];
+    if (!ch) continue;
+    const int n = graph.resolve(ch->mNodeName.C_Str());
+    if (n < 0) continue;  // warned once per file by the rig stage
+    if (out.node_keys[n] >= 0) {
+      ++out.twice;
+      continue;
+    }
+    NodeKeys k = extract_keys(*ch, &out.non_finite);
+    if (!k.any()) continue;
+    for (const auto* list : {&k.tt, &k.rt, &k.st}) {
+      if (!list->empty()) out.end_ticks = std::max(out.end_ticks, list->back());
+    }
+    out.node_keys[n] = static_cast<int>(out.keys.size());
+    out.keys.push_back(std::move(k));
+  }
+  return out;
+}
+
+/// One track per joint whose chain carries keys, in joint order.
+std::vector<SourceTrack> joint_tracks(const NodeGraph& graph, const Rig& rig, const ClipKeys& keys,
+                                      double tps, float duration, size_t* duplicates) {
+  std::vector<SourceTrack> tracks;
+  for (size_t j = 0; j < rig.chain.size(); ++j) {
+    const auto& chain = rig.chain[j];
+    std::vector<const NodeKeys*> keys_of(chain.size(), nullptr);
+    bool animated = false;
+    for (size_t i = 0; i < chain.size(); ++i) {
+      if (keys.node_keys[chain[i]] >= 0) {
+        keys_of[i] = &keys.keys[keys.node_keys[chain[i]]];
+        animated = true;
+      }
+    }
+    if (!animated) continue;
+    const RawTrack raw = joint_keys(graph, rig.prefix[j], chain, keys_of);
+    tracks.push_back(finish_track(raw, static_cast<uint16_t>(j), tps, duration, duplicates));
+  }
+  return tracks;
+}
+
+SourceClip import_clip(const Context& ctx, const NodeGraph& graph, const Rig& rig,
+                       const aiAnimation& anim, unsigned index, const GltfClip* gltf_clip,
+                       std::set<std::string>* names, ClipSummary* summary) {
+  SourceClip clip;
+  clip.name = clip_name(anim, index, names);
+  if (clip.name != std::string(anim.mName.C_Str()) && anim.mName.length) {
+    ctx.warn("clip name '" + std::string(anim.mName.C_Str()) + "' is used twice, renamed '" +
+             clip.name + "'");
+  }
+  const double tps = ticks_per_second(ctx, anim);
+  ClipKeys keys = collect_keys(graph, anim);
+  clip.duration = static_cast<float>(keys.end_ticks / tps);
+  const std::string label = "clip '" + clip.name + "': ";
+  bool off_grid = false;
+  clip.sample_rate =
+      clip_sample_rate(key_times(keys.keys, tps), estimate_sample_rate(keys.keys, tps), tps, clip.duration,
+                       &off_grid);
+  if (off_grid) {
+    ctx.warn(label + "keys are not on any uniform frame grid; resampled at " + std::to_string(clip.sample_rate) +
+             " frames per second");
+  }
+  if (gltf_clip && !gltf_clip->fixes.empty()) {
+    // The rate first (from the source's own key times), then the keys on that grid.
+    clip.sample_rate = resampling_rate(keys.keys, tps, clip.sample_rate, clip.duration);
+    const FrameGrid grid = frame_grid(clip);
+    for (const GltfFix& fix : gltf_clip->fixes) {
+      const int k = keys.node_keys[static_cast<size_t>(fix.node)];
+      if (k < 0) continue;  // Assimp gave the node no channel: nothing is animated there to fix
+      resample_gltf_channel(fix, grid, clip.duration, tps, &keys.keys[static_cast<size_t>(k)]);
+    }
+  }
+  if (gltf_clip && !gltf_clip->kept.empty()) {
+    ctx.warn(label + "glTF STEP / CUBICSPLINE channels kept as Assimp's linear keys: " +
+             join(gltf_clip->kept));
+  }
+  size_t duplicates = 0;
+  clip.tracks = joint_tracks(graph, rig, keys, tps, clip.duration, &duplicates);
+  if (keys.non_finite) ctx.warn(label + std::to_string(keys.non_finite) + " non-finite keys dropped");
+  if (keys.twice) {
+    ctx.warn(label + std::to_string(keys.twice) + " nodes have two channels, the second is dropped");
+  }
+  if (duplicates) {
+    ctx.warn(label + std::to_string(duplicates) + " keys at a time already keyed are dropped");
+  }
+  if (anim.mNumMeshChannels || anim.mNumMorphMeshChannels) summary->morphs.push_back(clip.name);
+  if (clip.tracks.empty()) summary->empty.push_back(clip.name);
+  return clip;
+}
+
+}  // namespace
+
+std::vector<SourceClip> import_clips(const Context& ctx, const NodeGraph& graph, const Rig& rig) {
+  std::vector<SourceClip> clips;
+  const aiScene& scene = *ctx.scene;
+  if (scene.mNumAnimations && rig.skeleton.joints.empty()) {
+    ctx.warn(std::to_string(scene.mNumAnimations) +
+             " animations are dropped: they animate nothing that is a joint");
+    return clips;
+  }
+  std::optional<GltfSamplers> gltf_samplers;
+  if (ctx.format == SourceFormat::Gltf && scene.mNumAnimations) {
+    gltf_samplers = read_gltf_samplers(ctx, graph, rig);
+  }
+  std::set<std::string> names;
+  ClipSummary summary;
+  for (unsigned a = 0; a < scene.mNumAnimations; ++a) {
+    if (!scene.mAnimations[a]) continue;
+    const GltfClip* gltf_clip = gltf_samplers ? &gltf_samplers->clips[a] : nullptr;
+    clips.push_back(
+        import_clip(ctx, graph, rig, *scene.mAnimations[a], a, gltf_clip, &names, &summary));
+  }
+  if (!summary.morphs.empty()) {
+    ctx.warn("mesh and morph-target channels are not supported, dropped from clips: " +
+             join(summary.morphs));
+  }
+  if (!summary.empty.empty()) ctx.warn("clips that animate no joint: " + join(summary.empty));
+  return clips;
+}
+
+}  // namespace ossa::cook::detail

@@ -1,0 +1,221 @@
+// import_materials.cpp — Assimp materials -> Phong SourceMaterials with their textures, and the
+// file's length unit.
+//
+// Materials map one to one onto aiMaterial, so a mesh's material index needs no remapping. The
+// viewer shades Phong, so PBR files give their base colour as the diffuse colour. Textures end up
+// as the encoded bytes the source has (embedded PNG/JPEG copied as is, external files read from
+// disk next to the source), so a cooked file is self-contained; nothing is decoded or re-encoded
+// here, which keeps the cooker's output byte-exact with the source images.
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+
+#include <assimp/scene.h>
+
+#include "cooker/import/import_internal.h"
+
+namespace ossa::cook::detail {
+namespace {
+
+constexpr float kDefaultShininess = 32.0f;
+constexpr std::uintmax_t kMaxTextureBytes = 256u << 20;  // refuse absurd files rather than OOM
+
+bool get_color(const aiMaterial& mat, const char* key, unsigned type, unsigned index, glm::vec3* out) {
+  aiColor4D c;
+  if (mat.Get(key, type, index, c) != AI_SUCCESS) return false;
+  if (!std::isfinite(c.r) || !std::isfinite(c.g) || !std::isfinite(c.b)) return false;
+  *out = glm::vec3(c.r, c.g, c.b);
+  return true;
+}
+
+std::string lower(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
+/// "image/png" / "image/jpeg" from a hint or extension, else from the bytes' signature.
+std::string mime_of(const std::string& hint, const std::vector<uint8_t>& bytes) {
+  const std::string h = lower(hint);
+  if (h == "png") return "image/png";
+  if (h == "jpg" || h == "jpeg") return "image/jpeg";
+  if (bytes.size() >= 8 && bytes[0] == 0x89 && bytes[1] == 'P' && bytes[2] == 'N' && bytes[3] == 'G') {
+    return "image/png";
+  }
+  if (bytes.size() >= 3 && bytes[0] == 0xFF && bytes[1] == 0xD8 && bytes[2] == 0xFF) {
+    return "image/jpeg";
+  }
+  return {};
+}
+
+/// Forward slashes, no "./": paths from Windows-authored FBX files use backslashes.
+std::string portable(std::string path) {
+  for (char& c : path) c = c == '\\' ? '/' : c;
+  while (path.rfind("./", 0) == 0) path.erase(0, 2);
+  return path;
+}
+
+bool read_file(const std::filesystem::path& file, std::vector<uint8_t>* bytes) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(file, ec)) return false;
+  const auto size = std::filesystem::file_size(file, ec);
+  if (ec || size > kMaxTextureBytes) return false;
+  std::ifstream in(file, std::ios::binary);
+  if (!in) return false;
+  bytes->assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  return !in.bad() && bytes->size() == size;
+}
+
+/// The texture file a material names: as written relative to the source, then just its file name
+/// next to the source (authoring tools often store absolute paths from another machine).
+bool read_external(const Context& ctx, const std::string& path, std::vector<uint8_t>* bytes) {
+  const std::filesystem::path dir = std::filesystem::path(ctx.path).parent_path();
+  const std::filesystem::path as_written(path);
+  if (as_written.is_relative() && read_file(dir / as_written, bytes)) return true;
+  return read_file(dir / as_written.filename(), bytes);
+}
+
+bool embedded(const Context& ctx, const aiTexture& tex, const std::string& label, SourceTexture* out) {
+  if (tex.mHeight != 0 || !tex.pcData) {
+    ctx.warn(label + ": embedded texture is raw texels, not PNG/JPEG, dropped");
+    return false;
+  }
+  const auto* begin = reinterpret_cast<const uint8_t*>(tex.pcData);
+  out->data.assign(begin, begin + tex.mWidth);
+  out->mime = mime_of(tex.achFormatHint, out->data);
+  if (out->mime.empty()) {
+    ctx.warn(label + ": embedded texture format '" + std::string(tex.achFormatHint) +
+             "' is neither PNG nor JPEG, dropped");
+    return false;
+  }
+  return true;  // no path: an embedded image's name (glTF's "Image_0") is not a file
+}
+
+/// The first texture of the first type in `types` the material has; false when none is usable.
+bool find_texture(const Context& ctx, const aiMaterial& mat, std::initializer_list<aiTextureType> types,
+                  TextureRole role, const std::string& label, SourceTexture* out) {
+  aiString file;
+  bool found = false;
+  for (aiTextureType type : types) {
+    if (mat.GetTextureCount(type) > 0 && mat.GetTexture(type, 0, &file) == AI_SUCCESS) {
+      found = true;
+      break;
+    }
+  }
+  if (!found || file.length == 0) return false;
+  out->role = role;
+  if (const aiTexture* tex = ctx.scene->GetEmbeddedTexture(file.C_Str())) {
+    return embedded(ctx, *tex, label, out);
+  }
+  const std::string path = portable(file.C_Str());
+  if (path.rfind('*', 0) == 0) {
+    ctx.warn(label + ": names embedded texture " + path + " that the file does not have, dropped");
+    return false;
+  }
+  out->path = path;
+  std::vector<uint8_t> bytes;
+  if (!read_external(ctx, path, &bytes)) {
+    ctx.warn(label + ": texture '" + path + "' cannot be read, only its path is kept");
+    return true;
+  }
+  const std::string ext = std::filesystem::path(path).extension().string();
+  out->mime = mime_of(ext.empty() ? std::string() : ext.substr(1), bytes);
+  if (out->mime.empty()) {
+    ctx.warn(label + ": texture '" + path + "' is neither PNG nor JPEG, only its path is kept");
+    return true;
+  }
+  out->data = std::move(bytes);
+  return true;
+}
+
+SourceMaterial import_material(const Context& ctx, const aiMaterial& mat, unsigned index) {
+  SourceMaterial out;
+  aiString name;
+  if (mat.Get(AI_MATKEY_NAME, name) == AI_SUCCESS) out.name = name.C_Str();
+  get_color(mat, AI_MATKEY_COLOR_AMBIENT, &out.ambient);
+  if (!get_color(mat, AI_MATKEY_COLOR_DIFFUSE, &out.diffuse)) {
+    get_color(mat, AI_MATKEY_BASE_COLOR, &out.diffuse);  // glTF without a Phong diffuse
+  }
+  get_color(mat, AI_MATKEY_COLOR_SPECULAR, &out.specular);
+  float shininess = 0.0f;
+  if (mat.Get(AI_MATKEY_SHININESS, shininess) == AI_SUCCESS && std::isfinite(shininess) &&
+      shininess > 0.0f) {
+    out.shininess = shininess;
+  } else {
+    out.shininess = kDefaultShininess;
+  }
+  float opacity = 1.0f;
+  if (mat.Get(AI_MATKEY_OPACITY, opacity) == AI_SUCCESS && std::isfinite(opacity)) {
+    out.opacity = std::clamp(opacity, 0.0f, 1.0f);
+  }
+  const std::string label = "material '" + out.name + "' (" + std::to_string(index) + ")";
+  SourceTexture tex;
+  if (find_texture(ctx, mat, {aiTextureType_DIFFUSE, aiTextureType_BASE_COLOR}, TextureRole::Diffuse,
+                   label, &tex)) {
+    out.textures.push_back(std::move(tex));
+  }
+  tex = {};
+  if (find_texture(ctx, mat, {aiTextureType_NORMALS, aiTextureType_NORMAL_CAMERA},
+                   TextureRole::Normal, label, &tex)) {
+    out.textures.push_back(std::move(tex));
+  }
+  tex = {};
+  if (find_texture(ctx, mat, {aiTextureType_SPECULAR}, TextureRole::Specular, label, &tex)) {
+    out.textures.push_back(std::move(tex));
+  }
+  return out;
+}
+
+template <class T>
+bool metadata_number(const aiMetadata* meta, const char* key, double* out) {
+  T value{};
+  if (!meta || !meta->Get(key, value)) return false;
+  *out = static_cast<double>(value);
+  return true;
+}
+
+}  // namespace
+
+std::vector<SourceMaterial> import_materials(const Context& ctx) {
+  std::vector<SourceMaterial> materials;
+  for (unsigned i = 0; i < ctx.scene->mNumMaterials; ++i) {
+    const aiMaterial* mat = ctx.scene->mMaterials[i];
+    materials.push_back(mat ? import_material(ctx, *mat, i) : SourceMaterial{});
+  }
+  return materials;
+}
+
+float metres_per_unit(const Context& ctx) {
+  switch (ctx.format) {
+    case SourceFormat::Fbx: {
+      // FBX states its unit as centimetres per unit; Assimp passes it through as metadata (and,
+      // with AI_CONFIG_FBX_CONVERT_TO_M off, leaves the geometry in those units).
+      double cm = 0.0;
+      const aiMetadata* meta = ctx.scene->mMetaData;
+      if ((metadata_number<float>(meta, "UnitScaleFactor", &cm) ||
+           metadata_number<double>(meta, "UnitScaleFactor", &cm)) &&
+          std::isfinite(cm) && cm > 0.0) {
+        return static_cast<float>(cm / 100.0);
+      }
+      ctx.warn("FBX without a usable UnitScaleFactor: centimetres assumed");
+      return 0.01f;
+    }
+    case SourceFormat::Collada:
+      // Assimp 5.2 exposes <unit meter> only by scaling the scene root node by it, and model space
+      // is Assimp's root space (that scale is folded into the root joint), so model space is
+      // already metres: reporting the unit again would scale twice.
+      return 1.0f;
+    case SourceFormat::Bvh:
+      // BVH has no unit field: 1 is a guess, said so in the warnings.
+      ctx.warn("BVH states no length unit: 1 metre per unit assumed");
+      return 1.0f;
+    case SourceFormat::Gltf:  // glTF is metres by specification
+    case SourceFormat::Other:
+      return 1.0f;
+  }
+  return 1.0f;
+}
+
+}  // namespace ossa::cook::detail

@@ -1,0 +1,127 @@
+// import_scene.cpp — the cooker's door to Assimp: read a source file with fixed settings, then
+// convert the aiScene into a SourceScene (the stages live in the other import_*.cpp files).
+//
+// The import flags are the few post-steps whose result the cooker wants from Assimp and cannot
+// cheaply do better itself: triangles only (Triangulate, and SortByPType so point and line meshes
+// come out separate, to be dropped with a warning), shared vertices welded (JoinIdenticalVertices),
+// and ValidateDataStructure so the converter can trust indices. Deliberately absent:
+// LimitBoneWeights (the cooker caps at 4 itself and counts the vertices that lose weight),
+// GenNormals (the mesh stage generates missing normals with OpenMesh), and the
+// PreTransform/Optimize steps, which would destroy the node tree the skeleton comes from.
+// FBX pivots are not preserved, so Assimp folds pivot chains into one node transform wherever it
+// can; the converter still folds any `$AssimpFbx$` helper nodes that remain.
+//
+// Nothing escapes as an exception: Assimp throws from some importers, the standard library may
+// throw bad_alloc, and both become an Error naming the file.
+#include <algorithm>
+#include <cctype>
+#include <exception>
+#include <filesystem>
+
+#include <assimp/Importer.hpp>
+#include <assimp/config.h>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+
+#include "cooker/import/import_internal.h"
+#include "cooker/import/import_scene.h"
+
+namespace ossa::cook {
+namespace detail {
+
+SourceFormat format_of(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (ext == ".fbx") return SourceFormat::Fbx;
+  if (ext == ".gltf" || ext == ".glb") return SourceFormat::Gltf;
+  if (ext == ".dae") return SourceFormat::Collada;
+  if (ext == ".bvh") return SourceFormat::Bvh;
+  return SourceFormat::Other;
+}
+
+Result<SourceScene> convert_scene(const aiScene& scene, const std::string& path, SourceFormat format,
+                                  const ImportOptions& options) {
+  SourceScene out;
+  Context ctx;
+  ctx.scene = &scene;
+  ctx.path = path;
+  ctx.format = format;
+  ctx.options = &options;
+  ctx.warnings = &out.warnings;
+  if (!scene.mRootNode) return ctx.error("the file has no node tree");
+  ctx.mesh_kept = select_meshes(ctx);
+  const NodeGraph graph = build_node_graph(ctx);
+  Result<Rig> rig = build_rig(ctx, graph);
+  if (!rig) return rig.error();
+  out.clips = import_clips(ctx, graph, *rig);
+  Result<std::vector<SourceMesh>> meshes =
+      import_meshes(ctx, graph, *rig, &out.vertices_over_4_influences);
+  if (!meshes) return meshes.error();
+  out.meshes = std::move(*meshes);
+  out.materials = import_materials(ctx);
+  if (out.materials.empty() && !out.meshes.empty()) out.materials.emplace_back();
+  for (SourceMesh& mesh : out.meshes) {
+    if (mesh.material >= out.materials.size()) {
+      ctx.warn("mesh '" + mesh.name + "' names a material the file does not have, uses material 0");
+      mesh.material = 0;
+    }
+  }
+  out.metres_per_unit = metres_per_unit(ctx);
+  out.skeleton = std::move(rig->skeleton);
+  if (out.skeleton.joints.empty() && out.meshes.empty() && out.clips.empty()) {
+    return ctx.error("holds no mesh, skeleton or animation to cook");
+  }
+  return out;
+}
+
+namespace {
+
+/// Tangents only where a normal map will need them: CalcTangentSpace costs a pass over every
+/// vertex, and most characters here have no normal map.
+bool wants_tangents(const aiScene& scene) {
+  for (unsigned m = 0; m < scene.mNumMeshes; ++m) {
+    const aiMesh* mesh = scene.mMeshes[m];
+    if (!mesh || mesh->mTangents || !mesh->mNormals || !mesh->mTextureCoords[0]) continue;
+    if (mesh->mMaterialIndex >= scene.mNumMaterials) continue;
+    const aiMaterial* mat = scene.mMaterials[mesh->mMaterialIndex];
+    if (mat && (mat->GetTextureCount(aiTextureType_NORMALS) > 0 ||
+                mat->GetTextureCount(aiTextureType_NORMAL_CAMERA) > 0)) {
+      return true;
+    }
+  }
+  return false;
+}
+
+Result<SourceScene> read_and_convert(const std::string& path, const ImportOptions& options) {
+  Assimp::Importer importer;
+  importer.SetPropertyBool(AI_CONFIG_IMPORT_FBX_PRESERVE_PIVOTS, false);
+  importer.SetPropertyBool(AI_CONFIG_FBX_CONVERT_TO_M, false);  // keep source units
+  importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, 0);      // drop lines ourselves, with a warning
+  const aiScene* scene = importer.ReadFile(path, assimp_import_flags());
+  if (!scene) return Error{path + ": " + importer.GetErrorString()};
+  if (wants_tangents(*scene)) {
+    scene = importer.ApplyPostProcessing(aiProcess_CalcTangentSpace);
+    if (!scene) return Error{path + ": " + importer.GetErrorString()};
+  }
+  return convert_scene(*scene, path, format_of(path), options);
+}
+
+}  // namespace
+}  // namespace detail
+
+unsigned assimp_import_flags() {
+  return aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_SortByPType |
+         aiProcess_ValidateDataStructure;
+}
+
+Result<SourceScene> import_scene(const std::string& path, const ImportOptions& options) {
+  try {
+    return detail::read_and_convert(path, options);
+  } catch (const std::exception& e) {
+    return Error{path + ": " + e.what()};
+  } catch (...) {
+    return Error{path + ": unknown error while importing"};
+  }
+}
+
+}  // namespace ossa::cook

@@ -1,0 +1,113 @@
+// source_scene.h — what the import stage hands to the processing and writing stages.
+//
+// Plain float data in the conventions of the .ossa format (parents-first joints, model space =
+// the skeleton root's parent space, seconds for time), but not yet quantized, optimized or
+// serialized. Keeping Assimp types out of this struct is what lets mesh processing and writing
+// be tested without importing anything, and keeps the importer the only Assimp-aware file.
+#pragma once
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+#include <glm/gtc/quaternion.hpp>
+
+namespace ossa::cook {
+
+struct SourceJoint {
+  std::string name;
+  int parent = -1;                       // < own index; -1 for the root
+  glm::vec3 translation{0.0f};           // bind pose, local to parent
+  glm::quat rotation{1.0f, 0.0f, 0.0f, 0.0f};
+  glm::vec3 scale{1.0f};
+  glm::mat4 inverse_bind{1.0f};          // inverse of the bind model-space matrix
+};
+
+struct SourceSkeleton {
+  std::vector<SourceJoint> joints;       // parents first
+};
+
+/// One source mesh (Assimp splits by material, so one material each). Positions etc. are in mesh
+/// space; joints are skeleton joint indices with the matching inverse bind in `bind`.
+struct SourceMesh {
+  std::string name;
+  uint32_t material = 0;                 // index into SourceScene::materials
+  std::vector<glm::vec3> positions;
+  std::vector<glm::vec3> normals;        // empty or one per vertex, unit length
+  std::vector<glm::vec4> tangents;       // empty or one per vertex: xyz unit, w = bitangent sign
+  std::vector<glm::vec2> uv0;            // empty or one per vertex
+  /// Up to 4 influences per vertex, largest first, weights summing to 1; unused slots have weight 0
+  /// and joint 0. Empty when the mesh is not skinned (no skeleton in the file).
+  std::vector<std::array<uint16_t, 4>> joints;
+  std::vector<glm::vec4> weights;
+  std::vector<uint32_t> indices;         // triangle list
+  /// Skeleton joint -> the inverse bind matrix this mesh's skin uses for it. Sorted by joint,
+  /// covering every joint referenced by `joints`.
+  std::vector<std::pair<uint16_t, glm::mat4>> bind;
+};
+
+struct SourceTrack {
+  uint16_t joint = 0;
+  std::vector<float> translation_times;  // seconds, strictly increasing
+  std::vector<glm::vec3> translations;
+  std::vector<float> rotation_times;
+  std::vector<glm::quat> rotations;      // unit, neighbours on the same hemisphere
+  std::vector<float> scale_times;
+  std::vector<glm::vec3> scales;
+};
+
+/// Root motion taken out of a clip at cook time (cooker/clip/root_motion.h), one sample per frame of
+/// the clip's frame grid (cooker/clip/clip_grid.h), relative to frame 0.
+struct SourceRootMotion {
+  std::vector<glm::vec3> translations;
+  std::vector<float> yaws;               // radians about up_axis
+  uint8_t up_axis = 1;                   // 0 x, 1 y, 2 z
+};
+
+/// A named marker at a time on a clip (sidecar JSON or graph file; see docs/GRAPH.md).
+struct SourceEvent {
+  std::string name;
+  float time = 0.0f;                     // seconds, in [0, duration]
+};
+
+struct SourceClip {
+  std::string name;
+  float duration = 0.0f;                 // seconds
+  float sample_rate = 0.0f;              // source keys per second, 0 when unknown
+  std::vector<SourceTrack> tracks;       // sorted by joint, one per animated joint
+  bool has_root_motion = false;
+  SourceRootMotion root_motion;          // when has_root_motion
+  std::vector<SourceEvent> events;       // sorted by time
+};
+
+enum class TextureRole : uint8_t { Diffuse = 0, Normal = 1, Specular = 2 };
+
+struct SourceTexture {
+  TextureRole role = TextureRole::Diffuse;
+  std::string path;                      // relative to the source file, when external
+  std::string mime;                      // "image/png", "image/jpeg" when embedded
+  std::vector<uint8_t> data;             // encoded bytes as the source had them, when embedded
+};
+
+struct SourceMaterial {
+  std::string name;
+  glm::vec3 ambient{0.1f};
+  glm::vec3 diffuse{0.8f};
+  glm::vec3 specular{0.5f};
+  float shininess = 32.0f;
+  float opacity = 1.0f;
+  std::vector<SourceTexture> textures;
+};
+
+struct SourceScene {
+  SourceSkeleton skeleton;               // empty for a file without joints
+  std::vector<SourceMesh> meshes;
+  std::vector<SourceClip> clips;
+  std::vector<SourceMaterial> materials;
+  float metres_per_unit = 1.0f;          // length of one source unit (FBX UnitScaleFactor / 100, ...)
+  std::vector<std::string> warnings;     // human-readable, deterministic order
+  uint32_t vertices_over_4_influences = 0;  // vertices that lost weight to the 4-influence cap
+};
+
+}  // namespace ossa::cook

@@ -1,0 +1,288 @@
+// write_ossa.cpp — SourceScene + CookedMeshes -> .ossa bytes (write_ossa.h).
+//
+// FlatBuffers builds back to front, so every child (string, vector, sub-table) is created before
+// its parent table starts. The order of creation is fixed — skeleton, meshes in order, clips in
+// order, materials in order, provenance, file — and every input is an ordered container, so the
+// bytes depend only on the input. Nothing time- or address-dependent is written.
+//
+// The GPU byte vectors (vertices, indices), embedded texture data and clips' key_values get
+// 16-byte alignment from ForceVectorAlignment right before CreateVector: flatc 2.0.8 accepts
+// force_align on vectors in the schema but generates nothing for it. The builder raises its minimum alignment to 16 with it, and
+// Finish pads the whole buffer to that, so "aligned from the end" is also "aligned from the start".
+#include "cooker/write/write_ossa.h"
+
+#include <flatbuffers/flatbuffers.h>
+
+#include <string_view>
+
+#include <ossa/format/clip_codec.h>
+#include <ossa/format/hash.h>
+#include <ossa/version.h>
+
+namespace ossa::cook {
+namespace {
+
+using flatbuffers::FlatBufferBuilder;
+using flatbuffers::Offset;
+using flatbuffers::Vector;
+
+constexpr size_t kGpuAlignment = 16;
+
+fb::Vec3 vec3(const glm::vec3& v) { return fb::Vec3(v.x, v.y, v.z); }
+fb::Quat quat(const glm::quat& q) { return fb::Quat(q.x, q.y, q.z, q.w); }
+
+// glm::mat4 is column-major (m[column][row]); so is fb::Mat4.
+fb::Mat4 mat4(const glm::mat4& m) {
+  float values[16];
+  for (int c = 0; c < 4; ++c)
+    for (int r = 0; r < 4; ++r) values[c * 4 + r] = m[c][r];
+  return fb::Mat4(flatbuffers::span<const float, 16>(values));
+}
+
+Offset<Vector<uint8_t>> aligned_bytes(FlatBufferBuilder& fbb, const std::vector<uint8_t>& bytes) {
+  fbb.ForceVectorAlignment(bytes.size(), 1, kGpuAlignment);
+  return fbb.CreateVector(bytes.data(), bytes.size());
+}
+
+Offset<fb::Skeleton> write_skeleton(FlatBufferBuilder& fbb, const SourceSkeleton& skeleton) {
+  std::vector<Offset<flatbuffers::String>> names;
+  std::vector<int16_t> parents;
+  std::vector<fb::Vec3> translations, scales;
+  std::vector<fb::Quat> rotations;
+  std::vector<fb::Mat4> inverse_bind;
+  for (const SourceJoint& j : skeleton.joints) {
+    names.push_back(fbb.CreateString(j.name));
+    parents.push_back(static_cast<int16_t>(j.parent));
+    translations.push_back(vec3(j.translation));
+    rotations.push_back(quat(j.rotation));
+    scales.push_back(vec3(j.scale));
+    inverse_bind.push_back(mat4(j.inverse_bind));
+  }
+  const auto names_v = fbb.CreateVector(names);
+  const auto parents_v = fbb.CreateVector(parents);
+  const auto translations_v = fbb.CreateVectorOfStructs(translations);
+  const auto rotations_v = fbb.CreateVectorOfStructs(rotations);
+  const auto scales_v = fbb.CreateVectorOfStructs(scales);
+  const auto inverse_bind_v = fbb.CreateVectorOfStructs(inverse_bind);
+  return fb::CreateSkeleton(fbb, names_v, parents_v, translations_v, rotations_v, scales_v, inverse_bind_v,
+                            skeleton_hash_of(skeleton));
+}
+
+Offset<fb::Mesh> write_mesh(FlatBufferBuilder& fbb, const CookedMesh& mesh) {
+  const auto name = fbb.CreateString(mesh.name);
+  const auto layout = fbb.CreateVectorOfStructs(mesh.layout);
+  const auto vertices = aligned_bytes(fbb, mesh.vertices);
+  const auto indices = aligned_bytes(fbb, mesh.indices);
+  const auto submeshes = fbb.CreateVectorOfStructs(mesh.submeshes);
+  const auto joints = fbb.CreateVector(mesh.joints);
+  std::vector<fb::Mat4> inverse_bind;
+  for (const glm::mat4& m : mesh.inverse_bind) inverse_bind.push_back(mat4(m));
+  const auto inverse_bind_v = fbb.CreateVectorOfStructs(inverse_bind);
+  const fb::Vec3 bounds_min = vec3(mesh.bounds_min), bounds_max = vec3(mesh.bounds_max);
+  const fb::Vec3 offset = vec3(mesh.position_offset), scale = vec3(mesh.position_scale);
+  return fb::CreateMesh(fbb, name, mesh.vertex_count, mesh.vertex_stride, layout, vertices, mesh.index_format,
+                        indices, submeshes, &bounds_min, &bounds_max, &offset, &scale, joints, inverse_bind_v);
+}
+
+Offset<fb::RootMotion> write_root_motion(FlatBufferBuilder& fbb, const SourceRootMotion& rm) {
+  std::vector<fb::Vec3> translations;
+  translations.reserve(rm.translations.size());
+  for (const glm::vec3& v : rm.translations) translations.push_back(vec3(v));
+  const auto translations_v = fbb.CreateVectorOfStructs(translations);
+  const auto yaws_v = fbb.CreateVector(rm.yaws);
+  return fb::CreateRootMotion(fbb, translations_v, yaws_v, rm.up_axis);
+}
+
+// Every vector is written, empty or not, so readers see the same shape for every clip.
+Offset<fb::Clip> write_clip(FlatBufferBuilder& fbb, const CompressedClip& clip, uint64_t skeleton_hash,
+                            uint16_t joint_count) {
+  const auto name = fbb.CreateString(clip.name);
+  std::vector<fb::ConstantChannel> constants;
+  constants.reserve(clip.constants.size());
+  for (const CompressedConstant& c : clip.constants) {
+    constants.emplace_back(c.joint, static_cast<fb::Channel>(c.channel),
+                           fb::Quat(c.value[0], c.value[1], c.value[2], c.value[3]));
+  }
+  std::vector<fb::AnimatedChannel> animated;
+  animated.reserve(clip.animated.size());
+  for (const CompressedAnimated& a : clip.animated) {
+    animated.emplace_back(a.joint, static_cast<fb::Channel>(a.channel), a.bits, a.dropped, a.first_key, a.key_count,
+                          a.bit_offset, fb::Vec3(a.range_min[0], a.range_min[1], a.range_min[2]),
+                          fb::Vec3(a.range_extent[0], a.range_extent[1], a.range_extent[2]));
+  }
+  const auto constants_v = fbb.CreateVectorOfStructs(constants);
+  const auto animated_v = fbb.CreateVectorOfStructs(animated);
+  const auto key_frames_v = fbb.CreateVector(clip.key_frames);
+  // Decoders read 64 bits at a time: the stream ends with kKeyValuePadding zero bytes (the
+  // compressor's BitWriter appends them; a hand-made clip without them gets them here).
+  std::vector<uint8_t> key_values = clip.key_values;
+  if (key_values.size() < kKeyValuePadding) key_values.resize(kKeyValuePadding, 0);
+  const auto key_values_v = aligned_bytes(fbb, key_values);
+  const auto compression = fb::CreateClipCompression(fbb, clip.tolerance, clip.probe_distance, clip.max_error,
+                                                     clip.mean_error, clip.worst_joint, clip.raw_bytes);
+  const auto root_motion = clip.has_root_motion ? write_root_motion(fbb, clip.root_motion) : Offset<fb::RootMotion>();
+  std::vector<Offset<fb::ClipEvent>> events;
+  for (const SourceEvent& e : clip.events) {
+    const auto event_name = fbb.CreateString(e.name);
+    events.push_back(fb::CreateClipEvent(fbb, event_name, e.time));
+  }
+  const auto events_v = fbb.CreateVector(events);
+  return fb::CreateClip(fbb, name, clip.grid.duration(), clip.grid.sample_rate, clip.grid.frame_count, skeleton_hash,
+                        joint_count, constants_v, animated_v, key_frames_v, key_values_v, compression, root_motion,
+                        events_v);
+}
+
+Offset<fb::Node> write_node(FlatBufferBuilder& fbb, const NodeDef& node) {
+  const auto name = fbb.CreateString(node.name);
+  fb::NodeData type = fb::NodeData::NONE;
+  Offset<void> data;
+  if (const auto* c = std::get_if<ClipNodeDef>(&node.kind)) {
+    type = fb::NodeData::ClipNode;
+    data = fb::CreateClipNode(fbb, c->clip, c->rate, c->rate_parameter, c->loop, c->start_offset).Union();
+  } else if (const auto* a = std::get_if<BlendAlphaDef>(&node.kind)) {
+    type = fb::NodeData::BlendAlphaNode;
+    data = fb::CreateBlendAlphaNode(fbb, a->a, a->b, a->alpha_parameter).Union();
+  } else if (const auto* s = std::get_if<SelectDef>(&node.kind)) {
+    type = fb::NodeData::SelectNode;
+    const auto children = fbb.CreateVector(s->children);
+    data = fb::CreateSelectNode(fbb, s->parameter, children, s->blend_time).Union();
+  } else if (const auto* l = std::get_if<LayeredDef>(&node.kind)) {
+    type = fb::NodeData::LayeredBlendNode;
+    std::vector<Offset<fb::Layer>> layers;
+    for (const LayerDef& layer : l->layers) {
+      std::vector<fb::MaskEntry> mask;
+      for (const MaskEntryDef& m : layer.mask) mask.emplace_back(m.joint, m.depth);
+      const auto mask_v = fbb.CreateVectorOfStructs(mask);
+      layers.push_back(fb::CreateLayer(fbb, layer.node, mask_v, layer.weight, layer.weight_parameter,
+                                       layer.blend_time, layer.mesh_space_rotation));
+    }
+    const auto layers_v = fbb.CreateVector(layers);
+    data = fb::CreateLayeredBlendNode(fbb, l->base, layers_v).Union();
+  } else if (const auto* b = std::get_if<BlendSpaceDef>(&node.kind)) {
+    type = fb::NodeData::BlendSpaceNode;
+    std::vector<fb::BlendSample> samples;
+    for (const BlendSampleDef& smp : b->samples) samples.emplace_back(smp.clip, smp.x, smp.y);
+    const auto samples_v = fbb.CreateVectorOfStructs(samples);
+    data = fb::CreateBlendSpaceNode(fbb, b->x_parameter, b->y_parameter, samples_v, b->rate, b->loop).Union();
+  } else if (const auto* d = std::get_if<AdditiveDef>(&node.kind)) {
+    type = fb::NodeData::AdditiveNode;
+    data = fb::CreateAdditiveNode(fbb, d->base, d->additive, d->weight, d->weight_parameter).Union();
+  } else if (const auto* m = std::get_if<StateMachineRefDef>(&node.kind)) {
+    type = fb::NodeData::StateMachineNode;
+    data = fb::CreateStateMachineNode(fbb, m->machine).Union();
+  }
+  return fb::CreateNode(fbb, name, type, data);
+}
+
+Offset<fb::StateMachine> write_machine(FlatBufferBuilder& fbb, const StateMachineDef& machine) {
+  const auto name = fbb.CreateString(machine.name);
+  std::vector<Offset<fb::State>> states;
+  for (const StateDef& st : machine.states) {
+    const auto state_name = fbb.CreateString(st.name);
+    states.push_back(fb::CreateState(fbb, state_name, st.node, st.restart));
+  }
+  const auto states_v = fbb.CreateVector(states);
+  std::vector<Offset<fb::Transition>> transitions;
+  for (const TransitionDef& t : machine.transitions) {
+    std::vector<fb::ConditionInstr> condition;
+    for (const CondInstr& c : t.condition)
+      condition.emplace_back(static_cast<fb::ConditionOp>(c.op), c.parameter, c.value);
+    const auto condition_v = fbb.CreateVectorOfStructs(condition);
+    transitions.push_back(fb::CreateTransition(fbb, t.from, t.to, condition_v, t.exit_time, t.duration,
+                                               static_cast<fb::TransitionMode>(t.mode)));
+  }
+  const auto transitions_v = fbb.CreateVector(transitions);
+  return fb::CreateStateMachine(fbb, name, states_v, machine.entry, transitions_v);
+}
+
+Offset<fb::Graph> write_graph(FlatBufferBuilder& fbb, const GraphDef& graph) {
+  const auto name = fbb.CreateString(graph.name);
+  std::vector<Offset<fb::Parameter>> parameters;
+  for (const GraphParameter& p : graph.parameters) {
+    const auto param_name = fbb.CreateString(p.name);
+    const auto values = p.enum_values.empty() ? Offset<Vector<Offset<flatbuffers::String>>>()
+                                              : fbb.CreateVectorOfStrings(p.enum_values);
+    parameters.push_back(fb::CreateParameter(fbb, param_name, static_cast<fb::ParameterType>(p.type), p.default_value,
+                                             p.min_value, p.max_value, values));
+  }
+  const auto parameters_v = fbb.CreateVector(parameters);
+  const auto clips_v = fbb.CreateVectorOfStrings(graph.clips);
+  std::vector<Offset<fb::Node>> nodes;
+  for (const NodeDef& node : graph.nodes) nodes.push_back(write_node(fbb, node));
+  const auto nodes_v = fbb.CreateVector(nodes);
+  std::vector<Offset<fb::StateMachine>> machines;
+  for (const StateMachineDef& machine : graph.machines) machines.push_back(write_machine(fbb, machine));
+  const auto machines_v = fbb.CreateVector(machines);
+  return fb::CreateGraph(fbb, name, graph.skeleton_hash, graph.joint_count, parameters_v, clips_v, nodes_v,
+                         machines_v, graph.root);
+}
+
+Offset<fb::Material> write_material(FlatBufferBuilder& fbb, const SourceMaterial& material) {
+  const auto name = fbb.CreateString(material.name);
+  std::vector<Offset<fb::Texture>> textures;
+  for (const SourceTexture& t : material.textures) {
+    // Absent rather than empty: a referenced texture has no data, an embedded one may have no path.
+    const auto path = t.path.empty() ? Offset<flatbuffers::String>() : fbb.CreateString(t.path);
+    const auto mime = t.mime.empty() ? Offset<flatbuffers::String>() : fbb.CreateString(t.mime);
+    const auto data = t.data.empty() ? Offset<Vector<uint8_t>>() : aligned_bytes(fbb, t.data);
+    textures.push_back(fb::CreateTexture(fbb, static_cast<fb::TextureRole>(t.role), path, mime, data));
+  }
+  const auto textures_v = fbb.CreateVector(textures);
+  const fb::Vec3 ambient = vec3(material.ambient), diffuse = vec3(material.diffuse), specular = vec3(material.specular);
+  return fb::CreateMaterial(fbb, name, &ambient, &diffuse, &specular, material.shininess, material.opacity, textures_v);
+}
+
+}  // namespace
+
+uint64_t skeleton_hash_of(const SourceSkeleton& skeleton) {
+  std::vector<std::string_view> names;
+  std::vector<int16_t> parents;
+  names.reserve(skeleton.joints.size());
+  parents.reserve(skeleton.joints.size());
+  for (const SourceJoint& j : skeleton.joints) {
+    names.push_back(j.name);
+    parents.push_back(static_cast<int16_t>(j.parent));
+  }
+  return skeleton_hash(names, parents);
+}
+
+std::vector<uint8_t> write_ossa(const SourceScene& scene, std::span<const CookedMesh> meshes,
+                                std::span<const CompressedClip> clips, const WriteProvenance& provenance,
+                                const WriteOptions& options) {
+  FlatBufferBuilder fbb(1 << 16);
+
+  // A file without joints has no skeleton table (readers see "no skeleton", not an empty one).
+  Offset<fb::Skeleton> skeleton;
+  if (options.include_skeleton && !scene.skeleton.joints.empty()) skeleton = write_skeleton(fbb, scene.skeleton);
+
+  std::vector<Offset<fb::Mesh>> mesh_offsets;
+  for (const CookedMesh& mesh : meshes) mesh_offsets.push_back(write_mesh(fbb, mesh));
+  const auto meshes_v = fbb.CreateVector(mesh_offsets);
+
+  const uint64_t rig_hash = skeleton_hash_of(scene.skeleton);
+  const auto joint_count = static_cast<uint16_t>(scene.skeleton.joints.size());
+  std::vector<Offset<fb::Clip>> clip_offsets;
+  for (const CompressedClip& clip : clips) clip_offsets.push_back(write_clip(fbb, clip, rig_hash, joint_count));
+  const auto clips_v = fbb.CreateVector(clip_offsets);
+
+  std::vector<Offset<fb::Material>> material_offsets;
+  for (const SourceMaterial& material : scene.materials) material_offsets.push_back(write_material(fbb, material));
+  const auto materials_v = fbb.CreateVector(material_offsets);
+
+  // Named first: the order of evaluation of function arguments is unspecified, the bytes must not be.
+  const auto source_name = fbb.CreateString(provenance.source_name);
+  const auto cooker_version = fbb.CreateString(kCookerVersion);
+  const auto options_text = fbb.CreateString(provenance.options);
+  const auto prov = fb::CreateProvenance(fbb, source_name, provenance.source_hash, cooker_version, options_text);
+
+  std::vector<Offset<fb::Graph>> graph_offsets;
+  for (const GraphDef& graph : options.graphs) graph_offsets.push_back(write_graph(fbb, graph));
+  const auto graphs_v = graph_offsets.empty() ? Offset<Vector<Offset<fb::Graph>>>() : fbb.CreateVector(graph_offsets);
+
+  const auto root = fb::CreateFile(fbb, kFormatVersion, scene.metres_per_unit, skeleton, meshes_v, clips_v,
+                                   materials_v, prov, graphs_v);
+  fb::FinishFileBuffer(fbb, root);
+  return std::vector<uint8_t>(fbb.GetBufferPointer(), fbb.GetBufferPointer() + fbb.GetSize());
+}
+
+}  // namespace ossa::cook

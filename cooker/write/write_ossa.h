@@ -1,0 +1,40 @@
+// write_ossa.h — serialize a cooked scene into .ossa bytes (FlatBuffers), deterministically.
+//
+// Tables are created in a fixed order from ordered containers, vertex/index/texture byte vectors are
+// aligned to 16 with ForceVectorAlignment (flatc 2.0.8 parses force_align on vectors but does not
+// generate it), and nothing time- or address-dependent is written. The result verifies with
+// ossa::verify_buffer.
+#pragma once
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "cooker/clip/clip_compress.h"
+#include "cooker/graph/graph_def.h"
+#include "cooker/mesh/mesh_build.h"
+#include "cooker/import/source_scene.h"
+
+namespace ossa::cook {
+
+struct WriteProvenance {
+  std::string source_name;   // file name only
+  uint64_t source_hash = 0;  // hash_bytes of the source file
+  std::string options;       // canonical option string
+};
+
+struct WriteOptions {
+  bool include_skeleton = true;  // false for clip-only files cooked against --skeleton
+  std::span<const GraphDef> graphs;  // animation graphs (a character cooked from a graph file)
+};
+
+/// The skeleton hash of a SourceSkeleton (ossa/format/hash.h's skeleton_hash over its names/parents).
+uint64_t skeleton_hash_of(const SourceSkeleton& skeleton);
+
+/// Serializes. `clips` are the compressed forms of scene.clips (same order); they are tagged with
+/// the hash of scene.skeleton. O(output size).
+std::vector<uint8_t> write_ossa(const SourceScene& scene, std::span<const CookedMesh> meshes,
+                                std::span<const CompressedClip> clips, const WriteProvenance& provenance,
+                                const WriteOptions& options);
+
+}  // namespace ossa::cook

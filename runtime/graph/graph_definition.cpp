@@ -1,0 +1,293 @@
+// graph_definition.cpp — binding a cooked graph to its clips and precomputing what every instance
+// shares (graph.h, graph_internal.h). Runs once per graph; allocation is fine here.
+//
+// The file was validated when it was opened (validate_graph.cpp): indices are in range, the node
+// tree is children first and shallow, conditions are well formed. What validation cannot know is
+// checked here: that the clips named exist (in this file or the extra clip files) and are bound to
+// this rig, and that 2D blend-space points triangulate.
+#include <algorithm>
+#include <cstdio>
+
+#include "graph/graph_internal.h"
+#include <ossa/anim/pose_ops.h>
+
+namespace ossa {
+using namespace graph_detail;
+
+namespace {
+
+
+const fb::Clip* find_clip(const Asset& asset, std::string_view name) {
+  const auto* clips = asset.file().clips();
+  if (!clips) return nullptr;
+  for (const fb::Clip* c : *clips)
+    if (flatbuffers::GetStringView(c->name()) == name) return c;
+  return nullptr;
+}
+
+}  // namespace
+
+size_t graph_count(const Asset& asset) {
+  const auto* graphs = asset.file().graphs();
+  return graphs ? graphs->size() : 0;
+}
+
+const fb::Graph* find_graph(const Asset& asset, std::string_view name) {
+  const auto* graphs = asset.file().graphs();
+  if (!graphs) return nullptr;
+  for (const fb::Graph* g : *graphs)
+    if (flatbuffers::GetStringView(g->name()) == name) return g;
+  return nullptr;
+}
+
+namespace graph_detail {
+
+uint32_t scratch_needed(const GraphDefinition::Impl& def, uint16_t n) {
+  const NodeInfo& info = def.nodes[n];
+  switch (info.kind) {
+    case Kind::Clip:
+      return 0;
+    case Kind::BlendAlpha: {
+      const auto* t = static_cast<const fb::BlendAlphaNode*>(info.table);
+      return std::max(scratch_needed(def, t->a()), 1 + scratch_needed(def, t->b()));
+    }
+    case Kind::Select: {
+      uint32_t need = 0;
+      for (uint16_t c : *static_cast<const fb::SelectNode*>(info.table)->children())
+        need = std::max(need, 1 + scratch_needed(def, c));
+      return need;
+    }
+    case Kind::Layered: {
+      const auto* t = static_cast<const fb::LayeredBlendNode*>(info.table);
+      uint32_t need = scratch_needed(def, t->base());
+      for (const fb::Layer* layer : *t->layers()) need = std::max(need, 1 + scratch_needed(def, layer->node()));
+      return need;
+    }
+    case Kind::BlendSpace: {
+      const auto* t = static_cast<const fb::BlendSpaceNode*>(info.table);
+      return std::min<uint32_t>(t->samples()->size(), t->y_parameter() < 0 ? 2 : 3);
+    }
+    case Kind::Additive: {
+      const auto* t = static_cast<const fb::AdditiveNode*>(info.table);
+      return std::max(scratch_needed(def, t->base()), 1 + scratch_needed(def, t->additive()));
+    }
+    case Kind::Machine: {
+      uint32_t need = 0;
+      for (const fb::State* st : *def.machines[info.machine].fb->states())
+        need = std::max(need, 1 + scratch_needed(def, st->node()));
+      return need;
+    }
+  }
+  return 0;
+}
+
+}  // namespace graph_detail
+
+GraphDefinition::GraphDefinition(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+GraphDefinition::GraphDefinition(GraphDefinition&&) noexcept = default;
+GraphDefinition& GraphDefinition::operator=(GraphDefinition&&) noexcept = default;
+GraphDefinition::~GraphDefinition() = default;
+
+Result<GraphDefinition> GraphDefinition::create(const Asset& asset, std::string_view graph_name,
+                                                std::span<const Asset* const> more_clips) {
+  const std::string where = asset.name() + ": graph '" + std::string(graph_name) + "'";
+  const fb::Graph* g = find_graph(asset, graph_name);
+  if (!g) {
+    std::string names;
+    if (const auto* graphs = asset.file().graphs())
+      for (const fb::Graph* other : *graphs) names += (names.empty() ? "" : ", ") + std::string(flatbuffers::GetStringView(other->name()));
+    return Error{asset.name() + ": no graph named '" + std::string(graph_name) + "'" +
+                 (names.empty() ? " (the file has no graphs)" : " (graphs: " + names + ")")};
+  }
+  auto impl = std::make_unique<Impl>();
+  Impl& d = *impl;
+  d.graph = g;
+  d.skeleton = asset.skeleton();
+  if (d.skeleton.empty()) return Error{where + ": the file has no skeleton to play the graph on"};
+  d.joints = static_cast<uint32_t>(d.skeleton.joint_count());
+  if (g->skeleton_hash() != d.skeleton.hash() || g->joint_count() != d.joints)
+    return Error{where + ": made for another rig (skeleton hash or joint count differs from the file's skeleton)"};
+
+  // Clips by name: this file first, then the extra clip files in order.
+  for (const flatbuffers::String* name : *g->clips()) {
+    const std::string_view clip_name = flatbuffers::GetStringView(name);
+    const fb::Clip* found = find_clip(asset, clip_name);
+    const Asset* owner = &asset;
+    for (size_t k = 0; !found && k < more_clips.size(); ++k) {
+      if (more_clips[k] == nullptr) continue;
+      found = find_clip(*more_clips[k], clip_name);
+      owner = more_clips[k];
+    }
+    if (!found) return Error{where + ": clip '" + std::string(clip_name) + "' not found in the file or the clip files given"};
+    ClipView view{found};
+    if (Status st = check_clip_binding(view, d.skeleton, owner->name() + ": clip '" + std::string(clip_name) + "'"); !st)
+      return Error{where + ": " + st.message()};
+    d.clips.push_back(view);
+    auto prototype = make_sampling_cache(view, d.skeleton);
+    if (!prototype) return Error{where + ": " + prototype.error().message};
+    d.prototypes.push_back(std::move(*prototype));
+  }
+
+  const auto& nodes = *g->nodes();
+  d.nodes.resize(nodes.size());
+  const auto parents = d.skeleton.parents();
+  std::vector<uint16_t> machine_nodes(g->machines() ? g->machines()->size() : 0, 0);
+  for (flatbuffers::uoffset_t i = 0; i < nodes.size(); ++i) {
+    const fb::Node& node = *nodes.Get(i);
+    NodeInfo& info = d.nodes[i];
+    info.floats = d.float_count;
+    info.caches = d.cache_count;
+    switch (node.data_type()) {
+      case fb::NodeData::ClipNode: {
+        info.kind = Kind::Clip;
+        const auto* c = node.data_as_ClipNode();
+        info.table = c;
+        d.float_count += 1;  // time
+        d.cache_count += 1;
+        if (c->rate() == 0.0f && c->rate_parameter() < 0) {
+          const ClipView& clip = d.clips[c->clip()];
+          auto cache = make_sampling_cache(clip, d.skeleton);
+          if (!cache) return Error{where + ": " + cache.error().message};
+          Pose pose(d.joints);
+          SampleOptions options;
+          options.loop = c->loop();
+          sample(clip, std::clamp(c->start_offset(), 0.0f, clip.duration()), options, *cache, pose);
+          info.held = static_cast<int32_t>(d.held.size());
+          d.held.push_back(std::move(pose));
+        }
+        break;
+      }
+      case fb::NodeData::BlendAlphaNode:
+        info.kind = Kind::BlendAlpha;
+        info.table = node.data_as_BlendAlphaNode();
+        break;
+      case fb::NodeData::SelectNode:
+        info.kind = Kind::Select;
+        info.table = node.data_as_SelectNode();
+        d.float_count += node.data_as_SelectNode()->children()->size();  // child weights
+        break;
+      case fb::NodeData::LayeredBlendNode: {
+        info.kind = Kind::Layered;
+        const auto* t = node.data_as_LayeredBlendNode();
+        info.table = t;
+        info.aux = static_cast<uint32_t>(d.masks.size());
+        d.float_count += t->layers()->size();  // current layer weights
+        for (const fb::Layer* layer : *t->layers()) {
+          std::vector<float> mask(d.joints, 0.0f);
+          for (const fb::MaskEntry* e : *layer->mask()) build_joint_mask(parents, e->joint(), e->depth(), mask);
+          // Mask roots and their ancestors: the joints a mesh-space blend needs model rotations of.
+          LayerJoints lj;
+          std::vector<uint8_t> on_chain(d.joints, 0), is_root(d.joints, 0);
+          for (uint32_t j = 0; j < d.joints; ++j) {
+            const int p = parents[j];
+            if (!(mask[j] > 0.0f) || (p >= 0 && mask[p] > 0.0f)) continue;
+            is_root[j] = 1;
+            for (int a = static_cast<int>(j); a >= 0 && !on_chain[a]; a = parents[a]) on_chain[a] = 1;
+          }
+          for (uint32_t j = 0; j < d.joints; ++j) {
+            if (!on_chain[j]) continue;
+            lj.chain.push_back(static_cast<uint16_t>(j));
+            lj.root.push_back(is_root[j]);
+          }
+          d.masks.push_back(std::move(mask));
+          d.layer_joints.push_back(std::move(lj));
+        }
+        break;
+      }
+      case fb::NodeData::BlendSpaceNode: {
+        info.kind = Kind::BlendSpace;
+        const auto* t = node.data_as_BlendSpaceNode();
+        info.table = t;
+        const uint32_t count = t->samples()->size();
+        d.float_count += 1 + count;  // phase, then the sample weights
+        d.cache_count += count;
+        info.samples = static_cast<uint32_t>(d.sample_x.size());
+        for (const fb::BlendSample* smp : *t->samples()) {
+          d.sample_x.push_back(smp->x());
+          d.sample_duration.push_back(d.clips[smp->clip()].duration());
+        }
+        if (t->y_parameter() >= 0) {
+          std::vector<glm::vec2> points;
+          for (const fb::BlendSample* smp : *t->samples()) points.emplace_back(smp->x(), smp->y());
+          auto space = make_blend_space_2d(points);
+          if (!space) return Error{where + ": node " + std::to_string(i) + ": " + space.error().message};
+          info.aux = static_cast<uint32_t>(d.spaces.size());
+          d.spaces.push_back(std::move(*space));
+        }
+        break;
+      }
+      case fb::NodeData::AdditiveNode:
+        info.kind = Kind::Additive;
+        info.table = node.data_as_AdditiveNode();
+        break;
+      case fb::NodeData::StateMachineNode:
+        info.kind = Kind::Machine;
+        info.table = node.data_as_StateMachineNode();
+        info.machine = node.data_as_StateMachineNode()->machine();
+        machine_nodes[info.machine] = static_cast<uint16_t>(i);
+        break;
+      default:
+        return Error{where + ": node " + std::to_string(i) + " has no kind"};  // validation forbids it
+    }
+  }
+
+  if (const auto* machines = g->machines()) {
+    d.machines.resize(machines->size());
+    for (flatbuffers::uoffset_t m = 0; m < machines->size(); ++m) {
+      MachineInfo& mi = d.machines[m];
+      mi.fb = machines->Get(m);
+      mi.node = machine_nodes[m];
+      if (const auto* transitions = mi.fb->transitions()) {
+        for (const fb::Transition* t : *transitions) {
+          TransitionInfo ti;
+          ti.fb = t;
+          ti.first_trigger = static_cast<uint32_t>(d.transition_triggers.size());
+          if (const auto* cond = t->condition())
+            for (const fb::ConditionInstr* c : *cond)
+              if (c->op() == fb::ConditionOp::Trigger) d.transition_triggers.push_back(c->parameter());
+          ti.trigger_count = static_cast<uint32_t>(d.transition_triggers.size()) - ti.first_trigger;
+          mi.transitions.push_back(ti);
+        }
+      }
+    }
+  }
+
+  d.bind = Pose(d.joints);
+  set_bind_pose(d.skeleton, d.bind);
+  d.scratch_depth = 1 + scratch_needed(d, g->root());  // poses[0]: the root evaluates there
+  return GraphDefinition(std::move(impl));
+}
+
+const fb::Graph& GraphDefinition::graph() const { return *impl_->graph; }
+const SkeletonView& GraphDefinition::skeleton() const { return impl_->skeleton; }
+uint32_t GraphDefinition::joint_count() const { return impl_->joints; }
+size_t GraphDefinition::parameter_count() const { return impl_->graph->parameters()->size(); }
+std::string_view GraphDefinition::parameter_name(size_t i) const {
+  if (i >= parameter_count()) return {};
+  return flatbuffers::GetStringView(impl_->graph->parameters()->Get(static_cast<flatbuffers::uoffset_t>(i))->name());
+}
+fb::ParameterType GraphDefinition::parameter_type(size_t i) const {
+  if (i >= parameter_count()) return fb::ParameterType::Float;
+  return impl_->graph->parameters()->Get(static_cast<flatbuffers::uoffset_t>(i))->type();
+}
+int GraphDefinition::find_parameter(std::string_view name) const {
+  for (size_t i = 0; i < parameter_count(); ++i)
+    if (parameter_name(i) == name) return static_cast<int>(i);
+  return -1;
+}
+size_t GraphDefinition::machine_count() const { return impl_->machines.size(); }
+std::string_view GraphDefinition::machine_name(size_t i) const {
+  return i < machine_count() ? flatbuffers::GetStringView(impl_->machines[i].fb->name()) : std::string_view();
+}
+size_t GraphDefinition::state_count(size_t machine) const {
+  return machine < machine_count() ? impl_->machines[machine].fb->states()->size() : 0;
+}
+std::string_view GraphDefinition::state_name(size_t machine, size_t state) const {
+  if (state >= state_count(machine)) return {};
+  return flatbuffers::GetStringView(impl_->machines[machine].fb->states()->Get(static_cast<flatbuffers::uoffset_t>(state))->name());
+}
+size_t GraphDefinition::node_count() const { return impl_->nodes.size(); }
+size_t GraphDefinition::clip_count() const { return impl_->clips.size(); }
+const ClipView& GraphDefinition::clip(size_t i) const { return impl_->clips[i]; }
+
+}  // namespace ossa

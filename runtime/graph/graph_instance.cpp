@@ -1,0 +1,212 @@
+// graph_instance.cpp — one character playing a graph: creation (every buffer reserved), the
+// parameter setters the host calls, and update() (graph.h).
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "graph/graph_internal.h"
+
+#include <cstring>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
+namespace ossa {
+using namespace graph_detail;
+
+namespace {
+
+const fb::Parameter* parameter_at(const GraphDefinition::Impl& d, int i) {
+  if (i < 0 || static_cast<size_t>(i) >= d.graph->parameters()->size()) return nullptr;
+  return d.graph->parameters()->Get(static_cast<flatbuffers::uoffset_t>(i));
+}
+
+}  // namespace
+
+GraphInstance::GraphInstance(std::unique_ptr<State> state) : state_(std::move(state)) {}
+GraphInstance::GraphInstance(GraphInstance&&) noexcept = default;
+GraphInstance& GraphInstance::operator=(GraphInstance&&) noexcept = default;
+GraphInstance::~GraphInstance() = default;
+
+namespace {
+
+std::unique_ptr<GraphScratch::Buffers> make_buffers(const GraphDefinition::Impl& d) {
+  auto b = std::make_unique<GraphScratch::Buffers>();
+  b->poses.reserve(d.scratch_depth);
+  for (uint32_t k = 0; k < d.scratch_depth; ++k) b->poses.emplace_back(d.joints);
+  b->model_base.resize(d.joints);
+  b->model_layer.resize(d.joints);
+  return b;
+}
+
+}  // namespace
+
+namespace graph_detail {
+
+void stream_pose(ConstPoseSpan from, PoseSpan to) {
+  const size_t n = static_cast<size_t>(kPoseComponents) * to.stride;
+#if defined(__SSE2__)
+  if (reinterpret_cast<uintptr_t>(from.base) % 16 == 0 && reinterpret_cast<uintptr_t>(to.base) % 16 == 0 &&
+      from.stride == to.stride) {
+    for (size_t i = 0; i < n; i += 4) _mm_stream_ps(to.base + i, _mm_load_ps(from.base + i));
+    return;  // update() fences once, after every stream of the frame
+  }
+#endif
+  std::memcpy(to.base, from.base, n * sizeof(float));
+}
+
+}  // namespace graph_detail
+
+GraphScratch::GraphScratch(std::unique_ptr<Buffers> b) : buffers_(std::move(b)) {}
+GraphScratch::GraphScratch(GraphScratch&&) noexcept = default;
+GraphScratch& GraphScratch::operator=(GraphScratch&&) noexcept = default;
+GraphScratch::~GraphScratch() = default;
+GraphScratch GraphScratch::create(const GraphDefinition& definition) {
+  return GraphScratch(make_buffers(definition.impl()));
+}
+
+Result<GraphInstance> GraphInstance::create(const GraphDefinition& definition, size_t event_capacity,
+                                            bool own_scratch) {
+  const GraphDefinition::Impl& d = definition.impl();
+  auto s = std::make_unique<State>();
+  s->def = &d;
+  s->owner = &definition;
+  const size_t param_count = d.graph->parameters()->size();
+  s->values.assign(param_count + d.float_count + d.nodes.size(), 0.0f);
+  s->params = std::span<float>(s->values.data(), param_count);
+  s->floats = std::span<float>(s->values.data() + param_count, d.float_count);
+  s->node_weights = std::span<float>(s->values.data() + param_count + d.float_count, d.nodes.size());
+  s->caches.reserve(d.cache_count);
+  for (size_t n = 0; n < d.nodes.size(); ++n) {
+    const NodeInfo& info = d.nodes[n];
+    if (info.kind == Kind::Clip && info.held >= 0) {
+      s->caches.emplace_back();  // keeps cache indices; a held pose is never sampled
+    } else if (info.kind == Kind::Clip) {
+      const auto* c = static_cast<const fb::ClipNode*>(info.table);
+      auto cache = make_sampling_cache(d.clips[c->clip()], d.skeleton, &d.prototypes[c->clip()]);
+      if (!cache) return cache.error();
+      s->caches.push_back(std::move(*cache));
+    } else if (info.kind == Kind::BlendSpace) {
+      for (const fb::BlendSample* smp : *static_cast<const fb::BlendSpaceNode*>(info.table)->samples()) {
+        auto cache = make_sampling_cache(d.clips[smp->clip()], d.skeleton, &d.prototypes[smp->clip()]);
+        if (!cache) return cache.error();
+        s->caches.push_back(std::move(*cache));
+      }
+    }
+  }
+  if (own_scratch) s->own_scratch = make_buffers(d);
+  s->machines.resize(d.machines.size());
+  for (MachineState& m : s->machines) {
+    m.translation.resize(d.joints);
+    m.rotation.resize(d.joints);
+    m.last = Pose(d.joints);
+    m.before_last = Pose(d.joints);
+  }
+  s->output = Pose(d.joints);
+  s->event_capacity = event_capacity;
+  s->events.reserve(event_capacity);
+  GraphInstance instance(std::move(s));
+  instance.reset();
+  return instance;
+}
+
+const GraphDefinition& GraphInstance::definition() const { return *state_->owner; }
+
+bool GraphInstance::set_float(int parameter, float value) {
+  const fb::Parameter* p = parameter_at(*state_->def, parameter);
+  if (!p || p->type() != fb::ParameterType::Float || std::isnan(value)) return false;
+  state_->params[static_cast<size_t>(parameter)] = std::clamp(value, p->min_value(), p->max_value());
+  return true;
+}
+
+bool GraphInstance::set_int(int parameter, int value) {
+  const fb::Parameter* p = parameter_at(*state_->def, parameter);
+  if (!p || p->type() != fb::ParameterType::Int) return false;
+  state_->params[static_cast<size_t>(parameter)] =
+      std::clamp(static_cast<float>(value), std::ceil(p->min_value()), std::floor(p->max_value()));
+  return true;
+}
+
+bool GraphInstance::set_bool(int parameter, bool value) {
+  const fb::Parameter* p = parameter_at(*state_->def, parameter);
+  if (!p || p->type() != fb::ParameterType::Bool) return false;
+  state_->params[static_cast<size_t>(parameter)] = value ? 1.0f : 0.0f;
+  return true;
+}
+
+bool GraphInstance::set_enum(int parameter, int value) {
+  const fb::Parameter* p = parameter_at(*state_->def, parameter);
+  if (!p || p->type() != fb::ParameterType::Enum || value < 0) return false;
+  const size_t count = p->enum_values() ? p->enum_values()->size() : 0;
+  if (static_cast<size_t>(value) >= count) return false;
+  state_->params[static_cast<size_t>(parameter)] = static_cast<float>(value);
+  return true;
+}
+
+bool GraphInstance::set_trigger(int parameter) {
+  const fb::Parameter* p = parameter_at(*state_->def, parameter);
+  if (!p || p->type() != fb::ParameterType::Trigger) return false;
+  state_->params[static_cast<size_t>(parameter)] = 1.0f;
+  return true;
+}
+
+float GraphInstance::value(int parameter) const {
+  if (!parameter_at(*state_->def, parameter)) return std::numeric_limits<float>::quiet_NaN();
+  return state_->params[static_cast<size_t>(parameter)];
+}
+
+void GraphInstance::reset() {
+  State& s = *state_;
+  const auto& params = *s.def->graph->parameters();
+  for (flatbuffers::uoffset_t i = 0; i < params.size(); ++i)
+    s.params[i] = params.Get(i)->type() == fb::ParameterType::Trigger ? 0.0f : params.Get(i)->default_value();
+  for (size_t m = 0; m < s.machines.size(); ++m) restart_machine(s, static_cast<uint16_t>(m));
+  restart(s, s.def->graph->root());
+  std::fill(s.node_weights.begin(), s.node_weights.end(), 0.0f);
+  s.events.clear();
+  s.dropped = 0;
+  copy_pose(s.def->bind, s.output);
+}
+
+void GraphInstance::update(float dt) {
+  if (!state_->own_scratch) return;  // made to share scratch: update(dt, scratch) only
+  update(dt, *state_->own_scratch);
+}
+
+void GraphInstance::update(float dt, GraphScratch& scratch) { update(dt, scratch.buffers()); }
+
+void GraphInstance::update(float dt, GraphScratch::Buffers& buffers) {
+  State& s = *state_;
+  s.scratch = &buffers;
+  if (!(dt >= 0.0f) || !std::isfinite(dt)) dt = 0.0f;
+  s.events.clear();
+  s.dropped = 0;
+  ++s.update_counter;
+  std::fill(s.node_weights.begin(), s.node_weights.end(), 0.0f);
+  Advance advance;
+  advance.dt = dt;
+  // The root evaluates into scratch (hot) and the result streams into the instance's output.
+  PoseSpan root = buffers.poses[0].span();
+  evaluate(s, s.def->graph->root(), advance, 1.0f, true, root, 1);
+  stream_pose(root, s.output);
+#if defined(__SSE2__)
+  // Streaming stores are weakly ordered: fence them so that whatever the host uses to hand this
+  // character to another thread (even a plain release store) publishes the pose and histories.
+  _mm_sfence();
+#endif
+  s.scratch = nullptr;
+}
+
+ConstPoseSpan GraphInstance::pose() const { return state_->output.span(); }
+std::span<const GraphEvent> GraphInstance::events() const { return state_->events; }
+size_t GraphInstance::dropped_events() const { return state_->dropped; }
+float GraphInstance::node_weight(size_t node) const {
+  return node < state_->node_weights.size() ? state_->node_weights[node] : 0.0f;
+}
+
+float GraphInstance::node_phase(size_t node) const {
+  if (node >= state_->def->nodes.size()) return 0.0f;
+  return cycle(*state_, static_cast<uint16_t>(node)).phase;
+}
+
+}  // namespace ossa

@@ -1,0 +1,194 @@
+// graph_internal.h — what the graph's .cpp files share: the bound definition (GraphDefinition::Impl)
+// and one character's state (GraphInstance::State). Not a public header.
+//
+// The definition decodes each node once into a NodeInfo (its kind, its table, where its variable
+// state lives), so evaluation switches on a small enum instead of re-reading unions, and per-joint
+// data that depends only on the graph (layer masks, 2D triangulations, the bind pose an additive
+// is measured against) is computed once and shared. Instance state is flat arrays indexed through
+// NodeInfo offsets: no per-node allocations, nothing allocated by update().
+#pragma once
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include <glm/glm.hpp>
+#include <glm/gtc/quaternion.hpp>
+
+#include <ossa/anim/blend_space.h>
+#include <ossa/graph/graph.h>
+#include <ossa/anim/sample.h>
+
+namespace ossa::graph_detail {
+
+enum class Kind : uint8_t { Clip, BlendAlpha, Select, Layered, BlendSpace, Additive, Machine };
+
+struct NodeInfo {
+  Kind kind = Kind::Clip;
+  const void* table = nullptr;  // the fb::*Node table of this kind
+  uint32_t floats = 0;          // offset of this node's variable state in State::floats
+  uint32_t caches = 0;          // first sampling cache (clip: 1, blend space: one per sample)
+  uint32_t aux = 0;             // layered: first mask (Impl::masks); blend space: 2D space index
+  uint32_t samples = 0;         // blend space: first entry in Impl::sample_x / sample_duration
+  uint16_t machine = 0;         // Machine: index into Impl::machines
+  int32_t held = -1;            // Clip with rate 0 and no rate parameter: index into Impl::held
+};
+
+/// A transition's condition and the triggers it consumes, decoded.
+struct TransitionInfo {
+  const fb::Transition* fb = nullptr;
+  uint32_t first_trigger = 0, trigger_count = 0;  // into Impl::transition_triggers
+};
+
+struct MachineInfo {
+  const fb::StateMachine* fb = nullptr;
+  uint16_t node = 0;                          // the StateMachineNode that plays it
+  std::vector<TransitionInfo> transitions;    // priority order
+};
+
+/// Per-layer joint data for a mesh-space rotation blend: the mask roots (masked joints whose parent
+/// is not masked) and their ancestors, ascending (parents first), whose model rotations the
+/// blend needs.
+struct LayerJoints {
+  std::vector<uint16_t> chain;      // ancestors of mask roots and the roots, ascending
+  std::vector<uint8_t> root;        // per chain entry: 1 when it is a mask root
+};
+
+}  // namespace ossa::graph_detail
+
+namespace ossa {
+
+struct GraphDefinition::Impl {
+  const fb::Graph* graph = nullptr;
+  SkeletonView skeleton;
+  uint32_t joints = 0;
+  std::vector<ClipView> clips;
+  std::vector<SamplingCache> prototypes;  // one per clip: the fixed values instances share
+  std::vector<graph_detail::NodeInfo> nodes;
+  std::vector<graph_detail::MachineInfo> machines;
+  std::vector<uint16_t> transition_triggers;
+  std::vector<std::vector<float>> masks;               // one per layer (joint weights)
+  std::vector<graph_detail::LayerJoints> layer_joints;  // parallel to masks
+  std::vector<BlendSpace2D> spaces;
+  std::vector<float> sample_x;         // blend-space sample positions (1D: sorted), per node in order
+  std::vector<float> sample_duration;  // their clips' durations
+  Pose bind;                       // the rig's bind pose, for additive deltas
+  /// Poses of held clips (rate 0, no rate parameter: a pose that never moves), sampled once here
+  /// and shared by every instance instead of being sampled by each, every frame.
+  std::vector<Pose> held;
+  uint32_t float_count = 0;        // size of State::floats
+  uint32_t cache_count = 0;        // sampling caches per instance
+  uint32_t scratch_depth = 0;      // scratch poses one evaluation needs at most, plus the root's
+};
+
+namespace graph_detail {
+
+/// Per joint inertialization of one channel (translation or rotation): offset = direction * x(t),
+/// x the quintic through (x0, v0, a0) reaching 0 with zero velocity and acceleration at t1.
+struct InertialChannel {
+  glm::vec3 direction{0.0f};
+  float x0 = 0.0f, v0 = 0.0f, a0 = 0.0f, t1 = 0.0f;
+};
+
+struct MachineState {
+  int current = 0;          // the state being entered / played
+  int source = -1;          // a running crossfade's source state
+  int transition = -1;      // running transition index
+  fb::TransitionMode mode = fb::TransitionMode::Crossfade;
+  float elapsed = 0.0f, duration = 0.0f;
+  double normalized = 0.0;       // the current state's normalized time since it was entered
+  double normalized_before = 0.0;  // ... at the start of the last update
+  bool looping = true;           // whether the current state's leader loops
+  // Inertialization: the offset kept when the machine switched discontinuously.
+  bool inertial = false;
+  float inertial_elapsed = 0.0f, inertial_duration = 0.0f;
+  std::vector<InertialChannel> translation, rotation;  // per joint
+  // The last two outputs (for the offset and its velocity) and when they were made.
+  Pose last, before_last;
+  float last_dt = 0.0f;
+  uint64_t last_update = 0, before_last_update = 0;  // update counter stamps; 0 = never
+  bool entered = false;    // false: enter the entry state at the next evaluation
+};
+
+}  // namespace graph_detail
+
+/// Memory an update uses only while it runs: shareable by every instance updated on one thread.
+struct GraphScratch::Buffers {
+  std::vector<Pose> poses;
+  // Mesh-space layering: model rotations of base and layer along a mask's chain, one per joint.
+  std::vector<glm::quat> model_base, model_layer;
+};
+
+struct GraphInstance::State {
+  const GraphDefinition::Impl* def = nullptr;
+  const GraphDefinition* owner = nullptr;
+  // One allocation for the per-frame scalars (a crowd pays one cache miss for them, not three):
+  std::vector<float> values;
+  std::span<float> params;          // parameter values
+  std::span<float> floats;          // node variable state
+  std::span<float> node_weights;    // per node, last update
+  std::vector<SamplingCache> caches;
+  std::unique_ptr<GraphScratch::Buffers> own_scratch;  // null when made to share a GraphScratch
+  GraphScratch::Buffers* scratch = nullptr;  // during update(): the buffers in use
+  std::vector<graph_detail::MachineState> machines;
+  Pose output;
+  std::vector<GraphEvent> events;   // capacity reserved; size() = events of the last update
+  size_t event_capacity = 0;
+  size_t dropped = 0;
+  uint64_t update_counter = 0;
+};
+
+namespace graph_detail {
+
+/// How a subtree advances this frame: by seconds, or (synchronized) by a normalized phase delta.
+struct Advance {
+  float dt = 0.0f;
+  float phase = 0.0f;
+  bool synced = false;
+};
+
+/// Evaluates node `n` into out, advancing it. weight: its contribution to the output (recorded for
+/// node_weight); dominant: whether its clips may fire events; depth: first free scratch pose.
+void evaluate(GraphInstance::State& s, uint16_t n, const Advance& advance, float weight, bool dominant,
+              PoseSpan out, uint32_t depth);
+/// Puts a subtree back to its start (clip times to start offsets, machines to entry, selection and
+/// layer weights to their targets).
+void restart(GraphInstance::State& s, uint16_t n);
+/// The subtree's leading cycle: duration in seconds (> 0) and normalized phase in [0, 1].
+struct Cycle {
+  float duration = 1.0f;
+  float phase = 0.0f;
+  bool loop = true;
+};
+Cycle cycle(const GraphInstance::State& s, uint16_t n);
+/// Moves every clip of the subtree to normalized phase p.
+void set_phase(GraphInstance::State& s, uint16_t n, float p);
+
+/// State machine node (graph_machine.cpp).
+void evaluate_machine(GraphInstance::State& s, uint16_t n, const Advance& advance, float weight, bool dominant,
+                      PoseSpan out, uint32_t depth);
+void restart_machine(GraphInstance::State& s, uint16_t machine);
+Cycle machine_cycle(const GraphInstance::State& s, uint16_t machine);
+void set_machine_phase(GraphInstance::State& s, uint16_t machine, float p);
+
+inline glm::quat rotation_at(ConstPoseSpan p, uint32_t j) {
+  return glm::quat(p[kRw][j], p[kRx][j], p[kRy][j], p[kRz][j]);
+}
+inline void set_rotation(PoseSpan p, uint32_t j, const glm::quat& q) {
+  p[kRx][j] = q.x;
+  p[kRy][j] = q.y;
+  p[kRz][j] = q.z;
+  p[kRw][j] = q.w;
+}
+
+/// Copies a pose with streaming stores (graph_instance.cpp): for destinations that are written
+/// every frame but read later or rarely (an instance's output, a machine's history). With a crowd
+/// those lines are not in cache; writing around the cache saves reading each line first and
+/// leaves the cache to what the next character reads. The caller fences (update() does, once).
+/// O(stride).
+void stream_pose(ConstPoseSpan from, PoseSpan to);
+
+/// Scratch needed by a subtree beyond `out` (graph_definition.cpp computes it once).
+uint32_t scratch_needed(const GraphDefinition::Impl& def, uint16_t n);
+
+}  // namespace graph_detail
+}  // namespace ossa

@@ -1,0 +1,187 @@
+// graph.h — the animation graph at runtime: a cooked Graph table (format/ossa.fbs) bound to its
+// clips once, then evaluated per character without allocation.
+//
+// The seed thesis studies Unreal's Animation Blueprint: an event graph sets variables each frame,
+// an anim graph of nodes turns them into a pose, and state machines (nested, with transition rules
+// and blend times) choose what plays. Here the host plays the event graph's role through the
+// parameter setters; GraphInstance::update(dt) runs the anim graph.
+//
+// Shape, after ozz-animation's split of immutable data from per-instance state:
+//   - GraphDefinition: the graph plus everything derivable from it once (clip views resolved by
+//     name, per-joint layer masks, 2D blend-space triangulations, the pose scratch depth). Read-only
+//     after creation, shared by every character (and thread) playing the graph.
+//   - GraphInstance: one character. Parameters, every node's state (clip times and sampling caches,
+//     selection weights, state machines with their transition and inertialization buffers), the
+//     scratch poses and the event buffer, all reserved when it is created. update() allocates
+//     nothing and is deterministic: the same inputs give the same bits.
+//
+// Evaluation is one recursive walk from the root over the nodes that have weight; a node with zero
+// weight is neither advanced nor sampled. Transitions:
+//   - Crossfade: source and target both advance; weight = elapsed / duration (linear, exact).
+//   - SyncCrossfade: the target starts at the source's normalized phase and both advance in
+//     normalized time over a cycle blended from the two durations, so feet stay in step.
+//   - Inertialize: the machine switches at once and the offset between the last output pose and
+//     the target's pose (per joint translation and rotation) decays to zero over the duration along
+//     a quintic that starts with the offset's own velocity (Bollo, "Inertialization", GDC 2018): no
+//     pop and no velocity jump.
+// An interruption (a transition out of a running transition's target) is handled the same way: the
+// new transition starts from the target, and the pose the character had is kept by an inertialized
+// offset, so the blend continues from the current blended pose without a pop.
+//
+// Events: a clip player reports the events its clip crosses in [previous time, new time) (wrapped
+// across loops, reversed for negative rates), only when it lies on the dominant path: at every blend
+// the child with the most weight (ties: the later child, i.e. a transition's target) passes dominance
+// down; a layer or additive passes it to its input too when its weight is >= 0.5.
+#pragma once
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <ossa/format/result.h>
+#include <ossa/loader/asset.h>
+#include <ossa/anim/pose.h>
+
+namespace ossa {
+
+/// Graphs in a file.
+size_t graph_count(const Asset& asset);
+/// The graph named `name`, or null.
+const fb::Graph* find_graph(const Asset& asset, std::string_view name);
+
+/// An event crossed during the last update.
+struct GraphEvent {
+  std::string_view name;  // points into the file
+  uint16_t clip = 0;      // index into the graph's clips
+  uint16_t node = 0;      // the clip player or blend space that played it
+  float time = 0.0f;      // the event's time in the clip, seconds
+};
+
+/// Where a state machine is: for the host's UI and for tests.
+struct MachineStatus {
+  int current = -1;         // the state being entered (a transition's target while one runs)
+  int previous = -1;        // a running crossfade's source state, -1 when none
+  float weight = 1.0f;      // the current state's blend weight (1 when no crossfade runs)
+  float elapsed = 0.0f;     // seconds since the last transition started
+  float duration = 0.0f;    // that transition's duration (0 when none ever ran)
+  int transition = -1;      // index of the running transition, -1 when none
+  float inertial_remaining = 0.0f;  // seconds left on an inertialization offset (0: none)
+};
+
+/// The immutable, shared part. Build once per (graph, clip sources); it must outlive its instances
+/// and stay where it is while they live (they point at it), and the Assets it was made from must
+/// outlive it (moving an Asset is fine: its bytes stay put).
+class GraphDefinition {
+ public:
+  /// Binds `graph_name` of `asset` (the file's skeleton is the rig) to its clips, looked up by name
+  /// in `asset` and then in `more_clips` (clip-only files cooked against the same rig). Errors name
+  /// the file and graph: missing graph, no skeleton, a clip not found or bound to another rig.
+  /// O(nodes + joints * layers + clips * names).
+  static Result<GraphDefinition> create(const Asset& asset, std::string_view graph_name,
+                                        std::span<const Asset* const> more_clips = {});
+
+  GraphDefinition(GraphDefinition&&) noexcept;
+  GraphDefinition& operator=(GraphDefinition&&) noexcept;
+  ~GraphDefinition();
+
+  const fb::Graph& graph() const;
+  const SkeletonView& skeleton() const;
+  uint32_t joint_count() const;
+  size_t parameter_count() const;
+  std::string_view parameter_name(size_t i) const;
+  fb::ParameterType parameter_type(size_t i) const;
+  /// Index of the parameter, or -1. O(parameters).
+  int find_parameter(std::string_view name) const;
+  size_t machine_count() const;
+  std::string_view machine_name(size_t i) const;
+  std::string_view state_name(size_t machine, size_t state) const;
+  size_t state_count(size_t machine) const;
+  size_t node_count() const;
+  size_t clip_count() const;
+  const ClipView& clip(size_t i) const;
+
+  struct Impl;
+  const Impl& impl() const { return *impl_; }
+
+ private:
+  explicit GraphDefinition(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+/// The memory an update needs only while it runs (scratch poses, model rotations for mesh-space
+/// layers): about three poses for the Pab sample. Every instance owns one by default; a host with
+/// thousands of characters makes instances without (GraphInstance::create(..., false)) and gives
+/// one GraphScratch per thread to update(), so each character's own state stays small and the
+/// scratch stays hot in cache. One scratch serves every instance of the definition it was made for.
+class GraphScratch {
+ public:
+  static GraphScratch create(const GraphDefinition& definition);
+  GraphScratch(GraphScratch&&) noexcept;
+  GraphScratch& operator=(GraphScratch&&) noexcept;
+  ~GraphScratch();
+  struct Buffers;
+  Buffers& buffers() { return *buffers_; }
+
+ private:
+  explicit GraphScratch(std::unique_ptr<Buffers> b);
+  std::unique_ptr<Buffers> buffers_;
+};
+
+/// One character playing a graph.
+class GraphInstance {
+ public:
+  /// Reserves everything update() will use. `event_capacity` bounds the events kept per update
+  /// (more are counted in dropped_events()). own_scratch = false: update(dt, scratch) only.
+  /// O(joints * (scratch poses + machines) + clip channels).
+  static Result<GraphInstance> create(const GraphDefinition& definition, size_t event_capacity = 64,
+                                      bool own_scratch = true);
+
+  GraphInstance(GraphInstance&&) noexcept;
+  GraphInstance& operator=(GraphInstance&&) noexcept;
+  ~GraphInstance();
+
+  const GraphDefinition& definition() const;
+
+  // ---- parameters (the event graph's side). Setters return false, and change nothing, for an
+  // index out of range or a parameter of another type. Floats and ints are clamped to the
+  // parameter's range; enums must be < the value count. O(1).
+  bool set_float(int parameter, float value);
+  bool set_int(int parameter, int value);
+  bool set_bool(int parameter, bool value);
+  bool set_enum(int parameter, int value);
+  /// Sets a trigger; it stays set until a transition whose condition reads it fires.
+  bool set_trigger(int parameter);
+  /// Any parameter's current value as stored (bools and triggers 0 / 1). NaN for a bad index.
+  float value(int parameter) const;
+
+  /// Advances by dt seconds (>= 0) and evaluates the output pose. Allocation-free. The first form
+  /// uses the instance's own scratch (it must have one); the second a shared one.
+  void update(float dt);
+  void update(float dt, GraphScratch& scratch);
+  /// Back to the state a fresh instance has (parameters to defaults, machines to entry, times to
+  /// start offsets). Allocation-free.
+  void reset();
+
+  /// The output local pose of the last update (the bind pose before the first).
+  ConstPoseSpan pose() const;
+  /// Events crossed in the last update, in the order they were reached.
+  std::span<const GraphEvent> events() const;
+  size_t dropped_events() const;
+
+  MachineStatus machine_status(size_t machine) const;
+  /// The weight a node contributed to the output in the last update (0 when it was not evaluated).
+  float node_weight(size_t node) const;
+  /// A node's normalized phase in [0, 1] (its leading clip's time / duration), for tools and tests.
+  float node_phase(size_t node) const;
+
+  struct State;
+
+ private:
+  explicit GraphInstance(std::unique_ptr<State> state);
+  void update(float dt, GraphScratch::Buffers& buffers);
+  std::unique_ptr<State> state_;
+};
+
+}  // namespace ossa
