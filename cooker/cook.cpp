@@ -44,18 +44,30 @@ std::string CookOptions::canonical() const {
     s += buf;
   }
   if (root_motion) s += std::string(";root_motion=") + "xyz"[up_axis % 3];
-  if (reference != nullptr) s += ";skeleton=" + reference_name;
+  // The rig by name and content: the reference usually lives in the output tree, outside the
+  // input's directory, so it enters the key through its hash here rather than as a relative path.
+  if (reference != nullptr) {
+    s += ";skeleton=" + reference_name;
+    if (reference_input.present) s += "@" + hex64(reference_input.hash);
+  }
   return s;
 }
 
 namespace detail {
 
-Result<std::vector<uint8_t>> read_bytes(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return Error{path.string() + ": cannot open: " + std::strerror(errno)};
-  std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (in.bad()) return Error{path.string() + ": read error"};
-  return bytes;
+Result<std::vector<uint8_t>> read_bytes(const fs::path& path) { return read_input(path); }
+
+void finish_provenance(WriteProvenance& provenance, CookRecord& record, const fs::path& input,
+                       const CookOptions& options) {
+  provenance.source_name = input.filename().string();
+  provenance.options = options.canonical();
+  const InputLog* log = current_input_log();
+  record.inputs_read = log != nullptr ? log->files() : std::vector<InputFile>{};
+  provenance.inputs = relative_inputs(record.inputs_read, input.parent_path());
+  provenance.cook_key = cook_key(provenance.inputs, provenance.options);
+  record.cook_key = provenance.cook_key;
+  for (const InputFile& f : provenance.inputs)
+    if (f.path == provenance.source_name) provenance.source_hash = f.hash;
 }
 
 Result<std::vector<CompressedClip>> cook_clips(SourceScene& scene, const CookOptions& options, CookRecord& record,
@@ -113,13 +125,14 @@ void count_meshes(CookRecord& record, const std::vector<CookedMesh>& meshes, con
 }
 
 bool write_verified(CookRecord& record, const std::vector<uint8_t>& bytes, const fs::path& input,
-                    const fs::path& output) {
+                    const fs::path& output, bool write) {
   // The writer's output must pass the same checks every reader makes; a cooker bug is caught here
   // rather than in a game.
   if (Status st = verify_buffer(bytes, output.filename().string()); !st) {
     record.error = input.string() + ": internal error, cooked bytes fail verification: " + st.message();
     return false;
   }
+  if (!write) return true;  // --list-inputs: the cook ran to the end, nothing is written
   if (Status st = write_file_atomic(output, bytes); !st) {
     record.error = st.message();
     return false;
@@ -135,6 +148,55 @@ namespace {
 using detail::count_meshes;
 using detail::count_scene;
 using detail::read_bytes;
+
+/// The up-to-date check (cook.h): the existing output's provenance lists what its cook read;
+/// those files are re-read and re-hashed (a file listed absent must still be absent) and the key
+/// recomputed with today's options and versions. Any doubt (no output, one that does not verify,
+/// an older format without a key, a listed file now unreadable) means "cook it".
+bool up_to_date(CookRecord& record, const fs::path& input, const fs::path& output, const CookOptions& options) {
+  std::error_code ec;
+  if (!fs::is_regular_file(output, ec)) return false;
+  auto asset = Asset::open(output.string(), OpenMode::kRead);
+  if (!asset) return false;
+  const fb::Provenance* prov = asset->file().provenance();
+  if (prov == nullptr || prov->inputs() == nullptr || prov->inputs()->size() == 0) return false;
+  const std::string canonical = options.canonical();
+  if (flatbuffers::GetStringView(prov->options()) != canonical) return false;
+  const fs::path base = input.parent_path();
+  InputLog log;
+  InputLogScope scope(&log);
+  for (const fb::InputFile* f : *prov->inputs()) {
+    if (f->path() == nullptr) return false;
+    const fs::path path = (base / fs::path(f->path()->str())).lexically_normal();
+    if (f->absent()) {
+      if (probe_input(path)) return false;  // it appeared: the cook would read it
+    } else if (!read_input(path)) {
+      return false;
+    }
+  }
+  const std::vector<InputFile> files = log.files();
+  if (cook_key(relative_inputs(files, base), canonical) != prov->cook_key()) return false;
+  record.ok = true;
+  record.up_to_date = true;
+  record.inputs_read = files;
+  record.cook_key = prov->cook_key();
+  record.cooked_bytes = fs::file_size(output, ec);
+  const std::string main_input = fs::absolute(input, ec).lexically_normal().string();
+  for (const InputFile& f : files)
+    if (f.present && f.path == main_input) record.source_bytes = f.size;
+  const SkeletonView sk = asset->skeleton();
+  record.joints = static_cast<uint32_t>(sk.empty() ? 0 : sk.joint_count());
+  record.meshes = static_cast<uint32_t>(asset->mesh_count());
+  uint32_t vertices = 0, triangles = 0;
+  for (size_t m = 0; m < asset->mesh_count(); ++m) {
+    vertices += asset->mesh(m).vertex_count();
+    triangles += asset->mesh(m).index_count() / 3;
+  }
+  record.vertices = vertices;
+  record.triangles = triangles;
+  record.clips = static_cast<uint32_t>(asset->clip_count());
+  return true;
+}
 
 void cook_into(CookRecord& record, const fs::path& input, const fs::path& output, const CookOptions& options) {
   std::error_code ec;
@@ -187,17 +249,13 @@ void cook_into(CookRecord& record, const fs::path& input, const fs::path& output
   }
 
   WriteProvenance provenance;
-  provenance.source_name = input.filename().string();
-  provenance.source_hash = hash_bytes(source->data(), source->size());
-  if (sidecar->present)
-    provenance.source_hash = hash_bytes(sidecar->bytes.data(), sidecar->bytes.size(), provenance.source_hash);
-  provenance.options = options.canonical();
+  detail::finish_provenance(provenance, record, input, options);
   // A clip-only file binds to its rig by hash and carries no skeleton; a file with meshes always
   // carries the rig its joint palettes index (with --skeleton, the reference's, hash-identical).
   WriteOptions write_options;
   write_options.include_skeleton = options.reference == nullptr || !meshes->empty();
   const std::vector<uint8_t> bytes = write_ossa(*scene, *meshes, *clips, provenance, write_options);
-  if (!detail::write_verified(record, bytes, input, output)) return;
+  if (!detail::write_verified(record, bytes, input, output, options.write)) return;
 
   record.ok = true;
   if (!write_options.include_skeleton) record.joints = 0;  // the file carries no rig of its own
@@ -210,8 +268,10 @@ CookRecord cook_file(const fs::path& input, const fs::path& output, const CookOp
   record.input = input.string();
   record.output = output.string();
   const auto start = std::chrono::steady_clock::now();
+  InputLog log;
+  InputLogScope scope(&log);
   try {
-    cook_into(record, input, output, options);
+    if (options.force || !up_to_date(record, input, output, options)) cook_into(record, input, output, options);
   } catch (const std::exception& e) {
     record.ok = false;
     record.error = input.string() + ": unexpected failure: " + e.what();
@@ -219,11 +279,25 @@ CookRecord cook_file(const fs::path& input, const fs::path& output, const CookOp
     record.ok = false;
     record.error = input.string() + ": unexpected failure";
   }
+  if (!record.ok && record.inputs_read.empty()) record.inputs_read = log.files();  // as far as it got
+  // --skeleton's file is keyed through the options (canonical()); the depfile still names it.
+  if (options.reference != nullptr && options.reference_input.present && !is_graph_file(input)) {
+    record.inputs_read.push_back(options.reference_input);
+    std::sort(record.inputs_read.begin(), record.inputs_read.end(),
+              [](const InputFile& a, const InputFile& b) { return a.path < b.path; });
+  }
   record.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return record;
 }
 
-Result<SourceSkeleton> load_reference_skeleton(const fs::path& ossa_file) {
+Result<SourceSkeleton> load_reference_skeleton(const fs::path& ossa_file, InputFile* as_read) {
+  if (as_read != nullptr) {
+    InputLog log;
+    InputLogScope scope(&log);
+    auto bytes = read_input(ossa_file);
+    if (!bytes) return bytes.error();
+    *as_read = log.files().front();
+  }
   auto asset = Asset::open(ossa_file.string());
   if (!asset) return asset.error();
   const SkeletonView sk = asset->skeleton();

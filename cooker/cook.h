@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "cooker/clip/clip_compress.h"
+#include "cooker/import/input_log.h"
 #include "cooker/import/source_scene.h"
 #include <ossa/format/result.h>
 
@@ -25,8 +26,13 @@ struct CookOptions {
   /// Clip-only cooking against this rig (loaded from --skeleton REF.ossa); null otherwise.
   const SourceSkeleton* reference = nullptr;
   std::string reference_name;  // REF.ossa's file name, recorded in the options string
+  InputFile reference_input;   // REF.ossa as read (absolute path, hash): its hash is in canonical()
   /// Canonical text of the options that change output bytes, recorded in provenance.
   std::string canonical() const;
+
+  // How to run, not what to make (not in canonical(), not in the key):
+  bool force = false;  // --force: cook even when the output is up to date
+  bool write = true;   // false (--list-inputs): cook in memory, write nothing
 };
 
 /// What compression achieved on one clip (--report, ossa-bench-compression).
@@ -59,9 +65,20 @@ struct CookRecord {
   uint64_t cooked_bytes = 0;          // the written file (ok only)
   double seconds = 0.0;
   std::vector<ClipRecord> clip_records;  // one per clip compressed before any failure
+  /// Every file the cook read or looked for (absolute paths, sorted), as far as it got; for an
+  /// up-to-date output, the inputs its provenance lists. The depfile and --list-inputs print these.
+  std::vector<InputFile> inputs_read;
+  uint64_t cook_key = 0;   // of the written (or up-to-date) output
+  bool up_to_date = false; // ok without cooking: the output's cook key matched (nothing written)
 };
 
 /// Cooks `input` to `output` (parent directories are created). Never throws.
+///
+/// Unless options.force, an existing `output` whose provenance cook key equals the key of the
+/// inputs it lists as they are now (re-hashed) is up to date: it is neither cooked nor rewritten
+/// (its mtime stays), and the record says so. Every file read goes into the record's inputs_read
+/// and, relative to the input's directory, into the output's provenance with the cook key
+/// (input_log.h).
 ///
 /// A source file's clips get the events of its sidecar `<stem>.events.json` when there is one
 /// (cooker/clip/clip_events.h; the sidecar's bytes are part of the provenance hash). A graph file
@@ -73,8 +90,9 @@ CookRecord cook_file(const std::filesystem::path& input, const std::filesystem::
 /// True for `*.graph.json` (case-insensitive): an animation graph file rather than a source.
 bool is_graph_file(const std::filesystem::path& path);
 
-/// Loads the skeleton of a cooked file (for --skeleton). Errors name the file.
-Result<SourceSkeleton> load_reference_skeleton(const std::filesystem::path& ossa_file);
+/// Loads the skeleton of a cooked file (for --skeleton). Errors name the file. `as_read`, when
+/// given, receives the file's input record (absolute path, hash, size) for the cooks' input logs.
+Result<SourceSkeleton> load_reference_skeleton(const std::filesystem::path& ossa_file, InputFile* as_read = nullptr);
 
 /// Writes bytes to a temporary file in path's directory, flushes, then renames it onto path.
 /// On any failure the temporary is removed and path is untouched.

@@ -10,6 +10,7 @@
 #include "cooker/cook.h"
 #include "cooker/import/source_scene.h"
 #include "cooker/mesh/mesh_build.h"
+#include "cooker/write/write_ossa.h"
 #include <ossa/format/result.h>
 
 namespace ossa::cook::detail {
@@ -29,10 +30,16 @@ void count_scene(CookRecord& record, const SourceScene& scene);
 /// The counts a record knows once the meshes are built: meshes, submeshes, vertices, triangles.
 void count_meshes(CookRecord& record, const std::vector<CookedMesh>& meshes, const MeshBuildStats& stats);
 
-/// verify_buffer, then write_file_atomic. On success sets record.cooked_bytes; otherwise
-/// record.error, and returns false.
+/// verify_buffer, then (when `write`) write_file_atomic. On success sets record.cooked_bytes;
+/// otherwise record.error, and returns false.
 bool write_verified(CookRecord& record, const std::vector<uint8_t>& bytes, const std::filesystem::path& input,
-                    const std::filesystem::path& output);
+                    const std::filesystem::path& output, bool write);
+
+/// Fills the provenance from the current input log once every input is read: source name and
+/// hash, canonical options, the inputs relative to the input's directory and the cook key; copies
+/// the inputs (absolute) and the key into the record.
+void finish_provenance(WriteProvenance& provenance, CookRecord& record, const std::filesystem::path& input,
+                       const CookOptions& options);
 
 /// cook_file for a graph file (cook_graph.cpp).
 void cook_graph(CookRecord& record, const std::filesystem::path& input, const std::filesystem::path& output,

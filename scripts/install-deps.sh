@@ -6,7 +6,7 @@ set -euo pipefail
 PACKAGES=(
   cmake ninja-build g++ pkg-config git
   libassimp-dev libglm-dev libglfw3-dev flatbuffers-compiler libflatbuffers-dev libstb-dev
-  libopenmesh-dev libmeshoptimizer-dev libcli11-dev nlohmann-json3-dev
+  libopenmesh-dev libmeshoptimizer-dev libcli11-dev nlohmann-json3-dev libxxhash-dev
   libgtest-dev libgmock-dev libbenchmark-dev libimgui-dev libepoxy-dev
   xvfb xauth libgl1-mesa-dri libglx-mesa0 mesa-utils
   clang libclang-rt-14-dev

@@ -286,7 +286,7 @@ TEST(GraphCli, DirectoriesPickUpGraphFilesButNotOtherJson) {
   EXPECT_EQ(count_files(dir / "out"), 2u) << "no output for notes.json or walk.events.json";
 }
 
-TEST(GraphCli, ProvenanceHashFollowsEveryFileTheGraphReads) {
+TEST(GraphCli, CookKeyFollowsEveryFileTheGraphReads) {
   const fs::path dir = ossa::test::make_temp_dir("graph-hash");
   fs::copy_file(pab("walk.fbx"), dir / "walk.fbx");
   ASSERT_TRUE(ossa::test::write_file(dir / "g.graph.json", small_graph(kSmallRoot, (dir / "walk.fbx").string())));
@@ -295,7 +295,7 @@ TEST(GraphCli, ProvenanceHashFollowsEveryFileTheGraphReads) {
     EXPECT_EQ(r.exit_code, 0) << r.err;
     auto a = ossa::Asset::open((dir / out / "g.ossa").string());
     EXPECT_TRUE(a.ok());
-    return a.ok() ? a->file().provenance()->source_hash() : 0;
+    return a.ok() ? a->file().provenance()->cook_key() : 0;
   };
   const uint64_t without_sidecar = hash_after_cook("a");
   ASSERT_TRUE(ossa::test::write_file(

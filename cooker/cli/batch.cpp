@@ -88,6 +88,32 @@ std::vector<CookRecord> run_batch(const std::vector<BatchItem>& items, const Coo
   return records;
 }
 
+namespace {
+
+std::string make_escaped(const std::string& path) {
+  std::string out;
+  for (char c : path) {
+    if (c == ' ' || c == '#') out += '\\';
+    if (c == '$') out += '$';
+    out += c;
+  }
+  return out;
+}
+
+}  // namespace
+
+Status write_depfile(const fs::path& path, const std::vector<CookRecord>& records) {
+  std::string text;
+  for (const CookRecord& r : records) {
+    if (!r.ok) continue;
+    text += make_escaped(fs::absolute(r.output).lexically_normal().string()) + ":";
+    for (const InputFile& f : r.inputs_read)
+      if (f.present) text += " \\\n  " + make_escaped(f.path);
+    text += "\n";
+  }
+  return write_file_atomic(path, std::vector<uint8_t>(text.begin(), text.end()));
+}
+
 nlohmann::ordered_json report_json(const std::vector<CookRecord>& records, const CookOptions& options) {
   nlohmann::ordered_json doc;
   doc["schema"] = kReportSchema;
@@ -137,6 +163,22 @@ nlohmann::ordered_json report_json(const std::vector<CookRecord>& records, const
     j["clip_compression"] = std::move(clips);
     j["source_bytes"] = r.source_bytes;
     if (r.ok) j["cooked_bytes"] = r.cooked_bytes;
+    if (r.ok) j["up_to_date"] = r.up_to_date;
+    if (r.ok) j["cook_key"] = hex64(r.cook_key);
+    // What the cook read (as far as it got), relative to the input's directory like provenance.
+    nlohmann::ordered_json inputs = nlohmann::ordered_json::array();
+    for (const InputFile& f : relative_inputs(r.inputs_read, fs::path(r.input).parent_path())) {
+      nlohmann::ordered_json fj;
+      fj["path"] = f.path;
+      if (f.present) {
+        fj["hash"] = hex64(f.hash);
+        fj["bytes"] = f.size;
+      } else {
+        fj["absent"] = true;
+      }
+      inputs.push_back(std::move(fj));
+    }
+    j["inputs_read"] = std::move(inputs);
     j["seconds"] = r.seconds;
     j["warnings"] = r.warnings;
     list.push_back(std::move(j));

@@ -45,6 +45,12 @@ using BatchProgress = std::function<void(size_t done, size_t total, const CookRe
 std::vector<CookRecord> run_batch(const std::vector<BatchItem>& items, const CookOptions& options,
                                   unsigned jobs, const BatchProgress& progress);
 
+/// Writes a Make-syntax depfile (atomically): one rule per output written or up to date,
+/// `OUTPUT: INPUT...`, naming every file its cook read that exists (a file looked for and absent
+/// cannot be a prerequisite: Make would fail and Ninja would re-cook every time). Spaces, '#' and
+/// '$' in paths are escaped as Make and Ninja read them. Failed inputs have no rule.
+Status write_depfile(const std::filesystem::path& path, const std::vector<CookRecord>& records);
+
 /// The --report document's "schema" and "schema_version": docs/schemas/ossa-cook-report.schema.json
 /// describes it (docs/JSON.md). The version moves only on an incompatible change (a field removed,
 /// renamed or given another meaning or type); an added optional field keeps it.

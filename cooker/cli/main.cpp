@@ -3,7 +3,12 @@
 //
 //   ossa-cook INPUT... -o OUTDIR [--root DIR] [--jobs N] [--report FILE.json]
 //             [--skeleton REF.ossa] [--float-vertices] [--clip-tolerance MM] [--no-clip-compression]
-//             [--root-motion] [--up-axis x|y|z] [-q | -v] [--version] [--help]
+//             [--root-motion] [--up-axis x|y|z] [--force] [--depfile FILE] [--list-inputs]
+//             [-q | -v] [--version] [--help]
+//
+// As a build step (docs/SCALE.md): an output whose cook key matches its inputs as they are now is
+// up to date and left alone (--force cooks anyway); --depfile writes a Make-syntax file naming
+// every file each output's cook read; --list-inputs prints those files without writing anything.
 //
 // Exit status (runtime/tools/cli/cli.h): 0 when every input cooked; 1 when any failed (the rest
 // are still cooked) or the report could not be written; 2 for a usage error or a plan that cannot
@@ -16,9 +21,11 @@
 // lines (dropped cameras, matched joint names) that would bury the failures. The --report document is docs/schemas/ossa-cook-report.schema.json (docs/JSON.md).
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <set>
 #include <string>
 #include <thread>
 #include <vector>
@@ -40,14 +47,19 @@ std::string human_bytes(uint64_t n) {
   return buf;
 }
 
+/// The end-of-batch table: the output column is as wide as the longest output path, so the
+/// number columns stay aligned whatever the tree's depth.
 void print_summary(const std::vector<CookRecord>& records) {
-  std::printf("%-40s %7s %7s %9s %6s %12s %12s\n", "output", "joints", "meshes", "vertices", "clips", "source",
-              "cooked");
+  int width = 6;
+  for (const CookRecord& r : records)
+    if (r.ok) width = std::max(width, static_cast<int>(r.output.size()));
+  std::printf("%-*s %7s %7s %9s %6s %12s %12s  %s\n", width, "output", "joints", "meshes", "vertices", "clips",
+              "source", "cooked", "status");
   for (const CookRecord& r : records) {
     if (!r.ok) continue;
-    std::printf("%-40s %7u %7u %9u %6u %12s %12s\n", r.output.c_str(), r.joints.value_or(0), r.meshes.value_or(0),
-                r.vertices.value_or(0), r.clips.value_or(0), human_bytes(r.source_bytes).c_str(),
-                human_bytes(r.cooked_bytes).c_str());
+    std::printf("%-*s %7u %7u %9u %6u %12s %12s  %s\n", width, r.output.c_str(), r.joints.value_or(0),
+                r.meshes.value_or(0), r.vertices.value_or(0), r.clips.value_or(0), human_bytes(r.source_bytes).c_str(),
+                human_bytes(r.cooked_bytes).c_str(), r.up_to_date ? "up to date" : "cooked");
   }
 }
 
@@ -75,7 +87,8 @@ int main(int argc, char** argv) {
   std::vector<std::string> inputs;
   std::string out_dir, root, report_path, skeleton_path;
   unsigned jobs = std::max(1u, std::thread::hardware_concurrency());
-  bool float_vertices = false, lossless_clips = false, root_motion = false;
+  bool float_vertices = false, lossless_clips = false, root_motion = false, force = false, list_inputs = false;
+  std::string depfile_path;
   double clip_tolerance_mm = 0.1;
   std::string up_axis = "y";
   app.add_option("inputs", inputs, "source files, graph files (X.graph.json -> X.ossa) or directories (searched recursively)")
@@ -92,6 +105,12 @@ int main(int argc, char** argv) {
   app.add_flag("--no-clip-compression", lossless_clips, "keep every clip key exact (raw floats at every frame)");
   app.add_flag("--root-motion", root_motion, "extract root translation and yaw from clips into a root-motion track");
   app.add_option("--up-axis", up_axis, "up axis for --root-motion")->check(CLI::IsMember({"x", "y", "z"}));
+  app.add_flag("--force", force, "cook every input, even those whose output is up to date");
+  app.add_option("--depfile", depfile_path,
+                 "write a Make-syntax depfile: each output and every file its cook read (for Ninja / CMake DEPFILE)");
+  app.add_flag("--list-inputs", list_inputs,
+               "print every file the cooks read (one per line, sorted) and write no output; up-to-date outputs "
+               "answer from their provenance");
   if (const auto exit_now = command.parse(argc, argv)) return *exit_now;
   const bool quiet = command.quiet(), verbose = command.verbose();
 
@@ -101,9 +120,11 @@ int main(int argc, char** argv) {
   options.clips.tolerance_metres = static_cast<float>(clip_tolerance_mm / 1000.0);
   options.root_motion = root_motion;
   options.up_axis = static_cast<uint8_t>(up_axis == "x" ? 0 : up_axis == "z" ? 2 : 1);
+  options.force = force;
+  options.write = !list_inputs;
   SourceSkeleton reference;
   if (!skeleton_path.empty()) {
-    auto loaded = load_reference_skeleton(skeleton_path);
+    auto loaded = load_reference_skeleton(skeleton_path, &options.reference_input);
     if (!loaded) {
       std::fprintf(stderr, "ossa-cook: --skeleton %s\n", loaded.error().message.c_str());
       return ossa::cli::kExitUsage;
@@ -134,9 +155,10 @@ int main(int argc, char** argv) {
     warnings += r.warnings.size();
     if (!r.ok) {
       std::fprintf(stderr, "%s[%zu/%zu] FAILED %s\n", tty ? "\r\033[K" : "", done, total, r.error.c_str());
-    } else if (!quiet) {
-      if (tty) std::fprintf(stderr, "\r\033[K[%zu/%zu] %s", done, total, r.input.c_str());
-      else std::fprintf(stderr, "[%zu/%zu] %s -> %s\n", done, total, r.input.c_str(), r.output.c_str());
+    } else if (!quiet && !list_inputs) {
+      const char* what = r.up_to_date ? " (up to date)" : "";
+      if (tty) std::fprintf(stderr, "\r\033[K[%zu/%zu] %s%s", done, total, r.input.c_str(), what);
+      else std::fprintf(stderr, "[%zu/%zu] %s -> %s%s\n", done, total, r.input.c_str(), r.output.c_str(), what);
     }
     if (verbose) {
       for (const std::string& w : r.warnings) std::fprintf(stderr, "warning: %s: %s\n", r.input.c_str(), w.c_str());
@@ -156,7 +178,21 @@ int main(int argc, char** argv) {
       return ossa::cli::kExitFailed;
     }
   }
-  if (!quiet) print_summary(records);
+  if (list_inputs) {
+    // One sorted, de-duplicated list: what a build system declares as the step's inputs.
+    std::set<std::string> files;
+    for (const CookRecord& r : records)
+      for (const InputFile& f : r.inputs_read)
+        if (f.present) files.insert(f.path);
+    for (const std::string& f : files) std::printf("%s\n", f.c_str());
+  }
+  if (!depfile_path.empty()) {
+    if (ossa::Status st = write_depfile(depfile_path, records); !st) {
+      std::fprintf(stderr, "ossa-cook: depfile: %s\n", st.message().c_str());
+      return ossa::cli::kExitFailed;
+    }
+  }
+  if (!quiet && !list_inputs) print_summary(records);
   if (!quiet && !verbose && warnings > 0)
     std::fprintf(stderr, "ossa-cook: %zu warning%s (-v prints them; --report records them)\n", warnings,
                  warnings == 1 ? "" : "s");

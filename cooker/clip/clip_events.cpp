@@ -10,6 +10,7 @@
 #include <iterator>
 
 #include "cooker/clip/clip_grid.h"
+#include "cooker/import/input_log.h"
 
 namespace ossa::cook {
 namespace fs = std::filesystem;
@@ -120,12 +121,11 @@ Status apply_event_sidecar(std::string_view text, const std::string& sidecar_nam
 Result<SidecarRead> attach_sidecar_events(const fs::path& source, std::vector<SourceClip>& clips) {
   SidecarRead read;
   read.path = event_sidecar_path(source);
-  std::error_code ec;
-  if (!fs::is_regular_file(read.path, ec)) return read;
-  std::ifstream in(read.path, std::ios::binary);
-  if (!in) return Error{read.path.string() + ": cannot open: " + std::strerror(errno)};
-  read.bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-  if (in.bad()) return Error{read.path.string() + ": read error"};
+  // Looked for on every cook, so that a sidecar created later makes the output out of date.
+  if (!probe_input(read.path)) return read;
+  auto bytes = read_input(read.path);
+  if (!bytes) return bytes.error();
+  read.bytes = std::move(*bytes);
   read.present = true;
   const std::string_view text(reinterpret_cast<const char*>(read.bytes.data()), read.bytes.size());
   if (Status st = apply_event_sidecar(text, read.path.string(), source.filename().string(), clips); !st)

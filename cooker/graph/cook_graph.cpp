@@ -6,8 +6,8 @@
 // Every source is imported as `ossa-cook --skeleton` would import it against the rig
 // (ImportOptions::reference), so clips authored on a superset rig (Pab's clips carry an extra
 // "Bip01 Footsteps" joint) bind by joint name. A source used by several clip entries is imported
-// once. The provenance hash covers the graph file's bytes and then every file it read (sources and
-// their event sidecars) in the order first read, so a build cache invalidates when any changes.
+// once. Every file it reads (the graph file, sources and their event sidecars) goes into the
+// cook's input log, so the cook key changes when any of them does.
 // Messages about a source start with the graph file's position of the entry naming it and then
 // carry the source's own message (which names the source).
 #include <map>
@@ -27,16 +27,10 @@ namespace fs = std::filesystem;
 
 namespace {
 
-/// What the graph reads besides itself, folded into one hash.
+/// The bytes the graph reads besides itself (each file it reads is in the cook's input log).
 struct SourceTally {
-  uint64_t hash = kFnvOffset;
   uint64_t bytes = 0;
-  void add(const std::vector<uint8_t>& data) {
-    const uint64_t size = data.size();
-    hash = hash_bytes(&size, sizeof size, hash);  // sizes too, so concatenations cannot collide
-    hash = hash_bytes(data.data(), data.size(), hash);
-    bytes += data.size();
-  }
+  void add(const std::vector<uint8_t>& data) { bytes += data.size(); }
 };
 
 struct GraphCook {
@@ -90,7 +84,6 @@ void cook_graph(CookRecord& record, const fs::path& input, const fs::path& outpu
     return;
   }
   GraphCook cook{record, input, input.parent_path(), {}, {}};
-  cook.tally.hash = hash_bytes(text->data(), text->size());
   cook.tally.bytes = text->size();
   record.source_bytes = text->size();
   auto doc = json::parse(std::string_view(reinterpret_cast<const char*>(text->data()), text->size()), input.string());
@@ -206,14 +199,12 @@ void cook_graph(CookRecord& record, const fs::path& input, const fs::path& outpu
   }
 
   WriteProvenance provenance;
-  provenance.source_name = input.filename().string();
-  provenance.source_hash = cook.tally.hash;
-  provenance.options = options.canonical();
+  finish_provenance(provenance, record, input, options);
   WriteOptions write_options;
   write_options.include_skeleton = true;
   write_options.graphs = std::span<const GraphDef>(&compiled->graph, 1);
   const std::vector<uint8_t> bytes = write_ossa(character, *meshes, *clips, provenance, write_options);
-  if (!write_verified(record, bytes, input, output)) return;
+  if (!write_verified(record, bytes, input, output, options.write)) return;
 
   record.ok = true;
 }

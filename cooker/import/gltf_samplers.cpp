@@ -9,6 +9,7 @@
 // a hostile file must give an error message, never a read out of bounds or a huge allocation.
 // All arithmetic on offsets is in uint64_t after checking each term, so nothing overflows.
 #include "cooker/import/gltf_samplers.h"
+#include "cooker/import/input_log.h"
 
 #include <algorithm>
 #include <cmath>
@@ -156,12 +157,9 @@ std::optional<std::vector<uint8_t>> base64_decode(const std::string& s, size_t b
 }
 
 std::optional<std::vector<uint8_t>> read_bytes(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return std::nullopt;
-  std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)),
-                             std::istreambuf_iterator<char>());
-  if (in.bad()) return std::nullopt;
-  return bytes;
+  auto bytes = read_input(path);  // recorded in the cook's input log
+  if (!bytes) return std::nullopt;
+  return std::move(*bytes);
 }
 
 // ---------------------------------------------------------------------------------------------

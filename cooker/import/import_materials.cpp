@@ -16,6 +16,7 @@
 #include <assimp/scene.h>
 
 #include "cooker/import/import_internal.h"
+#include "cooker/import/input_log.h"
 
 namespace ossa::cook::detail {
 namespace {
@@ -58,14 +59,10 @@ std::string portable(std::string path) {
 }
 
 bool read_file(const std::filesystem::path& file, std::vector<uint8_t>* bytes) {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(file, ec)) return false;
-  const auto size = std::filesystem::file_size(file, ec);
-  if (ec || size > kMaxTextureBytes) return false;
-  std::ifstream in(file, std::ios::binary);
-  if (!in) return false;
-  bytes->assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-  return !in.bad() && bytes->size() == size;
+  auto read = read_input(file, kMaxTextureBytes);  // recorded in the cook's input log (absent too)
+  if (!read) return false;
+  *bytes = std::move(*read);
+  return true;
 }
 
 /// The texture file a material names: as written relative to the source, then just its file name

@@ -24,6 +24,7 @@
 #include <assimp/scene.h>
 
 #include "cooker/import/import_internal.h"
+#include "cooker/import/import_io.h"
 #include "cooker/import/import_scene.h"
 
 namespace ossa::cook {
@@ -94,6 +95,7 @@ bool wants_tangents(const aiScene& scene) {
 
 Result<SourceScene> read_and_convert(const std::string& path, const ImportOptions& options) {
   Assimp::Importer importer;
+  importer.SetIOHandler(new LoggedIOSystem);  // every file the importer reads enters the cook key
   importer.SetPropertyBool(AI_CONFIG_IMPORT_FBX_PRESERVE_PIVOTS, false);
   importer.SetPropertyBool(AI_CONFIG_FBX_CONVERT_TO_M, false);  // keep source units
   importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, 0);      // drop lines ourselves, with a warning

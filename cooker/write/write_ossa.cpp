@@ -273,7 +273,14 @@ std::vector<uint8_t> write_ossa(const SourceScene& scene, std::span<const Cooked
   const auto source_name = fbb.CreateString(provenance.source_name);
   const auto cooker_version = fbb.CreateString(kCookerVersion);
   const auto options_text = fbb.CreateString(provenance.options);
-  const auto prov = fb::CreateProvenance(fbb, source_name, provenance.source_hash, cooker_version, options_text);
+  std::vector<Offset<fb::InputFile>> input_offsets;
+  for (const InputFile& f : provenance.inputs) {
+    const auto path = fbb.CreateString(f.path);
+    input_offsets.push_back(fb::CreateInputFile(fbb, path, f.hash, f.size, !f.present));
+  }
+  const auto inputs_v = fbb.CreateVector(input_offsets);
+  const auto prov = fb::CreateProvenance(fbb, source_name, provenance.source_hash, cooker_version, options_text,
+                                         inputs_v, provenance.cook_key);
 
   std::vector<Offset<fb::Graph>> graph_offsets;
   for (const GraphDef& graph : options.graphs) graph_offsets.push_back(write_graph(fbb, graph));

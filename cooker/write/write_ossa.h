@@ -12,6 +12,7 @@
 
 #include "cooker/clip/clip_compress.h"
 #include "cooker/graph/graph_def.h"
+#include "cooker/import/input_log.h"
 #include "cooker/mesh/mesh_build.h"
 #include "cooker/import/source_scene.h"
 
@@ -19,8 +20,10 @@ namespace ossa::cook {
 
 struct WriteProvenance {
   std::string source_name;   // file name only
-  uint64_t source_hash = 0;  // hash_bytes of the source file
+  uint64_t source_hash = 0;  // input_hash of the source file
   std::string options;       // canonical option string
+  std::vector<InputFile> inputs;  // every file read, relative to the input's directory, sorted
+  uint64_t cook_key = 0;     // cook_key(inputs, options)
 };
 
 struct WriteOptions {

@@ -305,11 +305,24 @@ double round6(double value) {
 json describe(const Asset& asset, std::string_view file_name, const DescribeOptions& options) {
   const fb::File& file = asset.file();
   json provenance = nullptr;
-  if (const fb::Provenance* p = file.provenance())
+  if (const fb::Provenance* p = file.provenance()) {
     provenance = json{{"source_name", str(p->source_name())},
                       {"source_hash", hex16(p->source_hash())},
                       {"cooker_version", str(p->cooker_version())},
                       {"options", str(p->options())}};
+    // Format v4: every file the cook read, and the key a build cache compares.
+    if (const auto* inputs = p->inputs()) {
+      json list = json::array();
+      for (const fb::InputFile* f : *inputs) {
+        json entry{{"path", str(f->path())}};
+        if (f->absent()) entry["absent"] = true;
+        else entry.update(json{{"hash", hex16(f->hash())}, {"bytes", f->size()}});
+        list.push_back(std::move(entry));
+      }
+      provenance["inputs"] = std::move(list);
+      provenance["cook_key"] = hex16(p->cook_key());
+    }
+  }
   const SkeletonView skeleton = asset.skeleton();
   json meshes = json::array(), clips = json::array(), materials = json::array();
   for (size_t i = 0; i < asset.mesh_count(); ++i) meshes.push_back(describe_mesh(asset.mesh(i)));
@@ -345,8 +358,15 @@ std::string describe_text(const json& d) {
   line("format version   " + text(d["format_version"]));
   line("metres per unit  " + text(d["metres_per_unit"]));
   if (const json& p = d["provenance"]; p.is_object())
+  {
     line("provenance       source '" + text(p["source_name"]) + "' (hash " + text(p["source_hash"]) + "), " +
          text(p["cooker_version"]) + ", options '" + text(p["options"]) + "'");
+    if (p.contains("cook_key")) line("cook key         " + text(p["cook_key"]));
+    if (p.contains("inputs"))
+      for (const json& f : p["inputs"])
+        line("  input          " + text(f["path"]) +
+             (f.contains("absent") ? std::string(" (absent)") : " (" + text(f["bytes"]) + " bytes, hash " + text(f["hash"]) + ")"));
+  }
   else
     line("provenance       -");
 

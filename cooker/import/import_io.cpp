@@ -1,0 +1,65 @@
+// import_io.cpp — Assimp's view of the file system during a cook (see import_io.h).
+#include "cooker/import/import_io.h"
+
+#include <algorithm>
+#include <cstring>
+#include <vector>
+
+#include <assimp/IOStream.hpp>
+
+#include "cooker/import/input_log.h"
+
+namespace ossa::cook {
+namespace {
+
+/// A read-only stream over a file's bytes, owned. Unlike Assimp's MemoryIOStream it asserts
+/// nothing about its arguments (Debian's Assimp is built with assertions, and an abort is the one
+/// failure a cook cannot turn into an error); a zero-sized read simply reads nothing.
+class BufferStream : public Assimp::IOStream {
+ public:
+  explicit BufferStream(std::vector<uint8_t> bytes) : bytes_(std::move(bytes)) {}
+
+  size_t Read(void* out, size_t size, size_t count) override {
+    if (size == 0 || count == 0 || out == nullptr) return 0;
+    const size_t whole = std::min(count, (bytes_.size() - pos_) / size);
+    if (whole > 0) std::memcpy(out, bytes_.data() + pos_, whole * size);
+    pos_ += whole * size;
+    return whole;
+  }
+  size_t Write(const void*, size_t, size_t) override { return 0; }
+  aiReturn Seek(size_t offset, aiOrigin origin) override {
+    size_t target = 0;
+    switch (origin) {
+      case aiOrigin_SET: target = offset; break;
+      case aiOrigin_CUR: target = pos_ + offset; break;
+      case aiOrigin_END: target = bytes_.size() - std::min(offset, bytes_.size()); break;
+      default: return aiReturn_FAILURE;
+    }
+    if (target > bytes_.size()) return aiReturn_FAILURE;
+    pos_ = target;
+    return aiReturn_SUCCESS;
+  }
+  size_t Tell() const override { return pos_; }
+  size_t FileSize() const override { return bytes_.size(); }
+  void Flush() override {}
+
+ private:
+  std::vector<uint8_t> bytes_;
+  size_t pos_ = 0;
+};
+
+}  // namespace
+
+bool LoggedIOSystem::Exists(const char* path) const { return path != nullptr && probe_input(path); }
+
+Assimp::IOStream* LoggedIOSystem::Open(const char* path, const char* mode) {
+  if (path == nullptr || (mode != nullptr && (std::strchr(mode, 'w') || std::strchr(mode, 'a') || std::strchr(mode, '+'))))
+    return nullptr;
+  auto bytes = read_input(path);
+  if (!bytes) return nullptr;
+  return new BufferStream(std::move(*bytes));
+}
+
+void LoggedIOSystem::Close(Assimp::IOStream* stream) { delete stream; }
+
+}  // namespace ossa::cook

@@ -1,0 +1,86 @@
+// input_log.h — every file one cook read, with its content hash: the cook key, the up-to-date
+// check and the depfile all come from this one list.
+//
+// Why a log and not a list each stage returns: files are read deep inside Assimp (a glTF's .bin,
+// an OBJ's .mtl), by the material stage (textures), by the sidecar and graph stages and by the
+// CLI (--skeleton). Every one of those reads goes through read_input / probe_input here (Assimp's
+// through the IOSystem of import_io.h), which records into the log of the cook running on this
+// thread (InputLogScope, set by cook_file). A read that bypasses this file is a cache-key bug, so
+// the cooker has no other file-reading function.
+//
+// Files that were looked for and not found are recorded too (absent): creating a sidecar
+// `walk.events.json` later must make the output out of date, so its absence is part of the key.
+//
+// The hash is XXH3-64 (Debian's libxxhash): ~30 GB/s against FNV-1a's ~1 GB/s, so keying a cook
+// costs nothing next to importing it (ossa-bench-cook measures both).
+#pragma once
+#include <cstdint>
+#include <filesystem>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <ossa/format/result.h>
+
+namespace ossa::cook {
+
+/// One file a cook read (or looked for).
+struct InputFile {
+  std::string path;      // absolute and lexically normal while cooking; relative in provenance
+  uint64_t hash = 0;     // input_hash of its bytes; 0 when absent
+  uint64_t size = 0;     // bytes; 0 when absent
+  bool present = false;  // false: looked for, not there
+};
+
+/// XXH3-64 of `bytes`.
+uint64_t input_hash(std::span<const uint8_t> bytes);
+
+/// The files one cook read. Not thread-safe: one log per cook, used by the thread running it.
+class InputLog {
+ public:
+  /// Records a file read whole. A path recorded twice keeps its first record.
+  void add(const std::filesystem::path& path, std::span<const uint8_t> bytes);
+  /// Records a file looked for and not found.
+  void add_absent(const std::filesystem::path& path);
+  /// Every record, sorted by path, one per path.
+  std::vector<InputFile> files() const;
+
+ private:
+  std::vector<InputFile> files_;
+};
+
+/// The log reads on this thread record into, or null. Set for a scope by InputLogScope.
+InputLog* current_input_log();
+
+/// Makes `log` the current log of this thread until destroyed (scopes nest; the previous is restored).
+class InputLogScope {
+ public:
+  explicit InputLogScope(InputLog* log);
+  ~InputLogScope();
+  InputLogScope(const InputLogScope&) = delete;
+  InputLogScope& operator=(const InputLogScope&) = delete;
+
+ private:
+  InputLog* previous_;
+};
+
+/// Reads the whole of `path` and records it in the current log (a missing file is recorded absent).
+/// Files over `max_bytes` are refused. Errors name the file. O(file size).
+Result<std::vector<uint8_t>> read_input(const std::filesystem::path& path, uint64_t max_bytes = UINT64_MAX);
+
+/// True when `path` is a regular file; when it is not, records it absent in the current log.
+bool probe_input(const std::filesystem::path& path);
+
+/// `files` (absolute paths) with each path made relative to `base` (the input's directory) and
+/// written with '/' separators, so the same tree cooked elsewhere records the same text. Sorted.
+std::vector<InputFile> relative_inputs(std::span<const InputFile> files, const std::filesystem::path& base);
+
+/// The cook key: XXH3-64 over the format version, the cooker version, the canonical options and
+/// every relative input (path, presence, size, hash) in path order. Equal keys mean equal outputs.
+uint64_t cook_key(std::span<const InputFile> relative, std::string_view options);
+
+/// A key or hash as the 16 lower-case hex digits the report and ossa-inspect print.
+std::string hex64(uint64_t value);
+
+}  // namespace ossa::cook
