@@ -1,7 +1,7 @@
 # install.cmake — what `cmake --install build --prefix P` puts where, and how a game finds it:
 #   P/include/ossa/...                    public headers (+ generated ossa_generated.h, version.h)
 #   P/lib/libossa_runtime.a, libossa_format.a
-#   P/lib/cmake/ossa/ossaConfig.cmake     find_package(ossa CONFIG REQUIRED) -> ossa::runtime
+#   P/lib/cmake/ossa/ossaConfig.cmake     find_package(ossa CONFIG REQUIRED) -> ossa::runtime, ossa_cook()
 #   P/lib/pkgconfig/ossa.pc               pkg-config --cflags --libs ossa
 #   P/bin/ossa-cook, ossa-inspect, ...    the tools (component "tools")
 #   P/share/ossa/ossa.fbs, P/share/doc/ossa/LICENSE
@@ -19,6 +19,7 @@ configure_package_config_file(${PROJECT_SOURCE_DIR}/cmake/ossaConfig.cmake.in
                               ${PROJECT_BINARY_DIR}/ossaConfig.cmake INSTALL_DESTINATION ${OSSA_CMAKE_DIR})
 write_basic_package_version_file(${PROJECT_BINARY_DIR}/ossaConfigVersion.cmake COMPATIBILITY SameMinorVersion)
 install(FILES ${PROJECT_BINARY_DIR}/ossaConfig.cmake ${PROJECT_BINARY_DIR}/ossaConfigVersion.cmake
+              ${PROJECT_SOURCE_DIR}/cmake/ossaCook.cmake
         DESTINATION ${OSSA_CMAKE_DIR} COMPONENT runtime)
 
 # The .pc file finds its prefix from its own location, so `cmake --install --prefix P` at any P works.

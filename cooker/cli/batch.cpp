@@ -5,6 +5,7 @@
 #include <atomic>
 #include <map>
 #include <mutex>
+#include <set>
 #include <thread>
 
 #include <ossa/version.h>
@@ -107,8 +108,19 @@ Status write_depfile(const fs::path& path, const std::vector<CookRecord>& record
   for (const CookRecord& r : records) {
     if (!r.ok) continue;
     text += make_escaped(fs::absolute(r.output).lexically_normal().string()) + ":";
-    for (const InputFile& f : r.inputs_read)
-      if (f.present) text += " \\\n  " + make_escaped(f.path);
+    std::set<std::string> deps;
+    for (const InputFile& f : r.inputs_read) {
+      if (f.present) {
+        deps.insert(f.path);
+      } else {
+        // A file looked for and absent cannot be a prerequisite, but its folder can: creating the
+        // file changes the folder's mtime, so the build tool re-runs the cook, which then reads it.
+        std::error_code ec;
+        const fs::path dir = fs::path(f.path).parent_path();
+        if (fs::is_directory(dir, ec)) deps.insert(dir.string());
+      }
+    }
+    for (const std::string& d : deps) text += " \\\n  " + make_escaped(d);
     text += "\n";
   }
   return write_file_atomic(path, std::vector<uint8_t>(text.begin(), text.end()));

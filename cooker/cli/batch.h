@@ -46,9 +46,11 @@ std::vector<CookRecord> run_batch(const std::vector<BatchItem>& items, const Coo
                                   unsigned jobs, const BatchProgress& progress);
 
 /// Writes a Make-syntax depfile (atomically): one rule per output written or up to date,
-/// `OUTPUT: INPUT...`, naming every file its cook read that exists (a file looked for and absent
-/// cannot be a prerequisite: Make would fail and Ninja would re-cook every time). Spaces, '#' and
-/// '$' in paths are escaped as Make and Ninja read them. Failed inputs have no rule.
+/// `OUTPUT: INPUT...`, naming every file its cook read. A file looked for and absent cannot be a
+/// prerequisite (Make would fail, Ninja would re-cook every time), so its folder is named instead:
+/// creating the file changes the folder's mtime, the build tool re-runs the cook, and a cook that
+/// finds nothing changed leaves its output alone. Absolute paths; spaces, '#' and '$' escaped as
+/// Make and Ninja read them. Failed inputs have no rule.
 Status write_depfile(const std::filesystem::path& path, const std::vector<CookRecord>& records);
 
 /// The --report document's "schema" and "schema_version": docs/schemas/ossa-cook-report.schema.json
