@@ -16,6 +16,7 @@
 
 #include "cooker/clip/clip_events.h"
 #include "cooker/cook_internal.h"
+#include "cooker/cook_settings.h"
 #include "cooker/import/import_scene.h"
 #include "cooker/mesh/mesh_build.h"
 #include "cooker/clip/root_motion.h"
@@ -198,13 +199,16 @@ bool up_to_date(CookRecord& record, const fs::path& input, const fs::path& outpu
   return true;
 }
 
-void cook_into(CookRecord& record, const fs::path& input, const fs::path& output, const CookOptions& options) {
+void cook_into(CookRecord& record, const fs::path& input, const fs::path& output, const CookOptions& options,
+               const AppliedSettings& settings) {
   std::error_code ec;
   if (fs::is_directory(input, ec)) {
     record.error = input.string() + ": is a directory, not a source file";
     return;
   }
   if (is_graph_file(input)) {
+    if (!settings.clip_names.empty())
+      record.warnings.push_back("\"clip_names\" in cook settings is not used for a graph file: the graph names its clips");
     detail::cook_graph(record, input, output, options);
     return;
   }
@@ -231,6 +235,11 @@ void cook_into(CookRecord& record, const fs::path& input, const fs::path& output
     return;
   }
   if (sidecar->present) record.source_bytes += sidecar->bytes.size();
+  // Settings rename clips after the sidecar (which speaks of the source's own clip names).
+  if (Status st = rename_clips(settings.clip_names, scene->clips, input.string()); !st) {
+    record.error = st.message();
+    return;
+  }
 
   MeshOptions mesh_options;
   mesh_options.float_vertices = options.float_vertices;
@@ -263,15 +272,21 @@ void cook_into(CookRecord& record, const fs::path& input, const fs::path& output
 
 }  // namespace
 
-CookRecord cook_file(const fs::path& input, const fs::path& output, const CookOptions& options) {
+CookRecord cook_file(const fs::path& input, const fs::path& output, const CookOptions& batch_options) {
   CookRecord record;
   record.input = input.string();
   record.output = output.string();
   const auto start = std::chrono::steady_clock::now();
   InputLog log;
   InputLogScope scope(&log);
+  // The batch's options with this input's settings files layered over them (cook_settings.h).
+  CookOptions options = batch_options;
+  AppliedSettings settings;
   try {
-    if (options.force || !up_to_date(record, input, output, options)) cook_into(record, input, output, options);
+    if (Status st = apply_cook_settings(input, options, settings); !st)
+      record.error = input.string() + ": cook settings: " + st.message();
+    else if (options.force || !up_to_date(record, input, output, options))
+      cook_into(record, input, output, options, settings);
   } catch (const std::exception& e) {
     record.ok = false;
     record.error = input.string() + ": unexpected failure: " + e.what();
