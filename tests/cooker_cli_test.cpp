@@ -164,3 +164,19 @@ TEST(CookerCli, FloatVerticesOption) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST(CookerCli, ProgressLinesCountFailuresAndEstimateTheRest) {
+  const fs::path dir = ossa::test::make_temp_dir("cli-progress");
+  const auto r = run_command(cook_cmd() + " " + q(dir / "missing.fbx") + " " + q(asset("RiggedSimple/RiggedSimple.glb")) +
+                             " " + q(asset("Fox/Fox.glb")) + " -o " + q(dir / "out") + " --jobs 1");
+  EXPECT_EQ(r.exit_code, 1);
+  // Not a terminal: one line per input, done/total, failures so far, and an ETA until the last.
+  EXPECT_NE(r.err.find("[1/3, 1 failed, ETA 0:"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("] FAILED " + (dir / "missing.fbx").string()), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("[2/3, 1 failed, ETA 0:"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("[3/3, 1 failed] "), std::string::npos) << r.err;
+}
+
+}  // namespace

@@ -19,11 +19,13 @@
 // input's warnings, time and sizes, one line per clip (frames, error, ratio) and the total time.
 // Warnings are not printed one by one by default: importing the samples alone gives dozens of
 // lines (dropped cameras, matched joint names) that would bury the failures. The --report document is docs/schemas/ossa-cook-report.schema.json (docs/JSON.md).
+#include <sys/ioctl.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <set>
 #include <string>
@@ -49,6 +51,33 @@ std::string human_bytes(uint64_t n) {
 
 /// The end-of-batch table: the output column is as wide as the longest output path, so the
 /// number columns stay aligned whatever the tree's depth.
+/// "[12/40, 1 failed, ETA 0:08]": done of total, failures so far, and the time left at the mean
+/// pace so far (inputs finish out of order with --jobs, so the mean is the honest estimate).
+std::string progress_head(size_t done, size_t total, size_t failed, double elapsed) {
+  std::string s = "[" + std::to_string(done) + "/" + std::to_string(total);
+  if (failed > 0) s += ", " + std::to_string(failed) + " failed";
+  if (done > 0 && done < total) {
+    const auto left = static_cast<long long>(elapsed / static_cast<double>(done) * static_cast<double>(total - done) + 0.5);
+    char eta[32];
+    std::snprintf(eta, sizeof eta, ", ETA %lld:%02lld", left / 60, left % 60);
+    s += eta;
+  }
+  return s + "]";
+}
+
+size_t terminal_columns() {
+  winsize w{};
+  if (::ioctl(STDERR_FILENO, TIOCGWINSZ, &w) == 0 && w.ws_col >= 20) return w.ws_col;
+  return 80;
+}
+
+/// `text` cut to `width` characters by dropping its start ("...tail"): the file name stays.
+std::string fit(const std::string& text, size_t width) {
+  width = std::max<size_t>(width, 8);
+  if (text.size() <= width) return text;
+  return "..." + text.substr(text.size() - (width - 3));
+}
+
 void print_summary(const std::vector<CookRecord>& records) {
   int width = 6;
   for (const CookRecord& r : records)
@@ -151,14 +180,22 @@ int main(int argc, char** argv) {
   // -v writes a block per input, which a progress line rewritten in place would tear.
   const bool tty = ::isatty(STDERR_FILENO) != 0 && !verbose;
   size_t warnings = 0;  // progress calls are serialized by the batch
+  size_t failed_so_far = 0;
+  const auto batch_start = std::chrono::steady_clock::now();
   auto progress = [&](size_t done, size_t total, const CookRecord& r) {
     warnings += r.warnings.size();
+    failed_so_far += r.ok ? 0 : 1;
+    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - batch_start).count();
+    const std::string head = progress_head(done, total, failed_so_far, elapsed);
     if (!r.ok) {
-      std::fprintf(stderr, "%s[%zu/%zu] FAILED %s\n", tty ? "\r\033[K" : "", done, total, r.error.c_str());
+      std::fprintf(stderr, "%s%s FAILED %s\n", tty ? "\r\033[K" : "", head.c_str(), r.error.c_str());
     } else if (!quiet && !list_inputs) {
       const char* what = r.up_to_date ? " (up to date)" : "";
-      if (tty) std::fprintf(stderr, "\r\033[K[%zu/%zu] %s%s", done, total, r.input.c_str(), what);
-      else std::fprintf(stderr, "[%zu/%zu] %s -> %s%s\n", done, total, r.input.c_str(), r.output.c_str(), what);
+      if (tty)  // one line rewritten in place: it must not wrap, so a long path keeps its tail
+        std::fprintf(stderr, "\r\033[K%s %s%s", head.c_str(),
+                     fit(r.input, terminal_columns() - head.size() - std::strlen(what) - 2).c_str(), what);
+      else
+        std::fprintf(stderr, "%s %s -> %s%s\n", head.c_str(), r.input.c_str(), r.output.c_str(), what);
     }
     if (verbose) {
       for (const std::string& w : r.warnings) std::fprintf(stderr, "warning: %s: %s\n", r.input.c_str(), w.c_str());
