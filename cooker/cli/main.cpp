@@ -93,7 +93,7 @@ int main(int argc, char** argv) {
   app.add_option("--root", root, "mirror inputs' paths relative to this directory under the output directory");
   app.add_option("-j,--jobs", jobs, "cook this many files in parallel, each in a worker process of its own")
       ->check(CLI::Range(1u, 256u));
-  app.add_option("--max-memory", max_memory_text,
+  CLI::Option* max_memory_option = app.add_option("--max-memory", max_memory_text,
                  "address space one input may use, e.g. 512M, 4G, 1.5GiB or bytes (K/M/G/T are powers of 1024; "
                  "0: no limit); past it the input fails alone (default: 0.8 x physical memory, or the cgroup's "
                  "limit if lower, / the number of workers, at least 1 GiB)");
@@ -112,7 +112,7 @@ int main(int argc, char** argv) {
   if (const auto exit_now = command.parse(argc, argv)) return *exit_now;
   const bool quiet = command.quiet(), verbose = command.verbose();
   std::optional<uint64_t> max_memory;
-  if (!max_memory_text.empty()) {
+  if (max_memory_option->count() > 0) {
     max_memory = parse_size(max_memory_text);
     if (!max_memory)
       return command.usage_error("--max-memory: '" + max_memory_text +

@@ -188,10 +188,10 @@ bool write_all(int fd, const uint8_t* data, size_t size) {
   return true;
 }
 
-/// OSSA_COOK_TEST_FAULT (worker.h): misbehave as asked when this input's path matches.
-void inject_test_fault(const std::string& input) {
+/// OSSA_COOK_TEST_FAULT (worker.h): the fault asked for this input, or "" (no allocation when unset).
+std::string_view test_fault(const std::string& input) {
   const char* spec = std::getenv("OSSA_COOK_TEST_FAULT");
-  if (spec == nullptr) return;
+  if (spec == nullptr) return {};
   std::string_view rest(spec);
   while (!rest.empty()) {
     const size_t comma = rest.find(',');
@@ -199,22 +199,42 @@ void inject_test_fault(const std::string& input) {
     rest = comma == std::string_view::npos ? std::string_view() : rest.substr(comma + 1);
     const size_t colon = entry.rfind(':');
     if (colon == std::string_view::npos || colon == 0) continue;
-    if (input.find(entry.substr(0, colon)) == std::string::npos) continue;
-    const std::string_view kind = entry.substr(colon + 1);
-    if (kind == "abort") std::abort();
-    if (kind == "segv") {
-      ::raise(SIGSEGV);
-      std::abort();  // not reached: SIGSEGV's default action ends the process
+    if (input.find(entry.substr(0, colon)) != std::string::npos) return entry.substr(colon + 1);
+  }
+  return {};
+}
+
+/// The faults that happen before cooking.
+void inject_fault_before(std::string_view fault, const BatchItem& item, int record_fd) {
+  if (fault == "abort") std::abort();
+  if (fault == "segv") {
+    ::raise(SIGSEGV);
+    std::abort();  // not reached: SIGSEGV's default action ends the process
+  }
+  if (fault == "hang")
+    for (;;) ::pause();
+  if (fault == "alloc") {
+    constexpr size_t kChunk = size_t{64} << 20;
+    for (;;) {  // leaked on purpose, every page touched so the memory is really used
+      volatile char* chunk = new char[kChunk];
+      for (size_t i = 0; i < kChunk; i += 4096) chunk[i] = 1;
     }
-    if (kind == "hang")
-      for (;;) ::pause();
-    if (kind == "alloc") {
-      constexpr size_t kChunk = size_t{64} << 20;
-      for (;;) {  // leaked on purpose, every page touched so the memory is really used
-        volatile char* chunk = new char[kChunk];
-        for (size_t i = 0; i < kChunk; i += 4096) chunk[i] = 1;
-      }
+  }
+  if (fault == "abort-writing") {  // die as if in the middle of write_file_atomic (cook.cpp)
+    std::error_code ignored;
+    fs::create_directories(item.output.parent_path(), ignored);
+    const fs::path tmp = item.output.parent_path() /
+                         ("." + item.output.filename().string() + ".tmp-" + std::to_string(::getpid()) + "-0");
+    if (FILE* f = std::fopen(tmp.c_str(), "wb")) {
+      std::fputs("half a file", f);
+      std::fclose(f);
     }
+    std::abort();
+  }
+  if (fault == "garble") {  // a record cut short, then a normal exit
+    const uint8_t truncated[] = {0xb2, 0x65, 'i', 'n'};
+    write_all(record_fd, truncated, sizeof truncated);
+    ::_exit(0);
   }
 }
 
@@ -237,9 +257,11 @@ void inject_test_fault(const std::string& input) {
     ::setrlimit(RLIMIT_AS, &limit);
   }
   std::set_new_handler(on_memory_exhausted);
-  inject_test_fault(item.input.string());
+  const std::string_view fault = test_fault(item.input.string());
+  if (!fault.empty()) inject_fault_before(fault, item, record_fd);
 
   const CookRecord record = cook_file(item.input, item.output, options);
+  if (fault == "abort-after") std::abort();  // the output is in place: the parent must remove it
   std::vector<uint8_t> bytes;
   try {
     bytes = json::to_cbor(record_to_json(record));

@@ -33,11 +33,13 @@
 //   an output it renamed into place before dying (told apart from a previous output, which a failed
 //   input must leave untouched, by its inode).
 //
-// Test hook: OSSA_COOK_TEST_FAULT=<substring>:<abort|segv|hang|alloc>[,<substring>:<kind>...]
-// makes the worker whose input path contains <substring> abort, crash with SIGSEGV, sleep forever,
-// or allocate (and touch) memory without bound before cooking. It is honoured only in workers
-// (never by cook_file) and exists so tests can check the batch's handling of each way a worker ends
-// without depending on a particular Assimp bug.
+// Test hook: OSSA_COOK_TEST_FAULT=<substring>:<fault>[,<substring>:<fault>...] makes the worker
+// whose input path contains <substring> misbehave, so that tests can check how the batch handles
+// each way a worker ends without depending on a particular Assimp bug. Faults, before cooking:
+// `abort`, `segv` (SIGSEGV), `hang` (sleep forever), `alloc` (allocate and touch memory without
+// bound), `abort-writing` (leave a temporary file named as write_file_atomic names them, then
+// abort), `garble` (send a truncated record and exit 0); after cooking: `abort-after` (abort with
+// the output renamed into place). Honoured only in workers (never by cook_file itself).
 #pragma once
 #include <cstddef>
 #include <cstdint>
