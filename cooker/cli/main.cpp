@@ -96,7 +96,7 @@ int main(int argc, char** argv) {
   CLI::Option* max_memory_option = app.add_option("--max-memory", max_memory_text,
                  "address space one input may use, e.g. 512M, 4G, 1.5GiB or bytes (K/M/G/T are powers of 1024; "
                  "0: no limit); past it the input fails alone (default: 0.8 x physical memory, or the cgroup's "
-                 "limit if lower, / the number of workers, at least 1 GiB)");
+                 "limit if lower, / the number of workers (--jobs, or the inputs if fewer), at least 1 GiB)");
   app.add_option("--timeout", timeout_seconds,
                  "seconds one input may take; past it its worker is killed and the input fails alone "
                  "(default 600; 0: no limit)");
