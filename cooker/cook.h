@@ -1,7 +1,8 @@
 // cook.h — cook one source file into one .ossa file: import, build meshes, write, atomically.
 //
-// The batch driver (main.cpp) calls cook_file once per input, possibly from several threads; a
-// call touches nothing shared, so the bytes written do not depend on --jobs. The output is written
+// The batch (cli/batch.h) calls cook_file once per input, each in a worker process of its own
+// (cli/worker.h); a call touches nothing shared (it is also safe on several threads at once), so
+// the bytes written do not depend on --jobs. The output is written
 // to a temporary file beside the target and renamed over it only when complete: a failed input
 // leaves no output file, and a reader never sees a half-written one.
 #pragma once

@@ -1,12 +1,17 @@
-// batch.cpp — output planning, the cooking thread pool and the report document (see batch.h).
+// batch.cpp — output planning, the limits' defaults, the batch around the worker processes
+// (cooker/cli/worker.h) and the report document (see batch.h).
 #include "cooker/cli/batch.h"
 
+#include <unistd.h>
+
 #include <algorithm>
-#include <atomic>
+#include <charconv>
+#include <cmath>
+#include <fstream>
 #include <map>
-#include <mutex>
 #include <set>
-#include <thread>
+
+#include "cooker/cli/worker.h"
 
 #include <ossa/version.h>
 
@@ -66,26 +71,49 @@ Result<std::vector<BatchItem>> plan_batch(const std::vector<fs::path>& inputs, c
   return items;
 }
 
-std::vector<CookRecord> run_batch(const std::vector<BatchItem>& items, const CookOptions& options, unsigned jobs,
-                                  const BatchProgress& progress) {
+uint64_t default_max_memory(unsigned workers) {
+  uint64_t available = 0;
+  const long pages = ::sysconf(_SC_PHYS_PAGES), page_size = ::sysconf(_SC_PAGESIZE);
+  if (pages > 0 && page_size > 0) available = static_cast<uint64_t>(pages) * static_cast<uint64_t>(page_size);
+  // In a container the cgroup's limit, not the machine's memory, is what the kernel enforces.
+  for (const char* file : {"/sys/fs/cgroup/memory.max", "/sys/fs/cgroup/memory/memory.limit_in_bytes"}) {
+    std::ifstream in(file);
+    uint64_t limit = 0;
+    if (in >> limit && limit > 0 && (available == 0 || limit < available)) available = limit;
+  }
+  constexpr uint64_t kGiB = uint64_t{1} << 30, kMiB = uint64_t{1} << 20;
+  const uint64_t share = static_cast<uint64_t>(0.8 * static_cast<double>(available)) / std::max(1u, workers);
+  return std::max(kGiB, share / kMiB * kMiB);
+}
+
+std::optional<uint64_t> parse_size(const std::string& text) {
+  double value = 0.0;
+  const char* const end = text.data() + text.size();
+  const auto [unit_at, ec] = std::from_chars(text.data(), end, value, std::chars_format::fixed);
+  if (ec != std::errc() || !(value >= 0.0)) return std::nullopt;
+  std::string unit(unit_at, end);
+  std::transform(unit.begin(), unit.end(), unit.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  double scale = 1.0;
+  if (!unit.empty() && unit != "b") {
+    const size_t power = std::string_view("kmgt").find(unit[0]);
+    const std::string rest = unit.substr(1);
+    if (power == std::string_view::npos || !(rest.empty() || rest == "b" || rest == "ib")) return std::nullopt;
+    scale = std::pow(1024.0, static_cast<double>(power + 1));
+  }
+  const double bytes = value * scale;
+  if (!(bytes < 18446744073709549568.0)) return std::nullopt;  // the largest double below 2^64
+  return static_cast<uint64_t>(bytes);
+}
+
+std::vector<CookRecord> run_batch(const std::vector<BatchItem>& items, const CookOptions& options,
+                                  const BatchLimits& limits, unsigned jobs, const BatchProgress& progress) {
   std::vector<CookRecord> records(items.size());
-  std::atomic<size_t> next{0};
   size_t done = 0;
-  std::mutex mutex;
-  auto worker = [&] {
-    for (size_t i = next.fetch_add(1); i < items.size(); i = next.fetch_add(1)) {
-      CookRecord record = cook_file(items[i].input, items[i].output, options);
-      std::lock_guard<std::mutex> lock(mutex);
-      records[i] = std::move(record);
-      ++done;
-      if (progress) progress(done, items.size(), records[i]);
-    }
-  };
-  const unsigned n = std::max(1u, std::min<unsigned>(jobs, static_cast<unsigned>(std::max<size_t>(1, items.size()))));
-  std::vector<std::thread> threads;
-  for (unsigned t = 1; t < n; ++t) threads.emplace_back(worker);
-  worker();
-  for (std::thread& t : threads) t.join();
+  cook_in_workers(items, options, limits, jobs, [&](size_t index, CookRecord record) {
+    records[index] = std::move(record);
+    ++done;
+    if (progress) progress(done, items.size(), records[index]);
+  });
   return records;
 }
 
@@ -126,13 +154,15 @@ Status write_depfile(const fs::path& path, const std::vector<CookRecord>& record
   return write_file_atomic(path, std::vector<uint8_t>(text.begin(), text.end()));
 }
 
-nlohmann::ordered_json report_json(const std::vector<CookRecord>& records, const CookOptions& options) {
+nlohmann::ordered_json report_json(const std::vector<CookRecord>& records, const CookOptions& options,
+                                   const BatchLimits& limits) {
   nlohmann::ordered_json doc;
   doc["schema"] = kReportSchema;
   doc["schema_version"] = kReportSchemaVersion;
   doc["cooker_version"] = kCookerVersion;
   doc["format_version"] = kFormatVersion;
   doc["options"] = options.canonical();
+  doc["limits"] = {{"max_memory_bytes", limits.max_memory_bytes}, {"timeout_seconds", limits.timeout_seconds}};
   size_t failed = 0;
   nlohmann::ordered_json list = nlohmann::ordered_json::array();
   for (const CookRecord& r : records) {

@@ -2,11 +2,15 @@
 //
 // Planning happens before any cooking so that a batch with two inputs mapping to one output is
 // refused whole (nothing is written), while a batch whose inputs merely fail goes on to the end:
-// each failure is a record, the others are cooked. Records come back in input order whatever the
-// number of threads, so reports are stable and outputs are identical for any --jobs.
+// each failure is a record, the others are cooked. Each input is cooked in a worker process of its
+// own (cooker/cli/worker.h), bounded by BatchLimits, so that an input that crashes the importer,
+// hangs or allocates without bound fails alone. Records come back in input order whatever the
+// number of workers, so reports are stable and outputs are identical for any --jobs.
 #pragma once
 #include <cstddef>
+#include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <functional>
 #include <string>
 #include <vector>
@@ -38,12 +42,29 @@ Result<std::vector<BatchItem>> plan_batch(const std::vector<std::filesystem::pat
                                           const std::filesystem::path& out_dir,
                                           const std::filesystem::path& root);
 
-/// Called after each item finishes, from the worker thread, serialized by the batch.
+/// What one input may take (--max-memory, --timeout). Not part of CookOptions: limits do not change
+/// the bytes of an output that cooks, so they stay out of options.canonical() and provenance.
+struct BatchLimits {
+  uint64_t max_memory_bytes = 0;  // address space of one worker (bytes); 0: no limit
+  unsigned timeout_seconds = 0;   // wall-clock time of one worker (seconds); 0: no limit
+};
+
+/// --max-memory's default: 0.8 x the memory this process may use (physical memory, or a smaller
+/// cgroup limit) / `workers`, rounded down to a MiB and at least 1 GiB.
+uint64_t default_max_memory(unsigned workers);
+
+/// "512M", "4G", "1.5GiB", "100k", "1048576": a byte count. K, M, G and T (optionally followed by
+/// "B" or "iB", any case) are powers of 1024; no suffix means bytes. nullopt for anything else.
+std::optional<uint64_t> parse_size(const std::string& text);
+
+/// Called after each item finishes, in the calling thread, once per item in the order they finish.
 using BatchProgress = std::function<void(size_t done, size_t total, const CookRecord& record)>;
 
-/// Cooks every item on `jobs` threads (>= 1). Returns one record per item, in item order.
+/// Cooks every item, each in a worker process of its own, up to `jobs` (>= 1) at once, within
+/// `limits`. Returns one record per item, in item order. The caller must not have started other
+/// threads (workers are forked; worker.h says why).
 std::vector<CookRecord> run_batch(const std::vector<BatchItem>& items, const CookOptions& options,
-                                  unsigned jobs, const BatchProgress& progress);
+                                  const BatchLimits& limits, unsigned jobs, const BatchProgress& progress);
 
 /// Writes a Make-syntax depfile (atomically): one rule per output written or up to date,
 /// `OUTPUT: INPUT...`, naming every file its cook read. A file looked for and absent cannot be a
@@ -59,9 +80,10 @@ Status write_depfile(const std::filesystem::path& path, const std::vector<CookRe
 inline constexpr const char* kReportSchema = "ossa-cook-report";
 inline constexpr int kReportSchemaVersion = 1;
 
-/// The --report document: schema name and version, cooker version, options, totals and one record
-/// per input. A failed record carries its error and the counts known before the failure, and no
-/// "output" or "cooked_bytes": nothing was written for it.
-nlohmann::ordered_json report_json(const std::vector<CookRecord>& records, const CookOptions& options);
+/// The --report document: schema name and version, cooker version, options, the limits each input
+/// ran under, totals and one record per input. A failed record carries its error and the counts
+/// known before the failure, and no "output" or "cooked_bytes": nothing was written for it.
+nlohmann::ordered_json report_json(const std::vector<CookRecord>& records, const CookOptions& options,
+                                   const BatchLimits& limits);
 
 }  // namespace ossa::cook

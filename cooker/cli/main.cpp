@@ -1,14 +1,19 @@
 // main.cpp — the ossa-cook command line: parse options, plan, cook in parallel, report.
 // Inputs are sources (FBX, glTF, ...) and animation graph files (`*.graph.json`, docs/GRAPH.md).
 //
-//   ossa-cook INPUT... -o OUTDIR [--root DIR] [--jobs N] [--report FILE.json]
-//             [--skeleton REF.ossa] [--float-vertices] [--clip-tolerance MM] [--no-clip-compression]
-//             [--root-motion] [--up-axis x|y|z] [--force] [--depfile FILE] [--list-inputs]
-//             [-q | -v] [--version] [--help]
+//   ossa-cook INPUT... -o OUTDIR [--root DIR] [--jobs N] [--max-memory SIZE] [--timeout SECONDS]
+//             [--report FILE.json] [--skeleton REF.ossa] [--float-vertices] [--clip-tolerance MM]
+//             [--no-clip-compression] [--root-motion] [--up-axis x|y|z] [--force] [--depfile FILE]
+//             [--list-inputs] [-q | -v] [--version] [--help]
 //
 // As a build step (docs/SCALE.md): an output whose cook key matches its inputs as they are now is
 // up to date and left alone (--force cooks anyway); --depfile writes a Make-syntax file naming
 // every file each output's cook read; --list-inputs prints those files without writing anything.
+//
+// Each input is cooked in a worker process of its own, up to --jobs at once (cooker/cli/worker.h):
+// an input that crashes or aborts the importer, runs past --timeout (default 600 s) or past
+// --max-memory (default 0.8 x memory / workers, at least 1 GiB) fails alone, named with the cause.
+// This process must stay single-threaded: it forks the workers.
 //
 // Exit status (runtime/tools/cli/cli.h): 0 when every input cooked; 1 when any failed (the rest
 // are still cooked) or the report could not be written; 2 for a usage error or a plan that cannot
@@ -27,12 +32,14 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <optional>
 #include <set>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include "cooker/cli/batch.h"
+#include "cooker/cli/worker.h"
 #include "cooker/cook.h"
 #include "runtime/tools/cli/cli.h"
 
@@ -116,6 +123,8 @@ int main(int argc, char** argv) {
   std::vector<std::string> inputs;
   std::string out_dir, root, report_path, skeleton_path;
   unsigned jobs = std::max(1u, std::thread::hardware_concurrency());
+  std::string max_memory_text;
+  unsigned timeout_seconds = 600;
   bool float_vertices = false, lossless_clips = false, root_motion = false, force = false, list_inputs = false;
   std::string depfile_path;
   double clip_tolerance_mm = 0.1;
@@ -124,7 +133,15 @@ int main(int argc, char** argv) {
       ->required();
   app.add_option("-o,--output", out_dir, "output directory")->required();
   app.add_option("--root", root, "mirror inputs' paths relative to this directory under the output directory");
-  app.add_option("-j,--jobs", jobs, "cook this many files in parallel")->check(CLI::Range(1u, 256u));
+  app.add_option("-j,--jobs", jobs, "cook this many files in parallel, each in a worker process of its own")
+      ->check(CLI::Range(1u, 256u));
+  CLI::Option* max_memory_option = app.add_option("--max-memory", max_memory_text,
+                 "address space one input may use, e.g. 512M, 4G, 1.5GiB or bytes (K/M/G/T are powers of 1024; "
+                 "0: no limit); past it the input fails alone (default: 0.8 x physical memory, or the cgroup's "
+                 "limit if lower, / the number of workers (--jobs, or the inputs if fewer), at least 1 GiB)");
+  app.add_option("--timeout", timeout_seconds,
+                 "seconds one input may take; past it its worker is killed and the input fails alone "
+                 "(default 600; 0: no limit)");
   app.add_option("--report", report_path, "write a JSON record per input to this file (docs/JSON.md)");
   app.add_option("--skeleton", skeleton_path, "cook clip-only files against this cooked skeleton (.ossa)");
   app.add_flag("--float-vertices", float_vertices, "store vertices as float32 instead of quantized");
@@ -142,6 +159,13 @@ int main(int argc, char** argv) {
                "answer from their provenance");
   if (const auto exit_now = command.parse(argc, argv)) return *exit_now;
   const bool quiet = command.quiet(), verbose = command.verbose();
+  std::optional<uint64_t> max_memory;
+  if (max_memory_option->count() > 0) {
+    max_memory = parse_size(max_memory_text);
+    if (!max_memory)
+      return command.usage_error("--max-memory: '" + max_memory_text +
+                                 "' is not a size (bytes, or a number followed by K, M, G or T)");
+  }
 
   CookOptions options;
   options.float_vertices = float_vertices;
@@ -173,9 +197,17 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "ossa-cook: no source files found in the inputs given\n");
     return ossa::cli::kExitUsage;
   }
+  BatchLimits limits;
+  limits.timeout_seconds = timeout_seconds;
+  // The default share is of the workers that will run: no more than there are inputs.
+  limits.max_memory_bytes = max_memory ? *max_memory
+                                       : default_max_memory(static_cast<unsigned>(std::min<size_t>(jobs, plan->size())));
   if (verbose)
-    std::fprintf(stderr, "ossa-cook: %zu inputs, %u jobs, options %s\n", plan->size(), jobs,
-                 options.canonical().c_str());
+    std::fprintf(stderr, "ossa-cook: %zu inputs, %u jobs, options %s, limits per input: memory %s%s, time %s\n",
+                 plan->size(), jobs, options.canonical().c_str(),
+                 limits.max_memory_bytes > 0 ? format_size(limits.max_memory_bytes).c_str() : "unlimited",
+                 limits.max_memory_bytes > 0 && !memory_limit_enforced() ? " (not enforced in a sanitizer build)" : "",
+                 limits.timeout_seconds > 0 ? (std::to_string(limits.timeout_seconds) + " s").c_str() : "unlimited");
 
   // -v writes a block per input, which a progress line rewritten in place would tear.
   const bool tty = ::isatty(STDERR_FILENO) != 0 && !verbose;
@@ -204,12 +236,12 @@ int main(int argc, char** argv) {
     if (tty && done == total && !quiet) std::fprintf(stderr, "\n");
     std::fflush(stderr);
   };
-  const std::vector<CookRecord> records = run_batch(*plan, options, jobs, progress);
+  const std::vector<CookRecord> records = run_batch(*plan, options, limits, jobs, progress);
 
   size_t failed = 0;
   for (const CookRecord& r : records) failed += r.ok ? 0 : 1;
   if (!report_path.empty()) {
-    const std::string text = report_json(records, options).dump(2) + "\n";
+    const std::string text = report_json(records, options, limits).dump(2) + "\n";
     if (ossa::Status st = write_file_atomic(report_path, std::vector<uint8_t>(text.begin(), text.end())); !st) {
       std::fprintf(stderr, "ossa-cook: report: %s\n", st.message().c_str());
       return ossa::cli::kExitFailed;
