@@ -58,7 +58,7 @@ namespace detail {
 
 Result<std::vector<uint8_t>> read_bytes(const fs::path& path) { return read_input(path); }
 
-void finish_provenance(WriteProvenance& provenance, CookRecord& record, const fs::path& input,
+bool finish_provenance(WriteProvenance& provenance, CookRecord& record, const fs::path& input,
                        const CookOptions& options) {
   provenance.source_name = input.filename().string();
   provenance.options = options.canonical();
@@ -69,6 +69,18 @@ void finish_provenance(WriteProvenance& provenance, CookRecord& record, const fs
   record.cook_key = provenance.cook_key;
   for (const InputFile& f : provenance.inputs)
     if (f.path == provenance.source_name) provenance.source_hash = f.hash;
+  if (log != nullptr && !log->refusals().empty()) {
+    record.error = refusal_error(input, *log);
+    return false;
+  }
+  return true;
+}
+
+std::string refusal_error(const fs::path& input, const InputLog& log) {
+  const auto& refusals = log.refusals();
+  std::string s = input.string() + ": " + refusals.front();
+  if (refusals.size() > 1) s += " (and " + std::to_string(refusals.size() - 1) + " more refused reads)";
+  return s;
 }
 
 Result<std::vector<CompressedClip>> cook_clips(SourceScene& scene, const CookOptions& options, CookRecord& record,
@@ -258,7 +270,7 @@ void cook_into(CookRecord& record, const fs::path& input, const fs::path& output
   }
 
   WriteProvenance provenance;
-  detail::finish_provenance(provenance, record, input, options);
+  if (!detail::finish_provenance(provenance, record, input, options)) return;
   // A clip-only file binds to its rig by hash and carries no skeleton; a file with meshes always
   // carries the rig its joint palettes index (with --skeleton, the reference's, hash-identical).
   WriteOptions write_options;
@@ -282,6 +294,10 @@ CookRecord cook_file(const fs::path& input, const fs::path& output, const CookOp
   // The batch's options with this input's settings files layered over them (cook_settings.h).
   CookOptions options = batch_options;
   AppliedSettings settings;
+  std::vector<fs::path> allowed = options.allow_dirs;
+  allowed.push_back(options.root.empty() ? input.parent_path() : options.root);
+  if (allowed.back().empty()) allowed.back() = ".";
+  ReadSandboxScope sandbox(allowed);
   try {
     if (Status st = apply_cook_settings(input, options, settings); !st)
       record.error = input.string() + ": cook settings: " + st.message();
@@ -295,6 +311,9 @@ CookRecord cook_file(const fs::path& input, const fs::path& output, const CookOp
     record.error = input.string() + ": unexpected failure";
   }
   if (!record.ok && record.inputs_read.empty()) record.inputs_read = log.files();  // as far as it got
+  // A read the sandbox refused is the cause to name, whatever the importer made of the missing file.
+  if (!record.ok && !log.refusals().empty() && record.error.find(log.refusals().front()) == std::string::npos)
+    record.error = detail::refusal_error(input, log) + "; then: " + record.error;
   // --skeleton's file is keyed through the options (canonical()); the depfile still names it.
   if (options.reference != nullptr && options.reference_input.present && !is_graph_file(input)) {
     record.inputs_read.push_back(options.reference_input);

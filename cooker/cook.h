@@ -32,6 +32,10 @@ struct CookOptions {
   std::string canonical() const;
 
   // How to run, not what to make (not in canonical(), not in the key):
+  /// The read sandbox (input_log.h): a cook reads only inside `root` (--root) or, without one, the
+  /// input's own folder tree, and inside each of `allow_dirs` (--allow-dir).
+  std::filesystem::path root;
+  std::vector<std::filesystem::path> allow_dirs;
   bool force = false;  // --force: cook even when the output is up to date
   bool write = true;   // false (--list-inputs): cook in memory, write nothing
 };

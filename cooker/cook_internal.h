@@ -37,9 +37,13 @@ bool write_verified(CookRecord& record, const std::vector<uint8_t>& bytes, const
 
 /// Fills the provenance from the current input log once every input is read: source name and
 /// hash, canonical options, the inputs relative to the input's directory and the cook key; copies
-/// the inputs (absolute) and the key into the record.
-void finish_provenance(WriteProvenance& provenance, CookRecord& record, const std::filesystem::path& input,
+/// the inputs (absolute) and the key into the record. False (with record.error) when the log holds
+/// a refused read: the cook must not write an output that silently lacks what its source named.
+bool finish_provenance(WriteProvenance& provenance, CookRecord& record, const std::filesystem::path& input,
                        const CookOptions& options);
+
+/// "<input>: <first refusal> (and N more refused reads)".
+std::string refusal_error(const std::filesystem::path& input, const InputLog& log);
 
 /// cook_file for a graph file (cook_graph.cpp).
 void cook_graph(CookRecord& record, const std::filesystem::path& input, const std::filesystem::path& output,

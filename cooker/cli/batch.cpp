@@ -32,7 +32,7 @@ std::string output_stem(const fs::path& input) {
 
 Result<std::vector<BatchItem>> plan_batch(const std::vector<fs::path>& inputs, const fs::path& out_dir,
                                           const fs::path& root) {
-  std::vector<fs::path> files;
+  std::vector<std::pair<fs::path, fs::path>> files;  // input, its tree
   for (const fs::path& input : inputs) {
     std::error_code ec;
     if (fs::is_directory(input, ec)) {
@@ -42,16 +42,19 @@ Result<std::vector<BatchItem>> plan_batch(const std::vector<fs::path>& inputs, c
           found.push_back(it->path());
       if (ec) return Error{input.string() + ": cannot list directory: " + ec.message()};
       std::sort(found.begin(), found.end());
-      files.insert(files.end(), found.begin(), found.end());
+      for (fs::path& f : found) files.push_back({std::move(f), input});
     } else {
-      files.push_back(input);
+      files.push_back({input, input.parent_path()});
     }
   }
 
   std::vector<BatchItem> items;
   std::map<fs::path, fs::path> claimed;  // output -> first input that maps to it
+  std::error_code root_ec;
+  if (!root.empty() && !fs::is_directory(root, root_ec))
+    return Error{"--root " + root.string() + ": " + (fs::exists(root, root_ec) ? "is not a directory" : "does not exist")};
   const fs::path abs_root = root.empty() ? fs::path() : fs::weakly_canonical(fs::absolute(root));
-  for (const fs::path& input : files) {
+  for (const auto& [input, tree] : files) {
     fs::path sub;
     if (!root.empty()) {
       const fs::path abs_in = fs::weakly_canonical(fs::absolute(input));
@@ -66,7 +69,7 @@ Result<std::vector<BatchItem>> plan_batch(const std::vector<fs::path>& inputs, c
       return Error{"inputs " + it->second.string() + " and " + input.string() + " would both write " +
                    output.string() +
                    (root.empty() ? " (use --root to mirror the source tree)" : " (cook them into separate output directories)")};
-    items.push_back({input, output});
+    items.push_back({input, output, tree});
   }
   return items;
 }

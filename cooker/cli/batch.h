@@ -25,6 +25,9 @@ namespace ossa::cook {
 struct BatchItem {
   std::filesystem::path input;
   std::filesystem::path output;
+  /// The folder tree this input's cook may read without --root: the directory argument it was
+  /// found in, or for an input named as a file, its own folder (input_log.h's read sandbox).
+  std::filesystem::path tree;
 };
 
 /// File extensions ossa-cook picks up when an input is a directory (lower case, with the dot).

@@ -132,7 +132,13 @@ int main(int argc, char** argv) {
   app.add_option("inputs", inputs, "source files, graph files (X.graph.json -> X.ossa) or directories (searched recursively)")
       ->required();
   app.add_option("-o,--output", out_dir, "output directory")->required();
-  app.add_option("--root", root, "mirror inputs' paths relative to this directory under the output directory");
+  app.add_option("--root", root,
+                 "mirror inputs' paths relative to this directory under the output directory; cooks may read only "
+                 "files inside it (without --root: inside the directory argument, or a file input's own folder)");
+  std::vector<std::string> allow_dirs;
+  app.add_option("--allow-dir", allow_dirs,
+                 "also let cooks read files inside this directory (repeatable), e.g. a shared texture library")
+      ->allow_extra_args(false);  // one directory per --allow-dir: the inputs that follow stay inputs
   app.add_option("-j,--jobs", jobs, "cook this many files in parallel, each in a worker process of its own")
       ->check(CLI::Range(1u, 256u));
   CLI::Option* max_memory_option = app.add_option("--max-memory", max_memory_text,
@@ -174,6 +180,15 @@ int main(int argc, char** argv) {
   options.root_motion = root_motion;
   options.up_axis = static_cast<uint8_t>(up_axis == "x" ? 0 : up_axis == "z" ? 2 : 1);
   options.force = force;
+  options.root = root;
+  for (const std::string& d : allow_dirs) {
+    std::error_code ec;
+    if (!fs::is_directory(d, ec)) {
+      std::fprintf(stderr, "ossa-cook: --allow-dir %s: not a directory\n", d.c_str());
+      return ossa::cli::kExitUsage;
+    }
+    options.allow_dirs.emplace_back(d);
+  }
   options.write = !list_inputs;
   SourceSkeleton reference;
   if (!skeleton_path.empty()) {

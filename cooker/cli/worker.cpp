@@ -278,7 +278,9 @@ void inject_fault_before(std::string_view fault, const BatchItem& item, int reco
   const std::string_view fault = test_fault(item.input.string());
   if (!fault.empty()) inject_fault_before(fault, item, record_fd);
 
-  const CookRecord record = cook_file(item.input, item.output, options);
+  CookOptions item_options = options;
+  if (item_options.root.empty()) item_options.root = item.tree;  // the read sandbox's default
+  const CookRecord record = cook_file(item.input, item.output, item_options);
   if (fault == "abort-after") std::abort();  // the output is in place: the parent must remove it
   std::vector<uint8_t> bytes;
   try {

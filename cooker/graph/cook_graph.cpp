@@ -199,7 +199,7 @@ void cook_graph(CookRecord& record, const fs::path& input, const fs::path& outpu
   }
 
   WriteProvenance provenance;
-  finish_provenance(provenance, record, input, options);
+  if (!finish_provenance(provenance, record, input, options)) return;
   WriteOptions write_options;
   write_options.include_skeleton = true;
   write_options.graphs = std::span<const GraphDef>(&compiled->graph, 1);

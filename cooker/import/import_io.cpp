@@ -50,12 +50,16 @@ class BufferStream : public Assimp::IOStream {
 
 }  // namespace
 
-bool LoggedIOSystem::Exists(const char* path) const { return path != nullptr && probe_input(path); }
+namespace {
+constexpr std::string_view kReference = "the source, read by the importer";
+}
+
+bool LoggedIOSystem::Exists(const char* path) const { return path != nullptr && probe_input(path, kReference); }
 
 Assimp::IOStream* LoggedIOSystem::Open(const char* path, const char* mode) {
   if (path == nullptr || (mode != nullptr && (std::strchr(mode, 'w') || std::strchr(mode, 'a') || std::strchr(mode, '+'))))
     return nullptr;
-  auto bytes = read_input(path);
+  auto bytes = read_input(path, UINT64_MAX, kReference);
   if (!bytes) return nullptr;
   return new BufferStream(std::move(*bytes));
 }

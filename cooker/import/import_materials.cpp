@@ -58,8 +58,9 @@ std::string portable(std::string path) {
   return path;
 }
 
-bool read_file(const std::filesystem::path& file, std::vector<uint8_t>* bytes) {
-  auto read = read_input(file, kMaxTextureBytes);  // recorded in the cook's input log (absent too)
+bool read_file(const std::filesystem::path& file, std::vector<uint8_t>* bytes, const std::string& reference) {
+  // Recorded in the cook's input log (absent too); outside the read sandbox, refused by name.
+  auto read = read_input(file, kMaxTextureBytes, reference);
   if (!read) return false;
   *bytes = std::move(*read);
   return true;
@@ -67,11 +68,13 @@ bool read_file(const std::filesystem::path& file, std::vector<uint8_t>* bytes) {
 
 /// The texture file a material names: as written relative to the source, then just its file name
 /// next to the source (authoring tools often store absolute paths from another machine).
-bool read_external(const Context& ctx, const std::string& path, std::vector<uint8_t>* bytes) {
+bool read_external(const Context& ctx, const std::string& path, std::vector<uint8_t>* bytes,
+                   const std::string& label) {
+  const std::string reference = label + "'s texture '" + path + "'";
   const std::filesystem::path dir = std::filesystem::path(ctx.path).parent_path();
   const std::filesystem::path as_written(path);
-  if (as_written.is_relative() && read_file(dir / as_written, bytes)) return true;
-  return read_file(dir / as_written.filename(), bytes);
+  if (as_written.is_relative() && read_file(dir / as_written, bytes, reference)) return true;
+  return read_file(dir / as_written.filename(), bytes, reference);
 }
 
 bool embedded(const Context& ctx, const aiTexture& tex, const std::string& label, SourceTexture* out) {
@@ -113,7 +116,7 @@ bool find_texture(const Context& ctx, const aiMaterial& mat, std::initializer_li
   }
   out->path = path;
   std::vector<uint8_t> bytes;
-  if (!read_external(ctx, path, &bytes)) {
+  if (!read_external(ctx, path, &bytes, label)) {
     ctx.warn(label + ": texture '" + path + "' cannot be read, only its path is kept");
     return true;
   }

@@ -1,6 +1,9 @@
 // input_log.cpp — the per-cook record of files read, and the cook key (see input_log.h).
 #include "cooker/import/input_log.h"
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
 #include <xxhash.h>
 
 #include <algorithm>
@@ -9,6 +12,7 @@
 #include <cstring>
 #include <fstream>
 
+#include "runtime/internal/message.h"
 #include <ossa/version.h>
 
 namespace ossa::cook {
@@ -17,6 +21,26 @@ namespace fs = std::filesystem;
 namespace {
 
 thread_local InputLog* t_current = nullptr;
+thread_local const std::vector<fs::path>* t_sandbox = nullptr;  // null: no limit
+
+/// `path` absolute, with `..` and every symlink of its existing part resolved.
+fs::path canonical_path(const fs::path& path) {
+  std::error_code ec;
+  fs::path abs = fs::absolute(path, ec);
+  if (ec) return path.lexically_normal();
+  fs::path canon = fs::weakly_canonical(abs, ec);
+  return ec ? abs.lexically_normal() : canon;
+}
+
+bool inside_sandbox(const fs::path& path) {
+  if (t_sandbox == nullptr) return true;
+  const fs::path canon = canonical_path(path);
+  for (const fs::path& dir : *t_sandbox) {
+    const fs::path rel = canon.lexically_relative(dir);
+    if (!rel.empty() && *rel.begin() != "..") return true;
+  }
+  return false;
+}
 
 fs::path normal_absolute(const fs::path& path) {
   std::error_code ec;
@@ -48,29 +72,98 @@ InputLog* current_input_log() { return t_current; }
 InputLogScope::InputLogScope(InputLog* log) : previous_(t_current) { t_current = log; }
 InputLogScope::~InputLogScope() { t_current = previous_; }
 
-Result<std::vector<uint8_t>> read_input(const fs::path& path, uint64_t max_bytes) {
-  std::error_code ec;
-  if (!fs::is_regular_file(path, ec)) {
-    if (InputLog* log = current_input_log()) log->add_absent(path);
-    if (fs::exists(path, ec)) return Error{path.string() + ": is not a regular file"};
-    return Error{path.string() + ": cannot open: " + std::strerror(ENOENT)};
+ReadSandboxScope::ReadSandboxScope(const std::vector<fs::path>& allowed_dirs) : previous_(t_sandbox) {
+  for (const fs::path& d : allowed_dirs) allowed_.push_back(canonical_path(d));
+  t_sandbox = &allowed_;
+}
+ReadSandboxScope::~ReadSandboxScope() { t_sandbox = previous_; }
+
+namespace {
+
+std::string allowed_list() {
+  std::string s;
+  for (const fs::path& d : *t_sandbox) s += (s.empty() ? "" : ", ") + d.string();
+  return s;
+}
+
+/// Refuses `path` (records why in the current log) and returns the message.
+std::string refuse(const fs::path& path, const std::string& why, std::string_view reference) {
+  // The file as resolved (`..` and symlinks followed), and as the reference wrote it when different.
+  const fs::path resolved = canonical_path(path);
+  std::string message = detail::printable(resolved.string(), 400) + ": refused: " + why;
+  if (!reference.empty() || resolved != path) {
+    message += " (named";
+    if (!reference.empty()) message += " by " + std::string(reference);
+    if (resolved != path) message += " as '" + detail::printable(path.string(), 400) + "'";
+    message += ")";
   }
-  const uintmax_t size = fs::file_size(path, ec);
-  if (ec) return Error{path.string() + ": cannot read its size: " + ec.message()};
-  if (size > max_bytes)
-    return Error{path.string() + ": is " + std::to_string(size) + " bytes, over the limit of " +
+  if (InputLog* log = current_input_log()) log->add_refusal(message);
+  return message;
+}
+
+std::string outside_message() {
+  return "outside the folders this cook may read (" + allowed_list() +
+         "; widen them with --root DIR or --allow-dir DIR)";
+}
+
+const char* kind_of(const struct stat& st) {
+  if (S_ISDIR(st.st_mode)) return "a directory";
+  if (S_ISFIFO(st.st_mode)) return "a FIFO";
+  if (S_ISCHR(st.st_mode) || S_ISBLK(st.st_mode)) return "a device";
+  if (S_ISSOCK(st.st_mode)) return "a socket";
+  return "not a regular file";
+}
+
+}  // namespace
+
+Result<std::vector<uint8_t>> read_input(const fs::path& path, uint64_t max_bytes, std::string_view reference) {
+  if (!inside_sandbox(path)) return Error{refuse(path, outside_message(), reference)};
+  struct stat st{};
+  if (::stat(path.c_str(), &st) != 0) {
+    const int err = errno;
+    if (err == ENOENT || err == ENOTDIR) {
+      if (InputLog* log = current_input_log()) log->add_absent(path);
+    }
+    return Error{detail::printable(path.string(), 400) + ": cannot open: " + std::strerror(err)};
+  }
+  if (!S_ISREG(st.st_mode)) return Error{refuse(path, std::string("is ") + kind_of(st) + ", not a regular file", reference)};
+  if (static_cast<uint64_t>(st.st_size) > max_bytes)
+    return Error{detail::printable(path.string(), 400) + ": is " + std::to_string(st.st_size) + " bytes, over the limit of " +
                  std::to_string(max_bytes)};
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return Error{path.string() + ": cannot open: " + std::strerror(errno)};
-  std::vector<uint8_t> bytes(static_cast<size_t>(size));
-  in.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
-  if (static_cast<uintmax_t>(in.gcount()) != size || in.bad()) return Error{path.string() + ": read error"};
-  if (in.peek() != std::char_traits<char>::eof()) return Error{path.string() + ": changed while being read"};
+  // O_NONBLOCK: should the path have become a FIFO since stat, open must not wait for a writer;
+  // fstat then sees what was actually opened.
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) return Error{detail::printable(path.string(), 400) + ": cannot open: " + std::strerror(errno)};
+  struct stat opened{};
+  if (::fstat(fd, &opened) != 0 || !S_ISREG(opened.st_mode)) {
+    ::close(fd);
+    return Error{refuse(path, "is not a regular file", reference)};
+  }
+  if (static_cast<uint64_t>(opened.st_size) > max_bytes) {
+    ::close(fd);
+    return Error{detail::printable(path.string(), 400) + ": grew over the limit while being opened"};
+  }
+  std::vector<uint8_t> bytes(static_cast<size_t>(opened.st_size));
+  size_t done = 0;
+  while (done < bytes.size()) {
+    const ssize_t n = ::read(fd, bytes.data() + done, bytes.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) break;
+    done += static_cast<size_t>(n);
+  }
+  uint8_t extra = 0;
+  const ssize_t more = done == bytes.size() ? ::read(fd, &extra, 1) : 0;
+  ::close(fd);
+  if (done != bytes.size() || more != 0) return Error{detail::printable(path.string(), 400) + ": changed while being read"};
   if (InputLog* log = current_input_log()) log->add(path, bytes);
   return bytes;
 }
 
-bool probe_input(const fs::path& path) {
+bool probe_input(const fs::path& path, std::string_view reference) {
+  if (!inside_sandbox(path)) {
+    refuse(path, outside_message(), reference);
+    return false;
+  }
   std::error_code ec;
   if (fs::is_regular_file(path, ec)) return true;
   if (InputLog* log = current_input_log()) log->add_absent(path);

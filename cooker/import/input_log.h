@@ -11,9 +11,17 @@
 // Files that were looked for and not found are recorded too (absent): creating a sidecar
 // `walk.events.json` later must make the output out of date, so its absence is part of the key.
 //
+// The same door is the read sandbox (ReadSandboxScope): while a cook runs, a file outside the
+// folders it may read (the input's own tree, or --root, and --allow-dir), after `..` and symlinks
+// are resolved, is refused by name and never opened, and so is anything that is not a regular file
+// (a device, a FIFO, a directory). Each refusal is kept in the log with the reference that named
+// the file, and fails the cook: a source cannot pull /etc/passwd or a neighbour's files into an
+// output, whichever importer reads them.
+//
 // The hash is XXH3-64 (Debian's libxxhash): ~30 GB/s against FNV-1a's ~1 GB/s, so keying a cook
 // costs nothing next to importing it (ossa-bench-cook measures both).
 #pragma once
+#include <algorithm>
 #include <cstdint>
 #include <filesystem>
 #include <span>
@@ -45,9 +53,15 @@ class InputLog {
   void add_absent(const std::filesystem::path& path);
   /// Every record, sorted by path, one per path.
   std::vector<InputFile> files() const;
+  /// Reads refused by the sandbox (or of files that are not regular files): one message each.
+  void add_refusal(std::string message) {
+    if (std::find(refusals_.begin(), refusals_.end(), message) == refusals_.end()) refusals_.push_back(std::move(message));
+  }
+  const std::vector<std::string>& refusals() const { return refusals_; }
 
  private:
   std::vector<InputFile> files_;
+  std::vector<std::string> refusals_;
 };
 
 /// The log reads on this thread record into, or null. Set for a scope by InputLogScope.
@@ -65,12 +79,30 @@ class InputLogScope {
   InputLog* previous_;
 };
 
-/// Reads the whole of `path` and records it in the current log (a missing file is recorded absent).
-/// Files over `max_bytes` are refused. Errors name the file. O(file size).
-Result<std::vector<uint8_t>> read_input(const std::filesystem::path& path, uint64_t max_bytes = UINT64_MAX);
+/// Limits this thread's reads to regular files inside `allowed_dirs` (made canonical here) until
+/// destroyed. Scopes nest; the previous limit is restored.
+class ReadSandboxScope {
+ public:
+  explicit ReadSandboxScope(const std::vector<std::filesystem::path>& allowed_dirs);
+  ~ReadSandboxScope();
+  ReadSandboxScope(const ReadSandboxScope&) = delete;
+  ReadSandboxScope& operator=(const ReadSandboxScope&) = delete;
 
-/// True when `path` is a regular file; when it is not, records it absent in the current log.
-bool probe_input(const std::filesystem::path& path);
+ private:
+  const std::vector<std::filesystem::path>* previous_;
+  std::vector<std::filesystem::path> allowed_;
+};
+
+/// Reads the whole of `path` and records it in the current log (a missing file is recorded absent).
+/// Refused without opening: a path outside the sandbox, anything not a regular file, a file over
+/// `max_bytes`; a refusal is also kept in the log. `reference` says what named the file (e.g.
+/// "a texture of material 'skin'") for the messages. Errors name the file. O(file size).
+Result<std::vector<uint8_t>> read_input(const std::filesystem::path& path, uint64_t max_bytes = UINT64_MAX,
+                                        std::string_view reference = {});
+
+/// True when `path` is a regular file inside the sandbox; a missing file is recorded absent, one
+/// outside the sandbox is recorded as a refusal (it was named by the input, and cannot be read).
+bool probe_input(const std::filesystem::path& path, std::string_view reference = {});
 
 /// `files` (absolute paths) with each path made relative to `base` (the input's directory) and
 /// written with '/' separators, so the same tree cooked elsewhere records the same text. Sorted.

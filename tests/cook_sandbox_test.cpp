@@ -1,0 +1,151 @@
+// cook_sandbox_test.cpp — the cook's read sandbox (cooker/import/input_log.h) against the attacks a
+// source from an untrusted hand can make: a glTF buffer or image URI climbing out of the tree, a
+// graph source given by absolute path, a symlink pointing out, a FIFO or device as an input or a
+// texture. Each is refused by name (never opened, so nothing hangs or leaks into an output), the
+// cook fails alone, and --root / --allow-dir widen the sandbox when the user means it.
+#include <sys/stat.h>
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <filesystem>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include <ossa/loader/asset.h>
+#include "test_files.h"
+
+namespace fs = std::filesystem;
+using ossa::test::run_command;
+
+namespace {
+
+std::string cook_cmd() { return (ossa::test::bin_dir() / "ossa-cook").string(); }
+fs::path asset(const char* rel) { return ossa::test::source_dir() / "assets" / rel; }
+std::string q(const fs::path& p) { return "'" + p.string() + "'"; }
+
+/// A minimal glTF: one triangle whose positions come from buffer `uri` (36 bytes of floats), with
+/// a material whose base-colour image is `image_uri` (none when empty).
+std::string triangle_gltf(const std::string& uri, const std::string& image_uri = "") {
+  nlohmann::json j = {
+      {"asset", {{"version", "2.0"}}},
+      {"scene", 0},
+      {"scenes", {{{"nodes", {0}}}}},
+      {"nodes", {{{"mesh", 0}}}},
+      {"meshes", {{{"primitives", {{{"attributes", {{"POSITION", 0}}}, {"material", 0}}}}}}},
+      {"materials", {nlohmann::json::object()}},
+      {"buffers", {{{"uri", uri}, {"byteLength", 36}}}},
+      {"bufferViews", {{{"buffer", 0}, {"byteLength", 36}}}},
+      {"accessors", {{{"bufferView", 0}, {"componentType", 5126}, {"count", 3}, {"type", "VEC3"},
+                      {"min", {0, 0, 0}}, {"max", {1, 1, 0}}}}}};
+  if (!image_uri.empty()) {
+    j["images"] = {{{"uri", image_uri}}};
+    j["textures"] = {{{"source", 0}}};
+    j["materials"][0]["pbrMetallicRoughness"] = {{"baseColorTexture", {{"index", 0}}}};
+  }
+  return j.dump();
+}
+
+std::string triangle_bytes() {
+  const float v[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+  return std::string(reinterpret_cast<const char*>(v), sizeof v);
+}
+
+class CookSandbox : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir = ossa::test::make_temp_dir("sandbox");
+    tree = dir / "tree";
+    secret = dir / "secret";
+    fs::create_directories(tree / "chars");
+    fs::create_directories(secret);
+    ASSERT_TRUE(ossa::test::write_file(secret / "creds.bin", triangle_bytes()));
+    ASSERT_TRUE(ossa::test::write_file(secret / "creds.png", std::string_view("\x89PNG\r\n\x1a\n secret")));
+    ASSERT_TRUE(ossa::test::write_file(tree / "chars" / "tri.bin", triangle_bytes()));
+  }
+  ossa::test::CommandResult cook(const fs::path& input, const std::string& extra = "") {
+    return run_command(cook_cmd() + " " + q(input) + " -o " + q(dir / "out") + " " + extra);
+  }
+  fs::path dir, tree, secret;
+};
+
+TEST_F(CookSandbox, AGltfInsideItsTreeCooks) {
+  ASSERT_TRUE(ossa::test::write_file(tree / "chars" / "ok.gltf", triangle_gltf("tri.bin")));
+  const auto r = cook(tree / "chars" / "ok.gltf");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(fs::exists(dir / "out" / "ok.ossa"));
+}
+
+TEST_F(CookSandbox, BufferUriClimbingOutIsRefusedByName) {
+  ASSERT_TRUE(ossa::test::write_file(tree / "chars" / "evil.gltf", triangle_gltf("../../secret/creds.bin")));
+  const auto r = cook(tree / "chars" / "evil.gltf", "--report " + q(dir / "report.json"));
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find((secret / "creds.bin").string() + ": refused: outside the folders this cook may read"),
+            std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("evil.gltf"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "out" / "evil.ossa"));
+  // With the secret's folder allowed, the same file cooks: the refusal was the sandbox's doing.
+  const auto allowed = cook(tree / "chars" / "evil.gltf", "--allow-dir " + q(secret));
+  EXPECT_EQ(allowed.exit_code, 0) << allowed.err;
+}
+
+TEST_F(CookSandbox, ImageUriClimbingOutIsRefusedAndNothingIsEmbedded) {
+  ASSERT_TRUE(ossa::test::write_file(tree / "chars" / "img.gltf", triangle_gltf("tri.bin", "../../secret/creds.png")));
+  const auto r = cook(tree / "chars" / "img.gltf");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("creds.png: refused: outside the folders this cook may read"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("texture"), std::string::npos) << "names the reference: " << r.err;
+  EXPECT_FALSE(fs::exists(dir / "out" / "img.ossa"));
+}
+
+TEST_F(CookSandbox, SymlinksOutOfTheTreeAreResolvedAndRefused) {
+  fs::create_symlink(secret / "creds.bin", tree / "chars" / "link.bin");
+  ASSERT_TRUE(ossa::test::write_file(tree / "chars" / "sym.gltf", triangle_gltf("link.bin")));
+  const auto r = cook(tree / "chars" / "sym.gltf");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find((secret / "creds.bin").string() + ": refused: outside the folders this cook may read"),
+            std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("link.bin'"), std::string::npos) << "names the link as written: " << r.err;
+}
+
+TEST_F(CookSandbox, GraphSourcesOutsideTheTreeAreRefused) {
+  const std::string graph = R"({"ossa_graph": 1, "name": "g", "skeleton": ")" + asset("Pab/skeleton.fbx").string() +
+                            R"(", "clips": {"walk": ")" + asset("Pab/walk.fbx").string() +
+                            R"("}, "parameters": {}, "root": {"clip": "walk"}})";
+  ASSERT_TRUE(ossa::test::write_file(tree / "g.graph.json", graph));
+  const auto r = cook(tree / "g.graph.json");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("skeleton.fbx: refused: outside the folders this cook may read"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("g.graph.json:1:"), std::string::npos) << "names the graph entry: " << r.err;
+}
+
+TEST_F(CookSandbox, RootWidensTheSandboxAndADirectoryArgumentIsItsOwnTree) {
+  fs::create_directories(tree / "textures");
+  ASSERT_TRUE(ossa::test::write_file(tree / "textures" / "tri.bin", triangle_bytes()));
+  ASSERT_TRUE(ossa::test::write_file(tree / "chars" / "up.gltf", triangle_gltf("../textures/tri.bin")));
+  EXPECT_EQ(cook(tree / "chars" / "up.gltf").exit_code, 1) << "a file input: its own folder only";
+  EXPECT_EQ(cook(tree / "chars" / "up.gltf", "--root " + q(tree)).exit_code, 0);
+  fs::remove_all(dir / "out");
+  const auto r = run_command(cook_cmd() + " " + q(tree) + " -o " + q(dir / "out") + " --root " + q(tree));
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+}
+
+TEST_F(CookSandbox, FifosAndDevicesAreRefusedWithoutBeingOpened) {
+  ASSERT_EQ(::mkfifo((tree / "chars" / "pipe.gltf").c_str(), 0644), 0);
+  ASSERT_EQ(::mkfifo((tree / "chars" / "pipe.bin").c_str(), 0644), 0);
+  ASSERT_TRUE(ossa::test::write_file(tree / "chars" / "fifo.gltf", triangle_gltf("pipe.bin")));
+  const auto start = std::chrono::steady_clock::now();
+  // A FIFO as the input itself, and a FIFO as a buffer; /dev/zero as an allowed folder's file.
+  const auto r = run_command(cook_cmd() + " " + q(tree / "chars" / "pipe.gltf") + " " + q(tree / "chars" / "fifo.gltf") +
+                             " /dev/zero -o " + q(dir / "out") + " --timeout 20");
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_LT(seconds, 10.0) << "nothing waited for a writer or read an endless device";
+  EXPECT_NE(r.err.find("pipe.gltf: refused: is a FIFO, not a regular file"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("pipe.bin: refused: is a FIFO, not a regular file"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("/dev/zero: refused: is a device, not a regular file"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "out"));
+}
+
+}  // namespace
