@@ -180,3 +180,25 @@ TEST(CookerCli, ProgressLinesCountFailuresAndEstimateTheRest) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST(CookerCli, Latin1AndControlCharactersInNamesNeitherAbortTheReportNorReachTheTerminal) {
+  const fs::path dir = ossa::test::make_temp_dir("cli-names");
+  // A Latin-1 file name (old tools) and one carrying a terminal escape sequence, both garbage.
+  const fs::path latin1 = dir / "caf\xe9.fbx", escape = dir / "evil\x1b[2Jname.fbx";
+  ASSERT_TRUE(ossa::test::write_file(latin1, std::string_view("not an fbx")));
+  ASSERT_TRUE(ossa::test::write_file(escape, std::string_view("not an fbx")));
+  const auto r = run_command(cook_cmd() + " " + q(latin1) + " " + q(escape) + " " +
+                             q(asset("RiggedSimple/RiggedSimple.glb")) + " -o " + q(dir / "out") + " --report " +
+                             q(dir / "report.json"));
+  EXPECT_EQ(r.exit_code, 1) << r.err;  // not 134: the report is written
+  const auto text = ossa::test::read_text(dir / "report.json");
+  ASSERT_TRUE(text.has_value());
+  const auto report = nlohmann::json::parse(*text);  // valid UTF-8 JSON
+  EXPECT_EQ(report["records"][0]["input"].get<std::string>(), (dir / "caf\xc3\xa9.fbx").string()) << "Latin-1 transcoded";
+  EXPECT_EQ(r.err.find('\x1b'), std::string::npos) << "no raw escape byte reaches stderr";
+  EXPECT_NE(r.err.find("evil\\x1b[2Jname.fbx"), std::string::npos) << r.err;
+}
+
+}  // namespace

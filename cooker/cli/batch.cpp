@@ -12,6 +12,7 @@
 #include <set>
 
 #include "cooker/cli/worker.h"
+#include "runtime/internal/message.h"
 
 #include <ossa/version.h>
 
@@ -157,6 +158,41 @@ Status write_depfile(const fs::path& path, const std::vector<CookRecord>& record
   return write_file_atomic(path, std::vector<uint8_t>(text.begin(), text.end()));
 }
 
+namespace {
+
+/// `text` as UTF-8: valid sequences kept, every other byte read as Latin-1 (what old FBX files
+/// carry in names) and encoded as that code point. JSON text must be UTF-8, and a report must be
+/// written whatever bytes a path, a joint name or a message holds.
+std::string as_utf8(const std::string& text) {
+  std::string out;
+  out.reserve(text.size());
+  for (size_t i = 0; i < text.size();) {
+    const auto c = static_cast<unsigned char>(text[i]);
+    if (c < 0x80) {
+      out += static_cast<char>(c);
+      ++i;
+    } else if (const size_t n = detail::utf8_sequence_length(text, i); n != 0) {
+      out.append(text, i, n);
+      i += n;
+    } else {
+      out += static_cast<char>(0xC0 | (c >> 6));
+      out += static_cast<char>(0x80 | (c & 0x3F));
+      ++i;
+    }
+  }
+  return out;
+}
+
+void make_utf8(nlohmann::ordered_json& j) {
+  if (j.is_string()) {
+    j = as_utf8(j.get_ref<const std::string&>());
+  } else if (j.is_array() || j.is_object()) {
+    for (auto& v : j) make_utf8(v);
+  }
+}
+
+}  // namespace
+
 nlohmann::ordered_json report_json(const std::vector<CookRecord>& records, const CookOptions& options,
                                    const BatchLimits& limits) {
   nlohmann::ordered_json doc;
@@ -231,6 +267,7 @@ nlohmann::ordered_json report_json(const std::vector<CookRecord>& records, const
   doc["inputs"] = records.size();
   doc["failed"] = failed;
   doc["records"] = std::move(list);
+  make_utf8(doc);  // keys are ours (ASCII); values may carry any bytes
   return doc;
 }
 

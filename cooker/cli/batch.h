@@ -83,7 +83,7 @@ Status write_depfile(const std::filesystem::path& path, const std::vector<CookRe
 inline constexpr const char* kReportSchema = "ossa-cook-report";
 inline constexpr int kReportSchemaVersion = 1;
 
-/// The --report document: schema name and version, cooker version, options, the limits each input
+/// The --report document (every string made valid UTF-8: invalid bytes read as Latin-1): schema name and version, cooker version, options, the limits each input
 /// ran under, totals and one record per input. A failed record carries its error and the counts
 /// known before the failure, and no "output" or "cooked_bytes": nothing was written for it.
 nlohmann::ordered_json report_json(const std::vector<CookRecord>& records, const CookOptions& options,

@@ -41,6 +41,7 @@
 #include "cooker/cli/batch.h"
 #include "cooker/cli/worker.h"
 #include "cooker/cook.h"
+#include "runtime/internal/message.h"
 #include "runtime/tools/cli/cli.h"
 
 namespace fs = std::filesystem;
@@ -58,6 +59,22 @@ std::string human_bytes(uint64_t n) {
 
 /// The end-of-batch table: the output column is as wide as the longest output path, so the
 /// number columns stay aligned whatever the tree's depth.
+/// Text from a record as it may reach a terminal: each line's control bytes (an escape sequence in
+/// a file name) and invalid UTF-8 shown as \xNN, and each line cut at 2000 characters (a source
+/// can make names megabytes long). Line breaks stay: a graph's errors are one per line.
+std::string shown(const std::string& text) {
+  std::string out;
+  size_t start = 0;
+  while (true) {
+    const size_t end = text.find('\n', start);
+    out += ossa::detail::printable(std::string_view(text).substr(start, end - start), 2000);
+    if (end == std::string::npos) break;
+    out += '\n';
+    start = end + 1;
+  }
+  return out;
+}
+
 /// "[12/40, 1 failed, ETA 0:08]": done of total, failures so far, and the time left at the mean
 /// pace so far (inputs finish out of order with --jobs, so the mean is the honest estimate).
 std::string progress_head(size_t done, size_t total, size_t failed, double elapsed) {
@@ -88,12 +105,12 @@ std::string fit(const std::string& text, size_t width) {
 void print_summary(const std::vector<CookRecord>& records) {
   int width = 6;
   for (const CookRecord& r : records)
-    if (r.ok) width = std::max(width, static_cast<int>(r.output.size()));
+    if (r.ok) width = std::max(width, static_cast<int>(shown(r.output).size()));
   std::printf("%-*s %7s %7s %9s %6s %12s %12s  %s\n", width, "output", "joints", "meshes", "vertices", "clips",
               "source", "cooked", "status");
   for (const CookRecord& r : records) {
     if (!r.ok) continue;
-    std::printf("%-*s %7u %7u %9u %6u %12s %12s  %s\n", width, r.output.c_str(), r.joints.value_or(0),
+    std::printf("%-*s %7u %7u %9u %6u %12s %12s  %s\n", width, shown(r.output).c_str(), r.joints.value_or(0),
                 r.meshes.value_or(0), r.vertices.value_or(0), r.clips.value_or(0), human_bytes(r.source_bytes).c_str(),
                 human_bytes(r.cooked_bytes).c_str(), r.up_to_date ? "up to date" : "cooked");
   }
@@ -101,13 +118,13 @@ void print_summary(const std::vector<CookRecord>& records) {
 
 /// -v: what one input took and what compression achieved on each of its clips.
 void print_details(const CookRecord& r) {
-  std::fprintf(stderr, "  %s: %.1f ms, source %s", r.input.c_str(), r.seconds * 1e3, human_bytes(r.source_bytes).c_str());
+  std::fprintf(stderr, "  %s: %.1f ms, source %s", shown(r.input).c_str(), r.seconds * 1e3, human_bytes(r.source_bytes).c_str());
   if (r.ok) std::fprintf(stderr, ", cooked %s", human_bytes(r.cooked_bytes).c_str());
   std::fprintf(stderr, "\n");
   for (const ClipRecord& c : r.clip_records)
     std::fprintf(stderr, "    clip '%s': %u frames, %u joints, max error %.4f mm (mean %.4f mm, at '%s'), %u -> %u bytes (%.1f:1)\n",
-                 c.name.c_str(), c.frames, c.joints, static_cast<double>(c.max_error_mm),
-                 static_cast<double>(c.mean_error_mm), c.worst_joint.c_str(), c.raw_bytes, c.cooked_bytes,
+                 shown(c.name).c_str(), c.frames, c.joints, static_cast<double>(c.max_error_mm),
+                 static_cast<double>(c.mean_error_mm), shown(c.worst_joint).c_str(), c.raw_bytes, c.cooked_bytes,
                  c.cooked_bytes > 0 ? static_cast<double>(c.raw_bytes) / c.cooked_bytes : 0.0);
 }
 
@@ -235,17 +252,17 @@ int main(int argc, char** argv) {
     const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - batch_start).count();
     const std::string head = progress_head(done, total, failed_so_far, elapsed);
     if (!r.ok) {
-      std::fprintf(stderr, "%s%s FAILED %s\n", tty ? "\r\033[K" : "", head.c_str(), r.error.c_str());
+      std::fprintf(stderr, "%s%s FAILED %s\n", tty ? "\r\033[K" : "", head.c_str(), shown(r.error).c_str());
     } else if (!quiet && !list_inputs) {
       const char* what = r.up_to_date ? " (up to date)" : "";
       if (tty)  // one line rewritten in place: it must not wrap, so a long path keeps its tail
         std::fprintf(stderr, "\r\033[K%s %s%s", head.c_str(),
-                     fit(r.input, terminal_columns() - head.size() - std::strlen(what) - 2).c_str(), what);
+                     fit(shown(r.input), terminal_columns() - head.size() - std::strlen(what) - 2).c_str(), what);
       else
-        std::fprintf(stderr, "%s %s -> %s%s\n", head.c_str(), r.input.c_str(), r.output.c_str(), what);
+        std::fprintf(stderr, "%s %s -> %s%s\n", head.c_str(), shown(r.input).c_str(), shown(r.output).c_str(), what);
     }
     if (verbose) {
-      for (const std::string& w : r.warnings) std::fprintf(stderr, "warning: %s: %s\n", r.input.c_str(), w.c_str());
+      for (const std::string& w : r.warnings) std::fprintf(stderr, "warning: %s: %s\n", shown(r.input).c_str(), shown(w).c_str());
       print_details(r);
     }
     if (tty && done == total && !quiet) std::fprintf(stderr, "\n");
@@ -287,7 +304,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "ossa-cook: %zu of %zu inputs failed:\n", failed, records.size());
     for (const CookRecord& r : records) {
       if (r.ok) continue;
-      std::string indented = r.error;  // graph files report one problem per line
+      std::string indented = shown(r.error);  // graph files report one problem per line
       for (size_t at = indented.find('\n'); at != std::string::npos; at = indented.find('\n', at + 3))
         indented.replace(at, 1, "\n  ");
       std::fprintf(stderr, "  %s\n", indented.c_str());
