@@ -25,7 +25,11 @@ gltf=0
 if [ -n "$shared" ] && [ -f "$shared/Khronos_embedded/interpolation_test.gltf" ]; then
   mkdir -p "$project/assets/gltf"
   cp "$shared/Khronos_embedded/interpolation_test.gltf" "$shared/Khronos_embedded/interpolation_test.bin" "$project/assets/gltf/"
-  printf '\xff\xd8\xff\xe0 a texture\xff\xd9' >"$project/assets/gltf/l.jpg"  # the texture it names
+  # The texture it names: a real 1x1 PNG (the cooker decodes every texture it embeds).
+  python3 -c 'import sys,zlib,struct
+def chunk(t, d): return struct.pack(">I", len(d)) + t + d + struct.pack(">I", zlib.crc32(t + d))
+sys.stdout.buffer.write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", 1, 1, 8, 2, 0, 0, 0))
+  + chunk(b"IDAT", zlib.compress(b"\x00\xff\x00\x00")) + chunk(b"IEND", b""))' >"$project/assets/gltf/l.jpg"
   gltf=1
 fi
 chmod -R u+w "$project"

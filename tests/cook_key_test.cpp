@@ -46,8 +46,9 @@ Tree make_tree(const fs::path& root) {
     fs::create_directories(root / "gltf");
     fs::copy_file(shared / "interpolation_test.gltf", root / "gltf" / "interpolation_test.gltf");
     fs::copy_file(shared / "interpolation_test.bin", root / "gltf" / "interpolation_test.bin");
-    // The texture it names (not shipped with it): JPEG magic is all the cooker checks.
-    EXPECT_TRUE(ossa::test::write_file(root / "gltf" / "l.jpg", std::string_view("\xFF\xD8\xFF\xE0 jpeg bytes\xFF\xD9")));
+    // The texture it names (not shipped with it): a real image, as the cooker decodes it (a PNG
+    // under a .jpg name is fine: images are identified by their bytes).
+    EXPECT_TRUE(ossa::test::write_file(root / "gltf" / "l.jpg", ossa::test::tiny_png()));
     t.has_gltf_bin = true;
   }
   return t;

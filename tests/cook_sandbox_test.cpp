@@ -148,4 +148,46 @@ TEST_F(CookSandbox, FifosAndDevicesAreRefusedWithoutBeingOpened) {
   EXPECT_FALSE(fs::exists(dir / "out"));
 }
 
+// Textures are identified by their bytes and must decode (cooker/import/image_check.h).
+TEST_F(CookSandbox, TexturesMustBeTheImagesTheyClaimToBe) {
+  const auto png = ossa::test::tiny_png();
+  std::string bomb(png.begin(), png.end());
+  // The IHDR's width and height (bytes 16..23) rewritten to 20000 x 20000: a decompression bomb.
+  for (int k = 0; k < 2; ++k) {
+    bomb[16 + 4 * k] = 0;
+    bomb[17 + 4 * k] = 0;
+    bomb[18 + 4 * k] = char(20000 >> 8);
+    bomb[19 + 4 * k] = char(20000 & 0xff);
+  }
+  const std::string cases[][2] = {
+      {"text.png", "just some text, named like a picture\n"},
+      {"truncated.png", std::string(png.begin(), png.begin() + 40)},
+      {"bomb.png", bomb},
+  };
+  const char* expected[] = {"is not a PNG or JPEG image", "does not decode as png", "claims 20000 x 20000 pixels"};
+  for (size_t i = 0; i < std::size(cases); ++i) {
+    ASSERT_TRUE(ossa::test::write_file(tree / "chars" / cases[i][0], cases[i][1]));
+    ASSERT_TRUE(ossa::test::write_file(tree / "chars" / "t.gltf", triangle_gltf("tri.bin", cases[i][0])));
+    const auto r = cook(tree / "chars" / "t.gltf");
+    EXPECT_EQ(r.exit_code, 1) << cases[i][0];
+    EXPECT_NE(r.err.find("texture '" + cases[i][0] + "' " + expected[i]), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(dir / "out" / "t.ossa")) << cases[i][0];
+  }
+  // A real PNG under a .jpg name is embedded as what it is.
+  ASSERT_TRUE(ossa::test::write_file(tree / "chars" / "real.jpg", png));
+  ASSERT_TRUE(ossa::test::write_file(tree / "chars" / "t.gltf", triangle_gltf("tri.bin", "real.jpg")));
+  const auto r = cook(tree / "chars" / "t.gltf");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  auto a = ossa::Asset::open((dir / "out" / "t.ossa").string());
+  ASSERT_TRUE(a.ok());
+  size_t embedded = 0;
+  for (const auto* m : *a->file().materials())
+    if (m->textures())
+      for (const auto* t : *m->textures()) {
+        EXPECT_EQ(t->mime()->str(), "image/png");
+        embedded += t->data() ? 1 : 0;
+      }
+  EXPECT_EQ(embedded, 1u);
+}
+
 }  // namespace

@@ -52,6 +52,7 @@ constexpr uint8_t kTinyPng[] = {
     0x60, 0x0c, 0x00, 0x5c, 0x88, 0x0a, 0x65, 0x38, 0xa8, 0x9b, 0x14, 0x00, 0x00, 0x00, 0x00, 0x49, 0x45,
     0x4e, 0x44, 0xae, 0x42, 0x60, 0x82};
 
+
 fb::Mat4 to_fb(const glm::mat4& m) {
   float columns[16];
   std::memcpy(columns, glm::value_ptr(m), sizeof columns);
@@ -608,5 +609,7 @@ size_t count_files(const std::filesystem::path& dir) {
     if (it->is_regular_file()) ++n;
   return n;
 }
+
+std::span<const uint8_t> tiny_png() { return kTinyPng; }
 
 }  // namespace ossa::test

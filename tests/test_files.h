@@ -216,6 +216,9 @@ std::filesystem::path shared_assets();  // OSSA_SHARED_ASSETS (may not exist)
 /// A new, empty directory under OSSA_TEST_TMP (created as needed) named <prefix>-XXXXXX.
 std::filesystem::path make_temp_dir(std::string_view prefix = "test");
 
+/// A valid 2x2 RGBA PNG (decodes with stb_image): a texture file for cooker tests.
+std::span<const uint8_t> tiny_png();
+
 /// Whole-file read; nullopt when the file cannot be opened or read.
 std::optional<std::vector<uint8_t>> read_file(const std::filesystem::path& path);
 std::optional<std::string> read_text(const std::filesystem::path& path);

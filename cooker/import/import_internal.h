@@ -93,7 +93,13 @@ struct Context {
   const ImportOptions* options = nullptr;
   std::vector<bool> mesh_kept;            // per aiMesh: false for dropped (lines, generated skeleton)
   std::vector<std::string>* warnings = nullptr;
+  /// A problem that must fail the import after the stage that found it (a texture that is not the
+  /// image it claims to be); the first one is kept.
+  std::string* failure = nullptr;
   void warn(std::string message) const { warnings->push_back(std::move(message)); }
+  void fail(std::string message) const {
+    if (failure != nullptr && failure->empty()) *failure = std::move(message);
+  }
   Error error(const std::string& what) const { return Error{path + ": " + what}; }
 };
 

@@ -15,6 +15,7 @@
 
 #include <assimp/scene.h>
 
+#include "cooker/import/image_check.h"
 #include "cooker/import/import_internal.h"
 #include "cooker/import/input_log.h"
 
@@ -30,25 +31,6 @@ bool get_color(const aiMaterial& mat, const char* key, unsigned type, unsigned i
   if (!std::isfinite(c.r) || !std::isfinite(c.g) || !std::isfinite(c.b)) return false;
   *out = glm::vec3(c.r, c.g, c.b);
   return true;
-}
-
-std::string lower(std::string s) {
-  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return s;
-}
-
-/// "image/png" / "image/jpeg" from a hint or extension, else from the bytes' signature.
-std::string mime_of(const std::string& hint, const std::vector<uint8_t>& bytes) {
-  const std::string h = lower(hint);
-  if (h == "png") return "image/png";
-  if (h == "jpg" || h == "jpeg") return "image/jpeg";
-  if (bytes.size() >= 8 && bytes[0] == 0x89 && bytes[1] == 'P' && bytes[2] == 'N' && bytes[3] == 'G') {
-    return "image/png";
-  }
-  if (bytes.size() >= 3 && bytes[0] == 0xFF && bytes[1] == 0xD8 && bytes[2] == 0xFF) {
-    return "image/jpeg";
-  }
-  return {};
 }
 
 /// Forward slashes, no "./": paths from Windows-authored FBX files use backslashes.
@@ -84,12 +66,13 @@ bool embedded(const Context& ctx, const aiTexture& tex, const std::string& label
   }
   const auto* begin = reinterpret_cast<const uint8_t*>(tex.pcData);
   out->data.assign(begin, begin + tex.mWidth);
-  out->mime = mime_of(tex.achFormatHint, out->data);
-  if (out->mime.empty()) {
-    ctx.warn(label + ": embedded texture format '" + std::string(tex.achFormatHint) +
-             "' is neither PNG nor JPEG, dropped");
+  // By its bytes, never by the format hint; and it must decode (image_check.h).
+  auto image = check_image(out->data);
+  if (!image) {
+    ctx.fail(label + ": embedded texture '" + std::string(tex.mFilename.C_Str()) + "' " + image.error().message);
     return false;
   }
+  out->mime = image->mime;
   return true;  // no path: an embedded image's name (glTF's "Image_0") is not a file
 }
 
@@ -120,12 +103,13 @@ bool find_texture(const Context& ctx, const aiMaterial& mat, std::initializer_li
     ctx.warn(label + ": texture '" + path + "' cannot be read, only its path is kept");
     return true;
   }
-  const std::string ext = std::filesystem::path(path).extension().string();
-  out->mime = mime_of(ext.empty() ? std::string() : ext.substr(1), bytes);
-  if (out->mime.empty()) {
-    ctx.warn(label + ": texture '" + path + "' is neither PNG nor JPEG, only its path is kept");
-    return true;
+  // By its bytes, never by its name; and it must decode (image_check.h).
+  auto image = check_image(bytes);
+  if (!image) {
+    ctx.fail(label + ": texture '" + path + "' " + image.error().message);
+    return false;
   }
+  out->mime = image->mime;
   out->data = std::move(bytes);
   return true;
 }

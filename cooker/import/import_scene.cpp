@@ -49,6 +49,8 @@ Result<SourceScene> convert_scene(const aiScene& scene, const std::string& path,
   ctx.format = format;
   ctx.options = &options;
   ctx.warnings = &out.warnings;
+  std::string failure;
+  ctx.failure = &failure;
   if (!scene.mRootNode) return ctx.error("the file has no node tree");
   ctx.mesh_kept = select_meshes(ctx);
   const NodeGraph graph = build_node_graph(ctx);
@@ -60,6 +62,7 @@ Result<SourceScene> convert_scene(const aiScene& scene, const std::string& path,
   if (!meshes) return meshes.error();
   out.meshes = std::move(*meshes);
   out.materials = import_materials(ctx);
+  if (!failure.empty()) return ctx.error(failure);
   if (out.materials.empty() && !out.meshes.empty()) out.materials.emplace_back();
   for (SourceMesh& mesh : out.meshes) {
     if (mesh.material >= out.materials.size()) {

@@ -1,0 +1,71 @@
+// image_check.cpp — signature, header bounds and a full decode of a texture (see image_check.h).
+#include "cooker/import/image_check.h"
+
+#include <cstdio>
+#include <limits>
+
+// stb_image, private to this file (STB_IMAGE_STATIC): the viewer links its own copy, and a program
+// that links both (ossa-bench-first-frame) must not see two definitions. PNG and JPEG only.
+#define STB_IMAGE_STATIC
+#define STB_IMAGE_IMPLEMENTATION
+#define STBI_ONLY_PNG
+#define STBI_ONLY_JPEG
+#define STBI_NO_STDIO
+#if defined(__GNUC__)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wunused-function"
+#pragma GCC diagnostic ignored "-Wmissing-field-initializers"
+#pragma GCC diagnostic ignored "-Wsign-compare"
+#pragma GCC diagnostic ignored "-Wshadow"
+#pragma GCC diagnostic ignored "-Wconversion"
+#pragma GCC diagnostic ignored "-Wdouble-promotion"
+#endif
+#include <stb_image.h>
+#if defined(__GNUC__)
+#pragma GCC diagnostic pop
+#endif
+
+namespace ossa::cook {
+
+Result<ImageInfo> check_image(std::span<const uint8_t> bytes) {
+  ImageInfo info;
+  const auto at = [&](size_t i) { return i < bytes.size() ? bytes[i] : 0; };
+  if (bytes.size() >= 8 && at(0) == 0x89 && at(1) == 'P' && at(2) == 'N' && at(3) == 'G' && at(4) == '\r' &&
+      at(5) == '\n' && at(6) == 0x1A && at(7) == '\n') {
+    info.mime = "image/png";
+  } else if (bytes.size() >= 3 && at(0) == 0xFF && at(1) == 0xD8 && at(2) == 0xFF) {
+    info.mime = "image/jpeg";
+  } else {
+    char start[64];
+    std::snprintf(start, sizeof start, "%02x %02x %02x %02x", at(0), at(1), at(2), at(3));
+    return Error{std::string("is not a PNG or JPEG image (its bytes start ") + start + ")"};
+  }
+  if (bytes.size() > static_cast<size_t>(std::numeric_limits<int>::max())) return Error{"is too large to decode"};
+  const auto* data = reinterpret_cast<const stbi_uc*>(bytes.data());
+  const int size = static_cast<int>(bytes.size());
+  int w = 0, h = 0, channels = 0;
+  // A PNG's size is in its first chunk: read it here, so a bomb is named as one even where
+  // stb_image would only say "unknown image type".
+  const auto be32 = [&](size_t i) { return uint32_t(at(i)) << 24 | uint32_t(at(i + 1)) << 16 | uint32_t(at(i + 2)) << 8 | at(i + 3); };
+  if (info.mime == "image/png" && bytes.size() >= 24 && at(12) == 'I' && at(13) == 'H' && at(14) == 'D' && at(15) == 'R') {
+    const uint32_t pw = be32(16), ph = be32(20);
+    if (pw > uint32_t(kMaxImageSide) || ph > uint32_t(kMaxImageSide) || uint64_t(pw) * ph > kMaxImagePixels)
+      return Error{"claims " + std::to_string(pw) + " x " + std::to_string(ph) + " pixels, over the limit of " +
+                   std::to_string(kMaxImageSide) + " per side and " + std::to_string(kMaxImagePixels) + " pixels"};
+  }
+  if (!stbi_info_from_memory(data, size, &w, &h, &channels))
+    return Error{"is not a readable " + info.mime.substr(6) + " image: " + stbi_failure_reason()};
+  if (w <= 0 || h <= 0 || w > kMaxImageSide || h > kMaxImageSide ||
+      static_cast<uint64_t>(w) * static_cast<uint64_t>(h) > kMaxImagePixels)
+    return Error{"claims " + std::to_string(w) + " x " + std::to_string(h) + " pixels, over the limit of " +
+                 std::to_string(kMaxImageSide) + " per side and " + std::to_string(kMaxImagePixels) + " pixels"};
+  stbi_uc* pixels = stbi_load_from_memory(data, size, &w, &h, &channels, 0);
+  if (pixels == nullptr)
+    return Error{"does not decode as " + info.mime.substr(6) + ": " + stbi_failure_reason()};
+  stbi_image_free(pixels);
+  info.width = w;
+  info.height = h;
+  return info;
+}
+
+}  // namespace ossa::cook
