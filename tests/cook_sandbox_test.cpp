@@ -190,4 +190,31 @@ TEST_F(CookSandbox, TexturesMustBeTheImagesTheyClaimToBe) {
   EXPECT_EQ(embedded, 1u);
 }
 
+// A huge but finite value in a source is named at import (it used to surface as "internal error,
+// cooked bytes fail verification").
+TEST_F(CookSandbox, HugeSourceValuesAreNamedAtImport) {
+  // An animated node: keys at 0 s and 1 s, the first translation 1e20.
+  const float data[8] = {0.0f, 1.0f, 1e20f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f};
+  ASSERT_TRUE(ossa::test::write_file(tree / "chars" / "anim.bin",
+                                     std::string(reinterpret_cast<const char*>(data), sizeof data)));
+  nlohmann::json j = {
+      {"asset", {{"version", "2.0"}}},
+      {"scene", 0},
+      {"scenes", {{{"nodes", {0}}}}},
+      {"nodes", {{{"name", "hips"}}}},
+      {"buffers", {{{"uri", "anim.bin"}, {"byteLength", 32}}}},
+      {"bufferViews", {{{"buffer", 0}, {"byteLength", 8}}, {{"buffer", 0}, {"byteOffset", 8}, {"byteLength", 24}}}},
+      {"accessors", {{{"bufferView", 0}, {"componentType", 5126}, {"count", 2}, {"type", "SCALAR"}, {"min", {0}}, {"max", {1}}},
+                     {{"bufferView", 1}, {"componentType", 5126}, {"count", 2}, {"type", "VEC3"}}}},
+      {"animations", {{{"name", "move"},
+                       {"samplers", {{{"input", 0}, {"output", 1}}}},
+                       {"channels", {{{"sampler", 0}, {"target", {{"node", 0}, {"path", "translation"}}}}}}}}}};
+  ASSERT_TRUE(ossa::test::write_file(tree / "chars" / "huge.gltf", j.dump()));
+  const auto r = cook(tree / "chars" / "huge.gltf");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_EQ(r.err.find("internal error"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("clip 'move', joint 'hips': translation key 0 (at 0 s) (1e+20, 0, 0) is unusable"),
+            std::string::npos) << r.err;
+}
+
 }  // namespace

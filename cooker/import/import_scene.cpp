@@ -26,6 +26,7 @@
 #include "cooker/import/import_internal.h"
 #include "cooker/import/import_io.h"
 #include "cooker/import/import_scene.h"
+#include "cooker/import/value_check.h"
 
 namespace ossa::cook {
 namespace detail {
@@ -75,6 +76,8 @@ Result<SourceScene> convert_scene(const aiScene& scene, const std::string& path,
   if (out.skeleton.joints.empty() && out.meshes.empty() && out.clips.empty()) {
     return ctx.error("holds no mesh, skeleton or animation to cook");
   }
+  // Values the format cannot hold are named here, not found by the writer's own verification.
+  if (Status st = check_scene_values(out); !st) return ctx.error(st.message());
   return out;
 }
 
