@@ -3,6 +3,8 @@
 #include "cooker/cook.h"
 
 #include <fcntl.h>
+#include <signal.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -355,12 +357,37 @@ Result<SourceSkeleton> load_reference_skeleton(const fs::path& ossa_file, InputF
   return out;
 }
 
+namespace {
+
+/// Removes `.<name>.tmp-<pid>-<n>` files in `dir` left by a cook whose process no longer exists
+/// (a worker or a whole ossa-cook killed mid-write). A live process's temporaries are kept.
+void remove_stale_temporaries(const fs::path& dir, const std::string& name) {
+  const std::string prefix = "." + name + ".tmp-";
+  std::error_code ec;
+  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string entry = it->path().filename().string();
+    if (entry.rfind(prefix, 0) != 0) continue;
+    const long pid = std::strtol(entry.c_str() + prefix.size(), nullptr, 10);
+    if (pid <= 0 || pid == static_cast<long>(::getpid())) continue;
+    if (::kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH) ::unlink(it->path().c_str());
+  }
+}
+
+}  // namespace
+
 Status write_file_atomic(const fs::path& path, const std::vector<uint8_t>& bytes) {
   static std::atomic<unsigned> counter{0};
   std::error_code ec;
   const fs::path dir = path.parent_path().empty() ? fs::path(".") : path.parent_path();
+  // A read-only file is the user's way of saying "do not replace": rename(2) would, so it is
+  // refused here (by its mode bits, which also hold for root, whom access(2) lets write anything).
+  struct stat existing{};
+  if (::stat(path.c_str(), &existing) == 0 && S_ISREG(existing.st_mode) &&
+      (existing.st_mode & (S_IWUSR | S_IWGRP | S_IWOTH)) == 0)
+    return Error{path.string() + ": is read-only, not replaced (make it writable or remove it)"};
   fs::create_directories(dir, ec);
   if (ec) return Error{path.string() + ": cannot create directory " + dir.string() + ": " + ec.message()};
+  remove_stale_temporaries(dir, path.filename().string());
   const fs::path tmp = dir / ("." + path.filename().string() + ".tmp-" + std::to_string(::getpid()) + "-" +
                               std::to_string(counter.fetch_add(1)));
   const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);

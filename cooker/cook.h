@@ -100,7 +100,8 @@ bool is_graph_file(const std::filesystem::path& path);
 Result<SourceSkeleton> load_reference_skeleton(const std::filesystem::path& ossa_file, InputFile* as_read = nullptr);
 
 /// Writes bytes to a temporary file in path's directory, flushes, then renames it onto path.
-/// On any failure the temporary is removed and path is untouched.
+/// On any failure the temporary is removed and path is untouched. A read-only file at path is
+/// refused, not replaced; temporaries of path left by processes that no longer exist are removed.
 Status write_file_atomic(const std::filesystem::path& path, const std::vector<uint8_t>& bytes);
 
 }  // namespace ossa::cook

@@ -202,3 +202,48 @@ TEST(CookerCli, Latin1AndControlCharactersInNamesNeitherAbortTheReportNorReachTh
 }
 
 }  // namespace
+
+namespace {
+
+TEST(CookerCli, AReadOnlyOutputIsRefusedNotReplaced) {
+  const fs::path dir = ossa::test::make_temp_dir("cli-readonly");
+  const std::string cmd = cook_cmd() + " " + q(asset("RiggedSimple/RiggedSimple.glb")) + " -o " + q(dir) + " -q";
+  ASSERT_EQ(run_command(cmd).exit_code, 0);
+  const fs::path out = dir / "RiggedSimple.ossa";
+  ASSERT_TRUE(ossa::test::write_file(out, std::string_view("kept")));
+  fs::permissions(out, fs::perms::owner_read | fs::perms::group_read | fs::perms::others_read);
+  const auto r = run_command(cmd + " --force");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("RiggedSimple.ossa: is read-only, not replaced"), std::string::npos) << r.err;
+  EXPECT_EQ(ossa::test::read_text(out).value_or(""), "kept");
+  EXPECT_EQ(count_files(dir), 1u) << "no temporary left";
+}
+
+TEST(CookerCli, TemporariesOfDeadCooksAreCleanedUp) {
+  const fs::path dir = ossa::test::make_temp_dir("cli-stale");
+  // pid 2^22 + 1 is above Linux's pid_max limit, so no process has it: a cook killed long ago.
+  const fs::path stale = dir / ".RiggedSimple.ossa.tmp-4194305-0";
+  const fs::path other = dir / ".Other.ossa.tmp-4194305-0";
+  ASSERT_TRUE(ossa::test::write_file(stale, std::string_view("half")));
+  ASSERT_TRUE(ossa::test::write_file(other, std::string_view("half")));
+  const auto r = run_command(cook_cmd() + " " + q(asset("RiggedSimple/RiggedSimple.glb")) + " -o " + q(dir) + " -q");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_FALSE(fs::exists(stale)) << "this output's stale temporary is removed";
+  EXPECT_TRUE(fs::exists(other)) << "another output's is left to its own cook";
+}
+
+TEST(CookerCli, ANulByteInAGraphPathIsRefused) {
+  const fs::path dir = ossa::test::make_temp_dir("cli-nul");
+  fs::copy_file(asset("Pab/skeleton.fbx"), dir / "skeleton.fbx");
+  fs::copy_file(asset("Pab/walk.fbx"), dir / "walk.fbx");
+  // "skeleton.fbx\u0000.txt" names skeleton.fbx to any C API: it must not be read as that.
+  ASSERT_TRUE(ossa::test::write_file(dir / "g.graph.json", std::string_view(
+      R"({"ossa_graph": 1, "name": "g", "skeleton": "skeleton.fbx\u0000.txt", "clips": {"walk": "walk.fbx"},)"
+      R"( "parameters": {}, "root": {"clip": "walk"}})")));
+  const auto r = run_command(cook_cmd() + " " + q(dir / "g.graph.json") + " -o " + q(dir / "out"));
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("refused: contains a NUL byte"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "out" / "g.ossa"));
+}
+
+}  // namespace

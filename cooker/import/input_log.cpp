@@ -117,6 +117,9 @@ const char* kind_of(const struct stat& st) {
 }  // namespace
 
 Result<std::vector<uint8_t>> read_input(const fs::path& path, uint64_t max_bytes, std::string_view reference) {
+  // A NUL byte (a JSON "\u0000") would cut the path short for the operating system: another file.
+  if (path.native().find('\0') != std::string::npos)
+    return Error{refuse(path, "contains a NUL byte", reference)};
   if (!inside_sandbox(path)) return Error{refuse(path, outside_message(), reference)};
   struct stat st{};
   if (::stat(path.c_str(), &st) != 0) {
@@ -160,6 +163,10 @@ Result<std::vector<uint8_t>> read_input(const fs::path& path, uint64_t max_bytes
 }
 
 bool probe_input(const fs::path& path, std::string_view reference) {
+  if (path.native().find('\0') != std::string::npos) {
+    refuse(path, "contains a NUL byte", reference);
+    return false;
+  }
   if (!inside_sandbox(path)) {
     refuse(path, outside_message(), reference);
     return false;
