@@ -293,4 +293,20 @@ TEST(CookKey, DepfileAndListInputsNameEveryFileRead) {
   EXPECT_EQ(text->find("events.json"), std::string::npos) << *text;
 }
 
+TEST(CookKey, AnInputNamedWithoutAFolderRecordsTheSameRelativeInputs) {
+  const fs::path dir = ossa::test::make_temp_dir("key-cwd");
+  const Tree t = make_tree(dir / "src");
+  const fs::path chars = t.root / "chars";
+  ASSERT_EQ(run_command(cook_cmd() + " " + q(chars / "RiggedSimple.glb") + " -o " + q(dir / "a") + " -q").exit_code, 0);
+  ASSERT_EQ(run_command("cd " + q(chars) + " && " + cook_cmd() + " RiggedSimple.glb -o " + q(dir / "b") + " -q").exit_code, 0);
+  const auto a = ossa::test::read_file(dir / "a" / "RiggedSimple.ossa"), b = ossa::test::read_file(dir / "b" / "RiggedSimple.ossa");
+  ASSERT_TRUE(a && b);
+  EXPECT_TRUE(*a == *b) << "the same bytes whether the input is named with its folder or from it";
+  auto asset = ossa::Asset::open((dir / "b" / "RiggedSimple.ossa").string());
+  ASSERT_TRUE(asset.ok());
+  const auto* prov = asset->file().provenance();
+  EXPECT_NE(prov->source_hash(), 0u);
+  for (const auto* f : *prov->inputs()) EXPECT_NE(f->path()->str().front(), '/') << f->path()->str();
+}
+
 }  // namespace

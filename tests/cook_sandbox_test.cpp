@@ -217,4 +217,52 @@ TEST_F(CookSandbox, HugeSourceValuesAreNamedAtImport) {
             std::string::npos) << r.err;
 }
 
+// What Assimp cannot take is handled before it reads the bytes (cooker/import/source_precheck.h).
+TEST_F(CookSandbox, DeepHierarchiesAreRefusedBeforeTheImporterRecurses) {
+  // A glTF chain of 20,000 nodes, and a BVH 20,000 joints deep.
+  nlohmann::json nodes = nlohmann::json::array();
+  for (int i = 0; i < 20000; ++i) {
+    nlohmann::json node = {{"name", "n" + std::to_string(i)}};
+    if (i + 1 < 20000) node["children"] = {i + 1};
+    nodes.push_back(node);
+  }
+  const nlohmann::json gltf = {{"asset", {{"version", "2.0"}}}, {"scene", 0}, {"scenes", {{{"nodes", {0}}}}}, {"nodes", nodes}};
+  ASSERT_TRUE(ossa::test::write_file(tree / "chars" / "chain.gltf", gltf.dump()));
+  std::string bvh = "HIERARCHY\nROOT j0\n{\n OFFSET 0 0 0\n CHANNELS 3 Zrotation Xrotation Yrotation\n";
+  for (int i = 1; i < 20000; ++i) bvh += " JOINT j" + std::to_string(i) + "\n {\n OFFSET 0 1 0\n CHANNELS 3 Zrotation Xrotation Yrotation\n";
+  bvh += " End Site\n {\n OFFSET 0 1 0\n }\n";
+  for (int i = 0; i < 20000; ++i) bvh += "}\n";
+  bvh += "MOTION\nFrames: 1\nFrame Time: 0.033\n";
+  for (int i = 0; i < 20000; ++i) bvh += "0 0 0 ";
+  ASSERT_TRUE(ossa::test::write_file(tree / "chars" / "chainb.bvh", bvh));
+  const auto r = run_command(cook_cmd() + " " + q(tree / "chars") + " -o " + q(dir / "out") + " --report " +
+                             q(dir / "report.json"));
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("chain.gltf: its node tree is nested over 1000+ levels deep"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("chainb.bvh: its joint hierarchy is nested over 1000+ levels deep"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("signal"), std::string::npos) << "refused, not crashed: " << r.err;
+}
+
+TEST_F(CookSandbox, AGltfSkinWithoutInverseBindMatricesMeansIdentity) {
+  // glTF 2.0: "When undefined, each matrix is a 4x4 identity matrix." Assimp 5.2 crashes on it;
+  // the cooker supplies the identity matrices before Assimp reads the file.
+  const fs::path shared = ossa::test::shared_assets() / "Khronos_embedded" / "rigged_simple.gltf";
+  if (!fs::exists(shared)) GTEST_SKIP() << "../shared/assets not present";
+  auto doc = nlohmann::json::parse(*ossa::test::read_text(shared));
+  ASSERT_TRUE(doc.contains("skins"));
+  for (auto& skin : doc["skins"]) skin.erase("inverseBindMatrices");
+  ASSERT_TRUE(ossa::test::write_file(tree / "chars" / "noibm.gltf", doc.dump()));
+  const auto r = run_command(cook_cmd() + " " + q(tree / "chars" / "noibm.gltf") + " -o " + q(dir / "out"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  auto a = ossa::Asset::open((dir / "out" / "noibm.ossa").string());
+  ASSERT_TRUE(a.ok());
+  ASSERT_GT(a->mesh_count(), 0u);
+  ASSERT_GT(a->skeleton().joint_count(), 0u);
+  // Every joint slot of the mesh binds with the identity.
+  const auto* mesh = a->file().meshes()->Get(0);
+  ASSERT_NE(mesh->inverse_bind(), nullptr);
+  for (const auto* m : *mesh->inverse_bind())
+    for (int k = 0; k < 16; ++k) EXPECT_FLOAT_EQ(m->m()->Get(k), k % 5 == 0 ? 1.0f : 0.0f) << k;
+}
+
 }  // namespace

@@ -2,12 +2,15 @@
 #include "cooker/import/import_io.h"
 
 #include <algorithm>
+#include <cctype>
+#include <filesystem>
 #include <cstring>
 #include <vector>
 
 #include <assimp/IOStream.hpp>
 
 #include "cooker/import/input_log.h"
+#include "cooker/import/source_precheck.h"
 
 namespace ossa::cook {
 namespace {
@@ -54,6 +57,16 @@ namespace {
 constexpr std::string_view kReference = "the source, read by the importer";
 }
 
+namespace {
+std::string normal_absolute(const char* path) {
+  std::error_code ec;
+  const std::filesystem::path abs = std::filesystem::absolute(path, ec);
+  return (ec ? std::filesystem::path(path) : abs).lexically_normal().string();
+}
+}  // namespace
+
+LoggedIOSystem::LoggedIOSystem(std::string main) : main_(normal_absolute(main.c_str())) {}
+
 bool LoggedIOSystem::Exists(const char* path) const { return path != nullptr && probe_input(path, kReference); }
 
 Assimp::IOStream* LoggedIOSystem::Open(const char* path, const char* mode) {
@@ -61,6 +74,16 @@ Assimp::IOStream* LoggedIOSystem::Open(const char* path, const char* mode) {
     return nullptr;
   auto bytes = read_input(path, UINT64_MAX, kReference);
   if (!bytes) return nullptr;
+  if (normal_absolute(path) == main_) {
+    std::string ext = std::filesystem::path(path).extension().string();
+    for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    auto checked = precheck_source(*bytes, ext);
+    if (!checked) {
+      refused_ = checked.error().message;
+      return nullptr;
+    }
+    if (*checked) return new BufferStream(std::move(**checked));  // the repaired bytes
+  }
   return new BufferStream(std::move(*bytes));
 }
 

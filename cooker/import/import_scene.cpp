@@ -101,11 +101,13 @@ bool wants_tangents(const aiScene& scene) {
 
 Result<SourceScene> read_and_convert(const std::string& path, const ImportOptions& options) {
   Assimp::Importer importer;
-  importer.SetIOHandler(new LoggedIOSystem);  // every file the importer reads enters the cook key
+  auto* io = new LoggedIOSystem(path);  // every file the importer reads enters the cook key
+  importer.SetIOHandler(io);            // (the importer owns it)
   importer.SetPropertyBool(AI_CONFIG_IMPORT_FBX_PRESERVE_PIVOTS, false);
   importer.SetPropertyBool(AI_CONFIG_FBX_CONVERT_TO_M, false);  // keep source units
   importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, 0);      // drop lines ourselves, with a warning
   const aiScene* scene = importer.ReadFile(path, assimp_import_flags());
+  if (!io->refused().empty()) return Error{path + ": " + io->refused()};
   if (!scene) return Error{path + ": " + importer.GetErrorString()};
   if (wants_tangents(*scene)) {
     scene = importer.ApplyPostProcessing(aiProcess_CalcTangentSpace);

@@ -178,7 +178,10 @@ bool probe_input(const fs::path& path, std::string_view reference) {
 }
 
 std::vector<InputFile> relative_inputs(std::span<const InputFile> files, const fs::path& base) {
-  const fs::path abs_base = normal_absolute(base);
+  // An input named without a folder has an empty parent: the current directory. No trailing
+  // separator either ("/a/b/" would make every path relative to a phantom empty element).
+  fs::path abs_base = normal_absolute(base.empty() ? fs::path(".") : base);
+  if (abs_base.has_relative_path() && abs_base.filename().empty()) abs_base = abs_base.parent_path();
   std::vector<InputFile> out;
   out.reserve(files.size());
   for (const InputFile& f : files) {

@@ -1,0 +1,215 @@
+// source_precheck.cpp — depth limits and glTF repairs before Assimp (see source_precheck.h).
+#include "cooker/import/source_precheck.h"
+
+#include <algorithm>
+#include <cstring>
+#include <string_view>
+
+#include <nlohmann/json.hpp>
+
+namespace ossa::cook {
+namespace {
+
+using Json = nlohmann::json;
+
+constexpr uint32_t kGlbMagic = 0x46546C67;   // "glTF"
+constexpr uint32_t kChunkJson = 0x4E4F534A;  // "JSON"
+
+uint32_t u32(const uint8_t* p) { return uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24; }
+void put_u32(std::vector<uint8_t>& out, uint32_t v) {
+  for (int i = 0; i < 4; ++i) out.push_back(static_cast<uint8_t>(v >> (8 * i)));
+}
+
+Error too_deep(uint64_t depth, const char* what) {
+  return Error{std::string("its ") + what + " is nested " + (depth > kMaxHierarchyDepth ? "over " : "") +
+               std::to_string(std::min<uint64_t>(depth, kMaxHierarchyDepth + 1) - 1) + "+ levels deep, more than the " +
+               std::to_string(kMaxHierarchyDepth) + " the importer can take without overflowing its stack"};
+}
+
+/// Deepest brace nesting of text (BVH, ASCII FBX), ignoring quoted strings and ';' comments.
+uint64_t brace_depth(std::span<const uint8_t> bytes, bool semicolon_comments) {
+  uint64_t depth = 0, deepest = 0;
+  bool quoted = false, comment = false;
+  for (uint8_t c : bytes) {
+    if (comment) {
+      comment = c != '\n';
+      continue;
+    }
+    if (quoted) {
+      quoted = c != '"';
+      continue;
+    }
+    if (c == '"') quoted = true;
+    else if (c == ';' && semicolon_comments) comment = true;
+    else if (c == '{') deepest = std::max(deepest, ++depth);
+    else if (c == '}' && depth > 0) --depth;
+  }
+  return deepest;
+}
+
+/// Deepest record nesting of a binary FBX (header "Kaydara FBX Binary  \0", version at 23; each
+/// record: end offset, property count, property bytes, name length, name, properties, nested
+/// records, then a null record). Iterative: a stack of the end offsets of the open records.
+/// Stops where the bytes no longer read as records (Assimp will say why) with the depth so far.
+uint64_t fbx_binary_depth(std::span<const uint8_t> b) {
+  if (b.size() < 27) return 0;
+  const uint32_t version = u32(b.data() + 23);
+  const bool wide = version >= 7500;  // 64-bit offsets
+  const size_t header = wide ? 25 : 13;
+  const auto read_offset = [&](size_t at) -> uint64_t {
+    if (!wide) return u32(b.data() + at);
+    uint64_t v = 0;
+    for (int i = 7; i >= 0; --i) v = v << 8 | b[at + size_t(i)];
+    return v;
+  };
+  std::vector<uint64_t> open;  // end offsets of the records being read
+  uint64_t deepest = 0;
+  size_t at = 27;
+  while (at + header <= b.size()) {
+    while (!open.empty() && at >= open.back()) open.pop_back();
+    const uint64_t end = read_offset(at);
+    const uint64_t property_bytes = wide ? read_offset(at + 16) : u32(b.data() + at + 8);
+    const uint8_t name_length = b[at + header - 1];
+    if (end == 0) {  // a null record closes the current list; at the top level, the last one
+      if (open.empty()) break;
+      at += header;
+      open.pop_back();
+      continue;
+    }
+    if (end <= at || end > b.size()) return deepest;  // unreadable from here: Assimp will say why
+    open.push_back(end);
+    deepest = std::max<uint64_t>(deepest, open.size());
+    if (deepest > kMaxHierarchyDepth) return deepest;
+    const uint64_t children = at + header + name_length + property_bytes;
+    if (children > end) return deepest;
+    at = static_cast<size_t>(children);
+  }
+  return deepest;
+}
+
+/// Deepest glTF node nesting, iteratively over "children"; cycles and bad indices are left to
+/// Assimp's validation (a node seen twice is not descended again).
+uint64_t gltf_depth(const Json& root) {
+  const Json* nodes = root.contains("nodes") && root["nodes"].is_array() ? &root["nodes"] : nullptr;
+  if (!nodes) return 0;
+  const size_t n = nodes->size();
+  std::vector<uint8_t> has_parent(n, 0), seen(n, 0);
+  for (const Json& node : *nodes)
+    if (node.is_object() && node.contains("children") && node["children"].is_array())
+      for (const Json& c : node["children"])
+        if (c.is_number_unsigned() && c.get<uint64_t>() < n) has_parent[c.get<size_t>()] = 1;
+  uint64_t deepest = 0;
+  std::vector<std::pair<size_t, uint64_t>> stack;
+  for (size_t r = 0; r < n; ++r) {
+    if (has_parent[r]) continue;
+    stack.push_back({r, 1});
+    while (!stack.empty()) {
+      const auto [i, depth] = stack.back();
+      stack.pop_back();
+      if (seen[i]) continue;
+      seen[i] = 1;
+      deepest = std::max(deepest, depth);
+      if (deepest > kMaxHierarchyDepth) return deepest;
+      const Json& node = (*nodes)[i];
+      if (node.is_object() && node.contains("children") && node["children"].is_array())
+        for (const Json& c : node["children"])
+          if (c.is_number_unsigned() && c.get<uint64_t>() < n) stack.push_back({c.get<size_t>(), depth + 1});
+    }
+  }
+  return deepest;
+}
+
+std::string base64(const std::vector<uint8_t>& in) {
+  static const char* k = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  out.reserve((in.size() + 2) / 3 * 4);
+  for (size_t i = 0; i < in.size(); i += 3) {
+    const uint32_t v = uint32_t(in[i]) << 16 | (i + 1 < in.size() ? uint32_t(in[i + 1]) << 8 : 0) |
+                       (i + 2 < in.size() ? uint32_t(in[i + 2]) : 0);
+    out += k[v >> 18 & 63];
+    out += k[v >> 12 & 63];
+    out += i + 1 < in.size() ? k[v >> 6 & 63] : '=';
+    out += i + 2 < in.size() ? k[v & 63] : '=';
+  }
+  return out;
+}
+
+/// Gives every skin without inverseBindMatrices an accessor of identity matrices (a buffer of its
+/// own, as a data URI). True when anything changed.
+bool add_identity_inverse_binds(Json& root) {
+  if (!root.contains("skins") || !root["skins"].is_array()) return false;
+  bool changed = false;
+  for (Json& skin : root["skins"]) {
+    if (!skin.is_object() || skin.contains("inverseBindMatrices")) continue;
+    if (!skin.contains("joints") || !skin["joints"].is_array() || skin["joints"].empty()) continue;
+    const size_t count = skin["joints"].size();
+    if (count > 65535) continue;  // Assimp refuses such a skin itself
+    std::vector<uint8_t> bytes(count * 64, 0);
+    for (size_t j = 0; j < count; ++j)
+      for (int d = 0; d < 4; ++d) {
+        const float one = 1.0f;
+        std::memcpy(bytes.data() + j * 64 + size_t(d) * 20, &one, 4);  // column-major diagonal
+      }
+    for (const char* key : {"buffers", "bufferViews", "accessors"})
+      if (!root.contains(key) || !root[key].is_array()) root[key] = Json::array();
+    const size_t buffer = root["buffers"].size(), view = root["bufferViews"].size(), accessor = root["accessors"].size();
+    root["buffers"].push_back({{"byteLength", bytes.size()}, {"uri", "data:application/octet-stream;base64," + base64(bytes)}});
+    root["bufferViews"].push_back({{"buffer", buffer}, {"byteLength", bytes.size()}});
+    root["accessors"].push_back({{"bufferView", view}, {"componentType", 5126}, {"count", count}, {"type", "MAT4"}});
+    skin["inverseBindMatrices"] = accessor;
+    changed = true;
+  }
+  return changed;
+}
+
+Result<std::optional<std::vector<uint8_t>>> precheck_gltf(std::span<const uint8_t> bytes) {
+  const bool glb = bytes.size() >= 20 && u32(bytes.data()) == kGlbMagic;
+  size_t json_at = 0, json_length = bytes.size();
+  if (glb) {
+    if (u32(bytes.data() + 16) != kChunkJson) return std::optional<std::vector<uint8_t>>{};
+    json_length = u32(bytes.data() + 12);
+    json_at = 20;
+    if (json_length > bytes.size() - json_at) return std::optional<std::vector<uint8_t>>{};
+  }
+  Json root = Json::parse(bytes.begin() + static_cast<std::ptrdiff_t>(json_at),
+                          bytes.begin() + static_cast<std::ptrdiff_t>(json_at + json_length), nullptr, false);
+  if (root.is_discarded() || !root.is_object()) return std::optional<std::vector<uint8_t>>{};  // Assimp says why
+  if (const uint64_t depth = gltf_depth(root); depth > kMaxHierarchyDepth) return too_deep(depth, "node tree");
+  if (!add_identity_inverse_binds(root)) return std::optional<std::vector<uint8_t>>{};
+  std::string text = root.dump();
+  if (!glb) return std::optional<std::vector<uint8_t>>(std::vector<uint8_t>(text.begin(), text.end()));
+  while (text.size() % 4 != 0) text += ' ';  // GLB chunks are padded to 4 bytes (JSON with spaces)
+  const size_t rest_at = json_at + ((json_length + 3) & ~size_t{3});
+  const size_t rest = rest_at <= bytes.size() ? bytes.size() - rest_at : 0;
+  std::vector<uint8_t> out;
+  out.reserve(12 + 8 + text.size() + rest);
+  put_u32(out, kGlbMagic);
+  put_u32(out, 2);
+  put_u32(out, static_cast<uint32_t>(12 + 8 + text.size() + rest));
+  put_u32(out, static_cast<uint32_t>(text.size()));
+  put_u32(out, kChunkJson);
+  out.insert(out.end(), text.begin(), text.end());
+  if (rest > 0) out.insert(out.end(), bytes.begin() + static_cast<std::ptrdiff_t>(rest_at), bytes.end());
+  return std::optional<std::vector<uint8_t>>(std::move(out));
+}
+
+}  // namespace
+
+Result<std::optional<std::vector<uint8_t>>> precheck_source(std::span<const uint8_t> bytes, const std::string& extension) {
+  try {
+    if (extension == ".gltf" || extension == ".glb") return precheck_gltf(bytes);
+    if (extension == ".bvh") {
+      if (const uint64_t d = brace_depth(bytes, false); d > kMaxHierarchyDepth) return too_deep(d, "joint hierarchy");
+    } else if (extension == ".fbx") {
+      constexpr std::string_view kBinary = "Kaydara FBX Binary  ";
+      const bool binary = bytes.size() >= kBinary.size() && std::memcmp(bytes.data(), kBinary.data(), kBinary.size()) == 0;
+      const uint64_t d = binary ? fbx_binary_depth(bytes) : brace_depth(bytes, true);
+      if (d > kMaxHierarchyDepth) return too_deep(d, "record tree");
+    }
+  } catch (const std::exception&) {
+    // A scan that cannot read the file leaves it to Assimp, which reports its own error.
+  }
+  return std::optional<std::vector<uint8_t>>{};
+}
+
+}  // namespace ossa::cook
