@@ -13,6 +13,9 @@
 // Tolerances were measured on llvmpipe (Mesa 22.3, Debian 12); see the constants below.
 #include <gtest/gtest.h>
 
+#include <sys/stat.h>
+
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <string>
@@ -399,6 +402,50 @@ TEST_F(Viewer, QuietHidesWarningsVerboseNamesTheContext) {
   EXPECT_NE(verbose.err.find("OpenGL "), std::string::npos) << verbose.err;
   EXPECT_NE(verbose.err.find("4 joints, 1 meshes"), std::string::npos) << verbose.err;
   EXPECT_NE(verbose.err.find("left out"), std::string::npos) << "-v keeps the warnings: " << verbose.err;
+}
+
+// The viewer trusts the loader, so whatever a loadable file names must be safe to show: texture
+// paths that leave the file's folder, a directory, a FIFO or /dev/zero as a texture, and an
+// embedded PNG claiming 16384 x 16384 pixels are each left out with a warning naming why, in
+// bounded time and memory; --time beyond an hour is a usage error rather than a long hang.
+TEST_F(Viewer, HostileTexturesAreLeftOutByName) {
+  ASSERT_EQ(::mkfifo((dir_ / "pipe.png").c_str(), 0644), 0);
+  fs::create_directories(dir_ / "folder.png");
+  const auto png = tiny_png();
+  std::vector<uint8_t> bomb(png.begin(), png.end());
+  for (int k = 0; k < 2; ++k) {  // IHDR width and height -> 16384
+    bomb[16 + 4 * k] = 0;
+    bomb[17 + 4 * k] = 0;
+    bomb[18 + 4 * k] = 0x40;
+    bomb[19 + 4 * k] = 0;
+  }
+  SyntheticSpec spec;
+  spec.materials[0].textures = {
+      {ossa::fb::TextureRole::Diffuse, "", "image/png", bomb},
+      {ossa::fb::TextureRole::Normal, "../../../../../../etc/passwd", "", std::nullopt},
+      {ossa::fb::TextureRole::Specular, "pipe.png", "", std::nullopt}};
+  SyntheticMaterial second;
+  second.textures = {{ossa::fb::TextureRole::Diffuse, "/dev/zero", "", std::nullopt},
+                     {ossa::fb::TextureRole::Normal, "folder.png", "", std::nullopt}};
+  spec.materials.push_back(second);
+  const fs::path file = dir_ / "hostile.ossa";
+  ASSERT_TRUE(write_file(file, make_valid_file(spec)));
+  const auto start = std::chrono::steady_clock::now();
+  const CommandResult r = run_viewer(quote(file.string()) + " --size 64x64 --frames 1");
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_LT(seconds, 20.0);
+  EXPECT_NE(r.err.find("over the viewer's limit of 16384 per side and 67108864 pixels"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("passwd left out: it lies outside the file's folder"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("pipe.png left out: it is not a regular file"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("/dev/zero left out: a texture path must be relative to the file"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("folder.png left out: it is not a regular file"), std::string::npos) << r.err;
+
+  const CommandResult forever = run_viewer(quote(cooked("Fox/Fox.ossa").string()) + " --time inf --frames 1");
+  EXPECT_EQ(forever.exit_code, 2);
+  EXPECT_NE(forever.err.find("--time: expected a finite number of seconds"), std::string::npos) << forever.err;
+  const CommandResult long_one = run_viewer(quote(cooked("Fox/Fox.ossa").string()) + " --time 1e9 --frames 1");
+  EXPECT_EQ(long_one.exit_code, 2) << long_one.err;
 }
 
 }  // namespace

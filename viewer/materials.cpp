@@ -1,6 +1,11 @@
 // materials.cpp — see materials.h.
 #include "viewer/materials.h"
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
 #include <climits>
 #include <filesystem>
 #include <fstream>
@@ -8,8 +13,17 @@
 
 #include <stb_image.h>
 
+#include "runtime/internal/message.h"
+
 namespace ossa::view {
 namespace {
+
+/// The largest texture the viewer decodes (the cooker embeds nothing larger): its size is read
+/// from the header first, so a small file claiming 16384 x 16384 (3.5 GB of pixels after
+/// decompression) costs nothing. External texture files are read up to kMaxTextureFileBytes.
+constexpr int kMaxTextureSide = 16384;
+constexpr uint64_t kMaxTexturePixels = uint64_t{64} << 20;
+constexpr uint64_t kMaxTextureFileBytes = uint64_t{256} << 20;
 
 /// Decodes an encoded image into an RGBA8 texture with mipmaps; 0 on failure (`why` says).
 GLuint decode_texture(const uint8_t* bytes, size_t size, std::string& why) {
@@ -18,6 +32,16 @@ GLuint decode_texture(const uint8_t* bytes, size_t size, std::string& why) {
     return 0;
   }
   int w = 0, h = 0, channels = 0;
+  if (!stbi_info_from_memory(bytes, static_cast<int>(size), &w, &h, &channels)) {
+    why = stbi_failure_reason() ? stbi_failure_reason() : "not an image it can read";
+    return 0;
+  }
+  if (w <= 0 || h <= 0 || w > kMaxTextureSide || h > kMaxTextureSide ||
+      static_cast<uint64_t>(w) * static_cast<uint64_t>(h) > kMaxTexturePixels) {
+    why = "it claims " + std::to_string(w) + " x " + std::to_string(h) + " pixels, over the viewer's limit of " +
+          std::to_string(kMaxTextureSide) + " per side and " + std::to_string(kMaxTexturePixels) + " pixels";
+    return 0;
+  }
   // Assimp (and so the cooker) keeps texture coordinates with v = 0 at the bottom, as GL does;
   // images start with their top row, so flip them on load.
   stbi_set_flip_vertically_on_load(1);
@@ -40,6 +64,55 @@ GLuint decode_texture(const uint8_t* bytes, size_t size, std::string& why) {
   return t;
 }
 
+/// Reads a texture a file names by path: relative, inside the file's folder once `..` and symlinks
+/// are resolved, a regular file (never a directory, FIFO or device: opened non-blocking and checked
+/// again after opening), at most kMaxTextureFileBytes. A file from elsewhere cannot make the viewer
+/// read outside its folder, hang on a FIFO or read /dev/zero until memory runs out.
+bool read_texture_file(const std::string& asset_path, const std::string& named, std::vector<uint8_t>& bytes,
+                       std::string& why) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::path as_named(named);
+  if (named.find('\0') != std::string::npos || as_named.is_absolute() || as_named.has_root_name()) {
+    why = "a texture path must be relative to the file";
+    return false;
+  }
+  const fs::path folder = fs::weakly_canonical(fs::absolute(fs::path(asset_path).parent_path(), ec), ec);
+  const fs::path file = fs::weakly_canonical(fs::absolute(fs::path(asset_path).parent_path() / as_named, ec), ec);
+  const fs::path rel = file.lexically_relative(folder);
+  if (ec || rel.empty() || *rel.begin() == "..") {
+    why = "it lies outside the file's folder";
+    return false;
+  }
+  const int fd = ::open(file.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) {
+    why = "cannot open it";
+    return false;
+  }
+  struct stat st{};
+  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+    ::close(fd);
+    why = "it is not a regular file";
+    return false;
+  }
+  if (static_cast<uint64_t>(st.st_size) > kMaxTextureFileBytes) {
+    ::close(fd);
+    why = "it is over " + std::to_string(kMaxTextureFileBytes >> 20) + " MiB";
+    return false;
+  }
+  bytes.resize(static_cast<size_t>(st.st_size));
+  size_t done = 0;
+  while (done < bytes.size()) {
+    const ssize_t n = ::read(fd, bytes.data() + done, bytes.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) break;
+    done += static_cast<size_t>(n);
+  }
+  ::close(fd);
+  bytes.resize(done);
+  return true;
+}
+
 GLuint load_texture(const fb::Texture& texture, const std::string& asset_path, std::vector<std::string>& warnings) {
   std::string why;
   std::string what;
@@ -49,14 +122,9 @@ GLuint load_texture(const fb::Texture& texture, const std::string& asset_path, s
     t = decode_texture(texture.data()->data(), texture.data()->size(), why);
   } else if (texture.path() != nullptr && texture.path()->size() > 0) {
     const std::filesystem::path p = std::filesystem::path(asset_path).parent_path() / texture.path()->str();
-    what = "texture " + p.string();
-    std::ifstream in(p, std::ios::binary);
-    if (!in) {
-      why = "cannot open it";
-    } else {
-      const std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-      t = decode_texture(bytes.data(), bytes.size(), why);
-    }
+    what = "texture " + detail::printable(p.string(), 400);
+    std::vector<uint8_t> bytes;
+    if (read_texture_file(asset_path, texture.path()->str(), bytes, why)) t = decode_texture(bytes.data(), bytes.size(), why);
   } else {
     return 0;
   }

@@ -3,10 +3,14 @@
 #include "viewer/options.h"
 
 #include <charconv>
+#include <cmath>
 
 #include "runtime/tools/cli/cli.h"
 
 namespace ossa::view {
+namespace {
+constexpr float kMaxSeconds = 3600.0f;
+}
 
 std::optional<std::pair<int, int>> parse_size(const std::string& text) {
   const size_t x = text.find('x');
@@ -62,6 +66,12 @@ ParsedOptions parse_options(int argc, const char* const* argv) {
     o.height = wh->second;
   }
   o.grid = !no_grid;
+  // A graph cannot seek: headless --time T plays T seconds in 1/60 s steps, so T is bounded (an
+  // hour is 216,000 steps); a clip's time wraps, but must still be a number.
+  if (!std::isfinite(o.time) || std::fabs(o.time) > kMaxSeconds)
+    return {std::nullopt, command.usage_error("--time: expected a finite number of seconds within +-" +
+                                              std::to_string(static_cast<int>(kMaxSeconds)) + ", got " +
+                                              std::to_string(o.time))};
   if (!o.screenshot.empty() && o.frames == 0 && o.window_frames == 0) o.frames = 1;
   return {o, 0};
 }

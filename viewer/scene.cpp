@@ -29,12 +29,14 @@ Status add_clips(Scene& scene, Asset asset, const std::string& path, bool is_cha
 
 }  // namespace
 
+// Files are read into memory, not mapped (OpenMode::kRead): the viewer is the tool artists leave
+// open while they re-cook, and a mapped file rewritten in place would end it with SIGBUS.
 Result<Scene> load_scene(std::span<const std::string> paths) {
   if (paths.empty()) return Error{"no .ossa file given"};
   std::vector<Asset> opened;
   size_t character = paths.size();
   for (size_t i = 0; i < paths.size(); ++i) {
-    Result<Asset> a = Asset::open(paths[i]);
+    Result<Asset> a = Asset::open(paths[i], OpenMode::kRead);
     if (!a) return a.error();
     if (character == paths.size() && a->mesh_count() > 0) character = i;
     opened.push_back(std::move(*a));
@@ -54,13 +56,13 @@ Result<Scene> load_scene(std::span<const std::string> paths) {
 }
 
 Status add_clip_file(Scene& scene, const std::string& path) {
-  Result<Asset> a = Asset::open(path);
+  Result<Asset> a = Asset::open(path, OpenMode::kRead);
   if (!a) return a.error();
   return add_clips(scene, std::move(*a), path, false);
 }
 
 Result<bool> file_has_mesh(const std::string& path) {
-  Result<Asset> a = Asset::open(path);
+  Result<Asset> a = Asset::open(path, OpenMode::kRead);
   if (!a) return a.error();
   return a->mesh_count() > 0;
 }
