@@ -162,6 +162,31 @@ bool add_identity_inverse_binds(Json& root) {
   return changed;
 }
 
+/// Skins Assimp 5.2 dereferences without checking: "joints" missing, empty or naming no node, an
+/// "inverseBindMatrices" that is not an accessor index. The spec requires what is checked here.
+std::optional<Error> check_skins(const Json& root) {
+  if (!root.contains("skins")) return std::nullopt;
+  if (!root["skins"].is_array()) return Error{"its \"skins\" is not an array"};
+  const size_t nodes = root.contains("nodes") && root["nodes"].is_array() ? root["nodes"].size() : 0;
+  const size_t accessors = root.contains("accessors") && root["accessors"].is_array() ? root["accessors"].size() : 0;
+  for (size_t i = 0; i < root["skins"].size(); ++i) {
+    const Json& skin = root["skins"][i];
+    const std::string at = "skin " + std::to_string(i);
+    if (!skin.is_object()) return Error{at + " is not an object"};
+    if (!skin.contains("joints") || !skin["joints"].is_array() || skin["joints"].empty())
+      return Error{at + " has no \"joints\" (the glTF spec requires at least one)"};
+    for (const Json& j : skin["joints"])
+      if (!j.is_number_unsigned() || j.get<uint64_t>() >= nodes)
+        return Error{at + ": a joint is not the index of a node (" + j.dump().substr(0, 40) + ")"};
+    if (skin.contains("inverseBindMatrices")) {
+      const Json& ibm = skin["inverseBindMatrices"];
+      if (!ibm.is_number_unsigned() || ibm.get<uint64_t>() >= accessors)
+        return Error{at + ": \"inverseBindMatrices\" is not the index of an accessor (" + ibm.dump().substr(0, 40) + ")"};
+    }
+  }
+  return std::nullopt;
+}
+
 Result<std::optional<std::vector<uint8_t>>> precheck_gltf(std::span<const uint8_t> bytes) {
   const bool glb = bytes.size() >= 20 && u32(bytes.data()) == kGlbMagic;
   size_t json_at = 0, json_length = bytes.size();
@@ -175,6 +200,7 @@ Result<std::optional<std::vector<uint8_t>>> precheck_gltf(std::span<const uint8_
                           bytes.begin() + static_cast<std::ptrdiff_t>(json_at + json_length), nullptr, false);
   if (root.is_discarded() || !root.is_object()) return std::optional<std::vector<uint8_t>>{};  // Assimp says why
   if (const uint64_t depth = gltf_depth(root); depth > kMaxHierarchyDepth) return too_deep(depth, "node tree");
+  if (auto bad = check_skins(root)) return *bad;
   if (!add_identity_inverse_binds(root)) return std::optional<std::vector<uint8_t>>{};
   std::string text = root.dump();
   if (!glb) return std::optional<std::vector<uint8_t>>(std::vector<uint8_t>(text.begin(), text.end()));

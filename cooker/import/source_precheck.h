@@ -8,7 +8,9 @@
 //     chain, a 100,000-level FBX). Measured by an iterative scan of the glTF node tree, the BVH
 //     and ASCII FBX brace nesting and the binary FBX record nesting;
 //   - a glTF skin without `inverseBindMatrices` (optional in the spec: identity matrices) gets
-//     an explicit accessor of identity matrices, because Assimp dereferences the missing one.
+//     an explicit accessor of identity matrices, because Assimp dereferences the missing one;
+//     a skin without joints, or with indices that name no node or accessor, is refused (found by
+//     tests/fuzz/source_fuzz.py: Assimp dereferences those too).
 // Files of other formats, and files this scan cannot read, pass unchanged: Assimp then reports
 // its own error.
 #pragma once
