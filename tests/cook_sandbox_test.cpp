@@ -265,4 +265,23 @@ TEST_F(CookSandbox, AGltfSkinWithoutInverseBindMatricesMeansIdentity) {
     for (int k = 0; k < 16; ++k) EXPECT_FLOAT_EQ(m->m()->Get(k), k % 5 == 0 ? 1.0f : 0.0f) << k;
 }
 
+// Broken containers are described as what they are, not by Assimp's consequences ("No suitable
+// reader found", "aiScene::mNumMeshes is 0", "4252017601 frames").
+TEST_F(CookSandbox, BrokenContainersAreDescribedAsSuch) {
+  const std::string gltf = triangle_gltf("tri.bin");
+  ASSERT_TRUE(ossa::test::write_file(tree / "chars" / "cut.gltf", gltf.substr(0, gltf.size() / 2)));
+  const auto glb = ossa::test::read_file(asset("RiggedSimple/RiggedSimple.glb"));
+  ASSERT_TRUE(glb.has_value());
+  ASSERT_TRUE(ossa::test::write_file(tree / "chars" / "cutb.glb", std::span<const uint8_t>(glb->data(), 5000)));
+  ASSERT_TRUE(ossa::test::write_file(tree / "chars" / "zero.bvh", std::string_view(
+      "HIERARCHY\nROOT Hips\n{\n OFFSET 0 0 0\n CHANNELS 3 Zrotation Xrotation Yrotation\n End Site\n {\n"
+      "  OFFSET 0 1 0\n }\n}\nMOTION\nFrames: 0\nFrame Time: 0.033\n")));
+  const auto r = run_command(cook_cmd() + " " + q(tree / "chars") + " -o " + q(dir / "out") + " --root " + q(tree));
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("cut.gltf: is not valid glTF JSON (truncated? parse error"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("cutb.glb: is a GLB file that declares " + std::to_string(glb->size()) + " bytes but has 5000"),
+            std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("zero.bvh: declares \"Frames: 0\": a BVH motion needs at least one frame"), std::string::npos) << r.err;
+}
+
 }  // namespace

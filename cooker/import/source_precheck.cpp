@@ -2,6 +2,7 @@
 #include "cooker/import/source_precheck.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cstring>
 #include <string_view>
 
@@ -188,17 +189,32 @@ std::optional<Error> check_skins(const Json& root) {
 }
 
 Result<std::optional<std::vector<uint8_t>>> precheck_gltf(std::span<const uint8_t> bytes) {
-  const bool glb = bytes.size() >= 20 && u32(bytes.data()) == kGlbMagic;
+  const bool glb = bytes.size() >= 4 && u32(bytes.data()) == kGlbMagic;
   size_t json_at = 0, json_length = bytes.size();
   if (glb) {
-    if (u32(bytes.data() + 16) != kChunkJson) return std::optional<std::vector<uint8_t>>{};
+    // Assimp's messages for a broken container are about its consequences ("no meshes"); the
+    // container's own story is plain: say it.
+    if (bytes.size() < 20) return Error{"is a GLB file shorter than its 20-byte header (" + std::to_string(bytes.size()) + " bytes)"};
+    const uint32_t declared = u32(bytes.data() + 8);
+    if (declared > bytes.size())
+      return Error{"is a GLB file that declares " + std::to_string(declared) + " bytes but has " +
+                   std::to_string(bytes.size()) + ": it is truncated"};
+    if (u32(bytes.data() + 16) != kChunkJson) return Error{"is a GLB file whose first chunk is not JSON"};
     json_length = u32(bytes.data() + 12);
     json_at = 20;
-    if (json_length > bytes.size() - json_at) return std::optional<std::vector<uint8_t>>{};
+    if (json_length > bytes.size() - json_at) return Error{"is a GLB file whose JSON chunk runs past its end"};
   }
-  Json root = Json::parse(bytes.begin() + static_cast<std::ptrdiff_t>(json_at),
-                          bytes.begin() + static_cast<std::ptrdiff_t>(json_at + json_length), nullptr, false);
-  if (root.is_discarded() || !root.is_object()) return std::optional<std::vector<uint8_t>>{};  // Assimp says why
+  Json root;
+  try {
+    root = Json::parse(bytes.begin() + static_cast<std::ptrdiff_t>(json_at),
+                       bytes.begin() + static_cast<std::ptrdiff_t>(json_at + json_length));
+  } catch (const Json::parse_error& e) {
+    // Assimp would say "No suitable reader found" for a .gltf that is not JSON.
+    std::string what = e.what();
+    if (const size_t at = what.find("parse error"); at != std::string::npos) what = what.substr(at);
+    return Error{std::string("is not valid glTF JSON (") + (json_at + e.byte >= bytes.size() ? "truncated? " : "") + what + ")"};
+  }
+  if (!root.is_object()) return Error{"is not a glTF document (its JSON is not an object)"};
   if (const uint64_t depth = gltf_depth(root); depth > kMaxHierarchyDepth) return too_deep(depth, "node tree");
   if (auto bad = check_skins(root)) return *bad;
   if (!add_identity_inverse_binds(root)) return std::optional<std::vector<uint8_t>>{};
@@ -226,6 +242,17 @@ Result<std::optional<std::vector<uint8_t>>> precheck_source(std::span<const uint
     if (extension == ".gltf" || extension == ".glb") return precheck_gltf(bytes);
     if (extension == ".bvh") {
       if (const uint64_t d = brace_depth(bytes, false); d > kMaxHierarchyDepth) return too_deep(d, "joint hierarchy");
+      // "Frames: 0" (or a negative count) reads as 4 billion frames in Assimp's BVH loader.
+      const std::string_view text(reinterpret_cast<const char*>(bytes.data()), bytes.size());
+      if (const size_t at = text.find("Frames:"); at != std::string_view::npos) {
+        size_t i = at + 7;
+        while (i < text.size() && (text[i] == ' ' || text[i] == '\t')) ++i;
+        const bool negative = i < text.size() && text[i] == '-';
+        const bool zero = i < text.size() && text[i] == '0' && (i + 1 >= text.size() || !std::isdigit(static_cast<unsigned char>(text[i + 1])));
+        if (negative || zero)
+          return Error{"declares \"Frames: " + std::string(text.substr(i, std::min<size_t>(12, text.find_first_of("\r\n", i) - i))) +
+                       "\": a BVH motion needs at least one frame"};
+      }
     } else if (extension == ".fbx") {
       constexpr std::string_view kBinary = "Kaydara FBX Binary  ";
       const bool binary = bytes.size() >= kBinary.size() && std::memcmp(bytes.data(), kBinary.data(), kBinary.size()) == 0;
