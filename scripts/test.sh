@@ -39,12 +39,31 @@ echo "== Windows: runtime + its suites cross-built with MinGW-w64, run under Win
 # POSIX), every runtime suite run under a headless Wine (one WINEPREFIX in build-win, created on the
 # first run; cmake/toolchains/wine-run.sh). Each test has a CTest TIMEOUT, and the stage is bounded
 # as a whole so a stuck Wine cannot hold CI.
+# Wine's own start-up is made serial and happens once: the prefix is created by one wineboot before
+# anything runs in it (the build runs test discovery under Wine, two at a time with -j2, and two
+# first runs racing to create a prefix is how a CI run once lost a test), and one persistent
+# wineserver serves the whole stage (a server that exits between two tests can drop a client that
+# connects just then). Both are undone on the way out.
 launcher=()
 if command -v ccache >/dev/null; then launcher=(-DCMAKE_C_COMPILER_LAUNCHER=ccache -DCMAKE_CXX_COMPILER_LAUNCHER=ccache); fi
+export WINEPREFIX="$PWD/build-win/wineprefix"
+wine_server=/usr/lib/wine/wineserver
+if [ -x /usr/lib/wine/wine64 ] && [ -x "$wine_server" ]; then
+  mkdir -p build-win
+  WINEDEBUG=-all WINEDLLOVERRIDES="mscoree,mshtml,winemenubuilder.exe=" DISPLAY='' \
+    timeout 300 /usr/lib/wine/wine64 wineboot -i </dev/null >build-win/wineboot.log 2>&1 ||
+    { echo "wineboot failed:"; cat build-win/wineboot.log; }
+  "$wine_server" -w </dev/null >/dev/null 2>&1 || true
+  "$wine_server" -p </dev/null >/dev/null 2>&1
+  trap '"$wine_server" -k >/dev/null 2>&1 || true' EXIT
+fi
 cmake -S . -B build-win -G Ninja -DCMAKE_TOOLCHAIN_FILE=cmake/toolchains/mingw-w64-x86_64.cmake \
   -DOSSA_RUNTIME_ONLY=ON -DOSSA_WERROR=ON -DOSSA_BUILD_BENCH=OFF "${launcher[@]}" >/dev/null
 timeout 900 cmake --build build-win -j "$jobs"
 timeout 300 ctest --test-dir build-win --output-on-failure -j "$jobs" --timeout 60
+if [ -x "$wine_server" ]; then "$wine_server" -k >/dev/null 2>&1 || true; fi
+trap - EXIT
+unset WINEPREFIX
 
 echo "== main build and suite"
 cmake -S . -B build -G Ninja -DOSSA_WERROR=ON >/dev/null

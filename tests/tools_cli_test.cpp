@@ -193,4 +193,33 @@ TEST(CliHelper, VersionLineNamesTheTool) {
             std::string("ossa-diff ") + ossa::kVersionString + " (format " + std::to_string(ossa::kFormatVersion) + ")");
 }
 
+// A 30,000-joint chain is within the format's joint limit: ossa-inspect prints it in bounded
+// lines (indentation stops at 32 levels and the depth is written instead), iteratively.
+TEST(ToolsCli, InspectPrintsADeepChainInBoundedLines) {
+  constexpr int kJoints = 30000;
+  ossa::test::SyntheticSpec spec;
+  ossa::test::SyntheticSkeleton& sk = *spec.skeleton;
+  sk.names.clear();
+  sk.parents.clear();
+  sk.translations.clear();
+  sk.rotations.clear();
+  sk.scales.clear();
+  for (int j = 0; j < kJoints; ++j) {
+    sk.names.push_back("j" + std::to_string(j));
+    sk.parents.push_back(static_cast<int16_t>(j - 1));
+    sk.translations.push_back({0, 0.001f, 0});
+    sk.rotations.push_back({0, 0, 0, 1});
+    sk.scales.push_back({1, 1, 1});
+  }
+  spec.meshes.clear();
+  spec.clips.clear();
+  spec.materials.clear();
+  const fs::path file = ossa::test::make_temp_dir("deep-chain") / "chain.ossa";
+  ASSERT_TRUE(ossa::test::write_file(file, ossa::test::make_valid_file(spec)));
+  const CommandResult r = run_tool("ossa-inspect", "'" + file.string() + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err.substr(0, 500);
+  EXPECT_NE(r.out.find("(depth 29999) [29999] j29999"), std::string::npos);
+  EXPECT_LT(r.out.size(), size_t{4} << 20) << "bounded output";
+}
+
 }  // namespace

@@ -40,9 +40,11 @@ run() {
 }
 run "$@"
 rc=$?
-# If the program never started because the server went away under it, run it once more.
-if [ $rc -ne 0 ] && head -n 1 "$out" | grep -q '^wine client error'; then
-  echo "wine-run.sh: wineserver connection lost before the program started; running it again" >&2
+# If Wine itself failed (the server went away under the program, or Wine's loader could not start
+# it), run it once more. Only Wine's own messages count: a test that fails fails again, so a retry
+# never hides a test's own failure, and a second Wine failure is reported as it is.
+if [ $rc -ne 0 ] && head -n 5 "$out" | grep -q -e '^wine client error' -e '^wine: ' -e '^wineserver: '; then
+  echo "wine-run.sh: Wine failed before or while starting the program; running it again" >&2
   run "$@"
   rc=$?
 fi

@@ -36,7 +36,7 @@
 // Test hook: OSSA_COOK_TEST_FAULT=<substring>:<fault>[,<substring>:<fault>...] makes the worker
 // whose input path contains <substring> misbehave, so that tests can check how the batch handles
 // each way a worker ends without depending on a particular Assimp bug. Faults, before cooking:
-// `abort`, `segv` (SIGSEGV), `hang` (sleep forever), `alloc` (allocate and touch memory without
+// `abort`, `segv` (SIGSEGV), `hang` (sleep forever), `alloc` (allocate address space without
 // bound), `abort-writing` (leave a temporary file named as write_file_atomic names them, then
 // abort), `garble` (send a truncated record and exit 0); after cooking: `abort-after` (abort with
 // the output renamed into place). Honoured only in workers (never by cook_file itself).

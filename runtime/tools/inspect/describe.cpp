@@ -373,9 +373,15 @@ std::string describe_text(const json& d) {
   if (const json& s = d["skeleton"]; s.is_object()) {
     line("");
     line("skeleton: " + text(s["joint_count"]) + " joints, hash " + text(s["hash"]));
-    for (const json& j : s["joints"])
-      line(std::string(2 + 2 * static_cast<size_t>(j["depth"].get<int>()), ' ') + "[" + text(j["index"]) + "] " +
-           text(j["name"]));
+    // Indentation shows the tree, up to kMaxIndent levels; deeper joints say their depth instead,
+    // so a 30,000-joint chain prints 30,000 short lines, not gigabytes of spaces.
+    constexpr int kMaxIndent = 32;
+    for (const json& j : s["joints"]) {
+      const int depth = j["depth"].get<int>();
+      line(std::string(2 + 2 * static_cast<size_t>(std::min(depth, kMaxIndent)), ' ') +
+           (depth > kMaxIndent ? "(depth " + std::to_string(depth) + ") " : std::string()) + "[" + text(j["index"]) +
+           "] " + text(j["name"]));
+    }
   } else {
     line("");
     line("skeleton: none");
