@@ -172,11 +172,14 @@ Status rename_clips(const std::map<std::string, std::string>& names, std::vector
                     const std::string& label) {
   for (const auto& [from, to] : names) {
     bool found = false;
-    for (const SourceClip& c : clips) found = found || c.name == from;
+    for (const SourceClip& c : clips) found = found || clip_named(c, from);
     if (!found) return Error{label + ": cook settings rename clip '" + from + "', which it does not have"};
   }
-  for (SourceClip& c : clips)  // all at once, so {"a": "b", "b": "a"} swaps
-    if (const auto it = names.find(c.name); it != names.end()) c.name = it->second;
+  for (SourceClip& c : clips) {  // all at once, so {"a": "b", "b": "a"} swaps
+    auto it = names.find(c.name);
+    if (it == names.end() && !c.source_name.empty()) it = names.find(c.source_name);
+    if (it != names.end()) c.name = it->second;
+  }
   std::set<std::string> seen;
   for (const SourceClip& c : clips)
     if (!seen.insert(c.name).second) return Error{label + ": two clips are named '" + c.name + "' after renaming"};

@@ -99,7 +99,7 @@ Status apply_event_sidecar(std::string_view text, const std::string& sidecar_nam
         continue;
       }
       size_t c = 0;
-      while (c < clips.size() && clips[c].name != m.key) ++c;
+      while (c < clips.size() && !clip_named(clips[c], m.key)) ++c;
       if (c == clips.size()) {
         std::string names;
         for (const SourceClip& clip : clips) names += (names.empty() ? "'" : ", '") + clip.name + "'";

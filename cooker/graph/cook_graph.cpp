@@ -155,7 +155,7 @@ void cook_graph(CookRecord& record, const fs::path& input, const fs::path& outpu
     const std::vector<SourceClip>& available = it->second.clips;
     const SourceClip* picked = nullptr;
     for (const SourceClip& c : available)
-      if (entry.source_clip.empty() || c.name == entry.source_clip) {
+      if (entry.source_clip.empty() || clip_named(c, entry.source_clip)) {
         picked = &c;
         break;
       }

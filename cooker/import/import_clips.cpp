@@ -25,7 +25,9 @@
 // a spline is the spline. Between frames the runtime interpolates linearly, so the grid rate
 // decides how close that comes to the source; see resampling_rate() for the choice.
 #include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <filesystem>
 #include <iterator>
 #include <map>
 #include <optional>
@@ -619,6 +621,35 @@ std::string clip_name(const aiAnimation& anim, unsigned index, std::set<std::str
   return name;
 }
 
+/// Whether a clip name says nothing about the motion: what exporters and importers invent when the
+/// artist named nothing. Mixamo's "mixamo.com", 3ds Max / Maya / MotionBuilder takes ("Take 001",
+/// "Unreal Take"), Blender's default "Action" (after an optional "Armature|" prefix), Assimp's own
+/// "Anim_0" / "Anim_0_Armature" for unnamed glTF animations and BVH's "Motion", this cooker's
+/// "clip0", and, for Collada, the name of a node in the file (Assimp names an unnamed animation
+/// after the first node it moves: "Hips", "Camera01").
+bool generic_clip_name(const std::string& name, const NodeGraph& graph) {
+  if (name.empty() || graph.by_name.count(name)) return true;
+  std::string n = name.substr(name.rfind('|') == std::string::npos ? 0 : name.rfind('|') + 1);
+  for (char& c : n) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (graph.by_name.count(n)) return true;
+  // A generic word, then an optional separator and number: "take 001", "take_1", "action.001".
+  static const char* const kWords[] = {"mixamo.com", "take", "unreal take", "default take", "default", "action",
+                                       "armatureaction", "animation", "anim", "clip", "motion", "scene",
+                                       "animstack", "base layer", "globalshape"};
+  for (const char* word : kWords) {
+    const std::string w(word);
+    if (n.compare(0, w.size(), w) != 0) continue;
+    size_t i = w.size();
+    if (i < n.size() && (n[i] == ' ' || n[i] == '_' || n[i] == '.' || n[i] == '-')) ++i;
+    size_t digits = i;
+    while (digits < n.size() && std::isdigit(static_cast<unsigned char>(n[digits]))) ++digits;
+    if (digits == n.size() && (digits > i || i == w.size())) return true;
+    // Assimp's glTF names: "anim_<index>_<node>".
+    if (w == "anim" && digits > i && digits < n.size() && n[digits] == '_') return true;
+  }
+  return false;
+}
+
 /// Clips to name in the per-file warnings (one line each, however many clips a file has).
 struct ClipSummary {
   std::vector<std::string> morphs, empty;
@@ -753,6 +784,17 @@ std::vector<SourceClip> import_clips(const Context& ctx, const NodeGraph& graph,
     const GltfClip* gltf_clip = gltf_samplers ? &gltf_samplers->clips[a] : nullptr;
     clips.push_back(
         import_clip(ctx, graph, rig, *scene.mAnimations[a], a, gltf_clip, &names, &summary));
+  }
+  // A file's single clip is its motion: with a generic source name it takes the file's stem, so a
+  // library of Mixamo exports is not a library of clips all named "mixamo.com". The source name is
+  // kept (SourceClip::source_name) so sidecars, settings and graph files may still use it.
+  if (clips.size() == 1 && generic_clip_name(clips[0].name, graph)) {
+    const std::string stem = std::filesystem::path(ctx.path).stem().string();
+    if (!stem.empty() && stem != clips[0].name) {
+      ctx.warn("clip '" + clips[0].name + "' is named '" + stem + "' after the file (its source name is generic)");
+      clips[0].source_name = clips[0].name;
+      clips[0].name = stem;
+    }
   }
   if (!summary.morphs.empty()) {
     ctx.warn("mesh and morph-target channels are not supported, dropped from clips: " +

@@ -139,6 +139,10 @@ std::vector<SourceClip> import_clips(const Context& ctx, const NodeGraph& graph,
 Result<std::vector<SourceMesh>> import_meshes(const Context& ctx, const NodeGraph& graph,
                                               const Rig& rig, uint32_t* vertices_over_4_influences);
 
+/// Whether mesh m is the bone display mesh Assimp builds for files without meshes (BVH, rig-only
+/// Collada), never part of the source (import_meshes.cpp).
+bool is_generated_skeleton_mesh(const aiScene& scene, unsigned m);
+
 /// Which meshes to keep, with warnings for those dropped (import_meshes.cpp).
 std::vector<bool> select_meshes(const Context& ctx);
 

@@ -276,6 +276,11 @@ void report(const Context& ctx, const MeshStats& stats) {
 
 }  // namespace
 
+bool is_generated_skeleton_mesh(const aiScene& scene, unsigned m) {
+  const aiMesh* mesh = scene.mMeshes[m];
+  return mesh != nullptr && material_name(scene, mesh->mMaterialIndex) == kGeneratedSkeletonMaterial;
+}
+
 std::vector<bool> select_meshes(const Context& ctx) {
   const aiScene& scene = *ctx.scene;
   std::vector<bool> kept(scene.mNumMeshes, false);
@@ -284,7 +289,7 @@ std::vector<bool> select_meshes(const Context& ctx) {
   for (unsigned m = 0; m < scene.mNumMeshes; ++m) {
     const aiMesh* mesh = scene.mMeshes[m];
     if (!mesh || !mesh->mNumVertices || !mesh->mVertices) continue;
-    if (material_name(scene, mesh->mMaterialIndex) == kGeneratedSkeletonMaterial) {
+    if (is_generated_skeleton_mesh(scene, m)) {
       generated = true;
       continue;
     }

@@ -283,6 +283,29 @@ void fill_bind_pose(const Context& ctx, const NodeGraph& graph, Rig* rig) {
   }
 }
 
+/// Joints the source left unnamed (some FBX exporters write empty model names, and Assimp keeps
+/// them) get a stable name from their place in the skeleton: "joint<index>", or "joint<index>_<n>"
+/// when the file already uses that name. The format requires a name per joint (masks, retargeting
+/// and clip binding go by name), so without this the cook failed its own verification.
+void name_unnamed_joints(const Context& ctx, SourceSkeleton* skeleton) {
+  std::set<std::string> used;
+  for (const SourceJoint& j : skeleton->joints) used.insert(j.name);
+  std::vector<std::string> named;
+  for (size_t j = 0; j < skeleton->joints.size(); ++j) {
+    SourceJoint& joint = skeleton->joints[j];
+    if (!joint.name.empty()) continue;
+    std::string name = "joint" + std::to_string(j);
+    for (int n = 2; used.count(name); ++n) name = "joint" + std::to_string(j) + "_" + std::to_string(n);
+    used.insert(name);
+    joint.name = name;
+    named.push_back(name);
+  }
+  if (!named.empty()) {
+    ctx.warn(std::to_string(named.size()) + " joints have no name in the source and are named by their index: " +
+             name_list(named));
+  }
+}
+
 Result<Rig> own_rig(const Context& ctx, const NodeGraph& graph, const std::vector<int>& seeds) {
   Rig rig;
   rig.node_joint.assign(graph.nodes.size(), -1);
@@ -306,6 +329,7 @@ Result<Rig> own_rig(const Context& ctx, const NodeGraph& graph, const std::vecto
     rig.chain.push_back(chain_to(graph, n, parent_node));
     rig.prefix.emplace_back(1.0);
   }
+  name_unnamed_joints(ctx, &rig.skeleton);
   for (size_t j = 0; j < order.size(); ++j) {
     if (!is_finite(chain_local(graph, rig.chain[j]))) {
       return ctx.error("joint '" + rig.skeleton.joints[j].name + "' has a non-finite transform");
@@ -529,13 +553,39 @@ Result<Rig> reference_rig(const Context& ctx, const NodeGraph& graph, const Seed
   return rig;
 }
 
+/// A rig-only file (a Collada or FBX skeleton exported without its body or any animation) has no
+/// bones and no keys to seed the skeleton: its node tree is the skeleton. The top-level subtree
+/// with the most nodes is taken (scenery beside it, cameras and lights, is left out); every node
+/// in it but cameras, lights and `$AssimpFbx$` helpers is a joint. Only for files that hold no
+/// mesh at all (Assimp's generated bone display mesh aside): nodes that hold point or line meshes
+/// are not a rig.
+std::vector<int> rig_only_seeds(const Context& ctx, const NodeGraph& graph) {
+  if (ctx.scene->mNumAnimations != 0 || graph.nodes.size() < 2) return {};
+  for (unsigned m = 0; m < ctx.scene->mNumMeshes; ++m)
+    if (!is_generated_skeleton_mesh(*ctx.scene, m)) return {};
+  std::vector<size_t> per_top(graph.nodes.size(), 0);
+  for (size_t n = 1; n < graph.nodes.size(); ++n)
+    if (!graph.nodes[n].helper && !graph.nodes[n].camera_or_light) ++per_top[graph.nodes[n].top];
+  const size_t top = static_cast<size_t>(std::max_element(per_top.begin() + 1, per_top.end()) - per_top.begin());
+  if (per_top[top] == 0) return {};
+  std::vector<int> seeds;
+  for (size_t n = 1; n < graph.nodes.size(); ++n)
+    if (graph.nodes[n].top == static_cast<int>(top) && !graph.nodes[n].helper && !graph.nodes[n].camera_or_light)
+      seeds.push_back(static_cast<int>(n));
+  ctx.warn("the file holds no mesh and no animation: its node tree under '" + graph.nodes[top].name +
+           "' (" + std::to_string(seeds.size()) + " nodes) is cooked as a skeleton");
+  return seeds;
+}
+
 }  // namespace
 
 Result<Rig> build_rig(const Context& ctx, const NodeGraph& graph) {
   const Seeds seeds = find_seeds(ctx, graph);
   if (ctx.options->reference) return reference_rig(ctx, graph, seeds, *ctx.options->reference);
   const std::vector<bool> tops = choose_rig_tops(graph, seeds);
-  return own_rig(ctx, graph, rig_seeds(ctx, graph, seeds, tops));
+  std::vector<int> kept = rig_seeds(ctx, graph, seeds, tops);
+  if (kept.empty()) kept = rig_only_seeds(ctx, graph);
+  return own_rig(ctx, graph, kept);
 }
 
 }  // namespace ossa::cook::detail

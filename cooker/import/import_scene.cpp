@@ -41,6 +41,22 @@ SourceFormat format_of(const std::string& path) {
   return SourceFormat::Other;
 }
 
+/// Materials no mesh uses are left out (Assimp's "SkeletonMaterial" for BVH and rig-only files, a
+/// glTF importer's default, an FBX's leftovers), and mesh indices renumbered; the order of those
+/// kept is the source's.
+void drop_unused_materials(SourceScene* scene) {
+  std::vector<int> remap(scene->materials.size(), -1);
+  for (const SourceMesh& mesh : scene->meshes) remap[mesh.material] = 0;
+  std::vector<SourceMaterial> kept;
+  for (size_t i = 0; i < scene->materials.size(); ++i) {
+    if (remap[i] < 0) continue;
+    remap[i] = static_cast<int>(kept.size());
+    kept.push_back(std::move(scene->materials[i]));
+  }
+  scene->materials = std::move(kept);
+  for (SourceMesh& mesh : scene->meshes) mesh.material = static_cast<uint32_t>(remap[mesh.material]);
+}
+
 Result<SourceScene> convert_scene(const aiScene& scene, const std::string& path, SourceFormat format,
                                   const ImportOptions& options) {
   SourceScene out;
@@ -71,9 +87,19 @@ Result<SourceScene> convert_scene(const aiScene& scene, const std::string& path,
       mesh.material = 0;
     }
   }
+  drop_unused_materials(&out);
   out.metres_per_unit = metres_per_unit(ctx);
   out.skeleton = std::move(rig->skeleton);
   if (out.skeleton.joints.empty() && out.meshes.empty() && out.clips.empty()) {
+    unsigned open_meshes = 0;
+    for (unsigned m = 0; m < scene.mNumMeshes; ++m)
+      if (scene.mMeshes[m] && scene.mMeshes[m]->mNumVertices && !(scene.mMeshes[m]->mPrimitiveTypes & aiPrimitiveType_TRIANGLE))
+        ++open_meshes;
+    if (open_meshes != 0 && open_meshes == scene.mNumMeshes) {
+      return ctx.error("its " + std::to_string(open_meshes) + (open_meshes == 1 ? " mesh holds" : " meshes hold") +
+                       " only points or lines, and ossa cooks triangle meshes; there is no skeleton or animation "
+                       "to cook either");
+    }
     return ctx.error("holds no mesh, skeleton or animation to cook");
   }
   // Values the format cannot hold are named here, not found by the writer's own verification.

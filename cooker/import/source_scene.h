@@ -73,6 +73,10 @@ struct SourceEvent {
 
 struct SourceClip {
   std::string name;
+  /// The name the source gave the clip, when the cooker chose another (a file's single clip with a
+  /// generic source name, "mixamo.com" or "Take 001", is named after the file); empty otherwise.
+  /// Sidecars, cook settings and graph files may name a clip by either (clip_named).
+  std::string source_name;
   float duration = 0.0f;                 // seconds
   float sample_rate = 0.0f;              // source keys per second, 0 when unknown
   std::vector<SourceTrack> tracks;       // sorted by joint, one per animated joint
@@ -80,6 +84,11 @@ struct SourceClip {
   SourceRootMotion root_motion;          // when has_root_motion
   std::vector<SourceEvent> events;       // sorted by time
 };
+
+/// Whether `name` names this clip: its cooked name, or the name its source gave it.
+inline bool clip_named(const SourceClip& clip, const std::string& name) {
+  return clip.name == name || (!clip.source_name.empty() && clip.source_name == name);
+}
 
 enum class TextureRole : uint8_t { Diffuse = 0, Normal = 1, Specular = 2 };
 

@@ -1,0 +1,255 @@
+// cook_fidelity_test.cpp — what a cook keeps of sources nobody here made (issue "Cooked = source"):
+// rig-only files, unnamed joints, point/line-only meshes, clip names that exporters invent, and
+// materials no mesh uses. Each case is a small real source the test writes (Collada, ASCII FBX,
+// OBJ, BVH), cooked by the real ossa-cook through Assimp and read back by the verifying loader.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include <ossa/loader/asset.h>
+#include "test_files.h"
+
+namespace fs = std::filesystem;
+using ossa::test::run_command;
+
+namespace {
+
+std::string cook_cmd() { return (ossa::test::bin_dir() / "ossa-cook").string(); }
+std::string q(const fs::path& p) { return "'" + p.string() + "'"; }
+
+bool contains(const std::string& text, const std::string& what) { return text.find(what) != std::string::npos; }
+
+/// A Collada rig with no mesh and no animation: Hips (1 m up) > Spine (+0.2) > Head (+0.4), and
+/// Hips > LegL; plus a camera node beside it that must not become a joint.
+const char* kRigDae = R"(<?xml version="1.0" encoding="utf-8"?>
+<COLLADA xmlns="http://www.collada.org/2005/11/COLLADASchema" version="1.4.1">
+  <asset><unit name="meter" meter="1"/><up_axis>Y_UP</up_axis></asset>
+  <library_visual_scenes>
+    <visual_scene id="Scene" name="Scene">
+      <node id="Hips" name="Hips" sid="Hips" type="JOINT">
+        <matrix sid="transform">1 0 0 0 0 1 0 1 0 0 1 0 0 0 0 1</matrix>
+        <node id="Spine" name="Spine" sid="Spine" type="JOINT">
+          <matrix sid="transform">1 0 0 0 0 1 0 0.2 0 0 1 0 0 0 0 1</matrix>
+          <node id="Head" name="Head" sid="Head" type="JOINT">
+            <matrix sid="transform">1 0 0 0 0 1 0 0.4 0 0 1 0 0 0 0 1</matrix>
+          </node>
+        </node>
+        <node id="LegL" name="LegL" sid="LegL" type="JOINT">
+          <matrix sid="transform">1 0 0 0.1 0 1 0 -0.5 0 0 1 0 0 0 0 1</matrix>
+        </node>
+      </node>
+    </visual_scene>
+  </library_visual_scenes>
+  <scene><instance_visual_scene url="#Scene"/></scene>
+</COLLADA>
+)";
+
+/// An ASCII FBX rig: LimbNodes Hips > "" > "", the two below Hips without names (some exporters
+/// write "Model::" and Assimp keeps the empty name).
+const char* kUnnamedFbx = R"(; FBX 7.4.0 project file
+FBXHeaderExtension:  {
+	FBXHeaderVersion: 1003
+	FBXVersion: 7400
+}
+GlobalSettings:  {
+	Version: 1000
+	Properties70:  {
+		P: "UnitScaleFactor", "double", "Number", "",1
+	}
+}
+Objects:  {
+	Model: 1000, "Model::Hips", "LimbNode" {
+		Version: 232
+		Properties70:  {
+			P: "Lcl Translation", "Lcl Translation", "", "A",0,100,0
+		}
+	}
+	Model: 1001, "Model::", "LimbNode" {
+		Version: 232
+		Properties70:  {
+			P: "Lcl Translation", "Lcl Translation", "", "A",0,20,0
+		}
+	}
+	Model: 1002, "Model::", "LimbNode" {
+		Version: 232
+		Properties70:  {
+			P: "Lcl Translation", "Lcl Translation", "", "A",0,30,0
+		}
+	}
+}
+Connections:  {
+	C: "OO",1000,0
+	C: "OO",1001,1000
+	C: "OO",1002,1001
+}
+)";
+
+/// A two-joint BVH with three frames; Assimp names its one clip "Motion".
+const char* kBvh = R"(HIERARCHY
+ROOT Hips
+{
+  OFFSET 0 0 0
+  CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation
+  JOINT Spine
+  {
+    OFFSET 0 10 0
+    CHANNELS 3 Zrotation Xrotation Yrotation
+    End Site
+    {
+      OFFSET 0 10 0
+    }
+  }
+}
+MOTION
+Frames: 3
+Frame Time: 0.033333
+0 90 0 0 0 0 0 0 0
+1 90 0 0 10 0 5 0 0
+2 90 0 0 20 0 10 0 0
+)";
+
+struct Cooked {
+  ossa::test::CommandResult run;
+  fs::path out;
+};
+
+Cooked cook(const fs::path& dir, const std::string& file, const std::string& text, const std::string& extra = "") {
+  EXPECT_TRUE(ossa::test::write_file(dir / file, std::vector<uint8_t>(text.begin(), text.end())));
+  Cooked c{run_command(cook_cmd() + " " + q(dir / file) + " -o " + q(dir / "out") + " -v " + extra), dir / "out"};
+  return c;
+}
+
+TEST(CookFidelity, RigOnlyColladaCooksAsASkeleton) {
+  const fs::path dir = ossa::test::make_temp_dir("fidelity-rig");
+  const Cooked c = cook(dir, "rig.dae", kRigDae);
+  ASSERT_EQ(c.run.exit_code, 0) << c.run.err;
+  EXPECT_TRUE(contains(c.run.err, "no mesh and no animation")) << c.run.err;
+  auto a = ossa::Asset::open((c.out / "rig.ossa").string());
+  ASSERT_TRUE(a.ok()) << a.error().message;
+  const ossa::SkeletonView s = a->skeleton();
+  ASSERT_EQ(s.joint_count(), 4u);
+  EXPECT_EQ(s.joint_name(0), "Hips");
+  EXPECT_EQ(s.parents()[0], -1);
+  const int head = s.find_joint("Head"), spine = s.find_joint("Spine"), leg = s.find_joint("LegL");
+  ASSERT_GE(head, 0);
+  ASSERT_GE(spine, 0);
+  ASSERT_GE(leg, 0);
+  EXPECT_EQ(s.parents()[static_cast<size_t>(head)], spine);
+  EXPECT_EQ(s.parents()[static_cast<size_t>(leg)], 0);
+  EXPECT_NEAR(s.bind_translations()[static_cast<size_t>(head)].y(), 0.4f, 1e-6f);
+  EXPECT_NEAR(s.bind_translations()[static_cast<size_t>(leg)].x(), 0.1f, 1e-6f);
+  EXPECT_EQ(a->mesh_count(), 0u);
+  EXPECT_EQ(a->material_count(), 0u) << "Assimp's generated SkeletonMaterial is used by no mesh";
+}
+
+TEST(CookFidelity, UnnamedJointsGetStableNamesByIndex) {
+  const fs::path dir = ossa::test::make_temp_dir("fidelity-unnamed");
+  const Cooked c = cook(dir, "rig.fbx", kUnnamedFbx);
+  ASSERT_EQ(c.run.exit_code, 0) << c.run.err;
+  EXPECT_FALSE(contains(c.run.err, "internal error")) << c.run.err;
+  EXPECT_TRUE(contains(c.run.err, "2 joints have no name in the source")) << c.run.err;
+  auto a = ossa::Asset::open((c.out / "rig.ossa").string());
+  ASSERT_TRUE(a.ok()) << a.error().message;
+  const ossa::SkeletonView s = a->skeleton();
+  ASSERT_EQ(s.joint_count(), 3u);
+  EXPECT_EQ(s.joint_name(0), "Hips");
+  EXPECT_EQ(s.joint_name(1), "joint1");
+  EXPECT_EQ(s.joint_name(2), "joint2");
+  EXPECT_EQ(s.parents()[2], 1);
+  EXPECT_NEAR(s.bind_translations()[2].y(), 30.0f, 1e-4f);
+  // Stable: a second cook gives the same bytes.
+  const fs::path again = dir / "again";
+  const auto r = run_command(cook_cmd() + " " + q(dir / "rig.fbx") + " -o " + q(again) + " -q");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(ossa::test::read_file(again / "rig.ossa"), ossa::test::read_file(c.out / "rig.ossa"));
+}
+
+TEST(CookFidelity, PointAndLineOnlyMeshesAreSaidToBeSo) {
+  const fs::path dir = ossa::test::make_temp_dir("fidelity-lines");
+  for (const auto& [file, text] : {std::pair<std::string, std::string>{"lines.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nl 1 2\nl 2 3\n"},
+                                   {"points.obj", "v 0 0 0\nv 1 0 0\np 1\np 2\n"}}) {
+    const Cooked c = cook(dir, file, text);
+    EXPECT_EQ(c.run.exit_code, 1) << file;
+    EXPECT_TRUE(contains(c.run.err, file + ": its 1 mesh holds only points or lines")) << c.run.err;
+    EXPECT_FALSE(fs::exists(c.out / (fs::path(file).stem().string() + ".ossa"))) << file;
+  }
+}
+
+TEST(CookFidelity, AGenericSingleClipNameBecomesTheFileStem) {
+  const fs::path dir = ossa::test::make_temp_dir("fidelity-clipname");
+  const Cooked c = cook(dir, "walk_fast.bvh", kBvh);
+  ASSERT_EQ(c.run.exit_code, 0) << c.run.err;
+  EXPECT_TRUE(contains(c.run.err, "clip 'Motion' is named 'walk_fast' after the file")) << c.run.err;
+  auto a = ossa::Asset::open((c.out / "walk_fast.ossa").string());
+  ASSERT_TRUE(a.ok()) << a.error().message;
+  ASSERT_EQ(a->clip_count(), 1u);
+  EXPECT_EQ(a->clip(0).name(), "walk_fast");
+  EXPECT_EQ(a->material_count(), 0u);
+}
+
+TEST(CookFidelity, SidecarsAndSettingsMayStillUseTheSourceClipName) {
+  const fs::path dir = ossa::test::make_temp_dir("fidelity-clipname-source");
+  const std::string events = R"({"ossa_events": 1, "clips": {"Motion": [{"name": "step", "time": 0.03}]}})";
+  ASSERT_TRUE(ossa::test::write_file(dir / "stroll.events.json", std::vector<uint8_t>(events.begin(), events.end())));
+  const std::string settings = R"({"ossa_cook": 1, "clip_names": {"Motion": "amble"}})";
+  ASSERT_TRUE(ossa::test::write_file(dir / "stroll.cook.json", std::vector<uint8_t>(settings.begin(), settings.end())));
+  const Cooked c = cook(dir, "stroll.bvh", kBvh);
+  ASSERT_EQ(c.run.exit_code, 0) << c.run.err;
+  auto a = ossa::Asset::open((c.out / "stroll.ossa").string());
+  ASSERT_TRUE(a.ok()) << a.error().message;
+  ASSERT_EQ(a->clip_count(), 1u);
+  EXPECT_EQ(a->clip(0).name(), "amble");
+  const auto* events_cooked = a->clip(0).fb->events();
+  ASSERT_NE(events_cooked, nullptr) << "the sidecar's events, keyed by the source name, reached the clip";
+  EXPECT_EQ(events_cooked->size(), 1u);
+}
+
+TEST(CookFidelity, GenericNamesAreRecognisedAndMeaningfulOnesKept) {
+  // One-clip glTF files, the animation named as exporters name it.
+  const fs::path dir = ossa::test::make_temp_dir("fidelity-gltf-names");
+  const fs::path src = ossa::test::shared_assets() / "Khronos_embedded" / "rigged_simple.gltf";
+  if (!fs::exists(src)) GTEST_SKIP() << "no " << src;
+  const auto text = ossa::test::read_file(src);
+  ASSERT_TRUE(text);
+  nlohmann::json doc = nlohmann::json::parse(text->begin(), text->end());
+  ASSERT_EQ(doc["animations"].size(), 1u);
+  struct Case {
+    std::string source_name, file_stem, expected;
+  };
+  const std::vector<Case> cases = {
+      {"mixamo.com", "a1", "a1"},           {"Armature|mixamo.com", "a2", "a2"}, {"Take 001", "a3", "a3"},
+      {"Unreal Take", "a4", "a4"},          {"Armature|Action.001", "a5", "a5"}, {"Bone", "a6", "a6"},
+      {"Wave", "k1", "Wave"},               {"Armature|Wave", "k2", "Armature|Wave"},
+      {"Takeoff", "k3", "Takeoff"},         {"animal", "k4", "animal"}};
+  for (const auto& [name, stem, expected] : cases) {
+    doc["animations"][0]["name"] = name;
+    const std::string body = doc.dump();
+    ASSERT_TRUE(ossa::test::write_file(dir / (stem + ".gltf"), std::vector<uint8_t>(body.begin(), body.end())));
+    const auto r = run_command(cook_cmd() + " " + q(dir / (stem + ".gltf")) + " -o " + q(dir / "out") + " -q");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    auto a = ossa::Asset::open((dir / "out" / (stem + ".ossa")).string());
+    ASSERT_TRUE(a.ok()) << a.error().message;
+    ASSERT_EQ(a->clip_count(), 1u);
+    EXPECT_EQ(a->clip(0).name(), expected) << "source name '" << name << "'";
+  }
+}
+
+TEST(CookFidelity, FilesWithSeveralClipsKeepTheirNames) {
+  const fs::path fox = ossa::test::source_dir() / "assets" / "Fox" / "Fox.glb";
+  const fs::path dir = ossa::test::make_temp_dir("fidelity-fox");
+  const auto r = run_command(cook_cmd() + " " + q(fox) + " -o " + q(dir) + " -q");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  auto a = ossa::Asset::open((dir / "Fox.ossa").string());
+  ASSERT_TRUE(a.ok()) << a.error().message;
+  ASSERT_EQ(a->clip_count(), 3u);
+  EXPECT_EQ(a->clip(0).name(), "Survey");
+  EXPECT_EQ(a->clip(1).name(), "Walk");
+  EXPECT_EQ(a->clip(2).name(), "Run");
+  // Fox.glb has a default material besides its textured one, used by no mesh: left out.
+  EXPECT_EQ(a->material_count(), 1u);
+}
+
+}  // namespace
