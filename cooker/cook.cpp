@@ -185,7 +185,7 @@ bool up_to_date(CookRecord& record, const fs::path& input, const fs::path& outpu
     const fs::path path = (base / fs::path(f->path()->str())).lexically_normal();
     if (f->absent()) {
       if (probe_input(path)) return false;  // it appeared: the cook would read it
-    } else if (!read_input(path)) {
+    } else if (!hash_input(path)) {
       return false;
     }
   }
@@ -286,7 +286,12 @@ void cook_into(CookRecord& record, const fs::path& input, const fs::path& output
 
 }  // namespace
 
-CookRecord cook_file(const fs::path& input, const fs::path& output, const CookOptions& batch_options) {
+namespace {
+
+/// cook_file's body. With only_if_up_to_date, stops after the up-to-date check: the record of an
+/// up-to-date output, or nullopt for anything else (settings that fail, --force, a stale output).
+std::optional<CookRecord> cook_or_check(const fs::path& input, const fs::path& output, const CookOptions& batch_options,
+                                        bool only_if_up_to_date) {
   CookRecord record;
   record.input = input.string();
   record.output = output.string();
@@ -301,14 +306,19 @@ CookRecord cook_file(const fs::path& input, const fs::path& output, const CookOp
   if (allowed.back().empty()) allowed.back() = ".";
   ReadSandboxScope sandbox(allowed);
   try {
-    if (Status st = apply_cook_settings(input, options, settings); !st)
+    if (Status st = apply_cook_settings(input, options, settings); !st) {
+      if (only_if_up_to_date) return std::nullopt;
       record.error = input.string() + ": cook settings: " + st.message();
-    else if (options.force || !up_to_date(record, input, output, options))
+    } else if (options.force || !up_to_date(record, input, output, options)) {
+      if (only_if_up_to_date) return std::nullopt;
       cook_into(record, input, output, options, settings);
+    }
   } catch (const std::exception& e) {
+    if (only_if_up_to_date) return std::nullopt;
     record.ok = false;
     record.error = input.string() + ": unexpected failure: " + e.what();
   } catch (...) {
+    if (only_if_up_to_date) return std::nullopt;
     record.ok = false;
     record.error = input.string() + ": unexpected failure";
   }
@@ -324,6 +334,17 @@ CookRecord cook_file(const fs::path& input, const fs::path& output, const CookOp
   }
   record.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return record;
+}
+
+}  // namespace
+
+CookRecord cook_file(const fs::path& input, const fs::path& output, const CookOptions& batch_options) {
+  return *cook_or_check(input, output, batch_options, false);
+}
+
+std::optional<CookRecord> up_to_date_record(const fs::path& input, const fs::path& output,
+                                            const CookOptions& batch_options) {
+  return cook_or_check(input, output, batch_options, true);
 }
 
 Result<SourceSkeleton> load_reference_skeleton(const fs::path& ossa_file, InputFile* as_read) {

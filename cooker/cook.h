@@ -93,6 +93,15 @@ CookRecord cook_file(const std::filesystem::path& input, const std::filesystem::
                      const CookOptions& options);
 
 /// True for `*.graph.json` (case-insensitive): an animation graph file rather than a source.
+/// The record cook_file would return for an output that is up to date (settings applied, the
+/// output's listed inputs re-read and re-hashed inside the read sandbox, the key recomputed), or
+/// nullopt when it would cook (or fail). Reads only the output and the files it lists, parses only
+/// the output (through the verifying loader) and settings files (ossa's own JSON reader): no
+/// importer runs, so the batch calls it in its own process before starting a worker for an input,
+/// and an all-up-to-date run costs no process per input. O(bytes of the listed inputs).
+std::optional<CookRecord> up_to_date_record(const std::filesystem::path& input, const std::filesystem::path& output,
+                                            const CookOptions& options);
+
 bool is_graph_file(const std::filesystem::path& path);
 
 /// Loads the skeleton of a cooked file (for --skeleton). Errors name the file. `as_read`, when

@@ -56,6 +56,10 @@ void InputLog::add(const fs::path& path, std::span<const uint8_t> bytes) {
   files_.push_back({normal_absolute(path).string(), input_hash(bytes), bytes.size(), true});
 }
 
+void InputLog::add_hashed(const fs::path& path, uint64_t hash, uint64_t size) {
+  files_.push_back({normal_absolute(path).string(), hash, size, true});
+}
+
 void InputLog::add_absent(const fs::path& path) { files_.push_back({normal_absolute(path).string(), 0, 0, false}); }
 
 std::vector<InputFile> InputLog::files() const {
@@ -116,7 +120,15 @@ const char* kind_of(const struct stat& st) {
 
 }  // namespace
 
-Result<std::vector<uint8_t>> read_input(const fs::path& path, uint64_t max_bytes, std::string_view reference) {
+namespace {
+
+struct OpenedInput {
+  int fd = -1;
+  uint64_t size = 0;
+};
+
+/// The checks every read makes (NUL byte, sandbox, regular file, size), then the open file.
+Result<OpenedInput> open_input(const fs::path& path, uint64_t max_bytes, std::string_view reference) {
   // A NUL byte (a JSON "\u0000") would cut the path short for the operating system: another file.
   if (path.native().find('\0') != std::string::npos)
     return Error{refuse(path, "contains a NUL byte", reference)};
@@ -146,7 +158,16 @@ Result<std::vector<uint8_t>> read_input(const fs::path& path, uint64_t max_bytes
     ::close(fd);
     return Error{detail::printable(path.string(), 400) + ": grew over the limit while being opened"};
   }
-  std::vector<uint8_t> bytes(static_cast<size_t>(opened.st_size));
+  return OpenedInput{fd, static_cast<uint64_t>(opened.st_size)};
+}
+
+}  // namespace
+
+Result<std::vector<uint8_t>> read_input(const fs::path& path, uint64_t max_bytes, std::string_view reference) {
+  auto opened = open_input(path, max_bytes, reference);
+  if (!opened) return opened.error();
+  const int fd = opened->fd;
+  std::vector<uint8_t> bytes(static_cast<size_t>(opened->size));
   size_t done = 0;
   while (done < bytes.size()) {
     const ssize_t n = ::read(fd, bytes.data() + done, bytes.size() - done);
@@ -160,6 +181,35 @@ Result<std::vector<uint8_t>> read_input(const fs::path& path, uint64_t max_bytes
   if (done != bytes.size() || more != 0) return Error{detail::printable(path.string(), 400) + ": changed while being read"};
   if (InputLog* log = current_input_log()) log->add(path, bytes);
   return bytes;
+}
+
+Status hash_input(const fs::path& path, std::string_view reference) {
+  auto opened = open_input(path, UINT64_MAX, reference);
+  if (!opened) return opened.error();
+  // Streamed through a fixed buffer: XXH3's streaming form gives the one-shot hash, and no
+  // file-sized buffer is allocated (and page-faulted in) only to be hashed and freed.
+  constexpr size_t kChunk = 256 << 10;
+  static thread_local std::vector<uint8_t> buffer(kChunk);
+  XXH3_state_t* state = XXH3_createState();
+  if (state == nullptr) {
+    ::close(opened->fd);
+    return Error{detail::printable(path.string(), 400) + ": out of memory"};
+  }
+  XXH3_64bits_reset(state);
+  uint64_t done = 0;
+  for (;;) {
+    const ssize_t n = ::read(opened->fd, buffer.data(), kChunk);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) break;
+    XXH3_64bits_update(state, buffer.data(), static_cast<size_t>(n));
+    done += static_cast<uint64_t>(n);
+  }
+  const uint64_t hash = XXH3_64bits_digest(state);
+  XXH3_freeState(state);
+  ::close(opened->fd);
+  if (done != opened->size) return Error{detail::printable(path.string(), 400) + ": changed while being read"};
+  if (InputLog* log = current_input_log()) log->add_hashed(path, hash, done);
+  return {};
 }
 
 bool probe_input(const fs::path& path, std::string_view reference) {

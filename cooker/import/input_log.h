@@ -49,6 +49,8 @@ class InputLog {
  public:
   /// Records a file read whole. A path recorded twice keeps its first record.
   void add(const std::filesystem::path& path, std::span<const uint8_t> bytes);
+  /// Records a file hashed without being kept (hash_input).
+  void add_hashed(const std::filesystem::path& path, uint64_t hash, uint64_t size);
   /// Records a file looked for and not found.
   void add_absent(const std::filesystem::path& path);
   /// Every record, sorted by path, one per path.
@@ -99,6 +101,11 @@ class ReadSandboxScope {
 /// "a texture of material 'skin'") for the messages. Errors name the file. O(file size).
 Result<std::vector<uint8_t>> read_input(const std::filesystem::path& path, uint64_t max_bytes = UINT64_MAX,
                                         std::string_view reference = {});
+
+/// read_input's checks and record, without keeping the bytes: the file is streamed through the
+/// hash in 256 KiB pieces (the up-to-date check needs the hash only). O(file size), no allocation
+/// of the file's size.
+Status hash_input(const std::filesystem::path& path, std::string_view reference = {});
 
 /// True when `path` is a regular file inside the sandbox; a missing file is recorded absent, one
 /// outside the sandbox is recorded as a refusal (it was named by the input, and cannot be read).
