@@ -9,6 +9,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include <flatbuffers/flatbuffers.h>
+
 #include <ossa/loader/asset.h>
 #include "test_files.h"
 
@@ -250,6 +252,63 @@ TEST(CookFidelity, FilesWithSeveralClipsKeepTheirNames) {
   EXPECT_EQ(a->clip(2).name(), "Run");
   // Fox.glb has a default material besides its textured one, used by no mesh: left out.
   EXPECT_EQ(a->material_count(), 1u);
+}
+
+/// An uncompressed 24-bit TGA, 2 x 2: red, green / blue, white (bottom row first, as TGA stores).
+std::vector<uint8_t> tiny_tga() {
+  std::vector<uint8_t> b = {0, 0, 2, 0, 0, 0, 0, 0, 0, 0, 0, 0, 2, 0, 2, 0, 24, 0};
+  for (uint8_t v : {0, 0, 255, 0, 255, 0, 255, 0, 0, 255, 255, 255}) b.push_back(v);  // BGR
+  return b;
+}
+
+/// An OBJ quad whose material names its diffuse map as `map`.
+void write_obj_with_texture(const fs::path& dir, const std::string& stem, const std::string& map) {
+  const std::string obj = "mtllib " + stem + ".mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
+                          "vn 0 0 1\nusemtl skin\nf 1/1/1 2/2/1 3/3/1\nf 1/1/1 3/3/1 4/4/1\n";
+  const std::string mtl = "newmtl skin\nKd 1 1 1\nmap_Kd " + map + "\n";
+  ASSERT_TRUE(ossa::test::write_file(dir / (stem + ".obj"), obj));
+  ASSERT_TRUE(ossa::test::write_file(dir / (stem + ".mtl"), mtl));
+}
+
+size_t count_of(const std::string& text, const std::string& what) {
+  size_t n = 0;
+  for (size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+  return n;
+}
+
+TEST(CookFidelity, AbsoluteWindowsTexturePathIsFoundByNameAndTgaEmbeddedAsPng) {
+  const fs::path dir = ossa::test::make_temp_dir("fidelity-texture");
+  ASSERT_TRUE(ossa::test::write_file(dir / "skin.tga", tiny_tga()));
+  write_obj_with_texture(dir, "quad", "C:\\Users\\artist\\textures\\skin.tga");
+  const auto r = run_command(cook_cmd() + " " + q(dir / "quad.obj") + " -o " + q(dir / "out") + " -v");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(count_of(r.err, "is absolute, looked up as 'skin.tga' next to the source"), 1u) << r.err;
+  EXPECT_EQ(count_of(r.err, "is a TGA image, embedded as PNG"), 1u) << r.err;
+  auto a = ossa::Asset::open((dir / "out" / "quad.ossa").string());
+  ASSERT_TRUE(a.ok()) << a.error().message;
+  ASSERT_EQ(a->material_count(), 1u);
+  const auto* textures = a->material(0).textures();
+  ASSERT_NE(textures, nullptr);
+  ASSERT_EQ(textures->size(), 1u);
+  const auto* tex = textures->Get(0);
+  EXPECT_EQ(flatbuffers::GetStringView(tex->mime()), "image/png");
+  EXPECT_EQ(flatbuffers::GetStringView(tex->path()), "skin.tga") << "the path kept is relative, never C:\\...";
+  ASSERT_NE(tex->data(), nullptr);
+  const std::vector<uint8_t> png(tex->data()->begin(), tex->data()->end());
+  ASSERT_GE(png.size(), 8u);
+  EXPECT_EQ(png[1], 'P');
+  EXPECT_EQ(png[2], 'N');
+  EXPECT_EQ(png[3], 'G');
+}
+
+TEST(CookFidelity, ATextFileNamedTgaIsRefusedByName) {
+  const fs::path dir = ossa::test::make_temp_dir("fidelity-fake-tga");
+  ASSERT_TRUE(ossa::test::write_file(dir / "skin.tga", std::string("this is not an image, whatever its name says\n")));
+  write_obj_with_texture(dir, "quad", "skin.tga");
+  const auto r = run_command(cook_cmd() + " " + q(dir / "quad.obj") + " -o " + q(dir / "out"));
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_TRUE(contains(r.err, "texture 'skin.tga' is not a TGA image")) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "out" / "quad.ossa"));
 }
 
 }  // namespace

@@ -10,6 +10,7 @@
 #define STB_IMAGE_IMPLEMENTATION
 #define STBI_ONLY_PNG
 #define STBI_ONLY_JPEG
+#define STBI_ONLY_TGA
 #define STBI_NO_STDIO
 #if defined(__GNUC__)
 #pragma GCC diagnostic push
@@ -21,6 +22,10 @@
 #pragma GCC diagnostic ignored "-Wdouble-promotion"
 #endif
 #include <stb_image.h>
+#define STB_IMAGE_WRITE_STATIC
+#define STB_IMAGE_WRITE_IMPLEMENTATION
+#define STBI_WRITE_NO_STDIO
+#include <stb_image_write.h>
 #if defined(__GNUC__)
 #pragma GCC diagnostic pop
 #endif
@@ -66,6 +71,37 @@ Result<ImageInfo> check_image(std::span<const uint8_t> bytes) {
   info.width = w;
   info.height = h;
   return info;
+}
+
+namespace {
+
+void append_bytes(void* context, void* data, int size) {
+  auto* out = static_cast<std::vector<uint8_t>*>(context);
+  const auto* begin = static_cast<const uint8_t*>(data);
+  out->insert(out->end(), begin, begin + size);
+}
+
+}  // namespace
+
+Result<std::vector<uint8_t>> tga_to_png(std::span<const uint8_t> bytes) {
+  if (bytes.size() > static_cast<size_t>(std::numeric_limits<int>::max())) return Error{"is too large to decode"};
+  const auto* data = reinterpret_cast<const stbi_uc*>(bytes.data());
+  const int size = static_cast<int>(bytes.size());
+  int w = 0, h = 0, channels = 0;
+  // stbi_info's TGA test reads the header only: a text file named .tga fails it here.
+  if (!stbi_info_from_memory(data, size, &w, &h, &channels))
+    return Error{"is not a TGA image (its header is not a TGA header)"};
+  if (w <= 0 || h <= 0 || w > kMaxImageSide || h > kMaxImageSide ||
+      static_cast<uint64_t>(w) * static_cast<uint64_t>(h) > kMaxImagePixels)
+    return Error{"claims " + std::to_string(w) + " x " + std::to_string(h) + " pixels, over the limit of " +
+                 std::to_string(kMaxImageSide) + " per side and " + std::to_string(kMaxImagePixels) + " pixels"};
+  stbi_uc* pixels = stbi_load_from_memory(data, size, &w, &h, &channels, 0);
+  if (pixels == nullptr) return Error{std::string("does not decode as TGA: ") + stbi_failure_reason()};
+  std::vector<uint8_t> png;
+  const int ok = stbi_write_png_to_func(append_bytes, &png, w, h, channels, pixels, w * channels);
+  stbi_image_free(pixels);
+  if (!ok || png.empty()) return Error{"could not be converted to PNG"};
+  return png;
 }
 
 }  // namespace ossa::cook

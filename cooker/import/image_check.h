@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <span>
 #include <string>
+#include <vector>
 
 #include <ossa/format/result.h>
 
@@ -23,6 +24,13 @@ struct ImageInfo {
   std::string mime;  // "image/png" or "image/jpeg"
   int width = 0, height = 0;
 };
+
+/// A TGA texture (no signature of its own: allowed only where the file name says .tga, and then
+/// its header must pass stb_image's TGA test and it must decode) converted to the PNG the format
+/// embeds, so a game's loader still sees only PNG and JPEG. The pixels are kept exactly (PNG is
+/// lossless; stb_image_write's encoder is deterministic, so the cook stays byte-reproducible).
+/// Bounded like check_image before any pixel is allocated. O(pixels).
+Result<std::vector<uint8_t>> tga_to_png(std::span<const uint8_t> bytes);
 
 /// Checks `bytes` as above. The error says what is wrong ("not a PNG or JPEG image (starts with
 /// ...)", "claims 20000 x 20000 pixels", "does not decode: <reason>"), without a file name: the

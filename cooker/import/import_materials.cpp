@@ -59,21 +59,55 @@ bool read_external(const Context& ctx, const std::string& path, std::vector<uint
   return read_file(dir / as_written.filename(), bytes, reference);
 }
 
+bool ends_with_tga(std::string name) {
+  for (char& c : name) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return name.size() >= 4 && name.compare(name.size() - 4, 4, ".tga") == 0;
+}
+
+/// Takes `bytes` as the texture's data: a PNG or JPEG as it is (identified by its bytes and fully
+/// decoded, image_check.h); a TGA, where the name says .tga, converted to PNG with a warning.
+/// Anything else fails the input, named by `what` ("texture 'x.png'").
+bool accept_image(const Context& ctx, std::vector<uint8_t> bytes, bool named_tga, const std::string& label,
+                  const std::string& what, SourceTexture* out) {
+  auto image = check_image(bytes);
+  if (image) {
+    out->mime = image->mime;
+    out->data = std::move(bytes);
+    return true;
+  }
+  if (named_tga) {
+    auto png = tga_to_png(bytes);
+    if (!png) {
+      ctx.fail(label + ": " + what + " " + png.error().message);
+      return false;
+    }
+    ctx.warn(label + ": " + what + " is a TGA image, embedded as PNG (same pixels)");
+    out->mime = "image/png";
+    out->data = std::move(*png);
+    return true;
+  }
+  ctx.fail(label + ": " + what + " " + image.error().message);
+  return false;
+}
+
 bool embedded(const Context& ctx, const aiTexture& tex, const std::string& label, SourceTexture* out) {
   if (tex.mHeight != 0 || !tex.pcData) {
     ctx.warn(label + ": embedded texture is raw texels, not PNG/JPEG, dropped");
     return false;
   }
   const auto* begin = reinterpret_cast<const uint8_t*>(tex.pcData);
-  out->data.assign(begin, begin + tex.mWidth);
-  // By its bytes, never by the format hint; and it must decode (image_check.h).
-  auto image = check_image(out->data);
-  if (!image) {
-    ctx.fail(label + ": embedded texture '" + std::string(tex.mFilename.C_Str()) + "' " + image.error().message);
-    return false;
-  }
-  out->mime = image->mime;
-  return true;  // no path: an embedded image's name (glTF's "Image_0") is not a file
+  const std::string name = tex.mFilename.C_Str();
+  const bool tga = ends_with_tga(name) || std::string(tex.achFormatHint) == "tga";
+  // no path: an embedded image's name (glTF's "Image_0") is not a file
+  return accept_image(ctx, std::vector<uint8_t>(begin, begin + tex.mWidth), tga, label,
+                      "embedded texture '" + name + "'", out);
+}
+
+/// A path another machine wrote: absolute on POSIX ("/home/..."), a Windows drive ("C:/...", after
+/// portable()) or a network share ("//server/...").
+bool foreign_absolute(const std::string& path) {
+  if (!path.empty() && path[0] == '/') return true;
+  return path.size() >= 2 && std::isalpha(static_cast<unsigned char>(path[0])) && path[1] == ':';
 }
 
 /// The first texture of the first type in `types` the material has; false when none is usable.
@@ -92,10 +126,18 @@ bool find_texture(const Context& ctx, const aiMaterial& mat, std::initializer_li
   if (const aiTexture* tex = ctx.scene->GetEmbeddedTexture(file.C_Str())) {
     return embedded(ctx, *tex, label, out);
   }
-  const std::string path = portable(file.C_Str());
+  std::string path = portable(file.C_Str());
   if (path.rfind('*', 0) == 0) {
     ctx.warn(label + ": names embedded texture " + path + " that the file does not have, dropped");
     return false;
+  }
+  if (foreign_absolute(path)) {
+    // Never joined onto anything: the file is looked for by its name next to the source, and the
+    // path kept is that name, so a viewer resolving it against the cooked file finds the same.
+    const std::string name = std::filesystem::path(path).filename().string();
+    ctx.warn(label + ": texture path '" + std::string(file.C_Str()) + "' is absolute, looked up as '" + name +
+             "' next to the source");
+    path = name;
   }
   out->path = path;
   std::vector<uint8_t> bytes;
@@ -103,15 +145,7 @@ bool find_texture(const Context& ctx, const aiMaterial& mat, std::initializer_li
     ctx.warn(label + ": texture '" + path + "' cannot be read, only its path is kept");
     return true;
   }
-  // By its bytes, never by its name; and it must decode (image_check.h).
-  auto image = check_image(bytes);
-  if (!image) {
-    ctx.fail(label + ": texture '" + path + "' " + image.error().message);
-    return false;
-  }
-  out->mime = image->mime;
-  out->data = std::move(bytes);
-  return true;
+  return accept_image(ctx, std::move(bytes), ends_with_tga(path), label, "texture '" + path + "'", out);
 }
 
 SourceMaterial import_material(const Context& ctx, const aiMaterial& mat, unsigned index) {

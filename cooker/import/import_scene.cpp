@@ -17,6 +17,7 @@
 #include <cctype>
 #include <exception>
 #include <filesystem>
+#include <set>
 
 #include <assimp/Importer.hpp>
 #include <assimp/config.h>
@@ -104,6 +105,13 @@ Result<SourceScene> convert_scene(const aiScene& scene, const std::string& path,
   }
   // Values the format cannot hold are named here, not found by the writer's own verification.
   if (Status st = check_scene_values(out); !st) return ctx.error(st.message());
+  // One line per thing said: a texture two materials share, or a slot Assimp fills twice, would
+  // otherwise say the same twice. The first occurrence keeps its place.
+  std::set<std::string> seen;
+  std::vector<std::string> unique;
+  for (std::string& w : out.warnings)
+    if (seen.insert(w).second) unique.push_back(std::move(w));
+  out.warnings = std::move(unique);
   return out;
 }
 
