@@ -47,6 +47,11 @@ std::string CookOptions::canonical() const {
     s += buf;
   }
   if (root_motion) s += std::string(";root_motion=") + "xyz"[up_axis % 3];
+  if (metres_per_unit > 0.0f) {
+    char unit[64];
+    std::snprintf(unit, sizeof unit, ";unit=%gm", static_cast<double>(metres_per_unit));
+    s += unit;
+  }
   // The rig by name and content: the reference usually lives in the output tree, outside the
   // input's directory, so it enters the key through its hash here rather than as a relative path.
   if (reference != nullptr) {
@@ -235,6 +240,7 @@ void cook_into(CookRecord& record, const fs::path& input, const fs::path& output
 
   ImportOptions import_options;
   import_options.reference = options.reference;
+  import_options.metres_per_unit = options.metres_per_unit;
   auto scene = import_scene(input.string(), import_options);
   if (!scene) {
     record.error = scene.error().message;
@@ -360,6 +366,7 @@ Result<SourceSkeleton> load_reference_skeleton(const fs::path& ossa_file, InputF
   const SkeletonView sk = asset->skeleton();
   if (sk.empty() || sk.joint_count() == 0) return Error{ossa_file.string() + ": holds no skeleton to cook against"};
   SourceSkeleton out;
+  out.metres_per_unit = asset->file().metres_per_unit();
   out.joints.resize(sk.joint_count());
   for (size_t i = 0; i < sk.joint_count(); ++i) {
     SourceJoint& j = out.joints[i];

@@ -24,6 +24,8 @@ struct CookOptions {
   ClipCompressionOptions clips;       // --clip-tolerance, --no-clip-compression
   bool root_motion = false;           // --root-motion: extract root motion from every clip
   uint8_t up_axis = 1;                // --up-axis: 0 x, 1 y, 2 z
+  /// --metres-per-unit: the sources' length unit, overriding the file (BVH states none); 0: the file's.
+  float metres_per_unit = 0.0f;
   /// Clip-only cooking against this rig (loaded from --skeleton REF.ossa); null otherwise.
   const SourceSkeleton* reference = nullptr;
   std::string reference_name;  // REF.ossa's file name, recorded in the options string

@@ -19,12 +19,13 @@ namespace {
 constexpr std::string_view kFolderFile = "ossa.cook.json";
 
 const std::initializer_list<std::string_view> kSettingKeys = {
-    "float_vertices", "clip_compression", "clip_tolerance_mm", "root_motion", "up_axis", "skeleton", "clip_names"};
+    "float_vertices", "clip_compression", "clip_tolerance_mm", "root_motion", "up_axis", "skeleton", "clip_names",
+    "metres_per_unit"};
 
 /// One layer of settings, checked; applied in order.
 struct Layer {
   std::optional<bool> float_vertices, clip_compression, root_motion;
-  std::optional<double> clip_tolerance_mm;
+  std::optional<double> clip_tolerance_mm, metres_per_unit;
   std::optional<uint8_t> up_axis;
   std::optional<fs::path> skeleton;  // resolved against the settings file's folder
   std::map<std::string, std::string> clip_names;
@@ -52,6 +53,12 @@ void read_layer(json::Checker& check, const json::Value& object, const fs::path&
       if (check.expect_number(v, what, &mm)) {
         if (!(mm >= 1e-6 && mm <= 1e4)) check.error(v.pos, what + " must be within [1e-6, 1e4] millimetres");
         else layer.clip_tolerance_mm = mm;
+      }
+    } else if (m.key == "metres_per_unit") {
+      double unit = 0.0;
+      if (check.expect_number(v, what, &unit)) {
+        if (!(unit >= 1e-6 && unit <= 1e6)) check.error(v.pos, what + " must be within [1e-6, 1e6] metres");
+        else layer.metres_per_unit = unit;
       }
     } else if (m.key == "up_axis") {
       if (check.expect(v, json::Type::String, what)) {
@@ -120,7 +127,7 @@ Result<std::vector<Layer>> read_settings(const fs::path& file, bool folder, cons
       }
     }
   } else {
-    check.expect_keys(root, {"ossa_cook", "float_vertices", "clip_compression", "clip_tolerance_mm", "root_motion",
+    check.expect_keys(root, {"ossa_cook", "float_vertices", "clip_compression", "clip_tolerance_mm", "root_motion", "metres_per_unit",
                              "up_axis", "skeleton", "clip_names"},
                       "a cook settings file");
     read_layer(check, root, dir, layers.emplace_back());
@@ -152,6 +159,7 @@ Status apply_cook_settings(const fs::path& input, CookOptions& options, AppliedS
       if (l.clip_tolerance_mm) options.clips.tolerance_metres = static_cast<float>(*l.clip_tolerance_mm / 1000.0);
       if (l.root_motion) options.root_motion = *l.root_motion;
       if (l.up_axis) options.up_axis = *l.up_axis;
+      if (l.metres_per_unit) options.metres_per_unit = static_cast<float>(*l.metres_per_unit);
       if (l.skeleton) skeleton = l.skeleton;
       for (const auto& [from, to] : l.clip_names) applied.clip_names[from] = to;
     }

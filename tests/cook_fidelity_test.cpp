@@ -4,6 +4,7 @@
 // OBJ, BVH), cooked by the real ossa-cook through Assimp and read back by the verifying loader.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <string>
 
@@ -11,6 +12,8 @@
 
 #include <flatbuffers/flatbuffers.h>
 
+#include <ossa/anim/pose.h>
+#include <ossa/anim/sample.h>
 #include <ossa/loader/asset.h>
 #include "test_files.h"
 
@@ -309,6 +312,58 @@ TEST(CookFidelity, ATextFileNamedTgaIsRefusedByName) {
   EXPECT_EQ(r.exit_code, 1) << r.err;
   EXPECT_TRUE(contains(r.err, "texture 'skin.tga' is not a TGA image")) << r.err;
   EXPECT_FALSE(fs::exists(dir / "out" / "quad.ossa"));
+}
+
+/// The root's (Hips) sampled translation at `time` of the only clip of `clip_file` on `rig_file`.
+glm::vec3 root_at(const fs::path& rig_file, const fs::path& clip_file, float time) {
+  auto rig = ossa::Asset::open(rig_file.string());
+  auto clips = ossa::Asset::open(clip_file.string());
+  EXPECT_TRUE(rig.ok() && clips.ok());
+  if (!rig.ok() || !clips.ok()) return glm::vec3(NAN);
+  const ossa::ClipView clip = clips->clip(0);
+  auto cache = ossa::make_sampling_cache(clip, rig->skeleton());
+  EXPECT_TRUE(cache.ok());
+  if (!cache.ok()) return glm::vec3(NAN);
+  ossa::Pose pose(static_cast<uint32_t>(rig->skeleton().joint_count()));
+  ossa::SampleOptions options;
+  options.loop = false;
+  ossa::sample(clip, time, options, *cache, pose);
+  return ossa::get_transform(pose, 0).translation;
+}
+
+TEST(CookFidelity, AClipInOtherUnitsIsConvertedIntoTheRigsUnits) {
+  const fs::path dir = ossa::test::make_temp_dir("fidelity-units");
+  fs::create_directories(dir / "rig");
+  fs::create_directories(dir / "cm");
+  ASSERT_TRUE(ossa::test::write_file(dir / "rig" / "actor.bvh", std::string(kBvh)));
+  ASSERT_TRUE(ossa::test::write_file(dir / "cm" / "take.bvh", std::string(kBvh)));
+  // The rig in metres (BVH states no unit: 1 m assumed, and said so).
+  auto r = run_command(cook_cmd() + " " + q(dir / "rig" / "actor.bvh") + " -o " + q(dir / "out") + " -v");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(contains(r.err, "BVH states no length unit: 1 metre per unit assumed")) << r.err;
+  // The same motion, its unit stated as centimetres: converted into the rig's metres.
+  r = run_command(cook_cmd() + " " + q(dir / "cm" / "take.bvh") + " --skeleton " + q(dir / "out" / "actor.ossa") +
+                  " --metres-per-unit 0.01 -o " + q(dir / "out") + " -v");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(contains(r.err, "converted from the file's unit (0.01 m) to the reference rig's (1 m): lengths x 0.01"))
+      << r.err;
+  // Frame 1 of kBvh puts Hips at (1, 90, 0) source units.
+  const float t1 = 0.033333f;
+  const glm::vec3 in_rig_units = root_at(dir / "out" / "actor.ossa", dir / "out" / "take.ossa", t1);
+  EXPECT_NEAR(in_rig_units.x, 0.01f, 1e-4f);
+  EXPECT_NEAR(in_rig_units.y, 0.90f, 1e-3f);
+  const glm::vec3 own = root_at(dir / "out" / "actor.ossa", dir / "out" / "actor.ossa", t1);
+  EXPECT_NEAR(own.y, 90.0f, 0.1f) << "the rig's own clip keeps the rig's units";
+  auto cooked = ossa::Asset::open((dir / "out" / "take.ossa").string());
+  ASSERT_TRUE(cooked.ok());
+  EXPECT_FLOAT_EQ(cooked->file().metres_per_unit(), 1.0f) << "the clip file states the rig's unit";
+
+  // The same through a per-asset setting, which also enters the cook key.
+  ASSERT_TRUE(ossa::test::write_file(dir / "cm" / "take.cook.json", std::string(R"({"ossa_cook": 1, "metres_per_unit": 0.01})")));
+  r = run_command(cook_cmd() + " " + q(dir / "cm" / "take.bvh") + " --skeleton " + q(dir / "out" / "actor.ossa") +
+                  " -o " + q(dir / "set") + " -v");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NEAR(root_at(dir / "out" / "actor.ossa", dir / "set" / "take.ossa", t1).y, 0.90f, 1e-3f);
 }
 
 }  // namespace

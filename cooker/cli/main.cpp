@@ -3,7 +3,7 @@
 //
 //   ossa-cook INPUT... -o OUTDIR [--root DIR] [--jobs N] [--max-memory SIZE] [--timeout SECONDS]
 //             [--report FILE.json] [--skeleton REF.ossa] [--float-vertices] [--clip-tolerance MM]
-//             [--no-clip-compression] [--root-motion] [--up-axis x|y|z] [--force] [--depfile FILE]
+//             [--no-clip-compression] [--root-motion] [--up-axis x|y|z] [--metres-per-unit M] [--force] [--depfile FILE]
 //             [--list-inputs] [-q | -v] [--version] [--help]
 //
 // As a build step (docs/SCALE.md): an output whose cook key matches its inputs as they are now is
@@ -145,6 +145,7 @@ int main(int argc, char** argv) {
   bool float_vertices = false, lossless_clips = false, root_motion = false, force = false, list_inputs = false;
   std::string depfile_path;
   double clip_tolerance_mm = 0.1;
+  double metres_per_unit = 0.0;
   std::string up_axis = "y";
   app.add_option("inputs", inputs, "source files, graph files (X.graph.json -> X.ossa) or directories (searched recursively)")
       ->required();
@@ -174,6 +175,10 @@ int main(int argc, char** argv) {
   app.add_flag("--no-clip-compression", lossless_clips, "keep every clip key exact (raw floats at every frame)");
   app.add_flag("--root-motion", root_motion, "extract root translation and yaw from clips into a root-motion track");
   app.add_option("--up-axis", up_axis, "up axis for --root-motion")->check(CLI::IsMember({"x", "y", "z"}));
+  app.add_option("--metres-per-unit", metres_per_unit,
+                 "length of one source unit in metres, for sources that state none (BVH: 1 assumed) or state it "
+                 "wrongly; clips cooked with --skeleton are converted into the rig's unit")
+      ->check(CLI::Range(1e-6, 1e6));
   app.add_flag("--force", force, "cook every input, even those whose output is up to date");
   app.add_option("--depfile", depfile_path,
                  "write a Make-syntax depfile: each output and every file its cook read (for Ninja / CMake DEPFILE)");
@@ -196,6 +201,7 @@ int main(int argc, char** argv) {
   options.clips.tolerance_metres = static_cast<float>(clip_tolerance_mm / 1000.0);
   options.root_motion = root_motion;
   options.up_axis = static_cast<uint8_t>(up_axis == "x" ? 0 : up_axis == "z" ? 2 : 1);
+  options.metres_per_unit = static_cast<float>(metres_per_unit);
   options.force = force;
   options.root = root;
   for (const std::string& d : allow_dirs) {

@@ -111,7 +111,8 @@ void cook_graph(CookRecord& record, const fs::path& input, const fs::path& outpu
     character.materials.clear();
     character.vertices_over_4_influences = 0;
   }
-  const SourceSkeleton rig = character.skeleton;
+  SourceSkeleton rig = character.skeleton;
+  rig.metres_per_unit = character.metres_per_unit;  // clips in other units are converted into the rig's
   record.joints = static_cast<uint32_t>(rig.joints.size());
   ImportOptions against_rig;
   against_rig.reference = &rig;

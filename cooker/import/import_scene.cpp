@@ -15,6 +15,8 @@
 // throw bad_alloc, and both become an Error naming the file.
 #include <algorithm>
 #include <cctype>
+#include <cmath>
+#include <cstdio>
 #include <exception>
 #include <filesystem>
 #include <set>
@@ -89,7 +91,11 @@ Result<SourceScene> convert_scene(const aiScene& scene, const std::string& path,
     }
   }
   drop_unused_materials(&out);
-  out.metres_per_unit = metres_per_unit(ctx);
+  if (options.metres_per_unit > 0.0f) {
+    out.metres_per_unit = options.metres_per_unit;
+  } else {
+    out.metres_per_unit = metres_per_unit(ctx);
+  }
   out.skeleton = std::move(rig->skeleton);
   if (out.skeleton.joints.empty() && out.meshes.empty() && out.clips.empty()) {
     unsigned open_meshes = 0;
@@ -133,6 +139,55 @@ bool wants_tangents(const aiScene& scene) {
   return false;
 }
 
+/// Every length in the scene times `s`: node translations, position keys, vertex positions and the
+/// translations of bone offset matrices. For a uniform s this is the change of basis S·M·S⁻¹ of
+/// every transform (a uniform scale commutes with rotations and scales), so globals, skinning and
+/// keys stay consistent and only the unit changes. Normals and directions are untouched.
+void scale_lengths(aiScene& scene, double s) {
+  const auto scale_translation = [s](aiMatrix4x4& m) {
+    m.a4 = static_cast<ai_real>(m.a4 * s);
+    m.b4 = static_cast<ai_real>(m.b4 * s);
+    m.c4 = static_cast<ai_real>(m.c4 * s);
+  };
+  std::vector<aiNode*> stack;
+  if (scene.mRootNode) stack.push_back(scene.mRootNode);
+  while (!stack.empty()) {  // iterative: hierarchies may be deep
+    aiNode* n = stack.back();
+    stack.pop_back();
+    scale_translation(n->mTransformation);
+    for (unsigned c = 0; c < n->mNumChildren; ++c)
+      if (n->mChildren[c]) stack.push_back(n->mChildren[c]);
+  }
+  for (unsigned a = 0; a < scene.mNumAnimations; ++a) {
+    const aiAnimation* anim = scene.mAnimations[a];
+    for (unsigned c = 0; anim && c < anim->mNumChannels; ++c) {
+      aiNodeAnim* ch = anim->mChannels[c];
+      for (unsigned k = 0; ch && k < ch->mNumPositionKeys; ++k) ch->mPositionKeys[k].mValue *= static_cast<ai_real>(s);
+    }
+  }
+  for (unsigned m = 0; m < scene.mNumMeshes; ++m) {
+    aiMesh* mesh = scene.mMeshes[m];
+    if (!mesh) continue;
+    for (unsigned v = 0; mesh->mVertices && v < mesh->mNumVertices; ++v) mesh->mVertices[v] *= static_cast<ai_real>(s);
+    for (unsigned b = 0; b < mesh->mNumBones; ++b)
+      if (mesh->mBones[b]) scale_translation(mesh->mBones[b]->mOffsetMatrix);
+  }
+}
+
+/// The unit the file's lengths are in: the override, else what convert_scene would find (with its
+/// warnings: "BVH states no length unit").
+float source_metres_per_unit(const aiScene& scene, const std::string& path, const ImportOptions& options,
+                             std::vector<std::string>* warnings) {
+  if (options.metres_per_unit > 0.0f) return options.metres_per_unit;
+  Context ctx;
+  ctx.scene = &scene;
+  ctx.path = path;
+  ctx.format = format_of(path);
+  ctx.options = &options;
+  ctx.warnings = warnings;
+  return metres_per_unit(ctx);
+}
+
 Result<SourceScene> read_and_convert(const std::string& path, const ImportOptions& options) {
   Assimp::Importer importer;
   auto* io = new LoggedIOSystem(path);  // every file the importer reads enters the cook key
@@ -146,6 +201,28 @@ Result<SourceScene> read_and_convert(const std::string& path, const ImportOption
   if (wants_tangents(*scene)) {
     scene = importer.ApplyPostProcessing(aiProcess_CalcTangentSpace);
     if (!scene) return Error{path + ": " + importer.GetErrorString()};
+  }
+  // Against a rig in other units (an FBX clip in centimetres onto a glTF rig in metres, the
+  // everyday Mixamo case), the file is converted into the rig's units before anything is folded:
+  // otherwise it would play 100x too large.
+  const float reference_unit = options.reference ? options.reference->metres_per_unit : 0.0f;
+  std::vector<std::string> unit_warnings;
+  const float file_unit = source_metres_per_unit(*scene, path, options, &unit_warnings);
+  if (reference_unit > 0.0f && file_unit > 0.0f && std::abs(file_unit / reference_unit - 1.0f) > 1e-6f) {
+    const double ratio = static_cast<double>(file_unit) / static_cast<double>(reference_unit);
+    scale_lengths(*const_cast<aiScene*>(scene), ratio);  // the importer's own scene, ours to edit
+    ImportOptions converted = options;
+    converted.metres_per_unit = reference_unit;
+    auto out = convert_scene(*scene, path, format_of(path), converted);
+    if (out) {
+      char text[200];
+      std::snprintf(text, sizeof text,
+                    "converted from the file's unit (%g m) to the reference rig's (%g m): lengths x %g",
+                    static_cast<double>(file_unit), static_cast<double>(reference_unit), ratio);
+      out->warnings.insert(out->warnings.begin(), text);
+      out->warnings.insert(out->warnings.begin(), unit_warnings.begin(), unit_warnings.end());
+    }
+    return out;
   }
   return convert_scene(*scene, path, format_of(path), options);
 }

@@ -19,6 +19,9 @@ struct ImportOptions {
   /// file's own skeleton. Joints the source animates or skins that the reference lacks are an
   /// error naming them. The imported scene's skeleton is then this reference.
   const SourceSkeleton* reference = nullptr;
+  /// The source's length unit in metres, overriding what the file says or what is assumed for a
+  /// unit-less format (BVH); 0: from the file (--metres-per-unit, the per-asset setting).
+  float metres_per_unit = 0.0f;
 };
 
 /// Imports `path`. Errors name the file and what is wrong (Assimp's message when it cannot read

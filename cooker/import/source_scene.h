@@ -26,6 +26,9 @@ struct SourceJoint {
 
 struct SourceSkeleton {
   std::vector<SourceJoint> joints;       // parents first
+  /// Length of one of its units in metres, when known (a cooked rig's File.metres_per_unit, a
+  /// source's unit); 0 when unknown. Clips cooked against it are converted into its units.
+  float metres_per_unit = 0.0f;
 };
 
 /// One source mesh (Assimp splits by material, so one material each). Positions etc. are in mesh
