@@ -366,4 +366,80 @@ TEST(CookFidelity, AClipInOtherUnitsIsConvertedIntoTheRigsUnits) {
   EXPECT_NEAR(root_at(dir / "out" / "actor.ossa", dir / "set" / "take.ossa", t1).y, 0.90f, 1e-3f);
 }
 
+/// A Collada arm: joints Upper > Lower, a six-vertex strip skinned to them with inverse bind
+/// matrices for a straight arm (Lower 1 m above Upper, unrotated), while the nodes stand bent (Lower
+/// turned 90 degrees about z): a source exported mid-pose.
+const char* kBentArmDae = R"(<?xml version="1.0" encoding="utf-8"?>
+<COLLADA xmlns="http://www.collada.org/2005/11/COLLADASchema" version="1.4.1">
+  <asset><unit name="meter" meter="1"/><up_axis>Y_UP</up_axis></asset>
+  <library_geometries>
+    <geometry id="arm-mesh" name="arm">
+      <mesh>
+        <source id="arm-pos">
+          <float_array id="arm-pos-array" count="18">-0.1 0 0  0.1 0 0  0.1 1 0  -0.1 1 0  0.1 2 0  -0.1 2 0</float_array>
+          <technique_common><accessor source="#arm-pos-array" count="6" stride="3">
+            <param name="X" type="float"/><param name="Y" type="float"/><param name="Z" type="float"/></accessor></technique_common>
+        </source>
+        <vertices id="arm-verts"><input semantic="POSITION" source="#arm-pos"/></vertices>
+        <triangles count="4">
+          <input semantic="VERTEX" source="#arm-verts" offset="0"/>
+          <p>0 1 2 0 2 3 3 2 4 3 4 5</p>
+        </triangles>
+      </mesh>
+    </geometry>
+  </library_geometries>
+  <library_controllers>
+    <controller id="arm-skin">
+      <skin source="#arm-mesh">
+        <bind_shape_matrix>1 0 0 0 0 1 0 0 0 0 1 0 0 0 0 1</bind_shape_matrix>
+        <source id="arm-joints"><Name_array id="arm-joints-array" count="2">Upper Lower</Name_array>
+          <technique_common><accessor source="#arm-joints-array" count="2" stride="1"><param name="JOINT" type="name"/></accessor></technique_common></source>
+        <source id="arm-ibm"><float_array id="arm-ibm-array" count="32">1 0 0 0 0 1 0 0 0 0 1 0 0 0 0 1  1 0 0 0 0 1 0 -1 0 0 1 0 0 0 0 1</float_array>
+          <technique_common><accessor source="#arm-ibm-array" count="2" stride="16"><param name="TRANSFORM" type="float4x4"/></accessor></technique_common></source>
+        <source id="arm-weights"><float_array id="arm-weights-array" count="2">1 1</float_array>
+          <technique_common><accessor source="#arm-weights-array" count="2" stride="1"><param name="WEIGHT" type="float"/></accessor></technique_common></source>
+        <joints><input semantic="JOINT" source="#arm-joints"/><input semantic="INV_BIND_MATRIX" source="#arm-ibm"/></joints>
+        <vertex_weights count="6">
+          <input semantic="JOINT" source="#arm-joints" offset="0"/><input semantic="WEIGHT" source="#arm-weights" offset="1"/>
+          <vcount>1 1 1 1 1 1</vcount>
+          <v>0 0 0 0 1 1 1 1 1 1 1 1</v>
+        </vertex_weights>
+      </skin>
+    </controller>
+  </library_controllers>
+  <library_visual_scenes>
+    <visual_scene id="Scene" name="Scene">
+      <node id="Upper" name="Upper" sid="Upper" type="JOINT">
+        <matrix sid="transform">1 0 0 0 0 1 0 0 0 0 1 0 0 0 0 1</matrix>
+        <node id="Lower" name="Lower" sid="Lower" type="JOINT">
+          <matrix sid="transform">0 -1 0 0 1 0 0 1 0 0 1 0 0 0 0 1</matrix>
+        </node>
+      </node>
+      <node id="arm" name="arm">
+        <instance_controller url="#arm-skin"><skeleton>#Upper</skeleton></instance_controller>
+      </node>
+    </visual_scene>
+  </library_visual_scenes>
+  <scene><instance_visual_scene url="#Scene"/></scene>
+</COLLADA>
+)";
+
+TEST(CookFidelity, TheBindPoseIsThePoseTheSkinWasBoundInNotTheNodePose) {
+  const fs::path dir = ossa::test::make_temp_dir("fidelity-bind");
+  const Cooked c = cook(dir, "bent.dae", kBentArmDae);
+  ASSERT_EQ(c.run.exit_code, 0) << c.run.err;
+  EXPECT_TRUE(contains(c.run.err, "the skins were bound in another pose than the nodes stand in")) << c.run.err;
+  auto a = ossa::Asset::open((c.out / "bent.ossa").string());
+  ASSERT_TRUE(a.ok()) << a.error().message;
+  const ossa::SkeletonView s = a->skeleton();
+  ASSERT_EQ(s.joint_count(), 2u);
+  const int lower = s.find_joint("Lower");
+  ASSERT_EQ(lower, 1);
+  const auto& t = s.bind_translations()[1];
+  const auto& r = s.bind_rotations()[1];
+  EXPECT_NEAR(t.y(), 1.0f, 1e-5f);
+  // Straight (the skin's pose), not the nodes' 90 degrees about z (w = 0.707).
+  EXPECT_NEAR(std::abs(r.w()), 1.0f, 1e-5f) << "x " << r.x() << " y " << r.y() << " z " << r.z() << " w " << r.w();
+}
+
 }  // namespace

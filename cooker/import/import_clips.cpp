@@ -693,7 +693,22 @@ ClipKeys collect_keys(const NodeGraph& graph, const aiAnimation& anim) {
   return out;
 }
 
-/// One track per joint whose chain carries keys, in joint order.
+/// A joint held at its node pose (Rig::rest) for the whole clip: one key per channel at time 0.
+SourceTrack rest_track(const Rig& rig, uint16_t joint) {
+  const Trs& r = rig.rest[joint];
+  SourceTrack t;
+  t.joint = joint;
+  t.translation_times = {0.0f};
+  t.translations = {glm::vec3(r.t)};
+  t.rotation_times = {0.0f};
+  t.rotations = {glm::normalize(glm::quat(r.r))};
+  t.scale_times = {0.0f};
+  t.scales = {glm::vec3(r.s)};
+  return t;
+}
+
+/// One track per joint whose chain carries keys, in joint order (and, where the bind pose is the
+/// skins' and not the node pose, one per other joint holding the node pose).
 std::vector<SourceTrack> joint_tracks(const NodeGraph& graph, const Rig& rig, const ClipKeys& keys,
                                       double tps, float duration, size_t* duplicates) {
   std::vector<SourceTrack> tracks;
@@ -707,9 +722,19 @@ std::vector<SourceTrack> joint_tracks(const NodeGraph& graph, const Rig& rig, co
         animated = true;
       }
     }
-    if (!animated) continue;
+    if (!animated) {
+      if (!rig.rest.empty()) tracks.push_back(rest_track(rig, static_cast<uint16_t>(j)));
+      continue;
+    }
     const RawTrack raw = joint_keys(graph, rig.prefix[j], chain, keys_of);
     tracks.push_back(finish_track(raw, static_cast<uint16_t>(j), tps, duration, duplicates));
+    if (!rig.rest.empty()) {  // channels the clip does not key stay at the node pose too
+      const SourceTrack rest = rest_track(rig, static_cast<uint16_t>(j));
+      SourceTrack& t = tracks.back();
+      if (t.translations.empty()) t.translation_times = rest.translation_times, t.translations = rest.translations;
+      if (t.rotations.empty()) t.rotation_times = rest.rotation_times, t.rotations = rest.rotations;
+      if (t.scales.empty()) t.scale_times = rest.scale_times, t.scales = rest.scales;
+    }
   }
   return tracks;
 }

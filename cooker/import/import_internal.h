@@ -124,6 +124,11 @@ struct Rig {
   std::vector<glm::dmat4> prefix;
   /// Per node: the joint it is, or -1.
   std::vector<int> node_joint;
+  /// Per joint, the node pose's local transform, when the bind pose was taken from the skins and
+  /// differs from it (import_rig.cpp, adopt_mesh_bind_pose); empty otherwise. A clip leaves a joint
+  /// or channel it does not key where the file's nodes stand, so the file's clips carry these
+  /// values for what they do not animate, instead of the bind value.
+  std::vector<Trs> rest;
 };
 
 Result<Rig> build_rig(const Context& ctx, const NodeGraph& graph);

@@ -24,6 +24,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <set>
 
 #include <assimp/scene.h>
@@ -283,6 +284,98 @@ void fill_bind_pose(const Context& ctx, const NodeGraph& graph, Rig* rig) {
   }
 }
 
+/// The bind pose is the pose the mesh was bound in. A source exported mid-animation has its nodes
+/// in some frame's pose while its skins' inverse bind matrices (aiBone::mOffsetMatrix) still say
+/// the T-pose; the skeleton's bind pose (the viewer's bind pose, additive references, the rest a
+/// game resets to) must be the latter. Bone j of a mesh held by node n was bound at model matrix
+/// global(n) x inverse(offset); the first mesh naming a joint decides (glTF keeps its node pose,
+/// see below). Joints no skin names keep
+/// their node-pose local under their (possibly moved) parent. Nothing changes when every bound
+/// matrix agrees with the node pose to kBindTolerance (most files), so those cook as before.
+void adopt_mesh_bind_pose(const Context& ctx, const NodeGraph& graph, Rig* rig) {
+  const size_t count = rig->skeleton.joints.size();
+  // glTF: the node pose is the rest pose by the specification, and its inverse bind matrices need
+  // not describe one consistent pose of the whole rig (RobotExpressive's hand skins name all 43
+  // joints in a pose that would scatter its rigid parts), so glTF keeps the node pose.
+  if (count == 0 || ctx.format == SourceFormat::Gltf) return;
+  std::vector<glm::dmat4> bound(count);
+  std::vector<bool> has(count, false);
+  for (size_t n = 0; n < graph.nodes.size(); ++n) {
+    const aiNode& node = *graph.nodes[n].ai;
+    for (unsigned i = 0; i < node.mNumMeshes; ++i) {
+      const unsigned m = node.mMeshes[i];
+      if (m >= ctx.mesh_kept.size() || !ctx.mesh_kept[m]) continue;
+      const aiMesh* mesh = ctx.scene->mMeshes[m];
+      for (unsigned b = 0; mesh && b < mesh->mNumBones; ++b) {
+        const aiBone* bone = mesh->mBones[b];
+        if (!bone) continue;
+        const int bn = graph.helper_owner(graph.resolve(bone->mName.C_Str()));
+        if (bn < 0 || rig->node_joint[static_cast<size_t>(bn)] < 0) continue;
+        const auto j = static_cast<size_t>(rig->node_joint[static_cast<size_t>(bn)]);
+        glm::dmat4 inverse_offset;
+        if (has[j] || !try_inverse(to_dmat4(bone->mOffsetMatrix), &inverse_offset)) continue;
+        // FBX and Collada through Assimp: the offset maps from the mesh node's space.
+        const glm::dmat4 model = graph.nodes[n].global * inverse_offset;
+        if (!is_finite(model)) continue;
+        bound[j] = model;
+        has[j] = true;
+      }
+    }
+  }
+  // The node pose's model matrices, and how far the skins' bind is from them.
+  std::vector<glm::dmat4> node_model(count), local(count);
+  size_t moved = 0;
+  double worst = 0.0;
+  std::string worst_joint;
+  for (size_t j = 0; j < count; ++j) {
+    const SourceJoint& joint = rig->skeleton.joints[j];
+    local[j] = compose(Trs{glm::dvec3(joint.translation), glm::dquat(joint.rotation), glm::dvec3(joint.scale)});
+    node_model[j] = joint.parent < 0 ? local[j] : node_model[static_cast<size_t>(joint.parent)] * local[j];
+    if (!has[j]) continue;
+    const double d = relative_difference(bound[j], node_model[j]);
+    if (d > kBindTolerance) {
+      ++moved;
+      if (d > worst) {
+        worst = d;
+        worst_joint = joint.name;
+      }
+    }
+  }
+  if (moved == 0) return;
+  rig->rest.resize(count);
+  for (size_t j = 0; j < count; ++j) {
+    const SourceJoint& joint = rig->skeleton.joints[j];
+    rig->rest[j] = Trs{glm::dvec3(joint.translation), glm::dquat(joint.rotation), glm::dvec3(joint.scale)};
+  }
+  std::vector<glm::dmat4> model(count);
+  std::vector<std::string> sheared;
+  for (size_t j = 0; j < count; ++j) {
+    SourceJoint& joint = rig->skeleton.joints[j];
+    const int parent = joint.parent;
+    model[j] = has[j] ? bound[j] : (parent < 0 ? local[j] : model[static_cast<size_t>(parent)] * local[j]);
+    glm::dmat4 parent_inverse(1.0);
+    if (parent >= 0 && !try_inverse(model[static_cast<size_t>(parent)], &parent_inverse)) return;  // keep the node pose
+    const glm::dmat4 wanted = parent_inverse * model[j];
+    const Trs trs = decompose(wanted);
+    joint.translation = glm::vec3(trs.t);
+    joint.rotation = glm::normalize(glm::quat(trs.r));
+    joint.scale = glm::vec3(trs.s);
+    // What the TRS holds is what the runtime will compose: carry that, not the wish, downwards.
+    model[j] = (parent < 0 ? glm::dmat4(1.0) : model[static_cast<size_t>(parent)]) * compose(trs);
+    if (has[j] && relative_difference(model[j], bound[j]) > kBindTolerance) sheared.push_back(joint.name);
+    glm::dmat4 inverse;
+    joint.inverse_bind = try_inverse(model[j], &inverse) ? to_float(inverse) : glm::mat4(1.0f);
+  }
+  char largest[64];
+  std::snprintf(largest, sizeof largest, "%.3g", worst);
+  ctx.warn("the skins were bound in another pose than the nodes stand in (" + std::to_string(moved) +
+           " joints differ, most '" + worst_joint + "', by " + largest +
+           " relative): the bind pose is the skins' pose; the file's clips keep the node pose for what they do "
+           "not animate");
+  if (!sheared.empty())
+    ctx.warn("bind matrices with shear cannot be held as translation/rotation/scale: " + name_list(sheared));
+}
+
 /// Joints the source left unnamed (some FBX exporters write empty model names, and Assimp keeps
 /// them) get a stable name from their place in the skeleton: "joint<index>", or "joint<index>_<n>"
 /// when the file already uses that name. The format requires a name per joint (masks, retargeting
@@ -336,6 +429,7 @@ Result<Rig> own_rig(const Context& ctx, const NodeGraph& graph, const std::vecto
     }
   }
   fill_bind_pose(ctx, graph, &rig);
+  adopt_mesh_bind_pose(ctx, graph, &rig);
   return rig;
 }
 
