@@ -442,4 +442,54 @@ TEST(CookFidelity, TheBindPoseIsThePoseTheSkinWasBoundInNotTheNodePose) {
   EXPECT_NEAR(std::abs(r.w()), 1.0f, 1e-5f) << "x " << r.x() << " y " << r.y() << " z " << r.z() << " w " << r.w();
 }
 
+/// A BVH capture of `frames` frames at 120 fps: the root walks along x (1 cm a frame) and the
+/// spine sways (frame-dependent z rotation), so every frame is a distinct key.
+std::string long_bvh(uint32_t frames) {
+  std::string text = "HIERARCHY\nROOT Hips\n{\n  OFFSET 0 0 0\n  CHANNELS 6 Xposition Yposition Zposition Zrotation "
+                     "Xrotation Yrotation\n  JOINT Spine\n  {\n    OFFSET 0 10 0\n    CHANNELS 3 Zrotation Xrotation "
+                     "Yrotation\n    End Site\n    {\n      OFFSET 0 10 0\n    }\n  }\n}\nMOTION\nFrames: " +
+                     std::to_string(frames) + "\nFrame Time: 0.0083333333\n";
+  char line[128];
+  for (uint32_t f = 0; f < frames; ++f) {
+    std::snprintf(line, sizeof line, "%.2f 90 0 0 0 0 %.3f 0 0\n", 0.01 * f, 20.0 * std::sin(0.01 * f));
+    text += line;
+  }
+  return text;
+}
+
+TEST(CookFidelity, ALongCaptureIsCookedInConsecutiveClipsNotRefused) {
+  // 100,000 frames at 120 fps (833 s) is past the 65,536 frames one clip addresses.
+  const fs::path dir = ossa::test::make_temp_dir("fidelity-long");
+  constexpr uint32_t kFrames = 100000;
+  const Cooked c = cook(dir, "session.bvh", long_bvh(kFrames));
+  ASSERT_EQ(c.run.exit_code, 0) << c.run.err.substr(0, 2000);
+  EXPECT_TRUE(contains(c.run.err, "clip 'session' has 100000 frames at 120 frames/s, more than the 65536 one clip holds: "
+                                  "cooked as 2 consecutive clips 'session.part1' (0.000-546.125 s), 'session.part2'"))
+      << c.run.err.substr(0, 2000);
+  auto a = ossa::Asset::open((c.out / "session.ossa").string());
+  ASSERT_TRUE(a.ok()) << a.error().message;
+  ASSERT_EQ(a->clip_count(), 2u);
+  EXPECT_EQ(a->clip(0).name(), "session.part1");
+  EXPECT_EQ(a->clip(1).name(), "session.part2");
+  EXPECT_EQ(a->clip(0).frame_count(), 65536u);
+  EXPECT_EQ(a->clip(0).frame_count() + a->clip(1).frame_count() - 1, kFrames) << "parts share their boundary frame";
+  EXPECT_FLOAT_EQ(a->clip(0).sample_rate(), 120.0f);
+  // The boundary: part 1's last frame and part 2's first are the source's frame 65535 (root at
+  // x = 655.35), and a frame well inside part 2 is the source's.
+  const auto sample_root = [&](size_t clip_index, float time) {
+    const ossa::ClipView clip = a->clip(clip_index);
+    auto cache = ossa::make_sampling_cache(clip, a->skeleton());
+    EXPECT_TRUE(cache.ok());
+    ossa::Pose pose(static_cast<uint32_t>(a->skeleton().joint_count()));
+    ossa::SampleOptions options;
+    options.loop = false;
+    ossa::sample(clip, time, options, *cache, pose);
+    return ossa::get_transform(pose, 0).translation;
+  };
+  const float end1 = a->clip(0).duration();
+  EXPECT_NEAR(sample_root(0, end1).x, 655.35f, 0.01f);
+  EXPECT_NEAR(sample_root(1, 0.0f).x, 655.35f, 0.01f);
+  EXPECT_NEAR(sample_root(1, 10000.0f / 120.0f).x, 0.01f * (65535 + 10000), 0.01f);
+}
+
 }  // namespace

@@ -36,6 +36,7 @@
 #include <assimp/scene.h>
 
 #include "cooker/clip/clip_grid.h"
+#include "cooker/clip/clip_split.h"
 #include "cooker/import/gltf_samplers.h"
 #include "cooker/import/import_internal.h"
 
@@ -380,9 +381,11 @@ float clip_sample_rate(const std::vector<double>& times, float estimated, double
     candidates.push_back(2.0 * r);
   }
   std::stable_sort(candidates.begin(), candidates.end());
-  const double fit = duration > 0.0f ? static_cast<double>(kMaxFrames - 1) / duration : 1e9;
+  // No cap from the 65,536 frames one clip can address: a longer clip is cooked in parts
+  // (clip_split.h), never resampled off its keys' grid to fit.
+  (void)duration;
   for (double r : candidates) {
-    if (r + 1e-9 < raw * 0.999 || r > fit) continue;  // never coarser than the keys' own spacing
+    if (r + 1e-9 < raw * 0.999) continue;  // never coarser than the keys' own spacing
     // A whole rate within a thousandth wins over the measured 23.99997 it was estimated as.
     const double rounded = std::round(r);
     if (rounded > 0.0 && std::abs(rounded - r) < 1e-3 * r && keys_on_grid(times, rounded))
@@ -390,9 +393,7 @@ float clip_sample_rate(const std::vector<double>& times, float estimated, double
     if (keys_on_grid(times, r)) return static_cast<float>(r);
   }
   *off_grid = true;
-  double rate = std::max(std::abs(raw - whole) < 1e-3 * raw ? whole : raw, file_rate);
-  if (rate > fit) rate = std::max(fit, raw);
-  return static_cast<float>(rate);
+  return static_cast<float>(std::max(std::abs(raw - whole) < 1e-3 * raw ? whole : raw, file_rate));
 }
 
 /// One channel whose node keys are replaced by its glTF sampler.
@@ -821,6 +822,14 @@ std::vector<SourceClip> import_clips(const Context& ctx, const NodeGraph& graph,
       clips[0].name = stem;
     }
   }
+  // A clip longer than the 65,536 frames one clip can address is cooked as consecutive parts
+  // (clip_split.h) rather than refused or resampled coarser.
+  std::vector<SourceClip> fitted;
+  for (SourceClip& clip : clips) {
+    const std::string split = split_long_clip(std::move(clip), &fitted);
+    if (!split.empty()) ctx.warn(split);
+  }
+  clips = std::move(fitted);
   if (!summary.morphs.empty()) {
     ctx.warn("mesh and morph-target channels are not supported, dropped from clips: " +
              join(summary.morphs));
