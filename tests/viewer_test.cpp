@@ -352,6 +352,29 @@ TEST_F(Viewer, ClipOnlyFileAloneHasNoMesh) {
   EXPECT_NE(r.err.find("no mesh"), std::string::npos) << r.err;
 }
 
+// A file with a skeleton and no mesh (mocap) is shown as its bones, with its clip playing.
+TEST_F(Viewer, SkeletonOnlyFileIsShownAsBones) {
+  const std::string bvh =
+      "HIERARCHY\nROOT Hips\n{\n  OFFSET 0 0 0\n  CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation "
+      "Yrotation\n  JOINT Spine\n  {\n    OFFSET 0 0.5 0\n    CHANNELS 3 Zrotation Xrotation Yrotation\n    JOINT Head\n"
+      "    {\n      OFFSET 0 0.5 0\n      CHANNELS 3 Zrotation Xrotation Yrotation\n      End Site\n      {\n"
+      "        OFFSET 0 0.2 0\n      }\n    }\n  }\n}\nMOTION\nFrames: 3\nFrame Time: 0.5\n"
+      "0 1 0 0 0 0 0 0 0 0 0 0\n0 1 0 0 0 0 40 0 0 0 0 0\n0 1 0 0 0 0 80 0 0 0 0 0\n";
+  ASSERT_TRUE(ossa::test::write_file(dir_ / "mocap.bvh", bvh));
+  const CommandResult cooked_bvh = ossa::test::run_command(quote((ossa::test::bin_dir() / "ossa-cook").string()) + " " +
+                                                           quote((dir_ / "mocap.bvh").string()) + " -o " +
+                                                           quote(dir_.string()) + " -q");
+  ASSERT_EQ(cooked_bvh.exit_code, 0) << cooked_bvh.err;
+  const std::string base = quote((dir_ / "mocap.ossa").string()) + " --size 192x192 --no-grid";
+  const CommandResult start = run_viewer(base + " --time 0 --screenshot " + quote((dir_ / "bones0.png").string()));
+  const CommandResult bent = run_viewer(base + " --time 0.5 --screenshot " + quote((dir_ / "bones1.png").string()));
+  ASSERT_EQ(start.exit_code + bent.exit_code, 0) << start.err << bent.err;
+  const Image a = load_png(dir_ / "bones0.png"), b = load_png(dir_ / "bones1.png");
+  EXPECT_GT(coverage(a), 0.002) << "bones drawn";
+  EXPECT_LT(coverage(a), 0.3);
+  EXPECT_GT(compare(a, b, kPixelThreshold).differing, 0.001) << "the clip bends the spine between t = 0 and t = 0.5";
+}
+
 TEST_F(Viewer, ClipOfAnotherSkeletonIsRefused) {
   const CommandResult r = run_viewer(quote(cooked("Fox/Fox.ossa").string()) + " " + quote(cooked("Pab/walk.ossa").string()) +
                                      " --frames 1");

@@ -104,6 +104,21 @@ Status set_crowd(App& app, size_t crowd, float aspect) {
 
   const int clip = had_clip ? previous.clip : (app.scene.clips.empty() ? -1 : 0);
   if (Status s = play_clip(app, clip, false); !s) return s;
+  if (shows_bones_only(app.scene) && clip >= 0 && app.crowd == 1) {
+    // Mocap has no body and its bind is often a zero pose at the origin (BVH OFFSETs) while the
+    // capture stands elsewhere: frame the bones as the clip starts too (the camera then follows
+    // the root across the floor).
+    produce_local_poses(app.scene, a, ignored);
+    compute_model_poses(app.scene, a, ignored);
+    const Box start = joint_bounds(a.instances.front().model);
+    if (!start.empty()) {
+      app.framing.add(start.min);
+      app.framing.add(start.max);
+      const float r = 0.5f * glm::length(app.framing.size());
+      set_grid(app.renderer, app.framing, app.framing.min.y, r);
+      frame_camera(app, aspect);
+    }
+  }
   if (had_clip) {
     Playback& p = a.playback;
     p.time = previous.time;

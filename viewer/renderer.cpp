@@ -366,7 +366,7 @@ Status render_frame(Renderer& r, const Scene& scene, const Animator& animator, s
   glPolygonMode(GL_FRONT_AND_BACK, GL_FILL);
   glDisable(GL_POLYGON_OFFSET_FILL);
 
-  if (toggles.skeleton && scene.joint_count() > 0) {
+  if ((toggles.skeleton || shows_bones_only(scene)) && scene.joint_count() > 0) {
     size_t bone_vertices = 0;
     build_skeleton_lines(r, scene, animator, offsets, bone_vertices);
     upload_lines(r.lines_buffer, r.lines);

@@ -41,10 +41,13 @@ Result<Scene> load_scene(std::span<const std::string> paths) {
     if (character == paths.size() && a->mesh_count() > 0) character = i;
     opened.push_back(std::move(*a));
   }
+  // No body among them: a file with a skeleton of its own (mocap, a rig) is shown as its bones.
+  for (size_t i = 0; character == paths.size() && i < opened.size(); ++i)
+    if (!opened[i].skeleton().empty() && opened[i].skeleton().joint_count() > 0) character = i;
   if (character == paths.size()) {
-    return Error{paths.size() == 1 ? paths[0] + ": has no mesh to show (a clip-only file needs its character: "
-                                                "ossa-view CHARACTER.ossa " + paths[0] + ")"
-                                   : paths[0] + " and the other files given: none has a mesh to show"};
+    return Error{paths.size() == 1 ? paths[0] + ": has no mesh or skeleton to show (a clip-only file needs its "
+                                                "character: ossa-view CHARACTER.ossa " + paths[0] + ")"
+                                   : paths[0] + " and the other files given: none has a mesh or skeleton to show"};
   }
   Scene scene;
   if (Status s = add_clips(scene, std::move(opened[character]), paths[character], true); !s) return s.error();
@@ -66,6 +69,8 @@ Result<bool> file_has_mesh(const std::string& path) {
   if (!a) return a.error();
   return a->mesh_count() > 0;
 }
+
+bool shows_bones_only(const Scene& scene) { return !scene.assets.empty() && scene.character().mesh_count() == 0; }
 
 int find_clip(const Scene& scene, std::string_view name) {
   for (size_t i = 0; i < scene.clips.size(); ++i) {

@@ -45,6 +45,10 @@ Status add_clip_file(Scene& scene, const std::string& path);
 /// for dropped files). Errors as Asset::open.
 Result<bool> file_has_mesh(const std::string& path);
 
+/// True when the character has no mesh: a skeleton-only file (mocap, a rig) shown as its bones,
+/// with the skeleton overlay always on.
+bool shows_bones_only(const Scene& scene);
+
 /// Index of the clip named `name` (its name in the file, or its label), or -1.
 int find_clip(const Scene& scene, std::string_view name);
 
