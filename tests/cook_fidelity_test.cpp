@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <optional>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -127,13 +128,21 @@ Cooked cook(const fs::path& dir, const std::string& file, const std::string& tex
   return c;
 }
 
+/// The cooked output of `c` named `file`, opened by the verifying loader (the test fails if not).
+std::optional<ossa::Asset> open_cooked(const Cooked& c, const std::string& file) {
+  auto a = ossa::Asset::open((c.out / file).string());
+  EXPECT_TRUE(a.ok()) << a.error().message;
+  if (!a.ok()) return std::nullopt;
+  return std::move(*a);
+}
+
 TEST(CookFidelity, RigOnlyColladaCooksAsASkeleton) {
   const fs::path dir = ossa::test::make_temp_dir("fidelity-rig");
   const Cooked c = cook(dir, "rig.dae", kRigDae);
   ASSERT_EQ(c.run.exit_code, 0) << c.run.err;
   EXPECT_TRUE(contains(c.run.err, "no mesh and no animation")) << c.run.err;
-  auto a = ossa::Asset::open((c.out / "rig.ossa").string());
-  ASSERT_TRUE(a.ok()) << a.error().message;
+  auto a = open_cooked(c, "rig.ossa");
+  ASSERT_TRUE(a);
   const ossa::SkeletonView s = a->skeleton();
   ASSERT_EQ(s.joint_count(), 4u);
   EXPECT_EQ(s.joint_name(0), "Hips");
@@ -156,8 +165,8 @@ TEST(CookFidelity, UnnamedJointsGetStableNamesByIndex) {
   ASSERT_EQ(c.run.exit_code, 0) << c.run.err;
   EXPECT_FALSE(contains(c.run.err, "internal error")) << c.run.err;
   EXPECT_TRUE(contains(c.run.err, "2 joints have no name in the source")) << c.run.err;
-  auto a = ossa::Asset::open((c.out / "rig.ossa").string());
-  ASSERT_TRUE(a.ok()) << a.error().message;
+  auto a = open_cooked(c, "rig.ossa");
+  ASSERT_TRUE(a);
   const ossa::SkeletonView s = a->skeleton();
   ASSERT_EQ(s.joint_count(), 3u);
   EXPECT_EQ(s.joint_name(0), "Hips");
@@ -188,8 +197,8 @@ TEST(CookFidelity, AGenericSingleClipNameBecomesTheFileStem) {
   const Cooked c = cook(dir, "walk_fast.bvh", kBvh);
   ASSERT_EQ(c.run.exit_code, 0) << c.run.err;
   EXPECT_TRUE(contains(c.run.err, "clip 'Motion' is named 'walk_fast' after the file")) << c.run.err;
-  auto a = ossa::Asset::open((c.out / "walk_fast.ossa").string());
-  ASSERT_TRUE(a.ok()) << a.error().message;
+  auto a = open_cooked(c, "walk_fast.ossa");
+  ASSERT_TRUE(a);
   ASSERT_EQ(a->clip_count(), 1u);
   EXPECT_EQ(a->clip(0).name(), "walk_fast");
   EXPECT_EQ(a->material_count(), 0u);
@@ -203,8 +212,8 @@ TEST(CookFidelity, SidecarsAndSettingsMayStillUseTheSourceClipName) {
   ASSERT_TRUE(ossa::test::write_file(dir / "stroll.cook.json", std::vector<uint8_t>(settings.begin(), settings.end())));
   const Cooked c = cook(dir, "stroll.bvh", kBvh);
   ASSERT_EQ(c.run.exit_code, 0) << c.run.err;
-  auto a = ossa::Asset::open((c.out / "stroll.ossa").string());
-  ASSERT_TRUE(a.ok()) << a.error().message;
+  auto a = open_cooked(c, "stroll.ossa");
+  ASSERT_TRUE(a);
   ASSERT_EQ(a->clip_count(), 1u);
   EXPECT_EQ(a->clip(0).name(), "amble");
   const auto* events_cooked = a->clip(0).fb->events();
@@ -429,8 +438,8 @@ TEST(CookFidelity, TheBindPoseIsThePoseTheSkinWasBoundInNotTheNodePose) {
   const Cooked c = cook(dir, "bent.dae", kBentArmDae);
   ASSERT_EQ(c.run.exit_code, 0) << c.run.err;
   EXPECT_TRUE(contains(c.run.err, "the skins were bound in another pose than the nodes stand in")) << c.run.err;
-  auto a = ossa::Asset::open((c.out / "bent.ossa").string());
-  ASSERT_TRUE(a.ok()) << a.error().message;
+  auto a = open_cooked(c, "bent.ossa");
+  ASSERT_TRUE(a);
   const ossa::SkeletonView s = a->skeleton();
   ASSERT_EQ(s.joint_count(), 2u);
   const int lower = s.find_joint("Lower");
@@ -466,8 +475,8 @@ TEST(CookFidelity, ALongCaptureIsCookedInConsecutiveClipsNotRefused) {
   EXPECT_TRUE(contains(c.run.err, "clip 'session' has 100000 frames at 120 frames/s, more than the 65536 one clip holds: "
                                   "cooked as 2 consecutive clips 'session.part1' (0.000-546.125 s), 'session.part2'"))
       << c.run.err.substr(0, 2000);
-  auto a = ossa::Asset::open((c.out / "session.ossa").string());
-  ASSERT_TRUE(a.ok()) << a.error().message;
+  auto a = open_cooked(c, "session.ossa");
+  ASSERT_TRUE(a);
   ASSERT_EQ(a->clip_count(), 2u);
   EXPECT_EQ(a->clip(0).name(), "session.part1");
   EXPECT_EQ(a->clip(1).name(), "session.part2");

@@ -364,7 +364,7 @@ float resampling_rate(const std::vector<NodeKeys>& keys, double tps, float estim
 /// Pab's FBX clips are such a case: Assimp merges each curve's own key times, which lie on no grid,
 /// and the file's 30 fps is what ozz-animation samples them at too. 0 when there is no estimate
 /// (fewer than two keys).
-float clip_sample_rate(const std::vector<double>& times, float estimated, double tps, float duration, bool* off_grid) {
+float clip_sample_rate(const std::vector<double>& times, float estimated, double tps, bool* off_grid) {
   *off_grid = false;
   if (!(estimated > 0.0f)) return 0.0f;
   const double raw = estimated;
@@ -383,7 +383,6 @@ float clip_sample_rate(const std::vector<double>& times, float estimated, double
   std::stable_sort(candidates.begin(), candidates.end());
   // No cap from the 65,536 frames one clip can address: a longer clip is cooked in parts
   // (clip_split.h), never resampled off its keys' grid to fit.
-  (void)duration;
   for (double r : candidates) {
     if (r + 1e-9 < raw * 0.999) continue;  // never coarser than the keys' own spacing
     // A whole rate within a thousandth wins over the measured 23.99997 it was estimated as.
@@ -755,8 +754,7 @@ SourceClip import_clip(const Context& ctx, const NodeGraph& graph, const Rig& ri
   const std::string label = "clip '" + clip.name + "': ";
   bool off_grid = false;
   clip.sample_rate =
-      clip_sample_rate(key_times(keys.keys, tps), estimate_sample_rate(keys.keys, tps), tps, clip.duration,
-                       &off_grid);
+      clip_sample_rate(key_times(keys.keys, tps), estimate_sample_rate(keys.keys, tps), tps, &off_grid);
   if (off_grid) {
     ctx.warn(label + "keys are not on any uniform frame grid; resampled at " + std::to_string(clip.sample_rate) +
              " frames per second");

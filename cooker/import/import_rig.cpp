@@ -289,8 +289,7 @@ void fill_bind_pose(const Context& ctx, const NodeGraph& graph, Rig* rig) {
 /// the T-pose; the skeleton's bind pose (the viewer's bind pose, additive references, the rest a
 /// game resets to) must be the latter. Bone j of a mesh held by node n was bound at model matrix
 /// global(n) x inverse(offset); the first mesh naming a joint decides (glTF keeps its node pose,
-/// see below). Joints no skin names keep
-/// their node-pose local under their (possibly moved) parent. Nothing changes when every bound
+/// see below). Joints no skin names keep their node-pose local under their (possibly moved) parent. Nothing changes when every bound
 /// matrix agrees with the node pose to kBindTolerance (most files), so those cook as before.
 void adopt_mesh_bind_pose(const Context& ctx, const NodeGraph& graph, Rig* rig) {
   const size_t count = rig->skeleton.joints.size();
@@ -323,13 +322,15 @@ void adopt_mesh_bind_pose(const Context& ctx, const NodeGraph& graph, Rig* rig) 
     }
   }
   // The node pose's model matrices, and how far the skins' bind is from them.
+  std::vector<Trs> node_pose(count);
   std::vector<glm::dmat4> node_model(count), local(count);
   size_t moved = 0;
   double worst = 0.0;
   std::string worst_joint;
   for (size_t j = 0; j < count; ++j) {
     const SourceJoint& joint = rig->skeleton.joints[j];
-    local[j] = compose(Trs{glm::dvec3(joint.translation), glm::dquat(joint.rotation), glm::dvec3(joint.scale)});
+    node_pose[j] = Trs{glm::dvec3(joint.translation), glm::dquat(joint.rotation), glm::dvec3(joint.scale)};
+    local[j] = compose(node_pose[j]);
     node_model[j] = joint.parent < 0 ? local[j] : node_model[static_cast<size_t>(joint.parent)] * local[j];
     if (!has[j]) continue;
     const double d = relative_difference(bound[j], node_model[j]);
@@ -342,11 +343,7 @@ void adopt_mesh_bind_pose(const Context& ctx, const NodeGraph& graph, Rig* rig) 
     }
   }
   if (moved == 0) return;
-  rig->rest.resize(count);
-  for (size_t j = 0; j < count; ++j) {
-    const SourceJoint& joint = rig->skeleton.joints[j];
-    rig->rest[j] = Trs{glm::dvec3(joint.translation), glm::dquat(joint.rotation), glm::dvec3(joint.scale)};
-  }
+  rig->rest = std::move(node_pose);
   std::vector<glm::dmat4> model(count);
   std::vector<std::string> sheared;
   for (size_t j = 0; j < count; ++j) {

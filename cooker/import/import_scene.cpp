@@ -91,11 +91,7 @@ Result<SourceScene> convert_scene(const aiScene& scene, const std::string& path,
     }
   }
   drop_unused_materials(&out);
-  if (options.metres_per_unit > 0.0f) {
-    out.metres_per_unit = options.metres_per_unit;
-  } else {
-    out.metres_per_unit = metres_per_unit(ctx);
-  }
+  out.metres_per_unit = options.metres_per_unit > 0.0f ? options.metres_per_unit : metres_per_unit(ctx);
   out.skeleton = std::move(rig->skeleton);
   if (out.skeleton.joints.empty() && out.meshes.empty() && out.clips.empty()) {
     unsigned open_meshes = 0;
