@@ -131,8 +131,9 @@ Status run(const std::string& source, int width, int height, int samples, std::c
 
   Assimp::Importer importer;
   importer.SetPropertyBool(AI_CONFIG_IMPORT_FBX_PRESERVE_PIVOTS, false);
-  const aiScene* scene = importer.ReadFile(source, cook::assimp_import_flags() | aiProcess_GenSmoothNormals |
-                                                       aiProcess_LimitBoneWeights);
+  // What a plain Assimp viewer asks for: the cooker's flags plus welding, normals and 4 weights.
+  const aiScene* scene = importer.ReadFile(source, cook::assimp_import_flags() | aiProcess_JoinIdenticalVertices |
+                                                       aiProcess_GenSmoothNormals | aiProcess_LimitBoneWeights);
   if (scene == nullptr || scene->mRootNode == nullptr) return Error{source + ": " + importer.GetErrorString()};
 
   std::map<std::string, glm::mat4> by_name;

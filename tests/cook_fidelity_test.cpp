@@ -1,10 +1,11 @@
 // cook_fidelity_test.cpp — what a cook keeps of sources nobody here made (issue "Cooked = source"):
-// rig-only files, unnamed joints, point/line-only meshes, clip names that exporters invent, and
-// materials no mesh uses. Each case is a small real source the test writes (Collada, ASCII FBX,
+// rig-only files, unnamed joints, point/line-only meshes, clip names that exporters invent,
+// materials no mesh uses, and vertex colours. Each case is a small real source the test writes (Collada, ASCII FBX,
 // OBJ, BVH), cooked by the real ossa-cook through Assimp and read back by the verifying loader.
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -15,6 +16,7 @@
 
 #include <ossa/anim/pose.h>
 #include <ossa/anim/sample.h>
+#include <ossa/format/vertex_codec.h>
 #include <ossa/loader/asset.h>
 #include "test_files.h"
 
@@ -499,6 +501,146 @@ TEST(CookFidelity, ALongCaptureIsCookedInConsecutiveClipsNotRefused) {
   EXPECT_NEAR(sample_root(0, end1).x, 655.35f, 0.01f);
   EXPECT_NEAR(sample_root(1, 0.0f).x, 655.35f, 0.01f);
   EXPECT_NEAR(sample_root(1, 10000.0f / 120.0f).x, 0.01f * (65535 + 10000), 0.01f);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Vertex colours
+
+/// One cooked vertex: de-quantized position and its colour (white when the mesh has none).
+struct ColouredVertex {
+  glm::vec3 position;
+  glm::vec4 colour;
+};
+
+std::vector<ColouredVertex> coloured_vertices(const ossa::MeshView& mesh) {
+  namespace fb = ossa::fb;
+  std::vector<ColouredVertex> out;
+  const fb::VertexAttribute* pos = mesh.attribute(fb::VertexSemantic::Position);
+  const fb::VertexAttribute* col = mesh.attribute(fb::VertexSemantic::Color0);
+  EXPECT_NE(pos, nullptr);
+  if (pos == nullptr) return out;
+  const fb::Vec3* o = mesh.fb->position_offset();
+  const fb::Vec3* sc = mesh.fb->position_scale();
+  const auto bytes = mesh.vertex_bytes();
+  for (uint32_t v = 0; v < mesh.vertex_count(); ++v) {
+    const uint8_t* p = bytes.data() + static_cast<size_t>(v) * mesh.vertex_stride();
+    ColouredVertex cv{glm::vec3(0.0f), glm::vec4(1.0f)};
+    if (pos->format() == fb::VertexFormat::Unorm16x4) {
+      uint16_t q[3];
+      std::memcpy(q, p + pos->offset(), sizeof q);
+      cv.position = glm::vec3(o->x(), o->y(), o->z()) +
+                    glm::vec3(sc->x(), sc->y(), sc->z()) *
+                        glm::vec3(ossa::unorm16_to_float(q[0]), ossa::unorm16_to_float(q[1]), ossa::unorm16_to_float(q[2]));
+    } else {
+      std::memcpy(&cv.position, p + pos->offset(), sizeof cv.position);
+    }
+    if (col != nullptr && col->format() == fb::VertexFormat::Unorm8x4) {
+      for (int k = 0; k < 4; ++k) cv.colour[k] = ossa::unorm8_to_float(p[col->offset() + k]);
+    } else if (col != nullptr) {
+      EXPECT_EQ(col->format(), fb::VertexFormat::Float32x4);
+      std::memcpy(&cv.colour, p + col->offset(), sizeof cv.colour);
+    }
+    out.push_back(cv);
+  }
+  return out;
+}
+
+/// The colour of the cooked vertex nearest `at` (the test meshes' vertices are far apart).
+glm::vec4 colour_at(const std::vector<ColouredVertex>& vertices, glm::vec3 at) {
+  const ColouredVertex* best = nullptr;
+  for (const auto& v : vertices)
+    if (!best || glm::length(v.position - at) < glm::length(best->position - at)) best = &v;
+  EXPECT_NE(best, nullptr);
+  EXPECT_LT(best ? glm::length(best->position - at) : 1.0f, 1e-3f)
+      << "nearest (" << best->position.x << ", " << best->position.y << ", " << best->position.z << ")";
+  return best ? best->colour : glm::vec4(-1.0f);
+}
+
+/// A glTF triangle (0,0,0) (1,0,0) (0,1,0) whose COLOR_0 is red, green, blue: as normalized
+/// unsigned bytes (VEC4, alpha 0.5 on the blue corner) or as floats (VEC3, whose alpha Assimp
+/// 5.2.5 loses: the cooker restores the specification's 1).
+void write_coloured_gltf(const fs::path& dir, const std::string& stem, bool bytes) {
+  const float positions[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+  std::string bin(reinterpret_cast<const char*>(positions), sizeof positions);
+  nlohmann::json colour_accessor;
+  if (bytes) {
+    const uint8_t c[12] = {255, 0, 0, 255, 0, 255, 0, 255, 0, 0, 255, 128};
+    bin.append(reinterpret_cast<const char*>(c), sizeof c);
+    colour_accessor = {{"bufferView", 1}, {"componentType", 5121}, {"normalized", true}, {"count", 3}, {"type", "VEC4"}};
+  } else {
+    const float c[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+    bin.append(reinterpret_cast<const char*>(c), sizeof c);
+    colour_accessor = {{"bufferView", 1}, {"componentType", 5126}, {"count", 3}, {"type", "VEC3"}};
+  }
+  const nlohmann::json j = {
+      {"asset", {{"version", "2.0"}}},
+      {"scene", 0},
+      {"scenes", {{{"nodes", {0}}}}},
+      {"nodes", {{{"mesh", 0}}}},
+      {"meshes", {{{"primitives", {{{"attributes", {{"POSITION", 0}, {"COLOR_0", 1}}}}}}}}},
+      {"buffers", {{{"uri", stem + ".bin"}, {"byteLength", bin.size()}}}},
+      {"bufferViews",
+       {{{"buffer", 0}, {"byteLength", 36}}, {{"buffer", 0}, {"byteOffset", 36}, {"byteLength", bin.size() - 36}}}},
+      {"accessors",
+       {{{"bufferView", 0}, {"componentType", 5126}, {"count", 3}, {"type", "VEC3"}, {"min", {0, 0, 0}}, {"max", {1, 1, 0}}},
+        colour_accessor}}};
+  ASSERT_TRUE(ossa::test::write_file(dir / (stem + ".bin"), bin));
+  ASSERT_TRUE(ossa::test::write_file(dir / (stem + ".gltf"), j.dump()));
+}
+
+void expect_rgb_corners(const ossa::Asset& a, float blue_alpha) {
+  ASSERT_EQ(a.mesh_count(), 1u);
+  ASSERT_NE(a.mesh(0).attribute(ossa::fb::VertexSemantic::Color0), nullptr) << "colours kept";
+  const auto v = coloured_vertices(a.mesh(0));
+  const float e = 0.5f / 255.0f + 1e-6f;  // Unorm8's rounding
+  const glm::vec4 r = colour_at(v, {0, 0, 0}), g = colour_at(v, {1, 0, 0}), b = colour_at(v, {0, 1, 0});
+  for (int k = 0; k < 4; ++k) {
+    EXPECT_NEAR(r[k], glm::vec4(1, 0, 0, 1)[k], e) << "component " << k;
+    EXPECT_NEAR(g[k], glm::vec4(0, 1, 0, 1)[k], e);
+    EXPECT_NEAR(b[k], glm::vec4(0, 0, 1, blue_alpha)[k], e);
+  }
+}
+
+TEST(CookFidelity, GltfVertexColoursAreCarriedAsStored) {
+  const fs::path dir = ossa::test::make_temp_dir("fidelity-colour-gltf");
+  write_coloured_gltf(dir, "bytes", true);
+  write_coloured_gltf(dir, "floats", false);
+  for (const char* stem : {"bytes", "floats"}) {
+    const auto r = run_command(cook_cmd() + " " + q(dir / (std::string(stem) + ".gltf")) + " -o " + q(dir / "out"));
+    ASSERT_EQ(r.exit_code, 0) << stem << ": " << r.err;
+  }
+  auto bytes = ossa::Asset::open((dir / "out" / "bytes.ossa").string());
+  auto floats = ossa::Asset::open((dir / "out" / "floats.ossa").string());
+  ASSERT_TRUE(bytes.ok() && floats.ok());
+  expect_rgb_corners(*bytes, 128.0f / 255.0f);
+  expect_rgb_corners(*floats, 1.0f);
+  // --float-vertices stores them as floats, exactly.
+  const auto r = run_command(cook_cmd() + " " + q(dir / "floats.gltf") + " -o " + q(dir / "f32") + " --float-vertices");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  auto f32 = ossa::Asset::open((dir / "f32" / "floats.ossa").string());
+  ASSERT_TRUE(f32.ok());
+  EXPECT_EQ(f32->mesh(0).attribute(ossa::fb::VertexSemantic::Color0)->format(), ossa::fb::VertexFormat::Float32x4);
+  expect_rgb_corners(*f32, 1.0f);
+}
+
+TEST(CookFidelity, ObjVertexColoursAreCarriedClampedOrLeftOutWhenWhite) {
+  const fs::path dir = ossa::test::make_temp_dir("fidelity-colour-obj");
+  const std::string faces = "f 1 2 3\nf 1 3 4\n";
+  // Colours past 1 (an HDR export) are clamped with a warning that names the mesh.
+  ASSERT_TRUE(ossa::test::write_file(dir / "painted.obj", "v 0 0 0 1 0 0\nv 1 0 0 0 1 0\nv 1 1 0 0 0 1\nv 0 1 0 2 0.5 -1\n" + faces));
+  ASSERT_TRUE(ossa::test::write_file(dir / "white.obj", "v 0 0 0 1 1 1\nv 1 0 0 1 1 1\nv 1 1 0 1 1 1\nv 0 1 0 1 1 1\n" + faces));
+  const auto r = run_command(cook_cmd() + " " + q(dir / "painted.obj") + " " + q(dir / "white.obj") + " -o " + q(dir / "out") + " -v");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(contains(r.err, "1 vertex colours outside [0, 1] were clamped")) << r.err;
+  auto painted = ossa::Asset::open((dir / "out" / "painted.ossa").string());
+  auto white = ossa::Asset::open((dir / "out" / "white.ossa").string());
+  ASSERT_TRUE(painted.ok() && white.ok());
+  const auto v = coloured_vertices(painted->mesh(0));
+  EXPECT_EQ(colour_at(v, {1, 1, 0}), glm::vec4(0, 0, 1, 1));
+  EXPECT_EQ(colour_at(v, {0, 1, 0}), glm::vec4(1, 128.0f / 255.0f, 0, 1))
+      << "2 -> 1, 0.5 -> 128 / 255, -1 -> 0";
+  EXPECT_EQ(white->mesh(0).attribute(ossa::fb::VertexSemantic::Color0), nullptr)
+      << "all-white colours draw as no colours and cost no bytes";
 }
 
 }  // namespace

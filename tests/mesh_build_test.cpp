@@ -168,6 +168,7 @@ struct Decoded {
   std::vector<std::array<uint32_t, 4>> slots;
   std::vector<glm::vec4> weights;             // as floats in [0, 1]
   std::vector<std::array<uint32_t, 4>> weights_raw;  // Unorm8 values (quantized layout only)
+  std::vector<glm::vec4> colors;
   std::vector<uint32_t> indices;
 };
 
@@ -211,7 +212,10 @@ Decoded decode(const CookedMesh& m) {
           break;
         }
         case fb::VertexFormat::Float32x4:
-          (a.semantic() == fb::VertexSemantic::Tangent ? d.tangents : d.weights).push_back(read<glm::vec4>(p));
+          (a.semantic() == fb::VertexSemantic::Tangent  ? d.tangents
+           : a.semantic() == fb::VertexSemantic::Color0 ? d.colors
+                                                        : d.weights)
+              .push_back(read<glm::vec4>(p));
           break;
         case fb::VertexFormat::Float16x2:
           d.uv0.push_back(glm::vec2(half_to_float(read<uint16_t>(p)), half_to_float(read<uint16_t>(p + 2))));
@@ -222,6 +226,10 @@ Decoded decode(const CookedMesh& m) {
           d.slots.push_back({read<uint16_t>(p), read<uint16_t>(p + 2), read<uint16_t>(p + 4), read<uint16_t>(p + 6)});
           break;
         case fb::VertexFormat::Unorm8x4:
+          if (a.semantic() == fb::VertexSemantic::Color0) {
+            d.colors.push_back(glm::vec4(p[0], p[1], p[2], p[3]) / 255.0f);
+            break;
+          }
           d.weights_raw.push_back({p[0], p[1], p[2], p[3]});
           d.weights.push_back(glm::vec4(p[0], p[1], p[2], p[3]) / 255.0f);
           break;
@@ -488,6 +496,10 @@ TEST(MeshBuild, MissingNormalsAreGeneratedUnitAndOutward) {
   for (const bool shared : {false, true}) {
     SCOPED_TRACE(shared ? "8 shared corners" : "24 face corners");
     SourceMesh src = shared ? shared_corner_box(center, half) : box_mesh(center, half, false);
+    // Face corners stay apart only where they differ (welding merges equal ones): a UV island per
+    // face, as a texture seam on every edge would have it.
+    if (!shared)
+      for (size_t v = 0; v < src.uv0.size(); ++v) src.uv0[v].x += static_cast<float>(v / 4);
     MeshOptions options;
     options.float_vertices = true;  // read the generated normals without octahedral rounding
     MeshBuildStats stats;
@@ -561,6 +573,40 @@ TEST(MeshBuild, GroupsByAttributeSetInFirstAppearanceOrder) {
     const auto& sm = meshes[0].submeshes[k];
     for (uint32_t i = sm.first_index(); i < sm.first_index() + sm.index_count(); ++i)
       EXPECT_FLOAT_EQ(d.uv0[d.indices[i]].x, k == 0 ? 0.25f : 0.75f);
+  }
+}
+
+// Colours do not split a group: a member without them is white in the merged mesh, and every
+// colour stays with its vertex through the cache and fetch reordering, in both layouts.
+TEST(MeshBuild, VertexColoursFollowTheirVerticesAndMembersWithoutAreWhite) {
+  SourceMesh a = triangle_soup(40, "Painted");
+  for (size_t v = 0; v < a.positions.size(); ++v)
+    a.colors.push_back(glm::vec4(static_cast<float>(v % 7) / 6.0f, static_cast<float>(v % 5) / 4.0f, 0.5f, 1.0f));
+  SourceMesh b = triangle_soup(10, "Plain");
+  for (auto& p : b.positions) p.z = 3.0f;  // tell them apart
+  for (const bool float_vertices : {false, true}) {
+    MeshOptions options;
+    options.float_vertices = float_vertices;
+    const auto meshes = build_ok(scene_with({a, b}), options);
+    ASSERT_EQ(meshes.size(), 1u) << "colours alone do not split the mesh";
+    const fb::VertexAttribute* colour = find(meshes[0], fb::VertexSemantic::Color0);
+    ASSERT_NE(colour, nullptr);
+    EXPECT_EQ(colour->format(), float_vertices ? fb::VertexFormat::Float32x4 : fb::VertexFormat::Unorm8x4);
+    const Decoded d = decode(meshes[0]);
+    ASSERT_EQ(d.colors.size(), d.positions.size());
+    const float e = float_vertices ? 0.0f : 0.5f / 255.0f + 1e-6f;
+    for (size_t v = 0; v < d.positions.size(); ++v) {
+      glm::vec4 want(1.0f);
+      if (d.positions[v].z < 1.0f) {
+        size_t s = 0;
+        while (s < a.positions.size() && glm::length(a.positions[s] - d.positions[v]) > 1e-3f) ++s;
+        ASSERT_LT(s, a.positions.size());
+        // triangle_soup repeats positions per triangle only within one triangle: the first match
+        // is this vertex's source when the soup's triangles do not share corners.
+        want = a.colors[s];
+      }
+      for (int k = 0; k < 4; ++k) EXPECT_NEAR(d.colors[v][k], want[k], e) << "vertex " << v;
+    }
   }
 }
 

@@ -15,11 +15,15 @@
 
 #include <sys/stat.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <string>
 #include <vector>
+
+#include <glm/glm.hpp>
 
 #include "test_files.h"
 #include "viewer_harness.h"
@@ -373,6 +377,42 @@ TEST_F(Viewer, SkeletonOnlyFileIsShownAsBones) {
   EXPECT_GT(coverage(a), 0.002) << "bones drawn";
   EXPECT_LT(coverage(a), 0.3);
   EXPECT_GT(compare(a, b, kPixelThreshold).differing, 0.001) << "the clip bends the spine between t = 0 and t = 0.5";
+}
+
+// A model coloured only by its vertex colours (no texture, a grey default material) is drawn in
+// those colours: the left half of the quad red, the right half blue.
+TEST_F(Viewer, VertexColoursTintTheSurface) {
+  ASSERT_TRUE(ossa::test::write_file(dir_ / "painted.obj",
+                                     std::string("v -1 0 0 1 0 0\nv 0 0 0 1 0 0\nv 0 2 0 1 0 0\nv -1 2 0 1 0 0\n"
+                                                 "v 0 0 0 0 0 1\nv 1 0 0 0 0 1\nv 1 2 0 0 0 1\nv 0 2 0 0 0 1\n"
+                                                 "vn 0 0 1\nf 1//1 2//1 3//1\nf 1//1 3//1 4//1\nf 5//1 6//1 7//1\nf 5//1 7//1 8//1\n")));
+  const CommandResult cooked_obj = ossa::test::run_command(quote((ossa::test::bin_dir() / "ossa-cook").string()) + " " +
+                                                           quote((dir_ / "painted.obj").string()) + " -o " +
+                                                           quote(dir_.string()) + " -q");
+  ASSERT_EQ(cooked_obj.exit_code, 0) << cooked_obj.err;
+  const CommandResult r = run_viewer(quote((dir_ / "painted.ossa").string()) + " --size 128x128 --no-grid --yaw 0 --pitch 0 " +
+                                     "--screenshot " + quote((dir_ / "painted.png").string()));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const Image img = load_png(dir_ / "painted.png");
+  ASSERT_FALSE(img.empty());
+  // Mean colour of the left and right thirds' non-background pixels.
+  const uint8_t* bg = img.at(0, 0);
+  glm::dvec3 left(0.0), right(0.0);
+  double nl = 0, nr = 0;
+  for (int y = 0; y < img.height; ++y)
+    for (int x = 0; x < img.width; ++x) {
+      const uint8_t* p = img.at(x, y);
+      if (std::abs(p[0] - bg[0]) + std::abs(p[1] - bg[1]) + std::abs(p[2] - bg[2]) < 30) continue;
+      const glm::dvec3 c(p[0], p[1], p[2]);
+      if (x < img.width / 3) { left += c; ++nl; }
+      if (x >= 2 * img.width / 3) { right += c; ++nr; }
+    }
+  ASSERT_GT(nl, 20.0);
+  ASSERT_GT(nr, 20.0);
+  left /= nl;
+  right /= nr;
+  EXPECT_GT(left.r, 3.0 * std::max(left.g, left.b) + 10.0) << "red half: " << left.r << " " << left.g << " " << left.b;
+  EXPECT_GT(right.b, 3.0 * std::max(right.r, right.g) + 10.0) << "blue half: " << right.r << " " << right.g << " " << right.b;
 }
 
 TEST_F(Viewer, ClipOfAnotherSkeletonIsRefused) {

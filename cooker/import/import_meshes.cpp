@@ -120,8 +120,13 @@ void repair_normals(SourceMesh* mesh, size_t* repaired) {
   }
 }
 
+/// A colour component at least this large is stored as Unorm8 255, i.e. white.
+constexpr float kWhite = 1.0f - 0.5f / 255.0f;
+
 /// Geometry as Assimp has it, in mesh space. false when positions are not finite.
-bool copy_geometry(const aiMesh& in, SourceMesh* out, size_t* dropped_faces) {
+/// Assimp 5.2.5's glTF importer copies a VEC3 COLOR_0 into aiColor4D leaving alpha 0 (the
+/// specification's implied alpha is 1); an all-zero alpha in a glTF file is read as that.
+bool copy_geometry(const aiMesh& in, SourceFormat format, SourceMesh* out, size_t* dropped_faces) {
   const unsigned nv = in.mNumVertices;
   out->positions.reserve(nv);
   for (unsigned v = 0; v < nv; ++v) {
@@ -144,6 +149,27 @@ bool copy_geometry(const aiMesh& in, SourceMesh* out, size_t* dropped_faces) {
     for (unsigned v = 0; v < nv; ++v) {
       out->uv0.emplace_back(in.mTextureCoords[0][v].x, in.mTextureCoords[0][v].y);
     }
+  }
+  if (in.mColors[0]) {
+    // All white (as Unorm8 stores it) draws exactly as no colours: keep no stream then, so the
+    // many exporters that write white colours by default cost no vertex bytes.
+    bool all_white = true;
+    out->colors.reserve(nv);
+    for (unsigned v = 0; v < nv; ++v) {
+      const aiColor4D& c = in.mColors[0][v];
+      out->colors.emplace_back(c.r, c.g, c.b, c.a);
+      for (int k = 0; k < 4; ++k) all_white = all_white && !(out->colors.back()[k] < kWhite);
+    }
+    const bool alpha_lost = format == SourceFormat::Gltf &&
+                            std::all_of(out->colors.begin(), out->colors.end(), [](const glm::vec4& c) { return c.a == 0.0f; });
+    if (alpha_lost) {
+      all_white = true;
+      for (glm::vec4& c : out->colors) {
+        c.a = 1.0f;
+        all_white = all_white && !(c.r < kWhite || c.g < kWhite || c.b < kWhite);
+      }
+    }
+    if (all_white) out->colors.clear();
   }
   for (unsigned f = 0; f < in.mNumFaces; ++f) {
     const aiFace& face = in.mFaces[f];
@@ -230,7 +256,7 @@ void import_instance(const Context& ctx, const NodeGraph& graph, const Rig& rig,
   SourceMesh out;
   out.name = in.mName.length ? in.mName.C_Str() : graph.nodes[node].name;
   out.material = in.mMaterialIndex;
-  if (!copy_geometry(in, &out, &stats->dropped_faces)) {
+  if (!copy_geometry(in, ctx.format, &out, &stats->dropped_faces)) {
     stats->non_finite.push_back(out.name);
     return;
   }

@@ -3,8 +3,9 @@
 //
 // The import flags are the few post-steps whose result the cooker wants from Assimp and cannot
 // cheaply do better itself: triangles only (Triangulate, and SortByPType so point and line meshes
-// come out separate, to be dropped with a warning), shared vertices welded (JoinIdenticalVertices),
-// and ValidateDataStructure so the converter can trust indices. Deliberately absent:
+// come out separate, to be dropped with a warning), and ValidateDataStructure so the converter can
+// trust indices. Deliberately absent: JoinIdenticalVertices (5.2.5's merges vertices whose colours
+// differ; the mesh stage welds exactly instead, cooker/mesh/mesh_build.cpp),
 // LimitBoneWeights (the cooker caps at 4 itself and counts the vertices that lose weight),
 // GenNormals (the mesh stage generates missing normals with OpenMesh), and the
 // PreTransform/Optimize steps, which would destroy the node tree the skeleton comes from.
@@ -227,8 +228,7 @@ Result<SourceScene> read_and_convert(const std::string& path, const ImportOption
 }  // namespace detail
 
 unsigned assimp_import_flags() {
-  return aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_SortByPType |
-         aiProcess_ValidateDataStructure;
+  return aiProcess_Triangulate | aiProcess_SortByPType | aiProcess_ValidateDataStructure;
 }
 
 Result<SourceScene> import_scene(const std::string& path, const ImportOptions& options) {

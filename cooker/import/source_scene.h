@@ -40,6 +40,10 @@ struct SourceMesh {
   std::vector<glm::vec3> normals;        // empty or one per vertex, unit length
   std::vector<glm::vec4> tangents;       // empty or one per vertex: xyz unit, w = bitangent sign
   std::vector<glm::vec2> uv0;            // empty or one per vertex
+  /// Empty or one per vertex: RGBA as the source stored it (glTF COLOR_0 is linear), the shader
+  /// multiplies the material colour by it. The importer leaves it empty when every vertex is
+  /// white, which draws exactly as no colours.
+  std::vector<glm::vec4> colors;
   /// Up to 4 influences per vertex, largest first, weights summing to 1; unused slots have weight 0
   /// and joint 0. Empty when the mesh is not skinned (no skeleton in the file).
   std::vector<std::array<uint16_t, 4>> joints;

@@ -65,6 +65,9 @@ Status check_scene_values(const SourceScene& scene) {
     for (size_t v = 0; v < mesh.uv0.size(); ++v)
       if (!std::isfinite(mesh.uv0[v].x) || !std::isfinite(mesh.uv0[v].y))
         return Error{m + ": vertex " + std::to_string(v) + " texture coordinate is not finite"};
+    for (size_t v = 0; v < mesh.colors.size(); ++v)
+      for (int k = 0; k < 4; ++k)
+        if (!std::isfinite(mesh.colors[v][k])) return Error{m + ": vertex " + std::to_string(v) + " colour is not finite"};
     for (size_t v = 0; v < mesh.weights.size(); ++v)
       for (int k = 0; k < 4; ++k)
         if (!std::isfinite(mesh.weights[v][k])) return Error{m + ": vertex " + std::to_string(v) + " weight is not finite"};

@@ -3,19 +3,24 @@
 // The stages, in order, per scene:
 //   1. validate each source mesh (stream sizes, indices < vertex count, finite positions, joints
 //      inside the skeleton, material inside the scene) — an error names the mesh;
-//   2. clean it: drop degenerate triangles (a repeated index, or no area at float precision), and
+//   2. weld it: vertices equal in every stream become one (meshoptimizer's remap, bit for bit);
+//   3. clean it: drop degenerate triangles (a repeated index, or no area at float precision), and
 //      generate area-weighted vertex normals with OpenMesh when the source had none;
-//   3. group meshes by attribute set (tangents, uv0, skinned) in order of first appearance and
-//      concatenate each group into one vertex/index buffer, one submesh per source mesh;
-//   4. build the group's joint palette: the distinct (joint, inverse bind) pairs its vertices use;
-//   5. reorder with meshoptimizer: vertex cache per submesh, then vertex fetch over the whole mesh;
-//   6. encode the interleaved quantized (or float32) layout.
+//   4. group meshes by attribute set (tangents, uv0, skinned) in order of first appearance and
+//      concatenate each group into one vertex/index buffer, one submesh per source mesh (vertex
+//      colours do not split a group: members without colours are white in it);
+//   5. build the group's joint palette: the distinct (joint, inverse bind) pairs its vertices use;
+//   6. reorder with meshoptimizer: vertex cache per submesh, then vertex fetch over the whole mesh;
+//   7. encode the interleaved quantized (or float32) layout.
 //
 // Decisions worth knowing, and why:
 // - Grouping happens after normal generation, so every cooked mesh has normals and a source mesh
 //   that lacked them still merges with its neighbours (fewer buffers, fewer draws).
-// - No welding: Assimp's JoinIdenticalVertices already merged equal vertices, and merging vertices
-//   that differ in any attribute would change what is drawn.
+// - Welding is the cooker's, not Assimp's: Assimp 5.2.5's JoinIdenticalVertices merges vertices
+//   whose colours differ (a red and a blue quad sharing an edge come out blended), and is known
+//   to desync morph targets. Here only vertices equal in every attribute merge, bit for bit, so
+//   merging never changes what is drawn; FBX's per-corner vertices, which are exact copies, weld.
+//   Welding comes before normal generation, whose area-weighted normals need shared corners.
 // - Each source mesh owns a disjoint vertex range of its group, so the cache optimizer runs on
 //   each submesh alone with local indices (keeping every submesh's triangles contiguous and its
 //   cost proportional to that submesh). The fetch optimizer then renumbers the whole buffer in first
@@ -25,6 +30,8 @@
 // - Weights are non-negative: a negative or non-finite weight counts as 0, and a vertex left with
 //   no weight at all is bound fully to its first influence (weight 1 / 255), with a warning, so it
 //   follows a joint instead of collapsing to the origin.
+// - Vertex colours are Unorm8x4 (a colour needs no more than the 8 bits a texture gives it);
+//   components outside [0, 1] are clamped, with a warning naming the mesh.
 // - Influences with weight 0 write slot 0; they contribute nothing, and pointing them at a real
 //   slot keeps every slot index valid for the validator and the shader.
 //
@@ -168,6 +175,7 @@ Status validate_mesh(const SourceScene& scene, size_t index) {
   if (Status s = check_size(m.normals.size(), "normals"); !s) return s;
   if (Status s = check_size(m.tangents.size(), "tangents"); !s) return s;
   if (Status s = check_size(m.uv0.size(), "texture coordinates"); !s) return s;
+  if (Status s = check_size(m.colors.size(), "colours"); !s) return s;
   if (Status s = check_size(m.joints.size(), "joint sets"); !s) return s;
   if (m.weights.size() != m.joints.size())
     return bad("has " + std::to_string(m.joints.size()) + " joint sets but " +
@@ -203,9 +211,51 @@ bool degenerate(const SourceMesh& m, uint32_t a, uint32_t b, uint32_t c) {
 
 struct CleanMesh {
   size_t source = 0;                // index into scene.meshes
-  std::vector<uint32_t> indices;    // degenerate triangles removed
-  std::vector<glm::vec3> normals;   // generated ones when the source had none, else empty
+  SourceMesh mesh;                  // welded, degenerate triangles removed, normals present
 };
+
+template <class T>
+void add_stream(std::vector<meshopt_Stream>& streams, const std::vector<T>& v) {
+  if (!v.empty()) streams.push_back({v.data(), sizeof(T), sizeof(T)});
+}
+
+template <class T>
+void compact(std::vector<T>& stream, const std::vector<unsigned>& remap, size_t unique) {
+  if (stream.empty()) return;
+  std::vector<T> out(unique);
+  meshopt_remapVertexBuffer(out.data(), stream.data(), stream.size(), sizeof(T), remap.data());
+  stream = std::move(out);
+}
+
+// The mesh with every set of vertices equal in all streams (bit for bit) merged into one, and
+// vertices no triangle references dropped (counted in *unused). O(vertices + indices), hashed.
+SourceMesh weld(const SourceMesh& m, size_t* unused) {
+  SourceMesh out = m;
+  const size_t n = m.positions.size();
+  std::vector<meshopt_Stream> streams;
+  add_stream(streams, m.positions);
+  add_stream(streams, m.normals);
+  add_stream(streams, m.tangents);
+  add_stream(streams, m.uv0);
+  add_stream(streams, m.colors);
+  add_stream(streams, m.joints);
+  add_stream(streams, m.weights);
+  std::vector<unsigned> remap(n);
+  const size_t unique =
+      meshopt_generateVertexRemapMulti(remap.data(), m.indices.data(), m.indices.size(), n, streams.data(), streams.size());
+  std::vector<bool> referenced(n, false);
+  for (const uint32_t i : m.indices) referenced[i] = true;
+  *unused = static_cast<size_t>(std::count(referenced.begin(), referenced.end(), false));
+  meshopt_remapIndexBuffer(out.indices.data(), m.indices.data(), m.indices.size(), remap.data());
+  compact(out.positions, remap, unique);
+  compact(out.normals, remap, unique);
+  compact(out.tangents, remap, unique);
+  compact(out.uv0, remap, unique);
+  compact(out.colors, remap, unique);
+  compact(out.joints, remap, unique);
+  compact(out.weights, remap, unique);
+  return out;
+}
 
 // Non-negative finite weights; all-zero becomes full weight on the first influence.
 glm::vec4 sanitize_weights(const glm::vec4& w, bool* was_empty) {
@@ -269,6 +319,7 @@ struct Streams {
   std::vector<glm::vec3> positions, normals;
   std::vector<glm::vec4> tangents;
   std::vector<glm::vec2> uv0;
+  std::vector<glm::vec4> colors;
   std::vector<std::array<uint16_t, 4>> slots;
   std::vector<glm::vec4> weights;
 };
@@ -283,14 +334,6 @@ bool same_matrix(const glm::mat4& a, const glm::mat4& b) {
     for (int r = 0; r < 4; ++r)
       if (!(a[c][r] == b[c][r])) return false;
   return true;
-}
-
-template <class T>
-void remap_stream(std::vector<T>& stream, const std::vector<unsigned>& remap, size_t new_count) {
-  if (stream.empty()) return;
-  std::vector<T> out(new_count);
-  meshopt_remapVertexBuffer(out.data(), stream.data(), stream.size(), sizeof(T), remap.data());
-  stream = std::move(out);
 }
 
 template <class T>
@@ -317,7 +360,7 @@ Result<CookedMesh> build_group(const SourceScene& scene, const std::vector<Clean
                                double& misses_after) {
   const size_t joint_count = scene.skeleton.joints.size();
   CookedMesh out;
-  out.name = scene.meshes[cleaned[members.front()].source].name;
+  out.name = cleaned[members.front()].mesh.name;
 
   // Sanitized weights per member, and the palette: distinct (joint, inverse bind) pairs, grouped
   // by joint (std::map order) and by first appearance within a joint.
@@ -328,7 +371,7 @@ Result<CookedMesh> build_group(const SourceScene& scene, const std::vector<Clean
   if (attrs.skinned) {
     for (size_t mi = 0; mi < members.size(); ++mi) {
       const size_t si = cleaned[members[mi]].source;
-      const SourceMesh& m = scene.meshes[si];
+      const SourceMesh& m = cleaned[members[mi]].mesh;
       std::map<uint16_t, const glm::mat4*> bind;
       for (const auto& [joint, matrix] : m.bind) bind.emplace(joint, &matrix);  // first one wins
       std::vector<bool> used(joint_count, false);
@@ -389,21 +432,37 @@ Result<CookedMesh> build_group(const SourceScene& scene, const std::vector<Clean
   }
 
   // Concatenate the members' streams and indices; one submesh each.
+  bool colored = false;
+  for (const size_t member : members) colored = colored || !cleaned[member].mesh.colors.empty();
   Streams s;
   std::vector<unsigned> indices;
   std::vector<uint32_t> member_base(members.size());
   for (size_t mi = 0; mi < members.size(); ++mi) {
     const CleanMesh& c = cleaned[members[mi]];
-    const SourceMesh& m = scene.meshes[c.source];
+    const SourceMesh& m = c.mesh;
     const size_t base = s.positions.size();
     if (base + m.positions.size() > std::numeric_limits<uint32_t>::max())
       return Error{"mesh '" + out.name + "': more than 2^32 - 1 vertices"};
     member_base[mi] = static_cast<uint32_t>(base);
     s.positions.insert(s.positions.end(), m.positions.begin(), m.positions.end());
-    const auto& normals = c.normals.empty() ? m.normals : c.normals;
-    s.normals.insert(s.normals.end(), normals.begin(), normals.end());
+    s.normals.insert(s.normals.end(), m.normals.begin(), m.normals.end());
     if (attrs.tangents) s.tangents.insert(s.tangents.end(), m.tangents.begin(), m.tangents.end());
     if (attrs.uv0) s.uv0.insert(s.uv0.end(), m.uv0.begin(), m.uv0.end());
+    if (colored) {
+      if (m.colors.empty()) {
+        s.colors.insert(s.colors.end(), m.positions.size(), glm::vec4(1.0f));
+      } else {
+        uint32_t clamped = 0;
+        for (const glm::vec4& col : m.colors) {
+          const glm::vec4 in_range = glm::clamp(col, glm::vec4(0.0f), glm::vec4(1.0f));
+          clamped += in_range != col ? 1u : 0u;
+          s.colors.push_back(in_range);
+        }
+        if (clamped > 0)
+          warnings.push_back(mesh_label(m, c.source) + ": " + std::to_string(clamped) +
+                             " vertex colours outside [0, 1] were clamped");
+      }
+    }
     if (attrs.skinned) {
       for (size_t v = 0; v < m.joints.size(); ++v) {
         std::array<uint16_t, 4> slots{0, 0, 0, 0};
@@ -414,10 +473,10 @@ Result<CookedMesh> build_group(const SourceScene& scene, const std::vector<Clean
         s.weights.push_back(weights[mi][v]);
       }
     }
-    if (indices.size() + c.indices.size() > std::numeric_limits<uint32_t>::max())
+    if (indices.size() + m.indices.size() > std::numeric_limits<uint32_t>::max())
       return Error{"mesh '" + out.name + "': more than 2^32 - 1 indices"};
-    fb::Submesh submesh(static_cast<uint32_t>(indices.size()), static_cast<uint32_t>(c.indices.size()), m.material);
-    for (const uint32_t i : c.indices) indices.push_back(static_cast<unsigned>(base + i));
+    fb::Submesh submesh(static_cast<uint32_t>(indices.size()), static_cast<uint32_t>(m.indices.size()), m.material);
+    for (const uint32_t i : m.indices) indices.push_back(static_cast<unsigned>(base + i));
     out.submeshes.push_back(submesh);
   }
   size_t vertex_count = s.positions.size();
@@ -428,7 +487,7 @@ Result<CookedMesh> build_group(const SourceScene& scene, const std::vector<Clean
   if (options.optimize) {
     for (size_t mi = 0; mi < members.size(); ++mi) {
       const fb::Submesh& sub = out.submeshes[mi];
-      const size_t count = scene.meshes[cleaned[members[mi]].source].positions.size();
+      const size_t count = cleaned[members[mi]].mesh.positions.size();
       const uint32_t base = member_base[mi];
       std::vector<unsigned> local(indices.begin() + sub.first_index(),
                                   indices.begin() + sub.first_index() + sub.index_count());
@@ -440,15 +499,16 @@ Result<CookedMesh> build_group(const SourceScene& scene, const std::vector<Clean
     std::vector<unsigned> remap(vertex_count);
     const size_t unique = meshopt_optimizeVertexFetchRemap(remap.data(), indices.data(), indices.size(), vertex_count);
     meshopt_remapIndexBuffer(indices.data(), indices.data(), indices.size(), remap.data());
-    remap_stream(s.positions, remap, unique);
-    remap_stream(s.normals, remap, unique);
-    remap_stream(s.tangents, remap, unique);
-    remap_stream(s.uv0, remap, unique);
-    remap_stream(s.slots, remap, unique);
-    remap_stream(s.weights, remap, unique);
+    compact(s.positions, remap, unique);
+    compact(s.normals, remap, unique);
+    compact(s.tangents, remap, unique);
+    compact(s.uv0, remap, unique);
+    compact(s.colors, remap, unique);
+    compact(s.slots, remap, unique);
+    compact(s.weights, remap, unique);
     if (unique < vertex_count)
       warnings.push_back("mesh '" + out.name + "': dropped " + std::to_string(vertex_count - unique) +
-                         " vertices no triangle uses");
+                         " vertices only degenerate triangles used");
     vertex_count = unique;
   }
 
@@ -478,7 +538,8 @@ Result<CookedMesh> build_group(const SourceScene& scene, const std::vector<Clean
     out.position_scale = glm::vec3(1.0f);
   }
 
-  // Layout: Position, Normal, Tangent, TexCoord0, Joints, Weights; every size is a multiple of 4.
+  // Layout: Position, Normal, Tangent, TexCoord0, Color0, Joints, Weights; every size is a
+  // multiple of 4.
   using Sem = fb::VertexSemantic;
   using Fmt = fb::VertexFormat;
   const bool wide_slots = out.joints.size() > 256;
@@ -487,6 +548,7 @@ Result<CookedMesh> build_group(const SourceScene& scene, const std::vector<Clean
   const uint16_t at_normal = layout.add(Sem::Normal, quantized ? Fmt::Snorm16x2 : Fmt::Float32x3);
   const uint16_t at_tangent = attrs.tangents ? layout.add(Sem::Tangent, quantized ? Fmt::Snorm16x4 : Fmt::Float32x4) : 0;
   const uint16_t at_uv0 = attrs.uv0 ? layout.add(Sem::TexCoord0, quantized ? Fmt::Float16x2 : Fmt::Float32x2) : 0;
+  const uint16_t at_color = colored ? layout.add(Sem::Color0, quantized ? Fmt::Unorm8x4 : Fmt::Float32x4) : 0;
   const uint16_t at_joints =
       attrs.skinned ? layout.add(Sem::Joints, quantized && !wide_slots ? Fmt::Uint8x4 : Fmt::Uint16x4) : 0;
   const uint16_t at_weights = attrs.skinned ? layout.add(Sem::Weights, quantized ? Fmt::Unorm8x4 : Fmt::Float32x4) : 0;
@@ -514,6 +576,11 @@ Result<CookedMesh> build_group(const SourceScene& scene, const std::vector<Clean
       }
       if (attrs.uv0)
         put(dst + at_uv0, std::array<uint16_t, 2>{float_to_half(s.uv0[v].x), float_to_half(s.uv0[v].y)});
+      if (colored) {
+        const glm::vec4& c = s.colors[v];
+        put(dst + at_color, std::array<uint8_t, 4>{float_to_unorm8(c.r), float_to_unorm8(c.g), float_to_unorm8(c.b),
+                                                   float_to_unorm8(c.a)});
+      }
       if (attrs.skinned) {
         const auto& slots = s.slots[v];
         if (wide_slots) {
@@ -529,10 +596,29 @@ Result<CookedMesh> build_group(const SourceScene& scene, const std::vector<Clean
       put(dst + at_normal, n);
       if (attrs.tangents) put(dst + at_tangent, s.tangents[v]);
       if (attrs.uv0) put(dst + at_uv0, s.uv0[v]);
+      if (colored) put(dst + at_color, s.colors[v]);
       if (attrs.skinned) {
         put(dst + at_joints, s.slots[v]);
         put(dst + at_weights, s.weights[v]);
       }
+    }
+  }
+
+  // Vertices the quantized layout made identical (source vertices a rounding error apart, which
+  // Assimp used to merge by epsilon) are one vertex: equal bytes draw exactly alike. The remap
+  // numbers vertices in first use order, which the fetch optimizer already gave them, so the
+  // fetch order is kept.
+  if (quantized && vertex_count > 0) {
+    std::vector<unsigned> remap(vertex_count);
+    const size_t unique = meshopt_generateVertexRemap(remap.data(), indices.data(), indices.size(), out.vertices.data(),
+                                                      vertex_count, layout.stride);
+    if (unique < vertex_count) {
+      std::vector<uint8_t> merged(unique * layout.stride);
+      meshopt_remapVertexBuffer(merged.data(), out.vertices.data(), vertex_count, layout.stride, remap.data());
+      meshopt_remapIndexBuffer(indices.data(), indices.data(), indices.size(), remap.data());
+      out.vertices = std::move(merged);
+      vertex_count = unique;
+      out.vertex_count = static_cast<uint32_t>(unique);
     }
   }
 
@@ -563,11 +649,16 @@ Result<std::vector<CookedMesh>> build_meshes(const SourceScene& scene, const Mes
   std::vector<CleanMesh> cleaned;
   for (size_t si = 0; si < scene.meshes.size(); ++si) {
     if (Status s = validate_mesh(scene, si); !s) return s.error();
-    const SourceMesh& m = scene.meshes[si];
-    stats.source_vertices += static_cast<uint32_t>(m.positions.size());
+    stats.source_vertices += static_cast<uint32_t>(scene.meshes[si].positions.size());
     CleanMesh c;
     c.source = si;
-    c.indices.reserve(m.indices.size());
+    size_t unused = 0;
+    c.mesh = weld(scene.meshes[si], &unused);
+    SourceMesh& m = c.mesh;
+    if (unused > 0)
+      warnings.push_back(mesh_label(m, si) + ": dropped " + std::to_string(unused) + " vertices no triangle uses");
+    std::vector<uint32_t> kept;
+    kept.reserve(m.indices.size());
     uint32_t dropped = 0;
     for (size_t t = 0; t < m.indices.size(); t += 3) {
       const uint32_t a = m.indices[t], b = m.indices[t + 1], cc = m.indices[t + 2];
@@ -575,17 +666,18 @@ Result<std::vector<CookedMesh>> build_meshes(const SourceScene& scene, const Mes
         ++dropped;
         continue;
       }
-      c.indices.insert(c.indices.end(), {a, b, cc});
+      kept.insert(kept.end(), {a, b, cc});
     }
+    m.indices = std::move(kept);
     stats.degenerate_triangles_removed += dropped;
     if (dropped > 0)
       warnings.push_back(mesh_label(m, si) + ": removed " + std::to_string(dropped) + " degenerate triangles");
-    if (c.indices.empty()) {
+    if (m.indices.empty()) {
       warnings.push_back(mesh_label(m, si) + ": no triangles left; mesh skipped");
       continue;
     }
     if (m.normals.empty()) {
-      c.normals = generate_normals(m.positions, c.indices);
+      m.normals = generate_normals(m.positions, m.indices);
       ++stats.meshes_with_generated_normals;
       warnings.push_back(mesh_label(m, si) + ": had no normals; generated area-weighted normals");
     }
@@ -595,7 +687,7 @@ Result<std::vector<CookedMesh>> build_meshes(const SourceScene& scene, const Mes
   // Group by attribute set, in order of first appearance.
   std::vector<std::pair<AttributeSet, std::vector<size_t>>> groups;
   for (size_t ci = 0; ci < cleaned.size(); ++ci) {
-    const AttributeSet attrs = attribute_set(scene.meshes[cleaned[ci].source]);
+    const AttributeSet attrs = attribute_set(cleaned[ci].mesh);
     auto it = std::find_if(groups.begin(), groups.end(), [&](const auto& g) { return g.first == attrs; });
     if (it == groups.end()) {
       groups.emplace_back(attrs, std::vector<size_t>{});

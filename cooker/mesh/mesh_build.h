@@ -2,8 +2,8 @@
 //
 // Source meshes with the same attribute set are merged into one vertex/index buffer with one
 // submesh per source mesh (per material), so a character is few buffers and few draws. Each source
-// mesh is validated and cleaned (degenerate triangles dropped and counted; Assimp's import already
-// joined identical vertices, so nothing is welded here), given normals by OpenMesh when it has none
+// mesh is welded (vertices equal in every attribute merged: the importer leaves that to this stage)
+// and cleaned (degenerate triangles dropped and counted), given normals by OpenMesh when it has none
 // (area-weighted vertex normals: the one job where OpenMesh earns its place), reordered with
 // meshoptimizer (vertex cache per submesh, then vertex fetch over the whole mesh), and written in the
 // quantized layout of the design (positions unorm16 in the bounds, octahedral normals/tangents,

@@ -29,6 +29,12 @@ inline uint16_t float_to_unorm16(float f) {
   f = f < 0.0f ? 0.0f : (f > 1.0f ? 1.0f : f);
   return static_cast<uint16_t>(std::lround(f * 65535.0f));
 }
+/// Unorm8 as OpenGL normalizes it (v / 255): vertex colours. NaN encodes as 0.
+inline float unorm8_to_float(uint8_t v) { return static_cast<float>(v) / 255.0f; }
+inline uint8_t float_to_unorm8(float f) {
+  f = f > 0.0f ? (f > 1.0f ? 1.0f : f) : 0.0f;
+  return static_cast<uint8_t>(std::lround(f * 255.0f));
+}
 
 /// Unit vector -> octahedral square in [-1, 1]^2. n need not be exactly unit; zero maps to +z.
 inline Float2 octahedral_encode(Float3 n) {
