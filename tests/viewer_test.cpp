@@ -25,6 +25,8 @@
 
 #include <glm/glm.hpp>
 
+#include <ossa/loader/asset.h>
+
 #include "test_files.h"
 #include "viewer_harness.h"
 
@@ -413,6 +415,92 @@ TEST_F(Viewer, VertexColoursTintTheSurface) {
   right /= nr;
   EXPECT_GT(left.r, 3.0 * std::max(left.g, left.b) + 10.0) << "red half: " << left.r << " " << left.g << " " << left.b;
   EXPECT_GT(right.b, 3.0 * std::max(right.r, right.g) + 10.0) << "blue half: " << right.r << " " << right.g << " " << right.b;
+}
+
+// A prop far larger than its rig (a 4 m plank held by a 0.2 m two-joint rig) is framed whole:
+// the camera frames the skinned vertices, not the joints plus a margin, so no edge of the plank
+// touches the image border.
+TEST_F(Viewer, APropLargerThanItsSkeletonIsFramedWhole) {
+  const std::string dae = R"(<?xml version="1.0" encoding="utf-8"?>
+<COLLADA xmlns="http://www.collada.org/2005/11/COLLADASchema" version="1.4.1">
+  <asset><unit name="meter" meter="1"/><up_axis>Y_UP</up_axis></asset>
+  <library_geometries>
+    <geometry id="plank-mesh" name="plank">
+      <mesh>
+        <source id="plank-pos">
+          <float_array id="plank-pos-array" count="12">-2 0.95 0  2 0.95 0  2 1.45 0  -2 1.45 0</float_array>
+          <technique_common><accessor source="#plank-pos-array" count="4" stride="3">
+            <param name="X" type="float"/><param name="Y" type="float"/><param name="Z" type="float"/></accessor></technique_common>
+        </source>
+        <vertices id="plank-verts"><input semantic="POSITION" source="#plank-pos"/></vertices>
+        <triangles count="2"><input semantic="VERTEX" source="#plank-verts" offset="0"/><p>0 1 2 0 2 3</p></triangles>
+      </mesh>
+    </geometry>
+  </library_geometries>
+  <library_controllers>
+    <controller id="plank-skin">
+      <skin source="#plank-mesh">
+        <bind_shape_matrix>1 0 0 0 0 1 0 0 0 0 1 0 0 0 0 1</bind_shape_matrix>
+        <source id="plank-joints"><Name_array id="plank-joints-array" count="2">Hips Hand</Name_array>
+          <technique_common><accessor source="#plank-joints-array" count="2" stride="1"><param name="JOINT" type="name"/></accessor></technique_common></source>
+        <source id="plank-ibm"><float_array id="plank-ibm-array" count="32">1 0 0 0 0 1 0 -1 0 0 1 0 0 0 0 1  1 0 0 0 0 1 0 -1.2 0 0 1 0 0 0 0 1</float_array>
+          <technique_common><accessor source="#plank-ibm-array" count="2" stride="16"><param name="TRANSFORM" type="float4x4"/></accessor></technique_common></source>
+        <source id="plank-weights"><float_array id="plank-weights-array" count="1">1</float_array>
+          <technique_common><accessor source="#plank-weights-array" count="1" stride="1"><param name="WEIGHT" type="float"/></accessor></technique_common></source>
+        <joints><input semantic="JOINT" source="#plank-joints"/><input semantic="INV_BIND_MATRIX" source="#plank-ibm"/></joints>
+        <vertex_weights count="4">
+          <input semantic="JOINT" source="#plank-joints" offset="0"/><input semantic="WEIGHT" source="#plank-weights" offset="1"/>
+          <vcount>1 1 1 1</vcount>
+          <v>1 0 1 0 1 0 1 0</v>
+        </vertex_weights>
+      </skin>
+    </controller>
+  </library_controllers>
+  <library_visual_scenes>
+    <visual_scene id="Scene" name="Scene">
+      <node id="Hips" name="Hips" sid="Hips" type="JOINT">
+        <matrix sid="transform">1 0 0 0 0 1 0 1 0 0 1 0 0 0 0 1</matrix>
+        <node id="Hand" name="Hand" sid="Hand" type="JOINT">
+          <matrix sid="transform">1 0 0 0 0 1 0 0.2 0 0 1 0 0 0 0 1</matrix>
+        </node>
+      </node>
+      <node id="plank" name="plank">
+        <instance_controller url="#plank-skin"><skeleton>#Hips</skeleton></instance_controller>
+      </node>
+    </visual_scene>
+  </library_visual_scenes>
+  <scene><instance_visual_scene url="#Scene"/></scene>
+</COLLADA>
+)";
+  ASSERT_TRUE(ossa::test::write_file(dir_ / "plank.dae", dae));
+  const CommandResult cooked_dae = ossa::test::run_command(quote((ossa::test::bin_dir() / "ossa-cook").string()) + " " +
+                                                           quote((dir_ / "plank.dae").string()) + " -o " +
+                                                           quote(dir_.string()) + " -q");
+  ASSERT_EQ(cooked_dae.exit_code, 0) << cooked_dae.err;
+  auto plank = ossa::Asset::open((dir_ / "plank.ossa").string());
+  ASSERT_TRUE(plank.ok()) << plank.error().message;
+  ASSERT_EQ(plank->skeleton().joint_count(), 2u) << "the plank is skinned to a rig, not baked";
+  const CommandResult r = run_viewer(quote((dir_ / "plank.ossa").string()) + " --size 160x120 --no-grid --yaw 0 --pitch 0 " +
+                                     "--screenshot " + quote((dir_ / "plank.png").string()));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const Image img = load_png(dir_ / "plank.png");
+  ASSERT_FALSE(img.empty());
+  const uint8_t* bg = img.at(0, 0);
+  const auto foreground = [&](int x, int y) {
+    const uint8_t* p = img.at(x, y);
+    return std::abs(p[0] - bg[0]) + std::abs(p[1] - bg[1]) + std::abs(p[2] - bg[2]) > 18;
+  };
+  int left = img.width, right = -1;
+  for (int y = 0; y < img.height; ++y)
+    for (int x = 0; x < img.width; ++x)
+      if (foreground(x, y)) {
+        left = std::min(left, x);
+        right = std::max(right, x);
+      }
+  ASSERT_GE(right, 0) << "the plank is drawn";
+  EXPECT_GT(left, 0) << "the plank's left end is cut off";
+  EXPECT_LT(right, img.width - 1) << "the plank's right end is cut off";
+  EXPECT_GT(right - left, img.width / 2) << "and it is framed, not lost in the distance";
 }
 
 TEST_F(Viewer, ClipOfAnotherSkeletonIsRefused) {

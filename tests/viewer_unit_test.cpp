@@ -141,7 +141,7 @@ std::vector<glm::mat4> bind_model(const SkeletonView& skeleton) {
 TEST(ViewerBounds, BindPoseBoundsMatchTheMeshWhereSkinAndRigAgree) {
   Result<Asset> a = Asset::open(cooked("CesiumMan/CesiumMan.ossa").string());
   ASSERT_TRUE(a) << a.error().message;
-  const Box b = bind_pose_bounds(*a, bind_model(a->skeleton()));
+  const Box b = posed_bounds(*a, bind_model(a->skeleton()));
   // CesiumMan stands 1.51 m tall in its cooked bounds, arms out to +-0.57 m.
   EXPECT_NEAR(b.size().y, 1.51f, 0.02f);
   EXPECT_NEAR(b.size().x, 1.14f, 0.02f);
@@ -151,26 +151,26 @@ Box synthetic_bounds(const test::SyntheticSpec& spec) {
   const std::vector<uint8_t> bytes = test::make_valid_file(spec);
   Result<Asset> a = Asset::from_bytes(bytes, "synthetic.ossa");
   EXPECT_TRUE(a) << a.error().message;
-  return a ? bind_pose_bounds(*a, bind_model(a->skeleton())) : Box{};
+  return a ? posed_bounds(*a, bind_model(a->skeleton())) : Box{};
 }
 
-TEST(ViewerBounds, AnImplausiblyDeepMeshBoxIsClippedToTheSkeleton) {
+TEST(ViewerBounds, AMeshReachingPastTheSkeletonIsFramedWhole) {
   // The synthetic rig (joints over x 0..0.5, y 0..2, z 0) and its 1 x 2 x 0.2 grid of vertices:
-  // an ordinary mesh keeps its exact box.
+  // the box is the mesh's.
   test::SyntheticSpec spec;
   const Box plain = synthetic_bounds(spec);
   EXPECT_NEAR(plain.min.x, -0.5f, 1e-3f);
   EXPECT_NEAR(plain.max.x, 0.5f, 1e-3f);
   EXPECT_NEAR(plain.size().y, 2.0f, 1e-3f);
   EXPECT_NEAR(plain.size().z, 0.2f, 1e-3f);
-  // A mesh box 4 units deep over a flat skeleton (what merging meshes cooked in different axis
-  // conventions gives): depth clipped to the joints' extent +- 10 % of their diagonal (0.206).
+  // A vertex 4 units in front of a flat skeleton (a spear, a flag, a prop far larger than the rig)
+  // is drawn there, so it is framed: the box must reach it, not stop at the joints.
   test::SyntheticVertex far = spec.meshes[0].vertices[0];
   far.position = fb::Vec3(0.0f, 1.0f, 4.0f);
   spec.meshes[0].vertices.push_back(far);
-  const Box clipped = synthetic_bounds(spec);
-  EXPECT_NEAR(clipped.max.z, 0.206f, 2e-3f);
-  EXPECT_NEAR(clipped.size().y, 2.0f, 1e-3f) << "axes of plausible extent are kept";
+  const Box whole = synthetic_bounds(spec);
+  EXPECT_NEAR(whole.max.z, 4.0f, 2e-3f);
+  EXPECT_NEAR(whole.size().y, 2.0f, 1e-3f);
 }
 
 TEST(ViewerBounds, SlotsPlacedByAnotherBindPoseDoNotInflateTheBox) {
@@ -180,7 +180,7 @@ TEST(ViewerBounds, SlotsPlacedByAnotherBindPoseDoNotInflateTheBox) {
   ASSERT_TRUE(a) << a.error().message;
   const MeshView mesh = a->mesh(0);
   const float mesh_width = mesh.fb->bounds_max()->x() - mesh.fb->bounds_min()->x();
-  const Box b = bind_pose_bounds(*a, bind_model(a->skeleton()));
+  const Box b = posed_bounds(*a, bind_model(a->skeleton()));
   EXPECT_LT(b.size().x, 1.05f * mesh_width);
   EXPECT_GT(b.size().x, 0.95f * mesh_width);
 }

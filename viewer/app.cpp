@@ -26,8 +26,29 @@ std::vector<glm::vec3> crowd_offsets(size_t n, const Box& one) {
 }  // namespace
 
 void frame_camera(App& app, float aspect) {
+  glm::vec3 moved(0.0f);
+  if (app.crowd == 1 && !app.animator.instances.empty()) {
+    // One character: frame it as it is drawn now (the shown clip time, or the bind pose).
+    Animator& a = app.animator;
+    PoseTimings ignored;
+    produce_local_poses(app.scene, a, ignored);
+    compute_model_poses(app.scene, a, ignored);
+    const auto& model = a.instances.front().model;
+    const Box shown = posed_bounds(app.scene.character(), model);
+    if (!shown.empty()) app.framing = shown;
+    if (!model.empty()) {
+      moved = glm::vec3(model[0][3]) - app.root_bind;
+      moved.y = 0.0f;
+    }
+    // The floor stays under the bind pose too (a frame mid-jump keeps the ground where it is).
+    Box ground = app.framing;
+    ground.add(app.bind_box);
+    set_grid(app.renderer, ground, ground.empty() ? 0.0f : ground.min.y,
+             ground.empty() ? 1.0f : 0.5f * glm::length(ground.size()));
+  }
   app.camera = frame_box(app.framing, app.angles.yaw, app.angles.pitch, aspect);
-  app.follow_applied = glm::vec3(0.0f);
+  // The framing already holds the root where it is now: following starts from here.
+  app.follow_applied = moved;
 }
 
 Status open_scene(App& app, std::span<const std::string> paths, size_t crowd, float aspect) {
@@ -87,7 +108,8 @@ Status set_crowd(App& app, size_t crowd, float aspect) {
   PoseTimings ignored;
   produce_local_poses(app.scene, a, ignored);  // no clip yet: bind pose
   compute_model_poses(app.scene, a, ignored);
-  const Box one = bind_pose_bounds(app.scene.character(), a.instances.front().model);
+  const Box one = posed_bounds(app.scene.character(), a.instances.front().model);
+  app.bind_box = one;
   app.offsets = crowd_offsets(app.crowd, one);
   app.framing = Box{};
   for (const glm::vec3& o : app.offsets) {
@@ -100,25 +122,9 @@ Status set_crowd(App& app, size_t crowd, float aspect) {
   app.follow = app.crowd == 1;
   const float radius = one.empty() ? 1.0f : 0.5f * glm::length(one.size());
   set_grid(app.renderer, app.framing, app.framing.empty() ? 0.0f : app.framing.min.y, radius);
-  frame_camera(app, aspect);
 
   const int clip = had_clip ? previous.clip : (app.scene.clips.empty() ? -1 : 0);
   if (Status s = play_clip(app, clip, false); !s) return s;
-  if (shows_bones_only(app.scene) && clip >= 0 && app.crowd == 1) {
-    // Mocap has no body and its bind is often a zero pose at the origin (BVH OFFSETs) while the
-    // capture stands elsewhere: frame the bones as the clip starts too (the camera then follows
-    // the root across the floor).
-    produce_local_poses(app.scene, a, ignored);
-    compute_model_poses(app.scene, a, ignored);
-    const Box start = joint_bounds(a.instances.front().model);
-    if (!start.empty()) {
-      app.framing.add(start.min);
-      app.framing.add(start.max);
-      const float r = 0.5f * glm::length(app.framing.size());
-      set_grid(app.renderer, app.framing, app.framing.min.y, r);
-      frame_camera(app, aspect);
-    }
-  }
   if (had_clip) {
     Playback& p = a.playback;
     p.time = previous.time;
@@ -132,6 +138,9 @@ Status set_crowd(App& app, size_t crowd, float aspect) {
     for (const auto& [index, value] : graph_values) set_graph_value(*app.animator.graph, index, value);
     app.animator.use_graph = used_graph || graph_values.empty();
   }
+  // Mocap has no body and its bind is often a zero pose at the origin (BVH OFFSETs) while the
+  // capture stands elsewhere; a prop may reach past the skeleton: frame what is shown.
+  frame_camera(app, aspect);
   return {};
 }
 

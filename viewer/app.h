@@ -34,7 +34,8 @@ struct App {
   CameraAngles angles;
   ViewToggles toggles;
   std::vector<glm::vec3> offsets;  // instance placements (crowd grid), one per instance
-  Box framing;                     // everything the camera frames: the crowd in its bind pose
+  Box framing;                     // what the camera frames: one character as shown, a crowd in its bind pose
+  Box bind_box;                    // one character in its bind pose (crowd spacing, the floor)
   size_t crowd = 1;
   bool follow = true;              // keep the camera on instance 0's root as it moves (crowd: off)
   glm::vec3 root_bind{0.0f};       // instance 0's root in the bind pose
@@ -58,7 +59,8 @@ Status set_crowd(App& app, size_t crowd, float aspect);
 /// added to the current character.
 Status open_or_add(App& app, std::span<const std::string> paths, float aspect);
 
-/// Points the camera at app.framing from app.angles.
+/// Points the camera at app.framing from app.angles. One character (crowd 1) is first re-framed
+/// as it is shown now: its skinned vertices at the current clip time or graph pose (bounds.h).
 void frame_camera(App& app, float aspect);
 
 /// Instantiates graph `name` (graph_driver.h) for every instance and lets it drive the poses.

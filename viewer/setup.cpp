@@ -52,6 +52,7 @@ Status setup_app(App& app, Scene scene, const ViewerOptions& o, float aspect) {
   p.speed = o.speed;
   p.playing = !o.paused;
   set_time(app.scene, app.animator, o.time);
+  frame_camera(app, aspect);  // the clip, the time and the pose are chosen: frame what is shown
   return {};
 }
 
