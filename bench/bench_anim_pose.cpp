@@ -15,6 +15,7 @@
 // Run: ossa-bench-anim --benchmark_repetitions=5 --benchmark_filter='BM_Blend3|BM_LocalToModel'
 #include <benchmark/benchmark.h>
 
+#include <cmath>
 #include <cstdint>
 #include <random>
 #include <span>
@@ -25,6 +26,7 @@
 
 #include "bench_fixture.h"
 #include <ossa/anim/pose.h>
+#include <ossa/anim/ik.h>
 #include <ossa/anim/pose_ops.h>
 
 namespace {
@@ -140,6 +142,63 @@ void BM_LocalToModel(benchmark::State& state) {
   set_ns_per_joint(state, b.joints);
 }
 BENCHMARK(BM_LocalToModel);
+
+// One two-bone IK job on Pab's left arm (LeftArm > LeftForeArm > Lefthand) in a sampled pose,
+// the target swept around the hand with a pole and softening on: ns per job.
+void BM_TwoBoneIk(benchmark::State& state) {
+  const PoseBench& b = pose_bench();
+  std::vector<glm::mat4> model(b.joints);
+  ossa::local_to_model(b.skeleton.parents(), b.inputs[0], model);
+  const int start = b.skeleton.find_joint("LeftArm"), mid = b.skeleton.find_joint("LeftForeArm"),
+            end = b.skeleton.find_joint("Lefthand");
+  if (start < 0 || mid < 0 || end < 0) {
+    state.SkipWithError("Pab's skeleton has no LeftArm > LeftForeArm > Lefthand");
+    return;
+  }
+  ossa::TwoBoneIkInput in;
+  in.start = model[static_cast<size_t>(start)];
+  in.mid = model[static_cast<size_t>(mid)];
+  in.end = model[static_cast<size_t>(end)];
+  in.pole = glm::vec3(0.0f, 0.0f, -1.0f);
+  in.soften = 0.97f;
+  const glm::vec3 hand(in.end[3]);
+  ossa::TwoBoneIkOutput out;
+  float phase = 0.0f;
+  for (auto _ : state) {
+    phase += 0.01f;
+    in.target = hand + 10.0f * glm::vec3(std::sin(phase), std::cos(phase), 0.0f);
+    benchmark::DoNotOptimize(ossa::two_bone_ik(in, &out));
+    benchmark::DoNotOptimize(out);
+  }
+}
+BENCHMARK(BM_TwoBoneIk);
+
+// One aim job on Pab's head (local +z forward, +y up assumed), the target swept around it with a
+// pole and a 70 degree limit: ns per joint of an aim chain.
+void BM_AimIk(benchmark::State& state) {
+  const PoseBench& b = pose_bench();
+  std::vector<glm::mat4> model(b.joints);
+  ossa::local_to_model(b.skeleton.parents(), b.inputs[0], model);
+  const int head = b.skeleton.find_joint("Head");
+  if (head < 0) {
+    state.SkipWithError("Pab's skeleton has no Head");
+    return;
+  }
+  ossa::AimIkInput in;
+  in.joint = model[static_cast<size_t>(head)];
+  in.pole = glm::vec3(0.0f, 1.0f, 0.0f);
+  in.max_angle = 1.2f;
+  const glm::vec3 at(in.joint[3]);
+  ossa::AimIkOutput out;
+  float phase = 0.0f;
+  for (auto _ : state) {
+    phase += 0.01f;
+    in.target = at + 100.0f * glm::vec3(std::sin(phase), 0.1f, std::cos(phase));
+    benchmark::DoNotOptimize(ossa::aim_ik(in, &out));
+    benchmark::DoNotOptimize(out);
+  }
+}
+BENCHMARK(BM_AimIk);
 
 // The yardstick: per joint, TRS -> mat4 with GLM's helpers and a generic mat4 product.
 void BM_GlmLocalToModel(benchmark::State& state) {
