@@ -15,6 +15,7 @@
 // Run: ossa-bench-anim --benchmark_repetitions=5 --benchmark_filter='BM_Blend3|BM_LocalToModel'
 #include <benchmark/benchmark.h>
 
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <random>
@@ -28,6 +29,7 @@
 #include <ossa/anim/pose.h>
 #include <ossa/anim/ik.h>
 #include <ossa/anim/pose_ops.h>
+#include <ossa/anim/spring.h>
 
 namespace {
 
@@ -199,6 +201,41 @@ void BM_AimIk(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_AimIk);
+
+// A spring chain over Pab's left arm and hand (LeftArm > LeftForeArm > Lefthand) with one sphere
+// collider on the spine, one fixed step per update: ns per spring joint per step (the pose
+// pass that writes the result included).
+void BM_SpringChain(benchmark::State& state) {
+  const PoseBench& b = pose_bench();
+  const int arm = b.skeleton.find_joint("LeftArm"), fore = b.skeleton.find_joint("LeftForeArm"),
+            hand = b.skeleton.find_joint("Lefthand"), spine = b.skeleton.find_joint("Spine");
+  if (arm < 0 || fore < 0 || hand < 0 || spine < 0) {
+    state.SkipWithError("Pab's skeleton lacks LeftArm > LeftForeArm > Lefthand or Spine");
+    return;
+  }
+  const std::array<uint16_t, 3> joints{static_cast<uint16_t>(arm), static_cast<uint16_t>(fore),
+                                       static_cast<uint16_t>(hand)};
+  ossa::SpringSettings settings;
+  settings.gravity = glm::vec3(0.0f, -981.0f, 0.0f);  // Pab is in centimetres
+  auto chain = ossa::make_spring_chain(b.skeleton.parents(), joints, settings);
+  if (!chain.ok()) {
+    state.SkipWithError(chain.error().message.c_str());
+    return;
+  }
+  const std::array<ossa::SpringCollider, 1> colliders{
+      ossa::SpringCollider{static_cast<uint16_t>(spine), glm::vec3(0.0f), glm::vec3(0.0f), 15.0f}};
+  ossa::Pose local(b.joints);
+  std::vector<glm::mat4> model(b.joints);
+  ossa::copy_pose(b.inputs[0], local);
+  ossa::local_to_model(b.skeleton.parents(), local, model);
+  for (auto _ : state) {
+    ossa::copy_pose(b.inputs[0], local);  // the animated pose, as each frame gives it
+    ossa::update_spring_chain(*chain, settings.step, b.skeleton.parents(), local, model, colliders);
+    benchmark::DoNotOptimize(model.data());
+  }
+  set_ns_per_joint(state, static_cast<uint32_t>(joints.size()));
+}
+BENCHMARK(BM_SpringChain);
 
 // The yardstick: per joint, TRS -> mat4 with GLM's helpers and a generic mat4 product.
 void BM_GlmLocalToModel(benchmark::State& state) {
