@@ -11,6 +11,7 @@
 // Normals are copied as unit vectors (missing ones are generated later, by the mesh stage); a
 // normal Assimp left at zero or NaN is replaced by its faces' normal rather than dropping all.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <set>
 
@@ -233,19 +234,28 @@ bool skin(const aiMesh& in, const NodeGraph& graph, const Rig& rig, int node, So
   const int fallback = attached_joint(graph, rig, node) >= 0 ? attached_joint(graph, rig, node) : 0;
   out->joints.resize(nv);
   out->weights.resize(nv);
+  // Counted by distinct position: importers that keep one vertex per face corner (FBX; nothing is
+  // welded before the mesh stage) would otherwise count each corner of one vertex.
+  std::set<std::array<float, 3>> lost_at, unweighted_at;
+  const auto at = [&](unsigned v) {
+    const glm::vec3& p = out->positions[v];
+    return std::array<float, 3>{p.x, p.y, p.z};
+  };
   for (unsigned v = 0; v < nv; ++v) {
     bool lost = false;
     if (!cap_influences(&per_vertex[v], &out->joints[v], &out->weights[v], &lost)) {
       // No weight at all: carried rigidly by the joint the mesh hangs under.
-      ++stats->unweighted;
+      unweighted_at.insert(at(v));
       out->joints[v] = {static_cast<uint16_t>(fallback), 0, 0, 0};
       out->weights[v] = glm::vec4(1, 0, 0, 0);
       if (!bind.count(static_cast<uint16_t>(fallback))) {
         bind.emplace(static_cast<uint16_t>(fallback), rigid_bind(graph, rig, fallback, node));
       }
     }
-    stats->over_4 += lost ? 1 : 0;
+    if (lost) lost_at.insert(at(v));
   }
+  stats->unweighted += unweighted_at.size();
+  stats->over_4 += static_cast<uint32_t>(lost_at.size());
   out->bind.assign(bind.begin(), bind.end());
   return true;
 }
