@@ -6,9 +6,13 @@
 // Each ASSET (a source file) is cooked in-process with default options into a temporary directory.
 // Then, in this one process and one after the other, it times (a) Assimp::Importer::ReadFile with
 // the cooker's import flags and settings, and (b) ossa::Asset::open = mmap + FlatBuffers verify +
-// semantic checks (+ unmap). Each is repeated for at least --min-seconds (and at least 5 / 200
-// times); the median is reported. Output: a tab-separated table with a header, one row per asset:
-//   asset source_bytes cooked_bytes assimp_import_ms ossa_open_ms speedup
+// semantic checks (+ unmap), and (c) the physical limit of (b): a plain open + read + close of the
+// same .ossa bytes into a buffer allocated once, outside the timing. Each is repeated for at least
+// --min-seconds (and at least 5 / 200 / 200 times); the median is reported. Output: a
+// tab-separated table with a header, one row per asset:
+//   asset source_bytes cooked_bytes assimp_import_ms ossa_open_ms read_ms open_over_read speedup
+// open_over_read is ossa_open_ms / read_ms (what verifying costs over reading the bytes);
+// speedup is assimp_import_ms / ossa_open_ms.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -18,6 +22,7 @@
 #include <string>
 #include <vector>
 
+#include <fcntl.h>
 #include <unistd.h>
 
 #include <assimp/Importer.hpp>
@@ -52,6 +57,20 @@ double median_ms(double min_seconds, int min_runs, S&& setup, F&& run) {
   return samples[samples.size() / 2];
 }
 
+/// open + read every byte + close, as a loader that copies the file would. False on any error.
+bool read_whole(const fs::path& path, std::vector<char>& buffer) {
+  const int fd = ::open(path.c_str(), O_RDONLY);
+  if (fd < 0) return false;
+  size_t got = 0;
+  while (got < buffer.size()) {
+    const ssize_t n = ::read(fd, buffer.data() + got, buffer.size() - got);
+    if (n <= 0) break;
+    got += static_cast<size_t>(n);
+  }
+  ::close(fd);
+  return got == buffer.size();
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -71,7 +90,7 @@ int main(int argc, char** argv) {
   }
   const fs::path tmp = fs::temp_directory_path() / ("ossa-bench-load-" + std::to_string(::getpid()));
   int status = 0;
-  std::printf("asset\tsource_bytes\tcooked_bytes\tassimp_import_ms\tossa_open_ms\tspeedup\n");
+  std::printf("asset\tsource_bytes\tcooked_bytes\tassimp_import_ms\tossa_open_ms\tread_ms\topen_over_read\tspeedup\n");
   for (size_t i = 0; i < assets.size(); ++i) {
     const fs::path& src = assets[i];
     const fs::path cooked = tmp / (std::to_string(i) + "-" + src.stem().string() + ".ossa");
@@ -95,14 +114,16 @@ int main(int argc, char** argv) {
         [&] { return importer->ReadFile(src.string(), flags) != nullptr; });
     const double ossa_ms =
         median_ms(min_seconds, 200, [] {}, [&] { return ossa::Asset::open(cooked.string()).ok(); });
-    if (assimp_ms < 0 || ossa_ms < 0) {
+    std::vector<char> buffer(static_cast<size_t>(rec.cooked_bytes));
+    const double read_ms = median_ms(min_seconds, 200, [] {}, [&] { return read_whole(cooked, buffer); });
+    if (assimp_ms < 0 || ossa_ms < 0 || read_ms < 0) {
       std::fprintf(stderr, "ossa-bench-load: %s: load failed during timing\n", src.string().c_str());
       status = 1;
       continue;
     }
-    std::printf("%s\t%llu\t%llu\t%.3f\t%.4f\t%.0f\n", src.filename().string().c_str(),
+    std::printf("%s\t%llu\t%llu\t%.3f\t%.4f\t%.4f\t%.2f\t%.0f\n", src.filename().string().c_str(),
                 static_cast<unsigned long long>(rec.source_bytes), static_cast<unsigned long long>(rec.cooked_bytes),
-                assimp_ms, ossa_ms, assimp_ms / ossa_ms);
+                assimp_ms, ossa_ms, read_ms, ossa_ms / read_ms, assimp_ms / ossa_ms);
     std::fflush(stdout);
   }
   std::error_code ec;
