@@ -1,8 +1,8 @@
 // asset.h — opening a .ossa file: map it, verify it, then read it through typed views.
 //
 // Loading is the whole point of the format: Asset::open memory-maps the file read-only (files
-// under 256 KiB are read into aligned memory instead: one read() is cheaper than mapping and
-// faulting in a few pages; OpenMode forces either), or Asset::borrow takes bytes the caller owns
+// up to 4 MiB are read into aligned memory instead: one read() is cheaper than mapping, faulting
+// in the pages verification touches and unmapping; OpenMode forces either), or Asset::borrow takes bytes the caller owns
 // (an engine's own file system or pack file), checks the identifier, runs flatbuffers::Verifier over every byte the reader could touch, checks the
 // format version, and then the semantic invariants FlatBuffers cannot see (validate.h). Only then
 // is an Asset handed out, so every view below can read without further checks. No per-vertex or
@@ -87,7 +87,7 @@ struct ClipView {
 
 /// How Asset::open gets a file's bytes into memory.
 enum class OpenMode : uint8_t {
-  /// Read files up to 256 KiB into memory, map larger ones (the fastest load for each size).
+  /// Read files up to 4 MiB into memory, map larger ones (the fastest load for each size).
   kAuto,
   /// Always read into memory the Asset owns (the installed Allocator). Costs one O(size) read and
   /// the memory; in exchange the Asset never depends on the file again. Use it when another
