@@ -144,6 +144,23 @@ void count_meshes(CookRecord& record, const std::vector<CookedMesh>& meshes, con
   record.triangles = stats.triangles;
 }
 
+void record_morphs(CookRecord& record, const std::vector<CookedMesh>& meshes, float metres_per_unit) {
+  const double mm = 1000.0 * (metres_per_unit > 0.0f ? metres_per_unit : 1.0f);
+  for (const CookedMesh& m : meshes)
+    for (const CookedMorphTarget& t : m.morph_targets) {
+      MorphRecord r;
+      r.mesh = m.name;
+      r.name = t.name;
+      r.vertices = static_cast<uint32_t>(t.vertices.size());
+      r.raw_bytes = t.source_bytes;
+      r.stored_bytes = static_cast<uint32_t>(4 * t.vertices.size() +
+                                             2 * (t.position_deltas.size() + t.normal_deltas.size() + t.tangent_deltas.size()));
+      r.position_error_mm = static_cast<float>(mm * t.position_error);
+      r.normal_error_deg = static_cast<float>(t.normal_error * 57.29577951308232);
+      record.morph_records.push_back(std::move(r));
+    }
+}
+
 bool write_verified(CookRecord& record, const std::vector<uint8_t>& bytes, const fs::path& input,
                     const fs::path& output, bool write) {
   // The writer's output must pass the same checks every reader makes; a cooker bug is caught here
@@ -270,6 +287,7 @@ void cook_into(CookRecord& record, const fs::path& input, const fs::path& output
     return;
   }
   count_meshes(record, *meshes, stats);
+  detail::record_morphs(record, *meshes, scene->metres_per_unit);
 
   auto clips = detail::cook_clips(*scene, options, record, input.string());
   if (!clips) {

@@ -51,6 +51,16 @@ struct ClipRecord {
   std::string worst_joint;
 };
 
+/// One morph target as cooked: how many vertices it stores and the error its bounds allowed.
+struct MorphRecord {
+  std::string mesh, name;
+  uint32_t vertices = 0;              // listed (stored) vertices
+  uint32_t raw_bytes = 0;             // dense float deltas over the mesh's vertices
+  uint32_t stored_bytes = 0;          // the sparse form in the file
+  float position_error_mm = 0.0f;     // millimetres (via metres_per_unit)
+  float normal_error_deg = 0.0f;
+};
+
 /// One line of the --report file (docs/schemas/ossa-cook-report.schema.json).
 ///
 /// A failed cook keeps what it learnt before it stopped: the counts are filled in as each stage
@@ -72,6 +82,7 @@ struct CookRecord {
   uint64_t cooked_bytes = 0;          // the written file (ok only)
   double seconds = 0.0;
   std::vector<ClipRecord> clip_records;  // one per clip compressed before any failure
+  std::vector<MorphRecord> morph_records;  // one per morph target, once meshes are built
   /// Every file the cook read or looked for (absolute paths, sorted), as far as it got; for an
   /// up-to-date output, the inputs its provenance lists. The depfile and --list-inputs print these.
   std::vector<InputFile> inputs_read;

@@ -194,6 +194,26 @@ class AssetWalker {
       if (s.material() >= std::max<size_t>(asset_.material_count(), 1)) fail(where, "submesh material out of range");
     }
 
+    // Morph targets: every listed vertex inside the mesh, ascending, three deltas per stream.
+    for (size_t t = 0; t < v.morph_target_count(); ++t) {
+      const fb::MorphTarget& target = v.morph_target(t);
+      const std::string tw = where + " morph target " + std::to_string(t);
+      text(target.name(), tw + " name");
+      const std::span<const uint32_t> listed = scalars(target.vertices());
+      touch(listed, tw + " vertices");
+      for (size_t i = 0; i < listed.size(); ++i) {
+        if (listed[i] >= count) return fail(tw, "vertex >= vertex_count");
+        if (i > 0 && listed[i] <= listed[i - 1]) return fail(tw, "vertices not strictly increasing");
+      }
+      for (const auto* deltas : {target.position_deltas(), target.normal_deltas(), target.tangent_deltas()}) {
+        const std::span<const int16_t> d = scalars(deltas);
+        touch(d, tw + " deltas");
+        if (!d.empty() && d.size() != 3 * listed.size()) return fail(tw, "deltas not 3 per listed vertex");
+      }
+      if (scalars(target.position_deltas()).size() != 3 * listed.size()) return fail(tw, "no position deltas");
+      if (!std::isfinite(target.default_weight())) return fail(tw, "default weight not finite");
+    }
+
     const std::span<const uint16_t> slots = v.joints();
     if (slots.size() != v.inverse_bind().size()) fail(where, "joints and inverse_bind differ in length");
     const size_t joint_count = asset_.skeleton().empty() ? 0 : asset_.skeleton().joint_count();
@@ -246,6 +266,21 @@ class AssetWalker {
     if (!(std::fabs(v.duration() - expected) <= 1e-4 * expected + 1e-6))
       return fail(where, "duration != (frame_count - 1) / sample_rate");
     const uint32_t joints = v.joint_count();
+
+    for (size_t k = 0; k < v.morph_track_count(); ++k) {
+      const fb::MorphTrack& track = v.morph_track(k);
+      const std::string kw = where + " morph track " + std::to_string(k);
+      text(track.name(), kw + " name");
+      const std::span<const uint16_t> f = scalars(track.key_frames());
+      touch(f, kw + " key_frames");
+      touch(scalars(track.values()), kw + " values");
+      if (f.empty() || f.size() != track.values()->size()) return fail(kw, "key frames and values differ or are empty");
+      if (f[0] != 0) return fail(kw, "first key not at frame 0");
+      for (size_t i = 1; i < f.size(); ++i)
+        if (f[i] <= f[i - 1]) return fail(kw, "key frames not strictly increasing");
+      if (f.size() > 1 && f.back() != frame_count - 1) return fail(kw, "last key not at the last frame");
+      if (!std::isfinite(track.range_min()) || !std::isfinite(track.range_extent())) return fail(kw, "range not finite");
+    }
 
     size_t keys = constants.size();
     for (size_t k = 0; k < constants.size(); ++k) {

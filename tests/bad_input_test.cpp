@@ -548,6 +548,103 @@ TEST(Mesh, JointsInverseBindLengthMismatch) {
 }
 
 // ---------------------------------------------------------------------------------------------
+// Morph targets and weight tracks (format v5): the "morph" variant of test_files.h is valid; each
+// case breaks one thing apply_morphs or sample_morph_weights would otherwise index with.
+
+SyntheticSpec morph_spec() {
+  for (auto& [name, spec] : valid_variants())
+    if (name == "morph") return spec;
+  ADD_FAILURE() << "no morph variant";
+  return {};
+}
+
+TEST(Morph, TheMorphVariantIsAccepted) {
+  const std::vector<uint8_t> bytes = make_valid_file(morph_spec());
+  const auto asset = Asset::from_bytes(bytes, "morph.ossa");
+  ASSERT_TRUE(asset.ok()) << asset.error().message;
+  EXPECT_EQ(asset->mesh(0).morph_target_count(), 2u);
+  EXPECT_EQ(asset->clip(0).morph_track_count(), 2u);
+}
+
+TEST(Morph, TargetVertexPastVertexCount) {
+  SyntheticSpec spec = morph_spec();
+  spec.meshes[0].morph_targets[0].vertices = {4, 6};  // 6 vertices: 0..5
+  EXPECT_TRUE(rejects(spec, with(kMesh, {"morph target 0 'smile'"}, {"vertex 6", "past the vertex count"})));
+}
+
+TEST(Morph, TargetVerticesNotIncreasing) {
+  SyntheticSpec spec = morph_spec();
+  spec.meshes[0].morph_targets[1].vertices = {2, 4, 3};
+  EXPECT_TRUE(rejects(spec, with(kMesh, {"frown"}, {"strictly increase"})));
+  spec.meshes[0].morph_targets[1].vertices = {2, 2, 3};
+  EXPECT_TRUE(rejects(spec, with(kMesh, {"frown"}, {"strictly increase"})));
+}
+
+TEST(Morph, DeltaCountNotThreePerVertex) {
+  SyntheticSpec spec = morph_spec();
+  spec.meshes[0].morph_targets[0].position_deltas.pop_back();
+  EXPECT_TRUE(rejects(spec, with(kMesh, {"position deltas"}, {"3 per vertex"})));
+  spec = morph_spec();
+  spec.meshes[0].morph_targets[1].normal_deltas.resize(12, 0);
+  EXPECT_TRUE(rejects(spec, with(kMesh, {"normal deltas"}, {"3 per vertex"})));
+}
+
+TEST(Morph, StepOrWeightNotFinite) {
+  for (float bad : {kNaN, kInf, -1.0f, 1e9f}) {
+    SyntheticSpec spec = morph_spec();
+    spec.meshes[0].morph_targets[0].position_step = fb::Vec3(0.001f, bad, 0.001f);
+    EXPECT_TRUE(rejects(spec, with(kMesh, {"position step"})));
+  }
+  for (float bad : {kNaN, kInf, 1e6f}) {
+    SyntheticSpec spec = morph_spec();
+    spec.meshes[0].morph_targets[0].default_weight = bad;
+    EXPECT_TRUE(rejects(spec, with(kMesh, {"default weight"})));
+  }
+}
+
+TEST(Morph, TargetNamesEmptyOrRepeated) {
+  SyntheticSpec spec = morph_spec();
+  spec.meshes[0].morph_targets[1].name = "";
+  EXPECT_TRUE(rejects(spec, with(kMesh, {"empty name"})));
+  spec.meshes[0].morph_targets[1].name = "smile";
+  EXPECT_TRUE(rejects(spec, with(kMesh, {"two morph targets named 'smile'"})));
+}
+
+TEST(Morph, WeightTrackValuesNotOnePerKey) {
+  SyntheticSpec spec = morph_spec();
+  spec.clips[0].morph_weights[1].values = {0};  // 2 key frames
+  EXPECT_TRUE(rejects(spec, with(kClip, {"morph weight track 1 'smile'"}, {"2 key frames but 1 values"})));
+  spec = morph_spec();
+  spec.clips[0].morph_weights[0].values.clear();
+  spec.clips[0].morph_weights[0].key_frames.clear();
+  EXPECT_TRUE(rejects(spec, with(kClip, {"frown"}, {"no keys"})));
+}
+
+TEST(Morph, WeightTrackKeysOffTheClip) {
+  SyntheticSpec spec = morph_spec();
+  spec.clips[0].morph_weights[1].key_frames = {0, 31};  // 31 frames: 0..30
+  EXPECT_TRUE(rejects(spec, with(kClip, {"smile"}, {"last key"})));
+  spec.clips[0].morph_weights[1].key_frames = {1, 30};
+  EXPECT_TRUE(rejects(spec, with(kClip, {"smile"}, {"first key"})));
+  spec.clips[0].morph_weights[1].key_frames = {15, 15};
+  EXPECT_TRUE(rejects(spec, with(kClip, {"smile"}, {"first key", "strictly increase"})));
+}
+
+TEST(Morph, WeightTracksNotSortedOrRangeUnbounded) {
+  SyntheticSpec spec = morph_spec();
+  std::swap(spec.clips[0].morph_weights[0], spec.clips[0].morph_weights[1]);
+  EXPECT_TRUE(rejects(spec, with(kClip, {"sorted by name"})));
+  for (float bad : {kNaN, kInf, 1e5f}) {
+    spec = morph_spec();
+    spec.clips[0].morph_weights[1].range_min = bad;
+    EXPECT_TRUE(rejects(spec, with(kClip, {"weight range"})));
+  }
+  spec = morph_spec();
+  spec.clips[0].morph_weights[1].range_extent = -1.0f;
+  EXPECT_TRUE(rejects(spec, with(kClip, {"weight range"})));
+}
+
+// ---------------------------------------------------------------------------------------------
 // Clip invariants
 
 // The default clip (test_files.h): 31 frames at 30/s; constants spine translation, head

@@ -308,6 +308,15 @@ TEST(CookIsolation, RecordRoundTripsEveryField) {
   c.mean_error_mm = 1.0f / 3.0f;
   c.worst_joint = "LeftHand";
   r.clip_records = {c, ossa::cook::ClipRecord{}};
+  ossa::cook::MorphRecord m;
+  m.mesh = "head";
+  m.name = "jawOpen";
+  m.vertices = 1234;
+  m.raw_bytes = 56789;
+  m.stored_bytes = 9876;
+  m.position_error_mm = 0.0199f;
+  m.normal_error_deg = 0.0625f;
+  r.morph_records = {m, ossa::cook::MorphRecord{}};
   r.inputs_read = {{"/src/walk.fbx", 0xfedcba9876543210ull, (uint64_t{1} << 33) + 1, true},
                    {"/src/walk.events.json", 0, 0, false}};
   r.cook_key = 0x8000000000000001ull;
@@ -341,6 +350,17 @@ TEST(CookIsolation, RecordRoundTripsEveryField) {
     EXPECT_EQ(back->inputs_read[i].hash, r.inputs_read[i].hash);
     EXPECT_EQ(back->inputs_read[i].size, r.inputs_read[i].size);
     EXPECT_EQ(back->inputs_read[i].present, r.inputs_read[i].present);
+  }
+  ASSERT_EQ(back->morph_records.size(), 2u);
+  for (size_t i = 0; i < 2; ++i) {
+    const ossa::cook::MorphRecord &a = back->morph_records[i], &b = r.morph_records[i];
+    EXPECT_EQ(a.mesh, b.mesh);
+    EXPECT_EQ(a.name, b.name);
+    EXPECT_EQ(a.vertices, b.vertices);
+    EXPECT_EQ(a.raw_bytes, b.raw_bytes);
+    EXPECT_EQ(a.stored_bytes, b.stored_bytes);
+    EXPECT_EQ(a.position_error_mm, b.position_error_mm);
+    EXPECT_EQ(a.normal_error_deg, b.normal_error_deg);
   }
   ASSERT_EQ(back->clip_records.size(), 2u);
   for (size_t i = 0; i < 2; ++i) {

@@ -209,8 +209,16 @@ flatbuffers::Offset<fb::Mesh> write_mesh(flatbuffers::FlatBufferBuilder& fbb, co
   const auto joints = fbb.CreateVector(m.joints);
   const auto inverse_bind = fbb.CreateVectorOfStructs(slot_inverse_bind);
   const uint32_t count = m.vertex_count.value_or(static_cast<uint32_t>(m.vertices.size()));
+  std::vector<flatbuffers::Offset<fb::MorphTarget>> targets;
+  for (const SyntheticMorphTarget& t : m.morph_targets) {
+    const auto normal_deltas = t.normal_deltas.empty() ? 0 : fbb.CreateVector(t.normal_deltas);
+    targets.push_back(fb::CreateMorphTarget(fbb, fbb.CreateString(t.name), fbb.CreateVector(t.vertices),
+                                            fbb.CreateVector(t.position_deltas), &t.position_step, normal_deltas,
+                                            &t.normal_step, 0, nullptr, t.default_weight, 0.0f, 0.0f));
+  }
+  const auto target_vector = targets.empty() ? 0 : fbb.CreateVector(targets);
   return fb::CreateMesh(fbb, name, count, m.vertex_stride, layout, vertex_bytes, m.index_format, index_bytes,
-                        submeshes, &lo, &hi, &offset, &scale, joints, inverse_bind);
+                        submeshes, &lo, &hi, &offset, &scale, joints, inverse_bind, target_vector);
 }
 
 flatbuffers::Offset<fb::Clip> write_clip(flatbuffers::FlatBufferBuilder& fbb, const SyntheticClip& c,
@@ -278,9 +286,14 @@ flatbuffers::Offset<fb::Clip> write_clip(flatbuffers::FlatBufferBuilder& fbb, co
   std::vector<flatbuffers::Offset<fb::ClipEvent>> events;
   for (const auto& [event_name, time] : c.events) events.push_back(fb::CreateClipEventDirect(fbb, event_name.c_str(), time));
   const auto event_vector = events.empty() ? 0 : fbb.CreateVector(events);
+  std::vector<flatbuffers::Offset<fb::MorphTrack>> tracks;
+  for (const SyntheticMorphTrack& t : c.morph_weights)
+    tracks.push_back(fb::CreateMorphTrack(fbb, fbb.CreateString(t.name), fbb.CreateVector(t.key_frames),
+                                          fbb.CreateVector(t.values), t.range_min, t.range_extent, 0.0f));
+  const auto track_vector = tracks.empty() ? 0 : fbb.CreateVector(tracks);
   return fb::CreateClip(fbb, name, c.duration_value(), c.sample_rate, c.frame_count,
                         c.skeleton_hash.value_or(skeleton_hash), joints, constant_vector, animated_vector, frame_vector,
-                        value_vector, compression, root_motion, event_vector);
+                        value_vector, compression, root_motion, event_vector, track_vector);
 }
 
 /// The synthetic graph (SyntheticSpec::graph): every node kind, parameter type and transition mode.
@@ -486,6 +499,22 @@ std::vector<std::pair<std::string, SyntheticSpec>> valid_variants() {
   spec.graph = true;
   spec.clips[0].events = {{"start", 0.0f}, {"step", 0.25f}, {"step", 0.75f}, {"end", 1.0f}};
   out.emplace_back("graph", spec);
+
+  spec = {};
+  SyntheticMorphTarget frown;
+  frown.name = "frown";
+  frown.vertices = {2, 3, 4};
+  frown.position_deltas = {-500, 0, 0, 500, 0, 0, 0, -300, 0};
+  frown.normal_deltas = {0, 0, 100, 0, 0, -100, 0, 0, 0};
+  frown.normal_step = {0.001f, 0.001f, 0.001f};
+  frown.default_weight = 0.25f;
+  spec.meshes[0].morph_targets = {SyntheticMorphTarget{}, frown};
+  SyntheticMorphTrack constant_frown;
+  constant_frown.name = "frown";
+  constant_frown.key_frames = {0};
+  constant_frown.values = {32768};
+  spec.clips[0].morph_weights = {constant_frown, SyntheticMorphTrack{}};
+  out.emplace_back("morph", spec);
 
   return out;
 }

@@ -53,6 +53,26 @@ struct SyntheticVertex {
   std::array<uint8_t, 4> weights{};  // unorm8, summing to 255
 };
 
+/// A morph target as stored (ossa.fbs MorphTarget): listed vertices with int16 deltas times steps.
+struct SyntheticMorphTarget {
+  std::string name = "smile";
+  std::vector<uint32_t> vertices = {4, 5};                   // the head row of the default grid
+  std::vector<int16_t> position_deltas = {0, 1000, 0, 0, 2000, 0};
+  fb::Vec3 position_step{0.0001f, 0.0001f, 0.0001f};
+  std::vector<int16_t> normal_deltas;                        // empty: none
+  fb::Vec3 normal_step{0, 0, 0};
+  float default_weight = 0.0f;
+};
+
+/// A morph weight track as stored (ossa.fbs MorphTrack).
+struct SyntheticMorphTrack {
+  std::string name = "smile";
+  std::vector<uint16_t> key_frames = {0, 30};
+  std::vector<uint16_t> values = {0, 65535};
+  float range_min = 0.0f;
+  float range_extent = 1.0f;
+};
+
 struct SyntheticMesh {
   std::string name = "body";
   /// A 2 x 3 grid of vertices up the spine: rows y = 0, 1, 2.
@@ -70,6 +90,7 @@ struct SyntheticMesh {
   std::vector<uint16_t> joints = {1, 2, 3};  // slot -> skeleton joint (spine, head, arm)
   /// Default: the skeleton's inverse bind of each slot's joint (identity when out of range).
   std::optional<std::vector<fb::Mat4>> inverse_bind;
+  std::vector<SyntheticMorphTarget> morph_targets;  // none by default
 
   /// Position Unorm16x4 @0, Normal Snorm16x2 @8, TexCoord0 Float16x2 @12, Joints Uint8x4 @16,
   /// Weights Unorm8x4 @20: stride 24, the cooker's default layout.
@@ -132,6 +153,8 @@ struct SyntheticClip {
   bool write_empty_channels = false;
   /// Clip events (name, seconds), written when not empty.
   std::vector<std::pair<std::string, float>> events;
+  /// Morph weight tracks (format v5), written when not empty.
+  std::vector<SyntheticMorphTrack> morph_weights;
 
   float duration_value() const { return duration.value_or(static_cast<float>(frame_count - 1) / sample_rate); }
 
@@ -186,7 +209,8 @@ std::vector<uint8_t> make_valid_file(const SyntheticSpec& spec = {});
 /// Valid files of different shapes, by name: default, uint32-indices, float32-layout (16-bit joint
 /// slots), static-mesh (no skeleton), clip-only, empty-channels (plus a clip without channels),
 /// single-frame (a 1-frame clip of constants), root-motion, low-bits (1- and 3-bit keys), drop-y
-/// (a rotation storing x, z, w in 19 bits), two-meshes, graph (an animation graph and clip events). For suites that must not over-fit the default, and for seeding fuzz corpora.
+/// (a rotation storing x, z, w in 19 bits), two-meshes, graph (an animation graph and clip events),
+/// morph (a mesh with two morph targets and a clip driving them). For suites that must not over-fit the default, and for seeding fuzz corpora.
 std::vector<std::pair<std::string, SyntheticSpec>> valid_variants();
 
 /// A 16-byte aligned copy of some bytes: what verify_buffer expects, and what a std::vector

@@ -242,6 +242,22 @@ nlohmann::ordered_json report_json(const std::vector<CookRecord>& records, const
       clips.push_back(std::move(cj));
     }
     j["clip_compression"] = std::move(clips);
+    if (!r.morph_records.empty()) {
+      nlohmann::ordered_json morphs = nlohmann::ordered_json::array();
+      for (const MorphRecord& m : r.morph_records) {
+        nlohmann::ordered_json mj;
+        mj["mesh"] = m.mesh;
+        mj["name"] = m.name;
+        mj["vertices"] = m.vertices;
+        mj["raw_bytes"] = m.raw_bytes;
+        mj["stored_bytes"] = m.stored_bytes;
+        mj["ratio"] = m.stored_bytes > 0 ? static_cast<double>(m.raw_bytes) / m.stored_bytes : 0.0;
+        mj["position_error_mm"] = m.position_error_mm;
+        mj["normal_error_deg"] = m.normal_error_deg;
+        morphs.push_back(std::move(mj));
+      }
+      j["morph_targets"] = std::move(morphs);
+    }
     j["source_bytes"] = r.source_bytes;
     if (r.ok) j["cooked_bytes"] = r.cooked_bytes;
     if (r.ok) j["up_to_date"] = r.up_to_date;

@@ -121,6 +121,11 @@ void print_details(const CookRecord& r) {
   std::fprintf(stderr, "  %s: %.1f ms, source %s", shown(r.input).c_str(), r.seconds * 1e3, human_bytes(r.source_bytes).c_str());
   if (r.ok) std::fprintf(stderr, ", cooked %s", human_bytes(r.cooked_bytes).c_str());
   std::fprintf(stderr, "\n");
+  for (const MorphRecord& m : r.morph_records)
+    std::fprintf(stderr, "    morph target '%s' of mesh '%s': %u vertices, error %.4f mm / %.3f deg, %u -> %u bytes (%.1f:1)\n",
+                 shown(m.name).c_str(), shown(m.mesh).c_str(), m.vertices, static_cast<double>(m.position_error_mm),
+                 static_cast<double>(m.normal_error_deg), m.raw_bytes, m.stored_bytes,
+                 m.stored_bytes > 0 ? static_cast<double>(m.raw_bytes) / m.stored_bytes : 0.0);
   for (const ClipRecord& c : r.clip_records)
     std::fprintf(stderr, "    clip '%s': %u frames, %u joints, max error %.4f mm (mean %.4f mm, at '%s'), %u -> %u bytes (%.1f:1)\n",
                  shown(c.name).c_str(), c.frames, c.joints, static_cast<double>(c.max_error_mm),

@@ -41,8 +41,11 @@ using Clock = std::chrono::steady_clock;
 // back without it. Sizes are checked on the one platform the cooker is built for (64-bit
 // libstdc++); a field that fits in padding slips through, so the round-trip test is the other half.
 #if defined(__GLIBCXX__) && defined(__LP64__)
-static_assert(sizeof(CookRecord) == 288,
+static_assert(sizeof(CookRecord) == 312,
               "CookRecord changed: extend record_to_json / record_from_json (cooker/cli/worker.cpp) and "
+              "the round trip in tests/cook_isolation_test.cpp, then update this size");
+static_assert(sizeof(MorphRecord) == 88,
+              "MorphRecord changed: extend record_to_json / record_from_json (cooker/cli/worker.cpp) and "
               "the round trip in tests/cook_isolation_test.cpp, then update this size");
 static_assert(sizeof(ClipRecord) == 88,
               "ClipRecord changed: extend record_to_json / record_from_json (cooker/cli/worker.cpp) and "
@@ -71,6 +74,15 @@ void read_field(const json& j, const char* key, T& out) {
 }  // namespace
 
 json record_to_json(const CookRecord& r) {
+  json morphs = json::array();
+  for (const MorphRecord& m : r.morph_records)
+    morphs.push_back({{"mesh", m.mesh},
+                      {"name", m.name},
+                      {"vertices", m.vertices},
+                      {"raw_bytes", m.raw_bytes},
+                      {"stored_bytes", m.stored_bytes},
+                      {"position_error_mm", m.position_error_mm},
+                      {"normal_error_deg", m.normal_error_deg}});
   json clips = json::array();
   for (const ClipRecord& c : r.clip_records)
     clips.push_back({{"name", c.name},
@@ -102,6 +114,7 @@ json record_to_json(const CookRecord& r) {
           {"cooked_bytes", r.cooked_bytes},
           {"seconds", r.seconds},
           {"clip_records", std::move(clips)},
+          {"morph_records", std::move(morphs)},
           {"inputs_read", std::move(inputs)},
           {"cook_key", r.cook_key},
           {"up_to_date", r.up_to_date}};
@@ -141,6 +154,19 @@ std::optional<CookRecord> record_from_json(const json& j) {
       read_field(cj, "mean_error_mm", c.mean_error_mm);
       read_field(cj, "worst_joint", c.worst_joint);
       r.clip_records.push_back(std::move(c));
+    }
+    if (const auto it = j.find("morph_records"); it != j.end() && it->is_array()) {
+      for (const json& mj : *it) {
+        MorphRecord m;
+        read_field(mj, "mesh", m.mesh);
+        read_field(mj, "name", m.name);
+        read_field(mj, "vertices", m.vertices);
+        read_field(mj, "raw_bytes", m.raw_bytes);
+        read_field(mj, "stored_bytes", m.stored_bytes);
+        read_field(mj, "position_error_mm", m.position_error_mm);
+        read_field(mj, "normal_error_deg", m.normal_error_deg);
+        r.morph_records.push_back(std::move(m));
+      }
     }
     const json& inputs = j.at("inputs_read");
     if (!inputs.is_array()) return std::nullopt;

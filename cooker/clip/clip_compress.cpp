@@ -887,6 +887,14 @@ Result<CompressedClip> compress_clip(const SourceClip& clip, const SourceSkeleto
   out.has_root_motion = clip.has_root_motion;
   out.events = clip.events;
   out.root_motion = clip.root_motion;
+  for (const SourceMorphTrack& track : clip.morph_weights)
+    out.morph_weights.push_back(
+        compress_morph_track(track, out.grid, options.enabled ? options.morph_weight_tolerance : 0.0f));
+  std::sort(out.morph_weights.begin(), out.morph_weights.end(),
+            [](const CompressedMorphTrack& a, const CompressedMorphTrack& b) { return a.name < b.name; });
+  for (size_t k = 1; k < out.morph_weights.size(); ++k)
+    if (out.morph_weights[k].name == out.morph_weights[k - 1].name)
+      return Error{label + "two morph weight tracks drive '" + out.morph_weights[k].name + "'"};
 
   const double unit = std::isfinite(metres_per_unit) && metres_per_unit > 0.0f ? metres_per_unit : 1.0;
   const double probe = options.probe_metres / unit;

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "cooker/clip/clip_grid.h"
+#include "cooker/clip/morph_weights.h"
 #include "cooker/import/source_scene.h"
 #include <ossa/format/result.h>
 
@@ -24,6 +25,7 @@ struct ClipCompressionOptions {
                                     // other channel raw floats at every frame)
   float tolerance_metres = 0.0001f; // 0.1 mm ...
   float probe_metres = 0.1f;        // ... at 10 cm
+  float morph_weight_tolerance = 0.001f;  // largest error of a morph weight at any frame
 };
 
 struct CompressedConstant {
@@ -62,6 +64,7 @@ struct CompressedClip {
   bool has_root_motion = false;
   SourceRootMotion root_motion;
   std::vector<SourceEvent> events;            // copied from the source clip
+  std::vector<CompressedMorphTrack> morph_weights;  // sorted by name (format v5)
 };
 
 /// Compresses one clip of `skeleton`. metres_per_unit converts the tolerances to source units.

@@ -12,6 +12,7 @@
 namespace ossa::cook {
 namespace {
 
+float mix_value(float a, float b, float t) { return a + (b - a) * t; }
 glm::vec3 mix_value(const glm::vec3& a, const glm::vec3& b, float t) { return a + (b - a) * t; }
 glm::quat mix_value(const glm::quat& a, const glm::quat& b, float t) {
   const glm::quat bb = glm::dot(a, b) < 0.0f ? -b : b;  // the short way, as the compressor blends
@@ -74,6 +75,12 @@ std::string split_long_clip(SourceClip clip, std::vector<SourceClip>* out) {
       cut_channel(track.rotation_times, track.rotations, t0, t1, &cut.rotation_times, &cut.rotations);
       cut_channel(track.scale_times, track.scales, t0, t1, &cut.scale_times, &cut.scales);
       part.tracks.push_back(std::move(cut));
+    }
+    for (const SourceMorphTrack& track : clip.morph_weights) {
+      SourceMorphTrack cut;
+      cut.name = track.name;
+      cut_channel(track.times, track.weights, t0, t1, &cut.times, &cut.weights);
+      part.morph_weights.push_back(std::move(cut));
     }
     char range[96];
     std::snprintf(range, sizeof range, " (%.3f-%.3f s)", static_cast<double>(t0), static_cast<double>(t1));

@@ -491,7 +491,17 @@ void read_sampler_keys(Reader& r, const Json& sampler, Sampler* s) {
       return;
     }
   }
-  if (components != 3 && components != 4) {
+  if (s->weights) {
+    if (components != 1) {
+      s->error = out_label + " is not SCALAR (morph weights)";
+      return;
+    }
+    if (s->width <= 0) {
+      s->error = "the weights it animates belong to no mesh with morph targets";
+      return;
+    }
+    components = s->width;  // one element = one weight per target
+  } else if (components != 3 && components != 4) {
     s->error = out_label + " is neither VEC3 nor VEC4";
     return;
   }
@@ -518,6 +528,7 @@ TargetPath target_path(const std::string& path) {
   if (path == "translation") return TargetPath::Translation;
   if (path == "rotation") return TargetPath::Rotation;
   if (path == "scale") return TargetPath::Scale;
+  if (path == "weights") return TargetPath::Weights;
   return TargetPath::Other;
 }
 
@@ -530,6 +541,7 @@ Result<Animations> parse_json(const Json& root, std::optional<std::span<const ui
     for (size_t i = 0; i < nodes->size(); ++i) {
       const Json& n = (*nodes)[i];
       out.nodes[i].name = get_string(n, "name");
+      if (const std::optional<uint64_t> mesh = get_uint(n, "mesh")) out.nodes[i].mesh = static_cast<int>(*mesh);
       if (const Json* children = get_array(n, "children")) {
         for (const Json& c : *children) {
           const bool valid = c.is_number_unsigned() && c.get<uint64_t>() < nodes->size();
@@ -538,6 +550,24 @@ Result<Animations> parse_json(const Json& root, std::optional<std::span<const ui
       }
     }
   }
+  if (const Json* meshes = get_array(root, "meshes")) {
+    for (const Json& m : *meshes) {
+      MeshTargets targets;
+      size_t count = 0;
+      if (const Json* primitives = get_array(m, "primitives"))
+        for (const Json& p : *primitives)
+          if (const Json* t = get_array(p, "targets")) count = std::max(count, t->size());
+      const Json* extras = get_object(m, "extras");
+      const Json* names = extras ? get_array(*extras, "targetNames") : nullptr;
+      for (size_t i = 0; i < count; ++i) {
+        const bool named = names && i < names->size() && (*names)[i].is_string() && !(*names)[i].get<std::string>().empty();
+        targets.names.push_back(named ? (*names)[i].get<std::string>() : "target" + std::to_string(i));
+      }
+      out.meshes.push_back(std::move(targets));
+    }
+  }
+  for (Node& node : out.nodes)
+    if (node.mesh >= 0 && static_cast<size_t>(node.mesh) >= out.meshes.size()) node.mesh = -1;
   const uint64_t scene_index = get_uint(root, "scene").value_or(0);
   if (const Json* scene = element(root, "scenes", scene_index)) {
     if (const Json* roots = get_array(*scene, "nodes")) {
@@ -582,13 +612,23 @@ Result<Animations> parse_json(const Json& root, std::optional<std::span<const ui
       out.animations.push_back(std::move(anim));
     }
   }
+  // Weights samplers: as wide as the target count of the mesh their node holds.
+  for (Animation& anim : out.animations) {
+    for (const Channel& ch : anim.channels) {
+      if (ch.path != TargetPath::Weights || ch.sampler < 0) continue;
+      Sampler& sampler = anim.samplers[static_cast<size_t>(ch.sampler)];
+      sampler.weights = true;
+      const int mesh = ch.node >= 0 ? out.nodes[static_cast<size_t>(ch.node)].mesh : -1;
+      sampler.width = mesh >= 0 ? static_cast<int>(out.meshes[static_cast<size_t>(mesh)].names.size()) : 0;
+    }
+  }
   // Decode the keys of the samplers Assimp mishandles, and only those.
   const Json* animations = get_array(root, "animations");
   for (size_t a = 0; a < out.animations.size(); ++a) {
     for (size_t s = 0; s < out.animations[a].samplers.size(); ++s) {
       Sampler& sampler = out.animations[a].samplers[s];
-      if (sampler.interpolation == Interpolation::Linear || !sampler.error.empty()) continue;
-      out.any_nonlinear = true;
+      if ((sampler.interpolation == Interpolation::Linear && !sampler.weights) || !sampler.error.empty()) continue;
+      if (sampler.interpolation != Interpolation::Linear) out.any_nonlinear = true;
       read_sampler_keys(reader, (*get_array((*animations)[a], "samplers"))[s], &sampler);
     }
   }
@@ -692,7 +732,7 @@ void evaluate(const Sampler& s, double time, double snap, double* out) {
         const double a = s.values[((k + 1) * 3 + 0) * w + c];
         out[c] = h00 * value(k, c) + h10 * delta * b + h01 * value(k + 1, c) + h11 * delta * a;
       }
-    } else if (w == 4) {
+    } else if (w == 4 && !s.weights) {
       // LINEAR rotation: slerp on the shorter arc.
       double dot = 0.0;
       for (size_t c = 0; c < 4; ++c) dot += value(k, c) * value(k + 1, c);
@@ -709,7 +749,7 @@ void evaluate(const Sampler& s, double time, double snap, double* out) {
       for (size_t c = 0; c < w; ++c) out[c] = (1.0 - u) * value(k, c) + u * value(k + 1, c);
     }
   }
-  if (w == 4) {
+  if (w == 4 && !s.weights) {
     const double len =
         std::sqrt(out[0] * out[0] + out[1] * out[1] + out[2] * out[2] + out[3] * out[3]);
     if (len > 1e-12 && std::isfinite(len)) {

@@ -24,8 +24,8 @@ namespace ossa::cook::gltf {
 
 enum class Interpolation : uint8_t { Linear, Step, CubicSpline };
 
-/// What a channel animates. Weights (morph targets) and anything unknown are Other: not read.
-enum class TargetPath : uint8_t { Translation, Rotation, Scale, Other };
+/// What a channel animates; anything unknown is Other (not read).
+enum class TargetPath : uint8_t { Translation, Rotation, Scale, Weights, Other };
 
 struct Sampler {
   Interpolation interpolation = Interpolation::Linear;
@@ -35,7 +35,9 @@ struct Sampler {
   /// (in-tangent, value, out-tangent) for CUBICSPLINE. Normalized integer outputs are converted
   /// to float with the specification's formulas. Rotations are (x, y, z, w).
   std::vector<float> values;
-  int width = 0;  // components per element: 3 (VEC3) or 4 (VEC4)
+  int width = 0;  // components per element: 3 (VEC3) or 4 (VEC4); weights: the mesh's target count
+  /// A morph weights sampler (SCALAR output, `width` weights per element): never a rotation.
+  bool weights = false;
   /// Non-empty when the sampler's keys could not be read: why, naming the accessor at fault.
   std::string error;
 };
@@ -55,6 +57,14 @@ struct Animation {
 struct Node {
   std::string name;           // "" when unnamed
   std::vector<int> children;  // glTF node indices, in the file's order
+  int mesh = -1;              // glTF mesh index, -1 when none
+};
+
+/// A mesh's morph targets as the file names them (for weight channels).
+struct MeshTargets {
+  /// One per target: `extras.targetNames[i]`, or "target<i>" (the name the cooker gives an unnamed
+  /// target on the mesh side too, import_meshes.cpp).
+  std::vector<std::string> names;
 };
 
 struct Animations {
@@ -62,10 +72,13 @@ struct Animations {
   /// Root nodes of the scene Assimp imports: `scene` when given, else scenes[0].
   std::vector<int> scene_roots;
   std::vector<Animation> animations;
+  std::vector<MeshTargets> meshes;  // one per glTF mesh
   /// True when at least one sampler is STEP or CUBICSPLINE (only then are buffers read).
   bool any_nonlinear = false;
 };
 
+/// Weights samplers (channels with path "weights") are always decoded, whatever their
+/// interpolation: Assimp 5.2.5 clamps negative weights and drops CUBICSPLINE tangents.
 /// Reads the animation part of a .gltf or .glb file (by its first bytes, not its extension).
 /// External buffers are resolved relative to the file; `data:` URIs must be base64.
 /// Errors name the file and what is wrong. Cost: the JSON parse, plus reading the buffers that
@@ -85,8 +98,8 @@ std::string assimp_node_name(const Animations& file, int index);
 /// value outside the keys, the held value for STEP, the Hermite spline for CUBICSPLINE (tangents
 /// scaled by the key interval), a lerp (slerp for width 4) for LINEAR. A key up to `snap` seconds
 /// after `time` counts as reached: a frame that should sit exactly on a key but was rounded a
-/// hair before it gets that key's STEP value. Writes `width` doubles to out; rotations are
-/// normalized. Requires a sampler without error and with at least one key.
+/// hair before it gets that key's STEP value. Writes `width` doubles to out; rotations (width 4,
+/// not weights) are slerped and normalized. Requires a sampler without error and with at least one key.
 void evaluate(const Sampler& sampler, double time, double snap, double* out);
 
 /// True when the sampler's curve is the straight line between its values, so Assimp's linear

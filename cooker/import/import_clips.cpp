@@ -406,6 +406,9 @@ struct GltfFix {
 struct GltfClip {
   std::vector<GltfFix> fixes;
   std::vector<std::string> kept;
+  /// Morph weight channels, read from the file (Assimp 5.2.5 clamps negative weights and drops
+  /// CUBICSPLINE tangents), each with the target names of the mesh its node holds.
+  std::vector<std::pair<const gltf::Sampler*, const std::vector<std::string>*>> weights;
 };
 
 /// The file's samplers mapped onto the node graph, one GltfClip per aiAnimation.
@@ -481,6 +484,15 @@ GltfClip plan_gltf_clip(const gltf::Animations& file, const gltf::Animation& ani
   for (const gltf::Channel& ch : anim.channels) {
     if (ch.node < 0 || ch.sampler < 0 || ch.path == gltf::TargetPath::Other) continue;
     const gltf::Sampler& s = anim.samplers[static_cast<size_t>(ch.sampler)];
+    if (ch.path == gltf::TargetPath::Weights) {
+      const int mesh = file.nodes[static_cast<size_t>(ch.node)].mesh;
+      if (!s.error.empty()) {
+        out.kept.push_back("'" + gltf::assimp_node_name(file, ch.node) + "' weights dropped (" + s.error + ")");
+      } else if (mesh >= 0 && !s.times.empty()) {
+        out.weights.emplace_back(&s, &file.meshes[static_cast<size_t>(mesh)].names);
+      }
+      continue;
+    }
     if (s.interpolation == gltf::Interpolation::Linear && s.error.empty()) continue;
     if (!seen.insert({ch.node, static_cast<int>(ch.path)}).second) continue;
     const std::string name = gltf::assimp_node_name(file, ch.node);
@@ -526,7 +538,10 @@ std::optional<GltfSamplers> read_gltf_samplers(const Context& ctx, const NodeGra
     ctx.warn("glTF samplers not read (" + file.error().message + ")" + fallback);
     return std::nullopt;
   }
-  if (!file->any_nonlinear) return std::nullopt;
+  bool any_weights = false;
+  for (const gltf::Animation& anim : file->animations)
+    for (const gltf::Channel& ch : anim.channels) any_weights = any_weights || ch.path == gltf::TargetPath::Weights;
+  if (!file->any_nonlinear && !any_weights) return std::nullopt;
   const aiScene& scene = *ctx.scene;
   if (file->animations.size() != scene.mNumAnimations) {
     ctx.warn("the file has " + std::to_string(file->animations.size()) + " animations, Assimp " +
@@ -600,6 +615,94 @@ void resample_gltf_channel(const GltfFix& fix, const FrameGrid& grid, float dura
       out_vec->push_back(glm::dvec3(v[0], v[1], v[2]));
     }
     out_times->push_back(t * tps);
+  }
+}
+
+/// Adds `track` unless a track of that name exists (several meshes of one head, each animated by
+/// its own node, usually carry the same curve); counts the differing duplicates.
+void add_morph_track(SourceMorphTrack track, std::vector<SourceMorphTrack>* tracks, size_t* conflicts) {
+  for (const SourceMorphTrack& t : *tracks) {
+    if (t.name != track.name) continue;
+    if (t.times != track.times || t.weights != track.weights) ++*conflicts;
+    return;
+  }
+  tracks->push_back(std::move(track));
+}
+
+/// The glTF weight channels of one clip as morph tracks: LINEAR keys as stored; STEP and
+/// CUBICSPLINE evaluated at every frame of the grid and at their own key times.
+void gltf_morph_tracks(const GltfClip& gltf_clip, const FrameGrid& grid, float duration,
+                       std::vector<SourceMorphTrack>* tracks, size_t* conflicts) {
+  const double snap = 1e-4 / grid.sample_rate;
+  for (const auto& [sampler, names] : gltf_clip.weights) {
+    const gltf::Sampler& s = *sampler;
+    std::vector<double> times;
+    if (s.interpolation == gltf::Interpolation::Linear) {
+      times.assign(s.times.begin(), s.times.end());
+    } else {
+      for (uint32_t f = 0; f < grid.frame_count && grid.time(f) <= duration + snap; ++f) times.push_back(grid.time(f));
+      for (float t : s.times)
+        if (t >= 0.0f && t <= duration) times.push_back(t);
+      std::sort(times.begin(), times.end());
+      std::vector<double> unique;
+      for (double t : times)
+        if (unique.empty() || t - unique.back() > snap) unique.push_back(t);
+      times = std::move(unique);
+    }
+    std::vector<double> value(static_cast<size_t>(s.width));
+    std::vector<SourceMorphTrack> per_target(names->size());
+    for (size_t i = 0; i < names->size(); ++i) per_target[i].name = (*names)[i];
+    for (double t : times) {
+      gltf::evaluate(s, t, snap, value.data());
+      for (size_t i = 0; i < names->size() && i < value.size(); ++i) {
+        per_target[i].times.push_back(static_cast<float>(t));
+        per_target[i].weights.push_back(static_cast<float>(value[i]));
+      }
+    }
+    for (SourceMorphTrack& track : per_target)
+      if (!track.times.empty()) add_morph_track(std::move(track), tracks, conflicts);
+  }
+}
+
+/// Assimp's morph channels (FBX blend shape animation; glTF's come from the file instead). Each
+/// aiMeshMorphAnim names a mesh (or the node holding it); its keys list, per time, the targets
+/// keyed then and their weights. Keys are merged across targets there, so each target's own keys
+/// are collected (a target absent from a key has no key at that time) and interpolated alone.
+void assimp_morph_tracks(const aiScene& scene, const aiAnimation& anim, double tps,
+                         std::vector<SourceMorphTrack>* tracks, size_t* conflicts) {
+  for (unsigned c = 0; c < anim.mNumMorphMeshChannels; ++c) {
+    const aiMeshMorphAnim* ch = anim.mMorphMeshChannels[c];
+    if (!ch) continue;
+    const aiMesh* mesh = nullptr;
+    for (unsigned m = 0; m < scene.mNumMeshes && !mesh; ++m)
+      if (scene.mMeshes[m] && scene.mMeshes[m]->mNumAnimMeshes && scene.mMeshes[m]->mName == ch->mName)
+        mesh = scene.mMeshes[m];
+    if (!mesh && scene.mRootNode) {
+      if (const aiNode* node = scene.mRootNode->FindNode(ch->mName))
+        for (unsigned i = 0; i < node->mNumMeshes && !mesh; ++i)
+          if (node->mMeshes[i] < scene.mNumMeshes && scene.mMeshes[node->mMeshes[i]]->mNumAnimMeshes)
+            mesh = scene.mMeshes[node->mMeshes[i]];
+    }
+    if (!mesh) continue;
+    std::map<unsigned, SourceMorphTrack> per_target;
+    for (unsigned k = 0; k < ch->mNumKeys; ++k) {
+      const aiMeshMorphKey& key = ch->mKeys[k];
+      const double t = key.mTime / tps;
+      if (!std::isfinite(t) || !key.mValues || !key.mWeights) continue;
+      for (unsigned i = 0; i < key.mNumValuesAndWeights; ++i) {
+        const unsigned target = key.mValues[i];
+        if (target >= mesh->mNumAnimMeshes || !std::isfinite(key.mWeights[i])) continue;
+        SourceMorphTrack& track = per_target[target];
+        if (!track.times.empty() && !(static_cast<float>(t) > track.times.back())) continue;
+        track.times.push_back(static_cast<float>(t));
+        track.weights.push_back(static_cast<float>(key.mWeights[i]));
+      }
+    }
+    for (auto& [target, track] : per_target) {
+      const aiAnimMesh* am = mesh->mAnimMeshes[target];
+      track.name = am && am->mName.length ? am->mName.C_Str() : "target" + std::to_string(target);
+      add_morph_track(std::move(track), tracks, conflicts);
+    }
   }
 }
 
@@ -759,6 +862,9 @@ SourceClip import_clip(const Context& ctx, const NodeGraph& graph, const Rig& ri
     ctx.warn(label + "keys are not on any uniform frame grid; resampled at " + std::to_string(clip.sample_rate) +
              " frames per second");
   }
+  // Weight keys past the joints' last key lengthen the clip.
+  if (gltf_clip)
+    for (const auto& w : gltf_clip->weights) clip.duration = std::max(clip.duration, w.first->times.back());
   if (gltf_clip && !gltf_clip->fixes.empty()) {
     // The rate first (from the source's own key times), then the keys on that grid.
     clip.sample_rate = resampling_rate(keys.keys, tps, clip.sample_rate, clip.duration);
@@ -782,8 +888,21 @@ SourceClip import_clip(const Context& ctx, const NodeGraph& graph, const Rig& ri
   if (duplicates) {
     ctx.warn(label + std::to_string(duplicates) + " keys at a time already keyed are dropped");
   }
-  if (anim.mNumMeshChannels || anim.mNumMorphMeshChannels) summary->morphs.push_back(clip.name);
-  if (clip.tracks.empty()) summary->empty.push_back(clip.name);
+  size_t conflicts = 0;
+  if (gltf_clip) {
+    gltf_morph_tracks(*gltf_clip, frame_grid(clip), clip.duration, &clip.morph_weights, &conflicts);
+  } else if (ctx.format != SourceFormat::Gltf) {
+    assimp_morph_tracks(*ctx.scene, anim, tps, &clip.morph_weights, &conflicts);
+  }
+  std::sort(clip.morph_weights.begin(), clip.morph_weights.end(),
+            [](const SourceMorphTrack& a, const SourceMorphTrack& b) { return a.name < b.name; });
+  if (conflicts) {
+    ctx.warn(label + std::to_string(conflicts) +
+             " morph weight curves differ from another curve for a target of the same name; the first is kept");
+  }
+  if (anim.mNumMeshChannels || (anim.mNumMorphMeshChannels && clip.morph_weights.empty()))
+    summary->morphs.push_back(clip.name);
+  if (clip.tracks.empty() && clip.morph_weights.empty()) summary->empty.push_back(clip.name);
   return clip;
 }
 
@@ -829,7 +948,7 @@ std::vector<SourceClip> import_clips(const Context& ctx, const NodeGraph& graph,
   }
   clips = std::move(fitted);
   if (!summary.morphs.empty()) {
-    ctx.warn("mesh and morph-target channels are not supported, dropped from clips: " +
+    ctx.warn("mesh channels, and morph channels for targets no mesh holds, are dropped from clips: " +
              join(summary.morphs));
   }
   if (!summary.empty.empty()) ctx.warn("clips that animate no joint: " + join(summary.empty));

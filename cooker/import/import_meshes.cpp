@@ -184,6 +184,54 @@ bool copy_geometry(const aiMesh& in, SourceFormat format, SourceMesh* out, size_
   return true;
 }
 
+/// The mesh's morph targets as deltas. Assimp 5.2.5 hands glTF and FBX targets over as absolute
+/// values (its aiAnimMesh starts as a copy of the base and adds the source's offsets), so the base
+/// is subtracted here; the cooker's own welding and reordering then carry each target with its
+/// vertices (mesh_build.cpp). Names are Assimp's (glTF `extras.targetNames`, FBX shape names), or
+/// "target<i>" for an unnamed one, made unique within the mesh. The default weight is glTF's
+/// mesh.weights; FBX targets start at 0, since Assimp reports 1 for every single-shape FBX channel
+/// whatever its DeformPercent. Targets whose vertex count differs from the mesh's are dropped.
+void copy_morph_targets(const aiMesh& in, SourceFormat format, SourceMesh* out, std::vector<std::string>* dropped) {
+  const unsigned nv = in.mNumVertices;
+  std::set<std::string> used;
+  for (unsigned t = 0; t < in.mNumAnimMeshes; ++t) {
+    const aiAnimMesh* am = in.mAnimMeshes[t];
+    const std::string given = am && am->mName.length ? am->mName.C_Str() : "target" + std::to_string(t);
+    if (!am || am->mNumVertices != nv || !am->mVertices) {
+      dropped->push_back(given);
+      continue;
+    }
+    SourceMorphTarget target;
+    target.name = given;
+    for (int n = 2; used.count(target.name); ++n) target.name = given + " (" + std::to_string(n) + ")";
+    used.insert(target.name);
+    target.default_weight = format == SourceFormat::Gltf && std::isfinite(am->mWeight) ? am->mWeight : 0.0f;
+    bool finite_deltas = true;
+    target.positions.reserve(nv);
+    for (unsigned v = 0; v < nv; ++v) {
+      target.positions.push_back(to_vec3(am->mVertices[v]) - to_vec3(in.mVertices[v]));
+      finite_deltas = finite_deltas && finite(target.positions.back());
+    }
+    if (am->mNormals && in.mNormals) {
+      for (unsigned v = 0; v < nv; ++v) {
+        target.normals.push_back(to_vec3(am->mNormals[v]) - to_vec3(in.mNormals[v]));
+        finite_deltas = finite_deltas && finite(target.normals.back());
+      }
+    }
+    if (am->mTangents && in.mTangents && !out->tangents.empty()) {
+      for (unsigned v = 0; v < nv; ++v) {
+        target.tangents.push_back(to_vec3(am->mTangents[v]) - to_vec3(in.mTangents[v]));
+        finite_deltas = finite_deltas && finite(target.tangents.back());
+      }
+    }
+    if (!finite_deltas) {
+      dropped->push_back(given);
+      continue;
+    }
+    out->morph_targets.push_back(std::move(target));
+  }
+}
+
 /// Bakes the node's global transform into a mesh that no joint carries.
 void bake(const glm::dmat4& global, SourceMesh* mesh) {
   const glm::mat4 m = to_float(global);
@@ -197,12 +245,18 @@ void bake(const glm::dmat4& global, SourceMesh* mesh) {
     const float len = glm::length(d);
     t = glm::vec4(len > 0.0f ? d / len : glm::vec3(1, 0, 0), t.w * mirror);
   }
+  // Deltas are differences of positions (directions): the linear part alone moves them.
+  for (SourceMorphTarget& target : mesh->morph_targets) {
+    for (auto& d : target.positions) d = linear * d;
+    for (auto& d : target.normals) d = normal_matrix * d;
+    for (auto& d : target.tangents) d = linear * d;
+  }
 }
 
 struct MeshStats {
   size_t dropped_faces = 0, repaired_normals = 0, unweighted = 0, bad_offsets = 0;
   uint32_t over_4 = 0;
-  std::vector<std::string> empty, non_finite;
+  std::vector<std::string> empty, non_finite, dropped_targets;
 };
 
 /// Influences from the mesh's bones; false when none of its bones is a joint.
@@ -274,6 +328,7 @@ void import_instance(const Context& ctx, const NodeGraph& graph, const Rig& rig,
     stats->empty.push_back(out.name);
     return;
   }
+  copy_morph_targets(in, ctx.format, &out, &stats->dropped_targets);
   const bool skinned = in.mNumBones > 0 && skin(in, graph, rig, node, &out, stats);
   if (!skinned) {
     const int joint = attached_joint(graph, rig, node);
@@ -305,6 +360,11 @@ void report(const Context& ctx, const MeshStats& stats) {
     ctx.warn(std::to_string(stats.unweighted) +
              " skinned vertices with no weight are carried by the joint their mesh hangs under");
   }
+  if (!stats.dropped_targets.empty()) {
+    std::string list;
+    for (size_t i = 0; i < stats.dropped_targets.size(); ++i) list += (i ? ", " : "") + stats.dropped_targets[i];
+    ctx.warn("morph targets whose vertices do not match their mesh's or are not finite are dropped: " + list);
+  }
   if (stats.bad_offsets) {
     ctx.warn(std::to_string(stats.bad_offsets) + " bones with a non-finite offset matrix dropped");
   }
@@ -334,10 +394,6 @@ std::vector<bool> select_meshes(const Context& ctx) {
       continue;
     }
     kept[m] = true;
-    if (mesh->mNumAnimMeshes) {
-      ctx.warn("mesh '" + std::string(mesh->mName.C_Str()) + "': " +
-               std::to_string(mesh->mNumAnimMeshes) + " morph targets are not supported, dropped");
-    }
   }
   if (generated) {
     ctx.warn("the skeleton display mesh Assimp generates for skeleton-only files is dropped");

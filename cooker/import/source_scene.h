@@ -31,6 +31,17 @@ struct SourceSkeleton {
   float metres_per_unit = 0.0f;
 };
 
+/// A morph target (blend shape) of one source mesh: dense deltas, one per vertex of the mesh,
+/// added to the base vertex scaled by the target's weight (before skinning). Importers that give
+/// targets as absolute values (Assimp does for glTF and FBX) subtract the base here.
+struct SourceMorphTarget {
+  std::string name;                      // unique within the mesh; binds clips' weight tracks
+  std::vector<glm::vec3> positions;      // one per vertex
+  std::vector<glm::vec3> normals;        // empty or one per vertex
+  std::vector<glm::vec3> tangents;       // empty or one per vertex (direction only)
+  float default_weight = 0.0f;           // glTF mesh.weights
+};
+
 /// One source mesh (Assimp splits by material, so one material each). Positions etc. are in mesh
 /// space; joints are skeleton joint indices with the matching inverse bind in `bind`.
 struct SourceMesh {
@@ -52,6 +63,7 @@ struct SourceMesh {
   /// Skeleton joint -> the inverse bind matrix this mesh's skin uses for it. Sorted by joint,
   /// covering every joint referenced by `joints`.
   std::vector<std::pair<uint16_t, glm::mat4>> bind;
+  std::vector<SourceMorphTarget> morph_targets;
 };
 
 struct SourceTrack {
@@ -78,6 +90,14 @@ struct SourceEvent {
   float time = 0.0f;                     // seconds, in [0, duration]
 };
 
+/// One morph target's weight over a clip: keys in seconds, linear between (the importer resamples
+/// STEP and CUBICSPLINE curves onto the clip's frame grid plus its key times).
+struct SourceMorphTrack {
+  std::string name;                      // the targets it drives (SourceMorphTarget::name)
+  std::vector<float> times;              // seconds, strictly increasing, at least one
+  std::vector<float> weights;            // one per time
+};
+
 struct SourceClip {
   std::string name;
   /// The name the source gave the clip, when the cooker chose another (a file's single clip with a
@@ -90,6 +110,7 @@ struct SourceClip {
   bool has_root_motion = false;
   SourceRootMotion root_motion;          // when has_root_motion
   std::vector<SourceEvent> events;       // sorted by time
+  std::vector<SourceMorphTrack> morph_weights;  // sorted by name, names unique
 };
 
 /// Whether `name` names this clip: its cooked name, or the name its source gave it.

@@ -56,6 +56,8 @@
 #include <cstring>
 #include <limits>
 #include <map>
+#include <set>
+#include <unordered_map>
 #include <utility>
 
 #include <ossa/format/vertex_codec.h>
@@ -195,6 +197,21 @@ Status validate_mesh(const SourceScene& scene, size_t index) {
     return bad("material " + std::to_string(m.material) + " is not below the material count " +
                std::to_string(scene.materials.size()));
   if (!m.joints.empty() && scene.skeleton.joints.empty()) return bad("is skinned but the scene has no skeleton");
+  std::set<std::string> target_names;
+  for (const SourceMorphTarget& t : m.morph_targets) {
+    const std::string tl = "morph target '" + t.name + "'";
+    if (t.name.empty()) return bad("has a morph target without a name");
+    if (!target_names.insert(t.name).second) return bad("has two morph targets named '" + t.name + "'");
+    if (t.positions.size() != n)
+      return bad(tl + " has " + std::to_string(t.positions.size()) + " position deltas for " + std::to_string(n) +
+                 " vertices");
+    if (!t.normals.empty() && t.normals.size() != n) return bad(tl + " has a normal delta count unlike its vertices'");
+    if (!t.tangents.empty() && t.tangents.size() != n) return bad(tl + " has a tangent delta count unlike its vertices'");
+    for (const auto* stream : {&t.positions, &t.normals, &t.tangents})
+      for (const glm::vec3& d : *stream)
+        if (!finite(d)) return bad(tl + " has a non-finite delta");
+    if (!std::isfinite(t.default_weight)) return bad(tl + " has a non-finite default weight");
+  }
   return {};
 }
 
@@ -229,9 +246,64 @@ void compact(std::vector<T>& stream, const std::vector<unsigned>& remap, size_t 
 
 // The mesh with every set of vertices equal in all streams (bit for bit) merged into one, and
 // vertices no triangle references dropped (counted in *unused). O(vertices + indices), hashed.
+// With morph targets the key is every stream's bytes plus every target's deltas: meshoptimizer's
+// multi-stream remap takes at most 16 streams, and a face has 52 targets. Numbered in first use
+// order of the indices, as meshoptimizer numbers them; unreferenced vertices get ~0u.
+template <class T>
+void append_bytes(std::string& key, const std::vector<T>& stream, size_t v) {
+  if (!stream.empty()) key.append(reinterpret_cast<const char*>(&stream[v]), sizeof(T));
+}
+
+size_t remap_with_targets(const SourceMesh& m, std::vector<unsigned>* remap) {
+  const size_t n = m.positions.size();
+  std::unordered_map<std::string, unsigned> first;
+  remap->assign(n, ~0u);
+  unsigned next = 0;
+  std::string key;
+  for (const uint32_t i : m.indices) {
+    if ((*remap)[i] != ~0u) continue;
+    key.clear();
+    append_bytes(key, m.positions, i);
+    append_bytes(key, m.normals, i);
+    append_bytes(key, m.tangents, i);
+    append_bytes(key, m.uv0, i);
+    append_bytes(key, m.colors, i);
+    append_bytes(key, m.joints, i);
+    append_bytes(key, m.weights, i);
+    for (const SourceMorphTarget& t : m.morph_targets) {
+      append_bytes(key, t.positions, i);
+      append_bytes(key, t.normals, i);
+      append_bytes(key, t.tangents, i);
+    }
+    const auto [it, inserted] = first.emplace(key, next);
+    if (inserted) ++next;
+    (*remap)[i] = it->second;
+  }
+  return next;
+}
+
 SourceMesh weld(const SourceMesh& m, size_t* unused) {
   SourceMesh out = m;
   const size_t n = m.positions.size();
+  if (!m.morph_targets.empty()) {
+    std::vector<unsigned> remap;
+    const size_t unique = remap_with_targets(m, &remap);
+    *unused = static_cast<size_t>(std::count(remap.begin(), remap.end(), ~0u));
+    meshopt_remapIndexBuffer(out.indices.data(), m.indices.data(), m.indices.size(), remap.data());
+    compact(out.positions, remap, unique);
+    compact(out.normals, remap, unique);
+    compact(out.tangents, remap, unique);
+    compact(out.uv0, remap, unique);
+    compact(out.colors, remap, unique);
+    compact(out.joints, remap, unique);
+    compact(out.weights, remap, unique);
+    for (SourceMorphTarget& t : out.morph_targets) {
+      compact(t.positions, remap, unique);
+      compact(t.normals, remap, unique);
+      compact(t.tangents, remap, unique);
+    }
+    return out;
+  }
   std::vector<meshopt_Stream> streams;
   add_stream(streams, m.positions);
   add_stream(streams, m.normals);
@@ -322,6 +394,7 @@ struct Streams {
   std::vector<glm::vec4> colors;
   std::vector<std::array<uint16_t, 4>> slots;
   std::vector<glm::vec4> weights;
+  std::vector<MorphStreams> targets;  // merged by name over the members; zeros where a member lacks one
 };
 
 struct PaletteEntry {
@@ -435,6 +508,26 @@ Result<CookedMesh> build_group(const SourceScene& scene, const std::vector<Clean
   bool colored = false;
   for (const size_t member : members) colored = colored || !cleaned[member].mesh.colors.empty();
   Streams s;
+  // Morph targets merge by name across members (a head split by material shares its "smile"); a
+  // stream is present when any member's target of that name has it.
+  for (const size_t member : members) {
+    for (const SourceMorphTarget& t : cleaned[member].mesh.morph_targets) {
+      auto it = std::find_if(s.targets.begin(), s.targets.end(), [&](const MorphStreams& m) { return m.name == t.name; });
+      if (it == s.targets.end()) {
+        s.targets.push_back({t.name, t.default_weight, {}, {}, {}});
+        it = s.targets.end() - 1;
+      }
+      if (!t.normals.empty()) it->normals.resize(1);   // marks the stream present; filled below
+      if (!t.tangents.empty() && attrs.tangents) it->tangents.resize(1);
+    }
+  }
+  std::vector<bool> target_normals, target_tangents;
+  for (MorphStreams& t : s.targets) {
+    target_normals.push_back(!t.normals.empty());
+    target_tangents.push_back(!t.tangents.empty());
+    t.normals.clear();
+    t.tangents.clear();
+  }
   std::vector<unsigned> indices;
   std::vector<uint32_t> member_base(members.size());
   for (size_t mi = 0; mi < members.size(); ++mi) {
@@ -473,6 +566,20 @@ Result<CookedMesh> build_group(const SourceScene& scene, const std::vector<Clean
         s.weights.push_back(weights[mi][v]);
       }
     }
+    for (size_t k = 0; k < s.targets.size(); ++k) {
+      MorphStreams& t = s.targets[k];
+      const auto own = std::find_if(m.morph_targets.begin(), m.morph_targets.end(),
+                                    [&](const SourceMorphTarget& mt) { return mt.name == t.name; });
+      const bool has = own != m.morph_targets.end();
+      const size_t nv = m.positions.size();
+      const auto append = [&](std::vector<glm::vec3>& dst, const std::vector<glm::vec3>* src) {
+        if (has && src && !src->empty()) dst.insert(dst.end(), src->begin(), src->end());
+        else dst.insert(dst.end(), nv, glm::vec3(0.0f));
+      };
+      append(t.positions, has ? &own->positions : nullptr);
+      if (target_normals[k]) append(t.normals, has ? &own->normals : nullptr);
+      if (target_tangents[k]) append(t.tangents, has ? &own->tangents : nullptr);
+    }
     if (indices.size() + m.indices.size() > std::numeric_limits<uint32_t>::max())
       return Error{"mesh '" + out.name + "': more than 2^32 - 1 indices"};
     fb::Submesh submesh(static_cast<uint32_t>(indices.size()), static_cast<uint32_t>(m.indices.size()), m.material);
@@ -506,6 +613,11 @@ Result<CookedMesh> build_group(const SourceScene& scene, const std::vector<Clean
     compact(s.colors, remap, unique);
     compact(s.slots, remap, unique);
     compact(s.weights, remap, unique);
+    for (MorphStreams& t : s.targets) {
+      compact(t.positions, remap, unique);
+      compact(t.normals, remap, unique);
+      compact(t.tangents, remap, unique);
+    }
     if (unique < vertex_count)
       warnings.push_back("mesh '" + out.name + "': dropped " + std::to_string(vertex_count - unique) +
                          " vertices only degenerate triangles used");
@@ -604,15 +716,55 @@ Result<CookedMesh> build_group(const SourceScene& scene, const std::vector<Clean
     }
   }
 
+  // Morph targets, quantized against the bounds in mesh units, still dense (morph_build.h).
+  std::vector<DenseMorph> dense;
+  if (!s.targets.empty()) {
+    MorphBounds bounds;
+    const float mpu = scene.metres_per_unit > 0.0f && std::isfinite(scene.metres_per_unit) ? scene.metres_per_unit : 1.0f;
+    bounds.position = options.morph_position_bound_m / mpu;
+    bounds.angle = options.morph_angle_bound;
+    std::vector<glm::vec3> base_tangents;
+    if (attrs.tangents)
+      for (const glm::vec4& t : s.tangents) base_tangents.emplace_back(t);
+    for (const MorphStreams& t : s.targets) {
+      dense.push_back(quantize_morph(t, s.normals, base_tangents, bounds));
+      if (dense.back().position_error > bounds.position * 1.0001f)
+        warnings.push_back("mesh '" + out.name + "': morph target '" + t.name + "' moves vertices so far that its " +
+                           "16-bit deltas err by " + std::to_string(dense.back().position_error) +
+                           " units, past the bound " + std::to_string(bounds.position));
+    }
+  }
+
   // Vertices the quantized layout made identical (source vertices a rounding error apart, which
   // Assimp used to merge by epsilon) are one vertex: equal bytes draw exactly alike. The remap
   // numbers vertices in first use order, which the fetch optimizer already gave them, so the
-  // fetch order is kept.
+  // fetch order is kept. With morph targets, the targets' quantized deltas are part of the key:
+  // two vertices merge only when every target moves them alike.
   if (quantized && vertex_count > 0) {
     std::vector<unsigned> remap(vertex_count);
-    const size_t unique = meshopt_generateVertexRemap(remap.data(), indices.data(), indices.size(), out.vertices.data(),
-                                                      vertex_count, layout.stride);
+    size_t unique = 0;
+    if (dense.empty()) {
+      unique = meshopt_generateVertexRemap(remap.data(), indices.data(), indices.size(), out.vertices.data(),
+                                           vertex_count, layout.stride);
+    } else {
+      std::unordered_map<std::string, unsigned> first;
+      std::fill(remap.begin(), remap.end(), ~0u);
+      std::string key;
+      for (const unsigned i : indices) {
+        if (remap[i] != ~0u) continue;
+        key.assign(reinterpret_cast<const char*>(out.vertices.data()) + size_t(i) * layout.stride, layout.stride);
+        for (const DenseMorph& d : dense) {
+          append_bytes(key, d.positions, i);
+          append_bytes(key, d.normals, i);
+          append_bytes(key, d.tangents, i);
+        }
+        const auto [it, inserted] = first.emplace(key, static_cast<unsigned>(unique));
+        if (inserted) ++unique;
+        remap[i] = it->second;
+      }
+    }
     if (unique < vertex_count) {
+      for (DenseMorph& d : dense) remap_morph(d, remap, unique);
       std::vector<uint8_t> merged(unique * layout.stride);
       meshopt_remapVertexBuffer(merged.data(), out.vertices.data(), vertex_count, layout.stride, remap.data());
       meshopt_remapIndexBuffer(indices.data(), indices.data(), indices.size(), remap.data());
@@ -632,6 +784,8 @@ Result<CookedMesh> build_group(const SourceScene& scene, const std::vector<Clean
     out.indices.resize(indices.size() * 4);
     if (!indices.empty()) std::memcpy(out.indices.data(), indices.data(), indices.size() * 4);
   }
+
+  for (const DenseMorph& d : dense) out.morph_targets.push_back(sparsify(d));
 
   stats.cooked_vertices += out.vertex_count;
   stats.triangles += static_cast<uint32_t>(indices.size() / 3);

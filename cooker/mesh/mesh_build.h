@@ -18,6 +18,7 @@
 #include <glm/glm.hpp>
 
 #include "cooker/import/source_scene.h"
+#include "cooker/mesh/morph_build.h"
 #include <ossa/format/ossa_generated.h>
 #include <ossa/format/result.h>
 
@@ -26,6 +27,10 @@ namespace ossa::cook {
 struct MeshOptions {
   bool float_vertices = false;  // float32 layout for exact round trips
   bool optimize = true;         // meshoptimizer vertex cache + fetch reordering
+  /// Morph targets: largest position error in metres (converted into mesh units with the scene's
+  /// metres_per_unit) and largest normal / tangent turn in radians.
+  float morph_position_bound_m = 2e-5f;
+  float morph_angle_bound = 0.001745f;
 };
 
 struct CookedMesh {
@@ -41,6 +46,7 @@ struct CookedMesh {
   glm::vec3 position_offset{0.0f}, position_scale{1.0f};
   std::vector<uint16_t> joints;           // skeleton joint per slot
   std::vector<glm::mat4> inverse_bind;    // per slot
+  std::vector<CookedMorphTarget> morph_targets;  // names unique, in first-appearance order
 };
 
 struct MeshBuildStats {

@@ -80,8 +80,22 @@ Offset<fb::Mesh> write_mesh(FlatBufferBuilder& fbb, const CookedMesh& mesh) {
   const auto inverse_bind_v = fbb.CreateVectorOfStructs(inverse_bind);
   const fb::Vec3 bounds_min = vec3(mesh.bounds_min), bounds_max = vec3(mesh.bounds_max);
   const fb::Vec3 offset = vec3(mesh.position_offset), scale = vec3(mesh.position_scale);
+  std::vector<Offset<fb::MorphTarget>> targets;
+  for (const CookedMorphTarget& t : mesh.morph_targets) {
+    const auto target_name = fbb.CreateString(t.name);
+    const auto vertices_v = fbb.CreateVector(t.vertices);
+    const auto positions_v = fbb.CreateVector(t.position_deltas);
+    const auto normals_v = t.normal_deltas.empty() ? Offset<flatbuffers::Vector<int16_t>>() : fbb.CreateVector(t.normal_deltas);
+    const auto tangents_v =
+        t.tangent_deltas.empty() ? Offset<flatbuffers::Vector<int16_t>>() : fbb.CreateVector(t.tangent_deltas);
+    const fb::Vec3 ps = vec3(t.position_step), ns = vec3(t.normal_step), ts = vec3(t.tangent_step);
+    targets.push_back(fb::CreateMorphTarget(fbb, target_name, vertices_v, positions_v, &ps, normals_v, &ns, tangents_v,
+                                            &ts, t.default_weight, t.position_error, t.normal_error));
+  }
+  const auto targets_v =
+      targets.empty() ? Offset<flatbuffers::Vector<Offset<fb::MorphTarget>>>() : fbb.CreateVector(targets);
   return fb::CreateMesh(fbb, name, mesh.vertex_count, mesh.vertex_stride, layout, vertices, mesh.index_format,
-                        indices, submeshes, &bounds_min, &bounds_max, &offset, &scale, joints, inverse_bind_v);
+                        indices, submeshes, &bounds_min, &bounds_max, &offset, &scale, joints, inverse_bind_v, targets_v);
 }
 
 Offset<fb::RootMotion> write_root_motion(FlatBufferBuilder& fbb, const SourceRootMotion& rm) {
@@ -127,9 +141,17 @@ Offset<fb::Clip> write_clip(FlatBufferBuilder& fbb, const CompressedClip& clip, 
     events.push_back(fb::CreateClipEvent(fbb, event_name, e.time));
   }
   const auto events_v = fbb.CreateVector(events);
+  std::vector<Offset<fb::MorphTrack>> tracks;
+  for (const CompressedMorphTrack& t : clip.morph_weights) {
+    const auto track_name = fbb.CreateString(t.name);
+    const auto frames_v = fbb.CreateVector(t.key_frames);
+    const auto values_v = fbb.CreateVector(t.values);
+    tracks.push_back(fb::CreateMorphTrack(fbb, track_name, frames_v, values_v, t.range_min, t.range_extent, t.max_error));
+  }
+  const auto tracks_v = tracks.empty() ? Offset<flatbuffers::Vector<Offset<fb::MorphTrack>>>() : fbb.CreateVector(tracks);
   return fb::CreateClip(fbb, name, clip.grid.duration(), clip.grid.sample_rate, clip.grid.frame_count, skeleton_hash,
                         joint_count, constants_v, animated_v, key_frames_v, key_values_v, compression, root_motion,
-                        events_v);
+                        events_v, tracks_v);
 }
 
 Offset<fb::Node> write_node(FlatBufferBuilder& fbb, const NodeDef& node) {

@@ -288,6 +288,15 @@ std::span<const uint8_t> MeshView::index_bytes() const { return scalar_span(fb->
 std::span<const fb::Submesh> MeshView::submeshes() const { return struct_span(fb->submeshes()); }
 std::span<const uint16_t> MeshView::joints() const { return scalar_span(fb->joints()); }
 std::span<const fb::Mat4> MeshView::inverse_bind() const { return struct_span(fb->inverse_bind()); }
+size_t MeshView::morph_target_count() const { return fb->morph_targets() ? fb->morph_targets()->size() : 0; }
+const fb::MorphTarget& MeshView::morph_target(size_t i) const {
+  return *fb->morph_targets()->Get(static_cast<flatbuffers::uoffset_t>(i));
+}
+int MeshView::find_morph_target(std::string_view name) const {
+  for (size_t i = 0; i < morph_target_count(); ++i)
+    if (flatbuffers::GetStringView(morph_target(i).name()) == name) return static_cast<int>(i);
+  return -1;
+}
 
 // ---- ClipView ----------------------------------------------------------------------------------
 
@@ -303,6 +312,10 @@ std::span<const uint16_t> ClipView::key_frames() const { return scalar_span(fb->
 std::span<const uint8_t> ClipView::key_values() const { return scalar_span(fb->key_values()); }
 const fb::ClipCompression* ClipView::compression() const { return fb->compression(); }
 const fb::RootMotion* ClipView::root_motion() const { return fb->root_motion(); }
+size_t ClipView::morph_track_count() const { return fb->morph_weights() ? fb->morph_weights()->size() : 0; }
+const fb::MorphTrack& ClipView::morph_track(size_t i) const {
+  return *fb->morph_weights()->Get(static_cast<flatbuffers::uoffset_t>(i));
+}
 
 size_t ClipView::key_count() const {
   size_t keys = constants().size();

@@ -19,6 +19,7 @@
 //   that would need more. That keeps validation O(buffer size) on any input.
 #include <ossa/loader/validate.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -442,6 +443,82 @@ class Validator {
                    {"position_scale", m.position_scale()}};
     for (const auto& v : vectors)
       if (v.value && !finite3(*v.value)) return fail(where, format("%s is not finite", v.field));
+    return check_morph_targets(m, where);
+  }
+
+  // ---- morph targets (format v5) ----
+  //
+  // apply_morphs (runtime/anim/morph.cpp) indexes the caller's vertex arrays by each listed vertex
+  // and reads three deltas per listed vertex, so both are proven here: vertices strictly increasing
+  // and below the vertex count, every delta array exactly three per listed vertex. Steps and
+  // weights are bounded so that a sum of weighted deltas over any number of targets stays finite.
+
+  /// Largest |weight| a file may store (defaults, weight keys): far past any authored face (glTF
+  /// weights are usually in [0, 1], sometimes [-1, 1]), and small enough that weights * deltas stay
+  /// finite.
+  static constexpr float kMaxMorphWeight = 1e3f;
+  /// Largest per-axis step: 32767 steps stay within the pose bound.
+  static constexpr float kMaxMorphStep = kMaxPoseValue / 32767.0f;
+
+  static bool step_ok(const fb::Vec3& s) {
+    const float v[3] = {s.x(), s.y(), s.z()};
+    for (float x : v)
+      if (!std::isfinite(x) || x < 0.0f || x > kMaxMorphStep) return false;
+    return true;
+  }
+
+  Status check_morph_targets(const fb::Mesh& m, const std::string& mesh_where) {
+    const auto* targets = m.morph_targets();
+    if (!targets) return {};
+    if (!spend(static_cast<uint64_t>(targets->size()) * 64)) return over_budget(mesh_where);
+    std::vector<std::string_view> names;
+    names.reserve(targets->size());
+    for (flatbuffers::uoffset_t t = 0; t < targets->size(); ++t) {
+      const fb::MorphTarget& target = *targets->Get(t);
+      const std::string_view name = flatbuffers::GetStringView(target.name());
+      const std::string where = mesh_where + ": " + label("morph target", t, target.name());
+      if (name.empty()) return fail(where, "has an empty name");
+      names.push_back(name);
+      const size_t n = target.vertices()->size();
+      if (!spend(static_cast<uint64_t>(n) * 4)) return over_budget(where);
+      const uint32_t* v = target.vertices()->data();
+      for (size_t i = 0; i < n; ++i) {
+        if (v[i] >= m.vertex_count())
+          return fail(where, format("moves vertex %u (entry %zu), past the vertex count %u", v[i], i, m.vertex_count()));
+        if (i > 0 && !(v[i] > v[i - 1]))
+          return fail(where, format("entry %zu names vertex %u after vertex %u: vertices must strictly increase", i,
+                                    v[i], v[i - 1]));
+      }
+      const struct {
+        const char* field;
+        const flatbuffers::Vector<int16_t>* deltas;
+        const fb::Vec3* step;
+        bool required;
+      } streams[] = {{"position", target.position_deltas(), target.position_step(), true},
+                     {"normal", target.normal_deltas(), target.normal_step(), false},
+                     {"tangent", target.tangent_deltas(), target.tangent_step(), false}};
+      for (const auto& st : streams) {
+        const size_t count = count_of(st.deltas);
+        if (count == 0 && !st.required) continue;
+        if (count != 3 * n)
+          return fail(where, format("has %zu %s deltas for %zu listed vertices; expected 3 per vertex (%zu)", count,
+                                    st.field, n, 3 * n));
+        if (!st.step || !step_ok(*st.step))
+          return fail(where, format("%s step %s must be finite, >= 0 and at most %g", st.field,
+                                    st.step ? vec3_text(*st.step).c_str() : "(missing)", kMaxMorphStep));
+      }
+      if (!std::isfinite(target.default_weight()) || std::fabs(target.default_weight()) > kMaxMorphWeight)
+        return fail(where, format("default weight %g must be finite and within +-%g", target.default_weight(),
+                                  kMaxMorphWeight));
+      if (!(target.position_error() >= 0.0f) || !std::isfinite(target.position_error()) ||
+          !(target.normal_error() >= 0.0f) || !std::isfinite(target.normal_error()))
+        return fail(where, format("recorded errors %g / %g must be finite and >= 0", target.position_error(),
+                                  target.normal_error()));
+    }
+    std::sort(names.begin(), names.end());
+    for (size_t i = 1; i < names.size(); ++i)
+      if (names[i] == names[i - 1])
+        return fail(mesh_where, "has two morph targets named '" + detail::printable(names[i]) + "'");
     return {};
   }
 
@@ -646,6 +723,46 @@ class Validator {
                                                     i - 1, previous));
         previous = t;
       }
+    }
+    return check_morph_weights(c, where);
+  }
+
+  /// Weight tracks: sorted by name (so a binder can merge-walk them), keys as for animated channels
+  /// but a single key is a constant, values one per key, ranges bounded (see kMaxMorphWeight).
+  Status check_morph_weights(const fb::Clip& c, const std::string& clip_where) {
+    const auto* tracks = c.morph_weights();
+    if (!tracks) return {};
+    if (!spend(static_cast<uint64_t>(tracks->size()) * 48)) return over_budget(clip_where);
+    std::string_view previous;
+    for (flatbuffers::uoffset_t t = 0; t < tracks->size(); ++t) {
+      const fb::MorphTrack& track = *tracks->Get(t);
+      const std::string_view name = flatbuffers::GetStringView(track.name());
+      const std::string where = clip_where + ": " + label("morph weight track", t, track.name());
+      if (name.empty()) return fail(where, "has an empty name");
+      if (t > 0 && !(name > previous))
+        return fail(where, "is not after track " + std::to_string(t - 1) + " '" + detail::printable(previous) +
+                               "': tracks are sorted by name, each name once");
+      previous = name;
+      const size_t n = track.key_frames()->size();
+      if (n < 1) return fail(where, "has no keys");
+      if (track.values()->size() != n)
+        return fail(where, format("has %zu key frames but %u values", n, track.values()->size()));
+      if (!spend(static_cast<uint64_t>(n) * 4)) return over_budget(where);
+      const uint16_t* f = track.key_frames()->data();
+      if (f[0] != 0) return fail(where, format("first key is at frame %u, must be 0", f[0]));
+      for (size_t i = 1; i < n; ++i)
+        if (!(f[i] > f[i - 1]))
+          return fail(where, format("key %zu at frame %u is not after key %zu at frame %u (frames must strictly "
+                                    "increase)", i, f[i], i - 1, f[i - 1]));
+      if (n > 1 && f[n - 1] != c.frame_count() - 1)
+        return fail(where, format("last key is at frame %u, must be the last frame %u", f[n - 1], c.frame_count() - 1));
+      const float lo = track.range_min(), ex = track.range_extent();
+      if (!std::isfinite(lo) || !std::isfinite(ex) || ex < 0.0f || std::fabs(lo) > kMaxMorphWeight ||
+          std::fabs(lo + ex) > kMaxMorphWeight)
+        return fail(where, format("weight range min %g extent %g must be finite within +-%g, extent >= 0", lo, ex,
+                                  kMaxMorphWeight));
+      if (!std::isfinite(track.max_error()) || !(track.max_error() >= 0.0f))
+        return fail(where, format("recorded error %g must be finite and >= 0", track.max_error()));
     }
     return {};
   }

@@ -51,7 +51,29 @@ json describe_skeleton(const SkeletonView& skeleton) {
   return json{{"joint_count", skeleton.joint_count()}, {"hash", hex16(skeleton.hash())}, {"joints", std::move(joints)}};
 }
 
-json describe_mesh(const MeshView& mesh) {
+/// A mesh's morph targets (format v5): what each stores and the error the cooker achieved.
+json describe_morph_targets(const MeshView& mesh, float metres_per_unit) {
+  json list = json::array();
+  for (size_t t = 0; t < mesh.morph_target_count(); ++t) {
+    const fb::MorphTarget& target = mesh.morph_target(t);
+    const size_t listed = target.vertices()->size();
+    const size_t normals = target.normal_deltas() ? target.normal_deltas()->size() : 0;
+    const size_t tangents = target.tangent_deltas() ? target.tangent_deltas()->size() : 0;
+    const size_t bytes = 4 * listed + 2 * (target.position_deltas()->size() + normals + tangents);
+    list.push_back(json{{"name", str(target.name())},
+                        {"vertices", listed},
+                        {"normals", normals != 0},
+                        {"tangents", tangents != 0},
+                        {"bytes", bytes},
+                        {"default_weight", round6(target.default_weight())},
+                        {"position_error", round6(target.position_error())},
+                        {"position_error_mm", round6(1000.0 * metres_per_unit * target.position_error())},
+                        {"normal_error_deg", round6(target.normal_error() * 57.29577951308232)}});
+  }
+  return list;
+}
+
+json describe_mesh(const MeshView& mesh, float metres_per_unit) {
   json layout = json::array();
   for (const fb::VertexAttribute& a : mesh.layout())
     layout.push_back(json{{"semantic", fb::EnumNameVertexSemantic(a.semantic())},
@@ -62,7 +84,7 @@ json describe_mesh(const MeshView& mesh) {
     submeshes.push_back(
         json{{"first_index", s.first_index()}, {"index_count", s.index_count()}, {"material", s.material()}});
   const fb::Mesh& m = *mesh.fb;
-  return json{{"name", std::string(mesh.name())},
+  json out{{"name", std::string(mesh.name())},
               {"vertex_count", mesh.vertex_count()},
               {"triangle_count", mesh.index_count() / 3},
               {"vertex_stride", mesh.vertex_stride()},
@@ -76,6 +98,9 @@ json describe_mesh(const MeshView& mesh) {
               {"bounds", json{{"min", vec3(m.bounds_min())}, {"max", vec3(m.bounds_max())}}},
               {"position_offset", vec3(m.position_offset())},
               {"position_scale", vec3(m.position_scale())}};
+  // Only when present, so files without targets describe as they did before format v5.
+  if (mesh.morph_target_count() > 0) out["morph_targets"] = describe_morph_targets(mesh, metres_per_unit);
+  return out;
 }
 
 /// Clip payload bytes: what its channel tables and key streams take in the file.
@@ -173,6 +198,18 @@ json describe_clip(const ClipView& clip, const SkeletonView& skeleton, float met
     json list = json::array();
     for (const fb::ClipEvent* e : *events) list.push_back(json{{"name", str(e->name())}, {"time", round6(e->time())}});
     out["events"] = std::move(list);
+  }
+  if (clip.morph_track_count() > 0) {
+    json list = json::array();
+    for (size_t k = 0; k < clip.morph_track_count(); ++k) {
+      const fb::MorphTrack& t = clip.morph_track(k);
+      list.push_back(json{{"name", str(t.name())},
+                          {"keys", t.key_frames()->size()},
+                          {"min", round6(t.range_min())},
+                          {"max", round6(t.range_min() + t.range_extent())},
+                          {"max_error", round6(t.max_error())}});
+    }
+    out["morph_weights"] = std::move(list);
   }
   if (options.channels) out["channels"] = describe_channels(clip, skeleton);
   return out;
@@ -325,7 +362,7 @@ json describe(const Asset& asset, std::string_view file_name, const DescribeOpti
   }
   const SkeletonView skeleton = asset.skeleton();
   json meshes = json::array(), clips = json::array(), materials = json::array();
-  for (size_t i = 0; i < asset.mesh_count(); ++i) meshes.push_back(describe_mesh(asset.mesh(i)));
+  for (size_t i = 0; i < asset.mesh_count(); ++i) meshes.push_back(describe_mesh(asset.mesh(i), asset.file().metres_per_unit()));
   for (size_t i = 0; i < asset.clip_count(); ++i) clips.push_back(describe_clip(asset.clip(i), skeleton, file.metres_per_unit(), options));
   for (size_t i = 0; i < asset.material_count(); ++i) materials.push_back(describe_material(asset.material(i)));
   json out{{"schema", kSchema},
@@ -405,6 +442,14 @@ std::string describe_text(const json& d) {
                   text(s["index_count"]).c_str(), text(s["material"]).c_str()));
     line("  joint slots    " + text(m["joint_slots"]));
     line("  bounds         " + vec_text(m["bounds"]["min"]) + " .. " + vec_text(m["bounds"]["max"]));
+    if (m.contains("morph_targets")) {
+      size_t t = 0;
+      for (const json& mt : m["morph_targets"])
+        line(format("  morph %-8zu ", t++) + "'" + text(mt["name"]) + "': " + text(mt["vertices"]) + " vertices" +
+             (mt["normals"].get<bool>() ? " + normals" : "") + (mt["tangents"].get<bool>() ? " + tangents" : "") + ", " +
+             text(mt["bytes"]) + " bytes, error " + text(mt["position_error_mm"]) + " mm / " +
+             text(mt["normal_error_deg"]) + " deg, default weight " + text(mt["default_weight"]));
+    }
   }
 
   index = 0;
@@ -433,6 +478,13 @@ std::string describe_text(const json& d) {
       line("  compression    -");
     }
     line("  root motion    " + (c["root_motion"].is_object() ? "yes, up axis " + text(c["root_motion"]["up_axis"]) : std::string("no")));
+    if (c.contains("morph_weights")) {
+      std::string tracks;
+      for (const json& t : c["morph_weights"])
+        tracks += (tracks.empty() ? "" : ", ") + text(t["name"]) + " (" + text(t["keys"]) + " keys, " + text(t["min"]) +
+                  ".." + text(t["max"]) + ", error " + text(t["max_error"]) + ")";
+      line("  morph weights  " + tracks);
+    }
     if (c.contains("events")) {
       std::string events;
       for (const json& e : c["events"]) events += (events.empty() ? "" : ", ") + text(e["name"]) + " @" + text(e["time"]);

@@ -55,6 +55,12 @@ struct MeshView {
   std::span<const fb::Submesh> submeshes() const;
   std::span<const uint16_t> joints() const;       // skeleton joint of each mesh-local slot
   std::span<const fb::Mat4> inverse_bind() const; // one per slot
+  /// Morph targets (format v5; ossa/anim/morph.h applies them). Validated: listed vertices
+  /// strictly increasing and < vertex_count(), three deltas per listed vertex, names unique.
+  size_t morph_target_count() const;
+  const fb::MorphTarget& morph_target(size_t i) const;
+  /// Index of the target with this name, -1 if none. O(targets).
+  int find_morph_target(std::string_view name) const;
 };
 
 /// Read-only view of one compressed clip (format v2, ossa.fbs "Clip"). Validation proved every
@@ -83,6 +89,9 @@ struct ClipView {
   const fb::RootMotion* root_motion() const;
   /// Keys over all channels: each animated channel's key_count plus one per constant. O(channels).
   size_t key_count() const;
+  /// Morph weight tracks (format v5), sorted by name; ossa/anim/morph.h samples them.
+  size_t morph_track_count() const;
+  const fb::MorphTrack& morph_track(size_t i) const;
 };
 
 /// How Asset::open gets a file's bytes into memory.
