@@ -17,11 +17,13 @@
 #include <cstring>
 #include <filesystem>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include <ossa/anim/morph.h>
+#include <ossa/graph/graph.h>
 #include <ossa/format/vertex_codec.h>
 #include <ossa/loader/asset.h>
 #include "test_files.h"
@@ -102,6 +104,12 @@ void write_face_gltf(const fs::path& path) {
   const int a_talk = b.floats(kTalk, kTalk.size(), "SCALAR");
   const int a_blink_t = b.floats(kBlinkTimes, 3, "SCALAR");
   const int a_blink = b.floats(kBlink, kBlink.size(), "SCALAR");
+  // "nod": the root joint turns; no weights (a layer playing it must leave the face alone).
+  const int a_nod_t = b.floats(kBlinkTimes, 3, "SCALAR");
+  const std::vector<float> nod = {0, 0, 0, 1, 0.2588190f, 0, 0, 0.9659258f, 0, 0, 0, 1};
+  const int a_nod = b.floats(nod, 3, "VEC4");
+  b.accessors[a_nod_t]["min"] = {0};
+  b.accessors[a_nod_t]["max"] = {1};
   for (int t : {a_talk_t, a_blink_t}) {
     b.accessors[t]["min"] = {0};
     b.accessors[t]["max"] = {t == a_talk_t ? 2 : 1};
@@ -125,7 +133,10 @@ void write_face_gltf(const fs::path& path) {
          {"channels", {{{"sampler", 0}, {"target", {{"node", 1}, {"path", "weights"}}}}}}},
         {{"name", "blink"},
          {"samplers", {{{"input", a_blink_t}, {"output", a_blink}, {"interpolation", "LINEAR"}}}},
-         {"channels", {{{"sampler", 0}, {"target", {{"node", 1}, {"path", "weights"}}}}}}}}},
+         {"channels", {{{"sampler", 0}, {"target", {{"node", 1}, {"path", "weights"}}}}}}},
+        {{"name", "nod"},
+         {"samplers", {{{"input", a_nod_t}, {"output", a_nod}, {"interpolation", "LINEAR"}}}},
+         {"channels", {{{"sampler", 0}, {"target", {{"node", 0}, {"path", "rotation"}}}}}}}}},
       {"buffers", {{{"uri", "face.bin"}, {"byteLength", b.bin.size()}}}},
       {"bufferViews", b.views},
       {"accessors", b.accessors}};
@@ -255,8 +266,10 @@ TEST(CookMorph, NormalDeltasAreKeptWhereTheyTurnTheNormal) {
 TEST(CookMorph, WeightsAtTheSourceKeysEqualTheSourceAndCurvesAreHermite) {
   const CookedFace c = cook_face("morph-face-weights");
   ASSERT_TRUE(c.asset.has_value());
-  ASSERT_EQ(c.asset->clip_count(), 2u);
+  ASSERT_EQ(c.asset->clip_count(), 3u);
   EXPECT_EQ(c.err.find("warning"), std::string::npos) << "nothing is dropped: " << c.err;
+  EXPECT_EQ(c.asset->clip(2).name(), "nod");
+  EXPECT_EQ(c.asset->clip(2).morph_track_count(), 0u) << "a clip without weight channels has no tracks";
   for (size_t i = 0; i < 2; ++i) {
     const ossa::ClipView clip = c.asset->clip(i);
     ASSERT_EQ(clip.morph_track_count(), 2u) << clip.name();
@@ -321,6 +334,62 @@ TEST(CookMorph, InspectReportsEveryTargetAndTrack) {
   EXPECT_EQ(morphs[0]["vertices"], 3);
   EXPECT_EQ(morphs[0]["stored_bytes"], 3 * (4 + 6 + 6));  // positions and normals
   EXPECT_LE(morphs[0]["position_error_mm"].get<double>(), 0.02);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Morph weights through the animation graph
+
+const char* kFaceGraph = R"({
+  "ossa_graph": 1, "name": "face", "skeleton": "face.gltf",
+  "clips": {"talk": {"source": "face.gltf", "clip": "talk"}, "blink": {"source": "face.gltf", "clip": "blink"},
+            "nod": {"source": "face.gltf", "clip": "nod"}},
+  "parameters": {"mix": {"type": "float", "default": 0, "min": 0, "max": 1},
+                 "surprise": {"type": "float", "default": 0, "min": 0, "max": 1}},
+  "root": {"morph": {"layered": {"blend": [{"clip": "talk"}, {"clip": "blink"}], "alpha": "mix"},
+                     "layers": [{"node": {"clip": "nod"}, "mask": [{"joint": "root"}]}]},
+           "drives": [{"target": "frown", "parameter": "surprise", "scale": 2}]}
+})";
+
+TEST(CookMorph, TheGraphBlendsWeightsLayersOnlyWhatALayerDrivesAndSetsThemFromParameters) {
+  const fs::path dir = ossa::test::make_temp_dir("morph-graph");
+  write_face_gltf(dir / "face.gltf");
+  ASSERT_TRUE(ossa::test::write_file(dir / "face.graph.json", kFaceGraph));
+  const auto r = run_command((ossa::test::bin_dir() / "ossa-cook").string() + " " + q(dir / "face.graph.json") +
+                             " -o " + q(dir / "out"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  auto asset = ossa::Asset::open((dir / "out" / "face.ossa").string());
+  ASSERT_TRUE(asset.ok()) << asset.error().message;
+  auto def = ossa::GraphDefinition::create(*asset, "face");
+  ASSERT_TRUE(def.ok()) << def.error().message;
+  ASSERT_EQ(def->morph_channels().size(), 2u);
+  EXPECT_EQ(def->morph_channels()[0], "smile");
+  EXPECT_EQ(def->morph_channels()[1], "frown");
+  auto inst = ossa::GraphInstance::create(*def);
+  ASSERT_TRUE(inst.ok()) << inst.error().message;
+  EXPECT_FLOAT_EQ(inst->morph_weights()[0], 0.5f) << "before the first update: the defaults";
+  const int mix = def->find_parameter("mix"), surprise = def->find_parameter("surprise");
+  // The graph's clips are the file's: expected weights come from sampling them directly.
+  const auto clip_named = [&](std::string_view name) {
+    for (size_t i = 0; i < asset->clip_count(); ++i)
+      if (asset->clip(i).name() == name) return asset->clip(i);
+    ADD_FAILURE() << "no clip " << name;
+    return asset->clip(0);
+  };
+  const ossa::ClipView talk = clip_named("talk"), blink = clip_named("blink");
+  const auto smile_of = [&](const ossa::ClipView& clip, float t) { return ossa::sample_morph_track(clip, clip.morph_track(1), t); };
+  // A clip advances only in the updates where it has weight (graph.h): track each one's time.
+  float talk_time = 0.0f, blink_time = 0.0f;
+  for (const auto& [m, s, dt] : std::vector<std::tuple<float, float, float>>{{0, 0, 0.25f}, {1, 0, 0.25f}, {0.3f, 0.4f, 0.3f}}) {
+    ASSERT_TRUE(inst->set_float(mix, m));
+    ASSERT_TRUE(inst->set_float(surprise, s));
+    inst->update(dt);
+    if (m < 1.0f) talk_time = std::fmod(talk_time + dt, talk.duration());
+    if (m > 0.0f) blink_time = std::fmod(blink_time + dt, blink.duration());
+    // talk lasts 2 s, blink 1 s (looping); the nod layer has no weight tracks and leaves them.
+    const float want = smile_of(talk, talk_time) * (1 - m) + smile_of(blink, blink_time) * m;
+    EXPECT_NEAR(inst->morph_weights()[0], want, 1e-5f) << "mix " << m << " at " << talk_time << " / " << blink_time;
+    EXPECT_NEAR(inst->morph_weights()[1], 2.0f * s, 1e-6f) << "the drive sets frown";
+  }
 }
 
 }  // namespace

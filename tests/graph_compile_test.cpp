@@ -299,6 +299,27 @@ TEST_F(GraphCompile, SelectFormsAdditiveAnd2DBlendSpace) {
   EXPECT_EQ(std::get<SelectDef>(named.nodes[2].kind).children, (std::vector<uint16_t>{1, 0}));
 }
 
+TEST_F(GraphCompile, MorphNodeDrivesTargetsFromParameters) {
+  const std::string root = R"({"morph": {"clip": "walk"}, "drives": [{"target": "smile", "parameter": "lean", "scale": 0.5},
+    {"target": "blink", "parameter": "crossed"}]})";
+  const GraphDef g = ok(graph(root)).graph;
+  ASSERT_EQ(g.nodes.size(), 2u);
+  const auto& m = std::get<MorphWeightsDef>(g.nodes[1].kind);
+  EXPECT_EQ(m.input, 0);
+  ASSERT_EQ(m.drives.size(), 2u);
+  EXPECT_EQ(m.drives[0].target, "smile");
+  EXPECT_EQ(m.drives[0].parameter, kLean);
+  EXPECT_EQ(m.drives[0].scale, 0.5f);
+  EXPECT_EQ(m.drives[1].parameter, kCrossed);
+  EXPECT_EQ(m.drives[1].scale, 1.0f);
+  const std::string a = graph(R"({"morph": {"clip": "walk"}, "drives": [{"target": "smile", "parameter": "gait"}]})");
+  EXPECT_HAS(errors(a), "parameter 'gait' is an enum; a drive's \"parameter\" needs a float or bool parameter");
+  const std::string b = graph(R"({"morph": {"clip": "walk"}, "drives": []})");
+  EXPECT_HAS(errors(b), at(b, "[]") + "\"drives\" is empty");
+  const std::string c = graph(R"({"morph": {"clip": "walk"}, "drives": [{"target": "", "parameter": "lean"}]})");
+  EXPECT_HAS(errors(c), "a drive's \"target\" is empty");
+}
+
 TEST_F(GraphCompile, GraphEventsMergeWithTheClipsOwn) {
   const std::string clips = R"({"walk": {"source": "walk.fbx", "events": [
       {"name": "step", "time": 0.75}, {"name": "foot_left", "time": 0.5}, {"name": "end", "time": 1.00005}]},

@@ -27,8 +27,8 @@ using json::Value;
 
 constexpr double kFloatMax = 3.4e38;      // Parameter.min_value / max_value defaults
 constexpr double kIntLimit = 16777216.0;  // ints are held as floats: exact up to 2^24
-const std::vector<std::string_view> kNodeKinds = {"clip",        "blend",    "select",        "layered",
-                                                  "blend_space", "additive", "state_machine", "use"};
+const std::vector<std::string_view> kNodeKinds = {"clip",     "blend",         "select", "layered", "blend_space",
+                                                  "additive", "state_machine", "morph",  "use"};
 
 
 std::string a_type(ParamType t) {
@@ -458,11 +458,12 @@ class GraphCompiler {
     }
     if (!kind) {
       if (check_.expect_keys(
-              v, {"clip", "blend", "select", "layered", "blend_space", "additive", "state_machine", "use", "name"},
+              v, {"clip", "blend", "select", "layered", "blend_space", "additive", "state_machine", "morph", "use",
+                  "name"},
               "a node"))
         check_.error(v.pos,
                      "a node needs one of the keys clip, blend, select, layered, blend_space, additive, "
-                     "state_machine, use");
+                     "state_machine, morph, use");
       return -1;
     }
     // Every node but a use (which stands for the node it copies) becomes one output node.
@@ -492,6 +493,7 @@ class GraphCompiler {
     else if (k == "blend_space") index = blend_space_node(v, name);
     else if (k == "additive") index = additive_node(v, name);
     else if (k == "state_machine") index = machine_node(v, name);
+    else if (k == "morph") index = morph_node(v, name);
     else index = use_node(v, name, v.find("name") != nullptr);
     --depth_;
     return index;
@@ -818,6 +820,43 @@ class GraphCompiler {
     a.base = static_cast<uint16_t>(base);
     a.additive = static_cast<uint16_t>(added);
     return emit(name, a);
+  }
+
+  /// {"morph": INPUT, "drives": [{"target": "smile", "parameter": "happy", "scale": 1}, ...]}
+  int morph_node(const Value& v, const std::string& name) {
+    check_.expect_keys(v, {"morph", "drives", "name"}, "a morph node");
+    MorphWeightsDef m;
+    const int input = node(*v.find("morph"), "");
+    bool ok = input >= 0;
+    const Value* drives = required(v, "drives", "a morph node");
+    if (!drives || !check_.expect(*drives, Type::Array, "\"drives\" ([{\"target\": ..., \"parameter\": ...}, ...])"))
+      return -1;
+    if (drives->items.empty()) ok = check_.error(drives->pos, "\"drives\" is empty: a morph node sets at least one target");
+    for (const Value& d : drives->items) {
+      if (!check_.expect(d, Type::Object, "a drive ({\"target\": ..., \"parameter\": ...})")) {
+        ok = false;
+        continue;
+      }
+      check_.expect_keys(d, {"target", "parameter", "scale"}, "a drive");
+      MorphDriveDef drive;
+      const Value* t = required(d, "target", "a drive");
+      if (!t || !check_.expect(*t, Type::String, "a drive's \"target\" (a morph target name)")) {
+        ok = false;
+      } else if (t->string.empty()) {
+        ok = check_.error(t->pos, "a drive's \"target\" is empty");
+      } else {
+        drive.target = t->string;
+      }
+      const Value* p = required(d, "parameter", "a drive");
+      const int param = p ? parameter(*p, {ParamType::Float, ParamType::Bool}, "a drive's \"parameter\"") : -1;
+      ok &= param >= 0;
+      drive.parameter = static_cast<uint16_t>(std::max(param, 0));
+      if (const Value* sc = d.find("scale")) ok &= read_float(*sc, "a drive's \"scale\"", &drive.scale);
+      m.drives.push_back(std::move(drive));
+    }
+    if (!ok) return -1;
+    m.input = static_cast<uint16_t>(input);
+    return emit(name, std::move(m));
   }
 
   // ---- state machines ------------------------------------------------------------------------

@@ -84,9 +84,18 @@ struct AdditiveDef {
 struct StateMachineRefDef {
   uint16_t machine = 0;
 };
+struct MorphDriveDef {
+  std::string target;
+  uint16_t parameter = 0;
+  float scale = 1.0f;
+};
+struct MorphWeightsDef {
+  uint16_t input = 0;
+  std::vector<MorphDriveDef> drives;
+};
 
 using NodeKind = std::variant<ClipNodeDef, BlendAlphaDef, SelectDef, LayeredDef, BlendSpaceDef, AdditiveDef,
-                              StateMachineRefDef>;
+                              StateMachineRefDef, MorphWeightsDef>;
 
 struct NodeDef {
   std::string name;

@@ -192,6 +192,15 @@ Offset<fb::Node> write_node(FlatBufferBuilder& fbb, const NodeDef& node) {
   } else if (const auto* m = std::get_if<StateMachineRefDef>(&node.kind)) {
     type = fb::NodeData::StateMachineNode;
     data = fb::CreateStateMachineNode(fbb, m->machine).Union();
+  } else if (const auto* w = std::get_if<MorphWeightsDef>(&node.kind)) {
+    type = fb::NodeData::MorphWeightsNode;
+    std::vector<Offset<fb::MorphDrive>> drives;
+    for (const MorphDriveDef& drive : w->drives) {
+      const auto target = fbb.CreateString(drive.target);
+      drives.push_back(fb::CreateMorphDrive(fbb, target, drive.parameter, drive.scale));
+    }
+    const auto drives_v = fbb.CreateVector(drives);
+    data = fb::CreateMorphWeightsNode(fbb, w->input, drives_v).Union();
   }
   return fb::CreateNode(fbb, name, type, data);
 }

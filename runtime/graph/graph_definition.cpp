@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cstdio>
 
+#include <ossa/anim/morph.h>
 #include "graph/graph_internal.h"
 #include <ossa/anim/pose_ops.h>
 
@@ -77,6 +78,8 @@ uint32_t scratch_needed(const GraphDefinition::Impl& def, uint16_t n) {
         need = std::max(need, 1 + scratch_needed(def, st->node()));
       return need;
     }
+    case Kind::Morph:
+      return scratch_needed(def, static_cast<const fb::MorphWeightsNode*>(info.table)->input());
   }
   return 0;
 }
@@ -87,6 +90,57 @@ GraphDefinition::GraphDefinition(std::unique_ptr<Impl> impl) : impl_(std::move(i
 GraphDefinition::GraphDefinition(GraphDefinition&&) noexcept = default;
 GraphDefinition& GraphDefinition::operator=(GraphDefinition&&) noexcept = default;
 GraphDefinition::~GraphDefinition() = default;
+
+namespace {
+
+/// Sets mask[c] = 1 for every channel a clip in node n's subtree has a weight track for.
+void mark_driven_channels(const GraphDefinition::Impl& d, uint16_t n, std::vector<float>& mask) {
+  const auto mark_clip = [&](uint16_t clip) {
+    for (const int32_t c : d.clip_channels[clip])
+      if (c >= 0) mask[static_cast<size_t>(c)] = 1.0f;
+  };
+  const NodeInfo& info = d.nodes[n];
+  switch (info.kind) {
+    case Kind::Clip:
+      return mark_clip(static_cast<const fb::ClipNode*>(info.table)->clip());
+    case Kind::BlendSpace:
+      for (const fb::BlendSample* smp : *static_cast<const fb::BlendSpaceNode*>(info.table)->samples()) mark_clip(smp->clip());
+      return;
+    case Kind::Select:
+      for (uint16_t c : *static_cast<const fb::SelectNode*>(info.table)->children()) mark_driven_channels(d, c, mask);
+      return;
+    case Kind::Layered: {
+      const auto* t = static_cast<const fb::LayeredBlendNode*>(info.table);
+      mark_driven_channels(d, t->base(), mask);
+      for (const fb::Layer* layer : *t->layers()) mark_driven_channels(d, layer->node(), mask);
+      return;
+    }
+    case Kind::BlendAlpha: {
+      const auto* t = static_cast<const fb::BlendAlphaNode*>(info.table);
+      mark_driven_channels(d, t->a(), mask);
+      mark_driven_channels(d, t->b(), mask);
+      return;
+    }
+    case Kind::Additive: {
+      const auto* t = static_cast<const fb::AdditiveNode*>(info.table);
+      mark_driven_channels(d, t->base(), mask);
+      mark_driven_channels(d, t->additive(), mask);
+      return;
+    }
+    case Kind::Machine:
+      for (const fb::State* st : *d.machines[info.machine].fb->states()) mark_driven_channels(d, st->node(), mask);
+      return;
+    case Kind::Morph: {
+      const auto* t = static_cast<const fb::MorphWeightsNode*>(info.table);
+      mark_driven_channels(d, t->input(), mask);
+      for (uint32_t k = 0; k < t->drives()->size(); ++k)
+        if (const int32_t c = d.drive_channels[info.aux + k]; c >= 0) mask[static_cast<size_t>(c)] = 1.0f;
+      return;
+    }
+  }
+}
+
+}  // namespace
 
 Result<GraphDefinition> GraphDefinition::create(const Asset& asset, std::string_view graph_name,
                                                 std::span<const Asset* const> more_clips) {
@@ -126,6 +180,20 @@ Result<GraphDefinition> GraphDefinition::create(const Asset& asset, std::string_
     auto prototype = make_sampling_cache(view, d.skeleton);
     if (!prototype) return Error{where + ": " + prototype.error().message};
     d.prototypes.push_back(std::move(*prototype));
+  }
+
+  // Morph channels: the asset's meshes' target names; each clip's tracks bound to them once.
+  for (size_t m = 0; m < asset.mesh_count(); ++m) collect_morph_channels(asset.mesh(m), d.channels);
+  d.default_weights.assign(d.channels.size(), 0.0f);
+  for (size_t m = asset.mesh_count(); m-- > 0;) {  // the first mesh holding a name gives its default
+    std::vector<int32_t> target_channel(asset.mesh(m).morph_target_count());
+    bind_morph_targets(asset.mesh(m), d.channels, target_channel);
+    default_morph_weights(asset.mesh(m), target_channel, d.default_weights);
+  }
+  for (const ClipView& clip : d.clips) {
+    std::vector<int32_t> track_channel(clip.morph_track_count());
+    bind_morph_tracks(clip, d.channels, track_channel);
+    d.clip_channels.push_back(std::move(track_channel));
   }
 
   const auto& nodes = *g->nodes();
@@ -226,6 +294,17 @@ Result<GraphDefinition> GraphDefinition::create(const Asset& asset, std::string_
         info.machine = node.data_as_StateMachineNode()->machine();
         machine_nodes[info.machine] = static_cast<uint16_t>(i);
         break;
+      case fb::NodeData::MorphWeightsNode: {
+        info.kind = Kind::Morph;
+        const auto* t = node.data_as_MorphWeightsNode();
+        info.table = t;
+        info.aux = static_cast<uint32_t>(d.drive_channels.size());
+        for (const fb::MorphDrive* drive : *t->drives()) {
+          const auto it = std::find(d.channels.begin(), d.channels.end(), flatbuffers::GetStringView(drive->target()));
+          d.drive_channels.push_back(it == d.channels.end() ? -1 : static_cast<int32_t>(it - d.channels.begin()));
+        }
+        break;
+      }
       default:
         return Error{where + ": node " + std::to_string(i) + " has no kind"};  // validation forbids it
     }
@@ -249,6 +328,17 @@ Result<GraphDefinition> GraphDefinition::create(const Asset& asset, std::string_
           mi.transitions.push_back(ti);
         }
       }
+    }
+  }
+
+  // Each layer's morph mask: the channels some clip under it has a track for.
+  for (size_t i = 0; i < d.nodes.size(); ++i) {
+    if (d.nodes[i].kind != Kind::Layered) continue;
+    const auto* t = static_cast<const fb::LayeredBlendNode*>(d.nodes[i].table);
+    for (const fb::Layer* layer : *t->layers()) {
+      std::vector<float> mask(d.channels.size(), 0.0f);
+      mark_driven_channels(d, layer->node(), mask);
+      d.layer_morphs.push_back(std::move(mask));
     }
   }
 
@@ -289,5 +379,6 @@ std::string_view GraphDefinition::state_name(size_t machine, size_t state) const
 size_t GraphDefinition::node_count() const { return impl_->nodes.size(); }
 size_t GraphDefinition::clip_count() const { return impl_->clips.size(); }
 const ClipView& GraphDefinition::clip(size_t i) const { return impl_->clips[i]; }
+std::span<const std::string_view> GraphDefinition::morph_channels() const { return impl_->channels; }
 
 }  // namespace ossa

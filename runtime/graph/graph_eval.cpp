@@ -9,6 +9,7 @@
 #include <cmath>
 
 #include "graph/graph_internal.h"
+#include <ossa/anim/morph.h>
 #include <ossa/anim/pose_ops.h>
 
 namespace ossa::graph_detail {
@@ -85,9 +86,20 @@ float clip_rate(const State& s, const fb::ClipNode& c) {
   return std::clamp(c.rate() * param_or(s, c.rate_parameter(), 1.0f), -kMaxScaledRate, kMaxScaledRate);
 }
 
-void evaluate_clip(State& s, uint16_t n, const NodeInfo& info, const Advance& advance, bool dominant, PoseSpan out) {
-  if (info.held >= 0) return copy_pose(s.def->held[static_cast<size_t>(info.held)], out);  // time never moves
+/// A clip's morph weights at `time`: the channels it has tracks for, the defaults elsewhere.
+void clip_weights(const State& s, uint16_t clip, float time, std::span<float> ow) {
+  if (ow.empty()) return;
+  std::copy(s.def->default_weights.begin(), s.def->default_weights.end(), ow.begin());
+  sample_morph_weights(s.def->clips[clip], time, s.def->clip_channels[clip], ow);
+}
+
+void evaluate_clip(State& s, uint16_t n, const NodeInfo& info, const Advance& advance, bool dominant, PoseSpan out,
+                   std::span<float> ow) {
   const auto& c = *static_cast<const fb::ClipNode*>(info.table);
+  if (info.held >= 0) {  // time never moves
+    clip_weights(s, c.clip(), std::clamp(c.start_offset(), 0.0f, s.def->clips[c.clip()].duration()), ow);
+    return copy_pose(s.def->held[static_cast<size_t>(info.held)], out);
+  }
   const ClipView& clip = s.def->clips[c.clip()];
   float& time = s.floats[info.floats];
   const float duration = clip.duration();
@@ -102,6 +114,7 @@ void evaluate_clip(State& s, uint16_t n, const NodeInfo& info, const Advance& ad
   SampleOptions options;
   options.loop = c.loop();
   sample(clip, time, options, s.caches[info.caches], out);
+  clip_weights(s, c.clip(), time, ow);
 }
 
 // ---- blend space ----
@@ -132,7 +145,7 @@ float blend_space_duration(const State& s, const NodeInfo& info) {
 }
 
 void evaluate_blend_space(State& s, uint16_t n, const NodeInfo& info, const Advance& advance, bool dominant,
-                          PoseSpan out, uint32_t depth) {
+                          PoseSpan out, std::span<float> ow, uint32_t depth) {
   const auto& b = *static_cast<const fb::BlendSpaceNode*>(info.table);
   const uint32_t count = blend_space_weights(s, info);
   const float* w = &s.floats[info.floats + 1];
@@ -183,6 +196,14 @@ void evaluate_blend_space(State& s, uint16_t n, const NodeInfo& info, const Adva
     PoseSpan target = active == 1 ? out : s.scratch->poses[depth + k].span();
     sample(clip, t1, options, s.caches[info.caches + indices[k]], target);
     poses[k] = target;
+    // Weights: the first sample's into ow, the others added in with their share.
+    if (!ow.empty()) {
+      std::span<float> tw = k == 0 ? ow : scratch_weights(s, depth + k);
+      clip_weights(s, smp.clip(), t1, tw);
+      float sum = 0.0f;
+      for (uint32_t i = 0; i <= k; ++i) sum += weights[i];
+      if (k > 0) blend_weights(ow, tw, weights[k] / sum);
+    }
   }
   if (active > 1) blend_n(std::span<const ConstPoseSpan>(poses, active), std::span<const float>(weights, active), out);
 }
@@ -207,7 +228,7 @@ uint32_t select_leader(const State& s, const NodeInfo& info, uint32_t n) {
 }
 
 void evaluate_select(State& s, const NodeInfo& info, const Advance& advance, float weight, bool dominant,
-                     PoseSpan out, uint32_t depth) {
+                     PoseSpan out, std::span<float> ow, uint32_t depth) {
   const auto& sel = *static_cast<const fb::SelectNode*>(info.table);
   const uint32_t n = sel.children()->size();
   float* w = &s.floats[info.floats];
@@ -229,11 +250,13 @@ void evaluate_select(State& s, const NodeInfo& info, const Advance& advance, flo
     const uint16_t child = sel.children()->Get(i);
     const float share = w[i] / total;
     if (accumulated == 0.0f) {
-      evaluate(s, child, advance, weight * share, dominant && i == leader, out, depth);
+      evaluate(s, child, advance, weight * share, dominant && i == leader, out, ow, depth);
     } else {
       PoseSpan tmp = s.scratch->poses[depth].span();
-      evaluate(s, child, advance, weight * share, dominant && i == leader, tmp, depth + 1);
+      const std::span<float> tw = scratch_weights(s, depth);
+      evaluate(s, child, advance, weight * share, dominant && i == leader, tmp, tw, depth + 1);
       blend(out, tmp, w[i] / (accumulated + w[i]), out);
+      blend_weights(ow, tw, w[i] / (accumulated + w[i]));
     }
     accumulated += w[i];
   }
@@ -277,9 +300,9 @@ void blend_mesh_space(State& s, const LayerJoints& lj, std::span<const float> ma
 }
 
 void evaluate_layered(State& s, const NodeInfo& info, const Advance& advance, float weight, bool dominant,
-                      PoseSpan out, uint32_t depth) {
+                      PoseSpan out, std::span<float> ow, uint32_t depth) {
   const auto& l = *static_cast<const fb::LayeredBlendNode*>(info.table);
-  evaluate(s, l.base(), advance, weight, dominant, out, depth);
+  evaluate(s, l.base(), advance, weight, dominant, out, ow, depth);
   const auto& layers = *l.layers();
   for (uint32_t k = 0; k < layers.size(); ++k) {
     const fb::Layer& layer = *layers.Get(k);
@@ -288,7 +311,12 @@ void evaluate_layered(State& s, const NodeInfo& info, const Advance& advance, fl
     current = ease(current, target, advance.dt, layer.blend_time());
     if (!(current > 0.0f)) continue;
     PoseSpan tmp = s.scratch->poses[depth].span();
-    evaluate(s, layer.node(), advance, weight * current, dominant && current >= 0.5f, tmp, depth + 1);
+    const std::span<float> tw = scratch_weights(s, depth);
+    evaluate(s, layer.node(), advance, weight * current, dominant && current >= 0.5f, tmp, tw, depth + 1);
+    // Morph weights: the layer blends the channels its own clips drive (a face layer over a body),
+    // and leaves the others to the base (an upper-body layer does not reset the face).
+    const std::vector<float>& morph_mask = s.def->layer_morphs[info.aux + k];
+    for (size_t c = 0; c < ow.size(); ++c) ow[c] += (tw[c] - ow[c]) * (current * morph_mask[c]);
     const std::vector<float>& mask = s.def->masks[info.aux + k];
     if (layer.mesh_space_rotation())
       blend_mesh_space(s, s.def->layer_joints[info.aux + k], mask, current, tmp, out);
@@ -300,50 +328,72 @@ void evaluate_layered(State& s, const NodeInfo& info, const Advance& advance, fl
 // ---- blend by alpha, additive ----
 
 void evaluate_alpha(State& s, const NodeInfo& info, const Advance& advance, float weight, bool dominant,
-                    PoseSpan out, uint32_t depth) {
+                    PoseSpan out, std::span<float> ow, uint32_t depth) {
   const auto& a = *static_cast<const fb::BlendAlphaNode*>(info.table);
   const float alpha = clamp01(s.params[a.alpha_parameter()]);
-  if (alpha <= 0.0f) return evaluate(s, a.a(), advance, weight, dominant, out, depth);
-  if (alpha >= 1.0f) return evaluate(s, a.b(), advance, weight, dominant, out, depth);
-  evaluate(s, a.a(), advance, weight * (1.0f - alpha), dominant && alpha < 0.5f, out, depth);
+  if (alpha <= 0.0f) return evaluate(s, a.a(), advance, weight, dominant, out, ow, depth);
+  if (alpha >= 1.0f) return evaluate(s, a.b(), advance, weight, dominant, out, ow, depth);
+  evaluate(s, a.a(), advance, weight * (1.0f - alpha), dominant && alpha < 0.5f, out, ow, depth);
   PoseSpan tmp = s.scratch->poses[depth].span();
-  evaluate(s, a.b(), advance, weight * alpha, dominant && alpha >= 0.5f, tmp, depth + 1);
+  const std::span<float> tw = scratch_weights(s, depth);
+  evaluate(s, a.b(), advance, weight * alpha, dominant && alpha >= 0.5f, tmp, tw, depth + 1);
   blend(out, tmp, alpha, out);
+  blend_weights(ow, tw, alpha);
 }
 
 void evaluate_additive(State& s, const NodeInfo& info, const Advance& advance, float weight, bool dominant,
-                       PoseSpan out, uint32_t depth) {
+                       PoseSpan out, std::span<float> ow, uint32_t depth) {
   const auto& a = *static_cast<const fb::AdditiveNode*>(info.table);
-  evaluate(s, a.base(), advance, weight, dominant, out, depth);
+  evaluate(s, a.base(), advance, weight, dominant, out, ow, depth);
   const float w = std::clamp(a.weight() * param_or(s, a.weight_parameter(), 1.0f), -kMaxScaledWeight, kMaxScaledWeight);
   if (w == 0.0f) return;
   PoseSpan tmp = s.scratch->poses[depth].span();
-  evaluate(s, a.additive(), advance, weight * std::fabs(w), dominant && std::fabs(w) >= 0.5f, tmp, depth + 1);
+  const std::span<float> tw = scratch_weights(s, depth);
+  evaluate(s, a.additive(), advance, weight * std::fabs(w), dominant && std::fabs(w) >= 0.5f, tmp, tw, depth + 1);
   make_additive(tmp, s.def->bind, tmp);
   add(out, tmp, w, out);
+  // Weights add their difference from the defaults (the additive's reference is the bind pose,
+  // whose weights are the defaults).
+  for (size_t c = 0; c < ow.size(); ++c) ow[c] += w * (tw[c] - s.def->default_weights[c]);
+}
+
+// ---- morph weights from parameters ----
+
+void evaluate_morph(State& s, const NodeInfo& info, const Advance& advance, float weight, bool dominant,
+                    PoseSpan out, std::span<float> ow, uint32_t depth) {
+  const auto& m = *static_cast<const fb::MorphWeightsNode*>(info.table);
+  evaluate(s, m.input(), advance, weight, dominant, out, ow, depth);
+  for (uint32_t k = 0; k < m.drives()->size(); ++k) {
+    const int32_t c = s.def->drive_channels[info.aux + k];
+    if (c < 0) continue;  // a target this character lacks
+    const fb::MorphDrive& d = *m.drives()->Get(k);
+    ow[static_cast<size_t>(c)] = std::clamp(d.scale() * s.params[d.parameter()], -kMaxScaledWeight, kMaxScaledWeight);
+  }
 }
 
 }  // namespace
 
 void evaluate(State& s, uint16_t n, const Advance& advance, float weight, bool dominant, PoseSpan out,
-              uint32_t depth) {
+              std::span<float> ow, uint32_t depth) {
   const NodeInfo& info = s.def->nodes[n];
   s.node_weights[n] = weight;
   switch (info.kind) {
     case Kind::Clip:
-      return evaluate_clip(s, n, info, advance, dominant, out);
+      return evaluate_clip(s, n, info, advance, dominant, out, ow);
     case Kind::BlendSpace:
-      return evaluate_blend_space(s, n, info, advance, dominant, out, depth);
+      return evaluate_blend_space(s, n, info, advance, dominant, out, ow, depth);
     case Kind::Select:
-      return evaluate_select(s, info, advance, weight, dominant, out, depth);
+      return evaluate_select(s, info, advance, weight, dominant, out, ow, depth);
     case Kind::Layered:
-      return evaluate_layered(s, info, advance, weight, dominant, out, depth);
+      return evaluate_layered(s, info, advance, weight, dominant, out, ow, depth);
     case Kind::BlendAlpha:
-      return evaluate_alpha(s, info, advance, weight, dominant, out, depth);
+      return evaluate_alpha(s, info, advance, weight, dominant, out, ow, depth);
     case Kind::Additive:
-      return evaluate_additive(s, info, advance, weight, dominant, out, depth);
+      return evaluate_additive(s, info, advance, weight, dominant, out, ow, depth);
     case Kind::Machine:
-      return evaluate_machine(s, n, advance, weight, dominant, out, depth);
+      return evaluate_machine(s, n, advance, weight, dominant, out, ow, depth);
+    case Kind::Morph:
+      return evaluate_morph(s, info, advance, weight, dominant, out, ow, depth);
   }
 }
 
@@ -392,6 +442,8 @@ void restart(State& s, uint16_t n) {
     }
     case Kind::Machine:
       return restart_machine(s, info.machine);
+    case Kind::Morph:
+      return restart(s, static_cast<const fb::MorphWeightsNode*>(info.table)->input());
   }
 }
 
@@ -430,6 +482,8 @@ Cycle cycle(const State& s, uint16_t n) {
       return cycle(s, static_cast<const fb::AdditiveNode*>(info.table)->base());
     case Kind::Machine:
       return machine_cycle(s, info.machine);
+    case Kind::Morph:
+      return cycle(s, static_cast<const fb::MorphWeightsNode*>(info.table)->input());
   }
   return {};
 }
@@ -470,6 +524,8 @@ void set_phase(State& s, uint16_t n, float p) {
     }
     case Kind::Machine:
       return set_machine_phase(s, info.machine, p);
+    case Kind::Morph:
+      return set_phase(s, static_cast<const fb::MorphWeightsNode*>(info.table)->input(), p);
   }
 }
 

@@ -34,6 +34,7 @@ std::unique_ptr<GraphScratch::Buffers> make_buffers(const GraphDefinition::Impl&
   auto b = std::make_unique<GraphScratch::Buffers>();
   b->poses.reserve(d.scratch_depth);
   for (uint32_t k = 0; k < d.scratch_depth; ++k) b->poses.emplace_back(d.joints);
+  b->weights.assign(d.scratch_depth, std::vector<float>(d.channels.size(), 0.0f));
   b->model_base.resize(d.joints);
   b->model_layer.resize(d.joints);
   return b;
@@ -101,8 +102,11 @@ Result<GraphInstance> GraphInstance::create(const GraphDefinition& definition, s
     m.rotation.resize(d.joints);
     m.last = Pose(d.joints);
     m.before_last = Pose(d.joints);
+    m.last_weights = d.default_weights;
+    m.weight_offset.assign(d.channels.size(), 0.0f);
   }
   s->output = Pose(d.joints);
+  s->morph = d.default_weights;
   s->event_capacity = event_capacity;
   s->events.reserve(event_capacity);
   GraphInstance instance(std::move(s));
@@ -166,6 +170,7 @@ void GraphInstance::reset() {
   s.events.clear();
   s.dropped = 0;
   copy_pose(s.def->bind, s.output);
+  s.morph = s.def->default_weights;  // same size: no allocation
 }
 
 void GraphInstance::update(float dt) {
@@ -187,8 +192,10 @@ void GraphInstance::update(float dt, GraphScratch::Buffers& buffers) {
   advance.dt = dt;
   // The root evaluates into scratch (hot) and the result streams into the instance's output.
   PoseSpan root = buffers.poses[0].span();
-  evaluate(s, s.def->graph->root(), advance, 1.0f, true, root, 1);
+  const std::span<float> root_weights = buffers.weights[0];
+  evaluate(s, s.def->graph->root(), advance, 1.0f, true, root, root_weights, 1);
   stream_pose(root, s.output);
+  std::copy(root_weights.begin(), root_weights.end(), s.morph.begin());
 #if defined(__SSE2__)
   // Streaming stores are weakly ordered: fence them so that whatever the host uses to hand this
   // character to another thread (even a plain release store) publishes the pose and histories.
@@ -198,6 +205,7 @@ void GraphInstance::update(float dt, GraphScratch::Buffers& buffers) {
 }
 
 ConstPoseSpan GraphInstance::pose() const { return state_->output.span(); }
+std::span<const float> GraphInstance::morph_weights() const { return state_->morph; }
 std::span<const GraphEvent> GraphInstance::events() const { return state_->events; }
 size_t GraphInstance::dropped_events() const { return state_->dropped; }
 float GraphInstance::node_weight(size_t node) const {

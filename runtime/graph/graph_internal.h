@@ -20,14 +20,15 @@
 
 namespace ossa::graph_detail {
 
-enum class Kind : uint8_t { Clip, BlendAlpha, Select, Layered, BlendSpace, Additive, Machine };
+enum class Kind : uint8_t { Clip, BlendAlpha, Select, Layered, BlendSpace, Additive, Machine, Morph };
 
 struct NodeInfo {
   Kind kind = Kind::Clip;
   const void* table = nullptr;  // the fb::*Node table of this kind
   uint32_t floats = 0;          // offset of this node's variable state in State::floats
   uint32_t caches = 0;          // first sampling cache (clip: 1, blend space: one per sample)
-  uint32_t aux = 0;             // layered: first mask (Impl::masks); blend space: 2D space index
+  uint32_t aux = 0;             // layered: first mask (Impl::masks); blend space: 2D space index;
+                                // morph: first drive channel (Impl::drive_channels)
   uint32_t samples = 0;         // blend space: first entry in Impl::sample_x / sample_duration
   uint16_t machine = 0;         // Machine: index into Impl::machines
   int32_t held = -1;            // Clip with rate 0 and no rate parameter: index into Impl::held
@@ -78,6 +79,13 @@ struct GraphDefinition::Impl {
   uint32_t float_count = 0;        // size of State::floats
   uint32_t cache_count = 0;        // sampling caches per instance
   uint32_t scratch_depth = 0;      // scratch poses one evaluation needs at most, plus the root's
+  // Morph weights (ossa/anim/morph.h): the channels are the distinct target names of the asset's
+  // meshes; every pose the graph makes carries one weight per channel beside it.
+  std::vector<std::string_view> channels;
+  std::vector<float> default_weights;              // per channel
+  std::vector<std::vector<int32_t>> clip_channels; // per clip: each weight track's channel, or -1
+  std::vector<std::vector<float>> layer_morphs;    // parallel to masks: 1 on channels the layer drives
+  std::vector<int32_t> drive_channels;             // morph nodes' drives, in order: channel or -1
 };
 
 namespace graph_detail {
@@ -104,6 +112,8 @@ struct MachineState {
   std::vector<InertialChannel> translation, rotation;  // per joint
   // The last two outputs (for the offset and its velocity) and when they were made.
   Pose last, before_last;
+  // Morph weights: the last output's, and the offset an inertialization decays (linearly).
+  std::vector<float> last_weights, weight_offset;
   float last_dt = 0.0f;
   uint64_t last_update = 0, before_last_update = 0;  // update counter stamps; 0 = never
   bool entered = false;    // false: enter the entry state at the next evaluation
@@ -114,6 +124,7 @@ struct MachineState {
 /// Memory an update uses only while it runs: shareable by every instance updated on one thread.
 struct GraphScratch::Buffers {
   std::vector<Pose> poses;
+  std::vector<std::vector<float>> weights;  // parallel to poses: morph channel weights
   // Mesh-space layering: model rotations of base and layer along a mask's chain, one per joint.
   std::vector<glm::quat> model_base, model_layer;
 };
@@ -131,6 +142,7 @@ struct GraphInstance::State {
   GraphScratch::Buffers* scratch = nullptr;  // during update(): the buffers in use
   std::vector<graph_detail::MachineState> machines;
   Pose output;
+  std::vector<float> morph;         // output morph channel weights
   std::vector<GraphEvent> events;   // capacity reserved; size() = events of the last update
   size_t event_capacity = 0;
   size_t dropped = 0;
@@ -148,8 +160,9 @@ struct Advance {
 
 /// Evaluates node `n` into out, advancing it. weight: its contribution to the output (recorded for
 /// node_weight); dominant: whether its clips may fire events; depth: first free scratch pose.
+/// ow: the output's morph channel weights (empty when the character has none), written beside out.
 void evaluate(GraphInstance::State& s, uint16_t n, const Advance& advance, float weight, bool dominant,
-              PoseSpan out, uint32_t depth);
+              PoseSpan out, std::span<float> ow, uint32_t depth);
 /// Puts a subtree back to its start (clip times to start offsets, machines to entry, selection and
 /// layer weights to their targets).
 void restart(GraphInstance::State& s, uint16_t n);
@@ -165,7 +178,14 @@ void set_phase(GraphInstance::State& s, uint16_t n, float p);
 
 /// State machine node (graph_machine.cpp).
 void evaluate_machine(GraphInstance::State& s, uint16_t n, const Advance& advance, float weight, bool dominant,
-                      PoseSpan out, uint32_t depth);
+                      PoseSpan out, std::span<float> ow, uint32_t depth);
+
+/// Morph weights beside a pose op: out = out + (b - out) * t per channel (a crossfade, a blend).
+inline void blend_weights(std::span<float> out, std::span<const float> b, float t) {
+  for (size_t c = 0; c < out.size(); ++c) out[c] += (b[c] - out[c]) * t;
+}
+/// The scratch weights at `depth` (parallel to the scratch pose there).
+inline std::span<float> scratch_weights(GraphInstance::State& s, uint32_t depth) { return s.scratch->weights[depth]; }
 void restart_machine(GraphInstance::State& s, uint16_t machine);
 Cycle machine_cycle(const GraphInstance::State& s, uint16_t machine);
 void set_machine_phase(GraphInstance::State& s, uint16_t machine, float p);

@@ -230,7 +230,7 @@ void set_machine_phase(State& s, uint16_t machine, float p) {
 }
 
 void evaluate_machine(State& s, uint16_t n, const Advance& advance, float weight, bool dominant, PoseSpan out,
-                      uint32_t depth) {
+                      std::span<float> ow, uint32_t depth) {
   const NodeInfo& info = s.def->nodes[n];
   MachineState& m = s.machines[info.machine];
   const MachineInfo& mi = s.def->machines[info.machine];
@@ -258,29 +258,39 @@ void evaluate_machine(State& s, uint16_t n, const Advance& advance, float weight
     normalized_step = both.synced ? both.phase : advance.dt / cycle(s, target).duration;
     if (w >= 1.0f) {
       m.source = -1;  // done: only the target from now on
-      evaluate(s, target, both, weight, dominant, out, depth);
+      evaluate(s, target, both, weight, dominant, out, ow, depth);
     } else {
-      evaluate(s, target, both, weight * w, dominant && w >= 0.5f, out, depth);
+      evaluate(s, target, both, weight * w, dominant && w >= 0.5f, out, ow, depth);
       PoseSpan tmp = s.scratch->poses[depth].span();
-      evaluate(s, source, both, weight * (1.0f - w), dominant && w < 0.5f, tmp, depth + 1);
+      const std::span<float> tw = scratch_weights(s, depth);
+      evaluate(s, source, both, weight * (1.0f - w), dominant && w < 0.5f, tmp, tw, depth + 1);
       blend(tmp, out, w, out);
+      for (size_t c = 0; c < ow.size(); ++c) ow[c] = tw[c] + (ow[c] - tw[c]) * w;
     }
   } else {
     m.elapsed += advance.dt;
     normalized_step = advance.synced ? advance.phase : advance.dt / cycle(s, target).duration;
-    evaluate(s, target, advance, weight, dominant, out, depth);
+    evaluate(s, target, advance, weight, dominant, out, ow, depth);
   }
   m.normalized_before = m.normalized;
   m.normalized += normalized_step;
 
-  if (capture) capture_offset(s, m, out, capture_duration);
+  if (capture) {
+    capture_offset(s, m, out, capture_duration);
+    // Morph weights: the jump at the switch, decayed linearly over the same duration.
+    for (size_t c = 0; c < ow.size(); ++c) m.weight_offset[c] = m.last_weights[c] - ow[c];
+  }
   if (m.inertial) {
     m.inertial_elapsed += advance.dt;
-    if (m.inertial_elapsed >= m.inertial_duration)
+    if (m.inertial_elapsed >= m.inertial_duration) {
       m.inertial = false;
-    else
+    } else {
       apply_offset(s, m, out);
+      const float keep = 1.0f - m.inertial_elapsed / m.inertial_duration;
+      for (size_t c = 0; c < ow.size(); ++c) ow[c] += m.weight_offset[c] * keep;
+    }
   }
+  std::copy(ow.begin(), ow.end(), m.last_weights.begin());
   if (m.source < 0 && !m.inertial && m.elapsed >= m.duration) m.transition = -1;
 
   // Keep this output for a later capture: the older buffer becomes the newest.

@@ -229,6 +229,23 @@ class GraphChecker {
         return check_param_ref(at + " weight", a.weight_parameter(), true,
                                {fb::ParameterType::Float, fb::ParameterType::Bool});
       }
+      case fb::NodeData::MorphWeightsNode: {
+        const auto& m = *node.data_as_MorphWeightsNode();
+        if (Status st = child(n, m.input(), "input"); !st) return st;
+        const auto& drives = *m.drives();
+        if (!spend(uint64_t(drives.size()) * 12)) return over_budget();
+        if (drives.size() == 0) return fail(at + ": a morph node has no drives");
+        for (flatbuffers::uoffset_t k = 0; k < drives.size(); ++k) {
+          const fb::MorphDrive& d = *drives.Get(k);
+          const std::string dat = at + format(" drive %u", k);
+          if (flatbuffers::GetStringView(d.target()).empty()) return fail(dat + ": empty target name");
+          if (!weight_ok(d.scale())) return fail(dat + format(": scale must be finite and within +-%g", kMaxWeight));
+          if (Status st = check_param_ref(dat, d.parameter(), false, {fb::ParameterType::Float, fb::ParameterType::Bool});
+              !st)
+            return st;
+        }
+        return {};
+      }
       case fb::NodeData::StateMachineNode: {
         const uint16_t m = node.data_as_StateMachineNode()->machine();
         if (m >= machine_count_) return fail(at + format(": state machine %u is out of range (%zu machines)", m, machine_count_));

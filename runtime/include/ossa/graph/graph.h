@@ -28,6 +28,11 @@
 // new transition starts from the target, and the pose the character had is kept by an inertialized
 // offset, so the blend continues from the current blended pose without a pop.
 //
+// Morph weights ride beside every pose (one float per morph channel, GraphInstance::morph_weights):
+// crossfades, blend spaces, selects and alpha blends mix them with the pose's weights, additives add
+// their difference from the defaults, an inertialized switch decays the jump linearly, and a layer
+// blends the channels its own clips drive.
+//
 // Events: a clip player reports the events its clip crosses in [previous time, new time) (wrapped
 // across loops, reversed for negative rates), only when it lies on the dominant path: at every blend
 // the child with the most weight (ties: the later child, i.e. a transition's target) passes dominance
@@ -101,6 +106,9 @@ class GraphDefinition {
   size_t node_count() const;
   size_t clip_count() const;
   const ClipView& clip(size_t i) const;
+  /// Morph channels: the distinct morph target names of the asset's meshes, in mesh order
+  /// (ossa/anim/morph.h). GraphInstance::morph_weights() has one weight per channel.
+  std::span<const std::string_view> morph_channels() const;
 
   struct Impl;
   const Impl& impl() const { return *impl_; }
@@ -166,6 +174,11 @@ class GraphInstance {
 
   /// The output local pose of the last update (the bind pose before the first).
   ConstPoseSpan pose() const;
+  /// The output's morph weights, one per GraphDefinition::morph_channels() entry: clips set the
+  /// channels they have tracks for (the defaults elsewhere), and every blend, crossfade, layer and
+  /// additive treats them as it treats joints. A layer blends only the channels its own clips
+  /// drive, so a face layer over a body changes the face and an upper-body layer leaves it.
+  std::span<const float> morph_weights() const;
   /// Events crossed in the last update, in the order they were reached.
   std::span<const GraphEvent> events() const;
   size_t dropped_events() const;
