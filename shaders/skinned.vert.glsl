@@ -20,6 +20,17 @@
 // palettes of every instance back to back: rigs with more joints than the uniform limits allow,
 // and crowds drawn with one instanced call, need no shader change. The CPU-skinning reference
 // path feeds already skinned float streams through this same shader with an identity palette.
+//
+// Morph targets (viewer/morphs.h) are added before skinning, as glTF specifies. The file stores
+// them per target; the viewer transposed them per vertex at load: u_morph_ranges[gl_VertexID] =
+// (first entry, entry count), and each entry is u_morph_texels texels of u_morph_entries: (position
+// delta xyz in mesh units, channel), then the normal delta, then the tangent delta (mesh space).
+// Weights are per instance: u_morph_weights[gl_InstanceID * u_morph_channels + channel], so a
+// crowd's members each show their own. A position delta is in mesh units while a quantized
+// position is in [0, 1] of the mesh bounds: it is multiplied by u_direction_prescale (1 /
+// position_scale) to be added to a_position. Direction deltas are added to the decoded direction
+// before the prescale, exactly as the CPU reference (apply_morphs, then skinning) does. A mesh
+// without targets sets u_morph_channels = 0 and skips all of it.
 #version 330 core
 
 layout(location = 0) in vec4 a_position;
@@ -37,6 +48,11 @@ uniform int u_normal_encoding;   // 0: xyz, 1: octahedral xy
 uniform int u_tangent_encoding;  // 0: none, 1: octahedral xy + sign z, 2: xyz + sign w
 uniform vec3 u_direction_prescale;
 uniform mat4 u_view_projection;
+uniform isamplerBuffer u_morph_ranges;  // RG32I, per vertex: first entry, entry count
+uniform samplerBuffer u_morph_entries;  // RGBA32F, u_morph_texels per entry
+uniform samplerBuffer u_morph_weights;  // R32F, per instance and channel
+uniform int u_morph_channels;           // channels per instance; 0: no morphs for this mesh
+uniform int u_morph_texels;             // 1: positions, 2: + normals, 3: + tangents
 
 out vec3 v_position;
 out vec3 v_normal;
@@ -59,20 +75,35 @@ mat4 palette(uint slot) {
 }
 
 void main() {
+  vec3 position = a_position.xyz;
+  vec3 n = u_normal_encoding == 1 ? octahedral_decode(a_normal.xy) : a_normal.xyz;
+  vec3 t = u_tangent_encoding == 1 ? octahedral_decode(a_tangent.xy) : a_tangent.xyz;
+  float t_sign = (u_tangent_encoding == 1 ? a_tangent.z : a_tangent.w) < 0.0 ? -1.0 : 1.0;
+
+  if (u_morph_channels > 0) {
+    ivec2 range = texelFetch(u_morph_ranges, gl_VertexID).xy;
+    int weights = gl_InstanceID * u_morph_channels;
+    vec3 dp = vec3(0.0), dn = vec3(0.0), dt = vec3(0.0);
+    for (int e = range.x; e < range.x + range.y; ++e) {
+      int texel = e * u_morph_texels;
+      vec4 entry = texelFetch(u_morph_entries, texel);
+      float w = texelFetch(u_morph_weights, weights + int(entry.w)).r;
+      dp += w * entry.xyz;
+      if (u_morph_texels > 1) dn += w * texelFetch(u_morph_entries, texel + 1).xyz;
+      if (u_morph_texels > 2) dt += w * texelFetch(u_morph_entries, texel + 2).xyz;
+    }
+    position += dp * u_direction_prescale;
+    n += dn;
+    t += dt;
+  }
+
   mat4 skin = a_weights.x * palette(a_joints.x) + a_weights.y * palette(a_joints.y) +
               a_weights.z * palette(a_joints.z) + a_weights.w * palette(a_joints.w);
-  vec4 world = skin * vec4(a_position.xyz, 1.0);
+  vec4 world = skin * vec4(position, 1.0);
   mat3 linear = mat3(skin);
 
-  vec3 n = u_normal_encoding == 1 ? octahedral_decode(a_normal.xy) : a_normal.xyz;
   v_normal = linear * (n * u_direction_prescale);
-
-  v_tangent = vec4(0.0);
-  if (u_tangent_encoding == 1) {
-    v_tangent = vec4(linear * (octahedral_decode(a_tangent.xy) * u_direction_prescale), a_tangent.z < 0.0 ? -1.0 : 1.0);
-  } else if (u_tangent_encoding == 2) {
-    v_tangent = vec4(linear * (a_tangent.xyz * u_direction_prescale), a_tangent.w < 0.0 ? -1.0 : 1.0);
-  }
+  v_tangent = u_tangent_encoding == 0 ? vec4(0.0) : vec4(linear * (t * u_direction_prescale), t_sign);
 
   v_position = world.xyz;
   v_uv = a_uv;

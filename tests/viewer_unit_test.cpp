@@ -1,6 +1,7 @@
 // viewer_unit_test.cpp — the viewer's parts that need no display: the command line, camera
-// framing, bind-pose bounds and how files become a scene (which files are the character, which
-// add clips, which are refused).
+// framing, bind-pose bounds, how files become a scene (which files are the character, which
+// add clips, which are refused), and morph targets (channels bound by name, the weights each
+// frame, the GPU's vertex-major entry lists, the CPU morph against skin_cpu).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -9,15 +10,19 @@
 #include <vector>
 
 #include <glm/glm.hpp>
+#include <glm/gtc/matrix_transform.hpp>
 
 #include <ossa/anim/pose.h>
 #include <ossa/anim/pose_ops.h>
+#include <ossa/skinning/skinning.h>
 #include "test_files.h"
 #include "viewer/bounds.h"
 #include "viewer/camera.h"
 #include "viewer/gl.h"
 #include "viewer/graph_driver.h"
+#include "viewer/animation.h"
 #include "viewer/graph_keys.h"
+#include "viewer/morphs.h"
 #include "viewer/options.h"
 #include "viewer/scene.h"
 
@@ -79,6 +84,18 @@ TEST(ViewerOptions, UsageErrorsExitWithTwo) {
   EXPECT_EQ(parse({"a.ossa", "--size", "big"}).exit_code, 2);
   EXPECT_EQ(parse({"a.ossa", "--crowd", "0"}).exit_code, 2);
   EXPECT_EQ(parse({"a.ossa", "--help"}).exit_code, 0);
+}
+
+TEST(ViewerOptions, MorphWeightsAreNameEqualsWeight) {
+  const ParsedOptions p = parse({"a.ossa", "--morph", "smile=0.5", "--morph", "brow=up=-1", "--morph", "frown=1e2"});
+  ASSERT_TRUE(p.options);
+  using Held = std::vector<std::pair<std::string, float>>;
+  EXPECT_EQ(p.options->morphs, (Held{{"smile", 0.5f}, {"brow=up", -1.0f}, {"frown", 100.0f}}));
+  EXPECT_EQ(p.options->files, (std::vector<std::string>{"a.ossa"}));
+  for (const char* bad : {"smile", "smile=", "=1", "smile=x", "smile=1x", "smile=nan", "smile=inf", "smile=1001"})
+    EXPECT_EQ(parse({"a.ossa", "--morph", bad}).exit_code, 2) << bad;
+  EXPECT_FALSE(parse_morph("smile=-1000.5"));
+  EXPECT_EQ(parse_morph("smile=-1000"), std::make_pair(std::string("smile"), -1000.0f));
 }
 
 /// Every corner of `box` projects inside the view, and the framing is tight: some corner lies
@@ -217,6 +234,174 @@ TEST(ViewerScene, RefusesWithTheFileNamed) {
   EXPECT_FALSE(add_clip_file(*ok, walk));
   EXPECT_EQ(ok->clips.size(), clips) << "a refused file leaves the scene as it was";
   EXPECT_EQ(ok->assets.size(), 1u);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Morph targets: test_files' "morph" variant (targets smile on vertices 4, 5 and frown on 2, 3, 4
+// with normal deltas and default weight 0.25; the clip drives frown constant at 0.5 and smile
+// 0 -> 1 over its second; its tracks are sorted by name: frown, smile).
+
+test::SyntheticSpec morph_variant() {
+  for (const auto& [name, spec] : test::valid_variants())
+    if (name == "morph") return spec;
+  ADD_FAILURE() << "no morph variant";
+  return {};
+}
+
+Result<Scene> morph_scene(const test::SyntheticSpec& spec) {
+  const fs::path file = test::make_temp_dir("viewer-morph") / "morph.ossa";
+  if (!test::write_file(file, test::make_valid_file(spec))) return Error{"cannot write " + file.string()};
+  return load_scene(std::vector<std::string>{file.string()});
+}
+
+TEST(ViewerMorph, SceneBindsChannelsDefaultsAndTracksByName) {
+  Result<Scene> s = morph_scene(morph_variant());
+  ASSERT_TRUE(s) << s.error().message;
+  EXPECT_EQ(s->morph_channels, (std::vector<std::string_view>{"smile", "frown"}));
+  ASSERT_EQ(s->morph_targets.size(), 1u);
+  EXPECT_EQ(s->morph_targets[0], (std::vector<int32_t>{0, 1}));
+  EXPECT_EQ(s->morph_defaults, (std::vector<float>{0.0f, 0.25f}));
+  ASSERT_EQ(s->clips.size(), 1u);
+  EXPECT_EQ(s->clips[0].morph_tracks, (std::vector<int32_t>{1, 0})) << "tracks frown, smile";
+  EXPECT_EQ(find_morph_channel(*s, "frown"), 1);
+  EXPECT_EQ(find_morph_channel(*s, "grin"), -1);
+
+  Result<Scene> plain = morph_scene(test::SyntheticSpec{});
+  ASSERT_TRUE(plain) << plain.error().message;
+  EXPECT_TRUE(plain->morph_channels.empty());
+  EXPECT_TRUE(plain->clips[0].morph_tracks.empty());
+}
+
+TEST(ViewerMorph, WeightsAreDefaultsThenTheClipThenHeldChannels) {
+  Result<Scene> s = morph_scene(morph_variant());
+  ASSERT_TRUE(s) << s.error().message;
+  Animator a = make_animator(*s, 2);
+  produce_morph_weights(*s, a);
+  EXPECT_EQ(a.instances[0].morph_weights, (std::vector<float>{0.0f, 0.25f})) << "no clip: the defaults";
+
+  ASSERT_TRUE(select_clip(*s, a, 0, false));
+  set_time(*s, a, 0.5f);
+  produce_morph_weights(*s, a);
+  EXPECT_NEAR(a.instances[0].morph_weights[0], 0.5f, 1e-4f) << "smile: 0 -> 1 over the second";
+  EXPECT_NEAR(a.instances[0].morph_weights[1], 0.5f, 1e-4f) << "frown: constant 32768 / 65535";
+  // Instance 1 plays 0.618 of a loop later: its own weight.
+  const float t1 = std::fmod(0.5f + a.instances[1].time_offset, 1.0f);
+  EXPECT_NEAR(a.instances[1].morph_weights[0], t1, 1e-3f);
+
+  hold_morph(a, 0, true, 0.8f);
+  produce_morph_weights(*s, a);
+  EXPECT_FLOAT_EQ(a.instances[0].morph_weights[0], 0.8f);
+  EXPECT_FLOAT_EQ(a.instances[1].morph_weights[0], 0.8f) << "a held channel holds for the whole crowd";
+  EXPECT_NEAR(a.instances[0].morph_weights[1], 0.5f, 1e-4f) << "the other channel still follows the clip";
+
+  a.playback.bind_pose = true;
+  produce_morph_weights(*s, a);
+  EXPECT_EQ(a.instances[0].morph_weights, (std::vector<float>{0.8f, 0.25f})) << "bind pose: defaults and held";
+  hold_morph(a, 0, false, 0.0f);
+  a.playback.bind_pose = false;
+  produce_morph_weights(*s, a);
+  EXPECT_NEAR(a.instances[0].morph_weights[0], 0.5f, 1e-4f) << "released: the clip again";
+}
+
+TEST(ViewerMorph, EntriesAreListedPerVertexInTargetOrder) {
+  const std::vector<uint8_t> bytes = test::make_valid_file(morph_variant());
+  Result<Asset> a = Asset::from_bytes(bytes, "morph.ossa");
+  ASSERT_TRUE(a) << a.error().message;
+  const MeshView mesh = a->mesh(0);
+  const std::vector<int32_t> both{0, 1};
+  const MorphEntries e = build_morph_entries(mesh, both);
+  ASSERT_EQ(e.entry_count, 5u);  // smile: 4, 5; frown: 2, 3, 4
+  EXPECT_EQ(e.texels_per_entry, 2) << "frown has normal deltas";
+  EXPECT_EQ(e.ranges, (std::vector<int32_t>{0, 0, 0, 0, 0, 1, 1, 1, 2, 2, 4, 1}));
+  ASSERT_EQ(e.texels.size(), 5u * 8u);
+  const auto entry = [&](size_t i) {
+    const auto first = e.texels.begin() + static_cast<std::ptrdiff_t>(8 * i);
+    return std::vector<float>(first, first + 8);
+  };
+  const auto near = [](const std::vector<float>& got, const std::vector<float>& want) {
+    for (size_t k = 0; k < want.size(); ++k) EXPECT_NEAR(got[k], want[k], 1e-6f) << "component " << k;
+  };
+  near(entry(0), {-0.05f, 0, 0, 1, 0, 0, 0.1f, 0});     // vertex 2: frown, its normal delta
+  near(entry(1), {0.05f, 0, 0, 1, 0, 0, -0.1f, 0});     // vertex 3: frown
+  near(entry(2), {0, 0.1f, 0, 0, 0, 0, 0, 0});          // vertex 4: smile first (no normal deltas)
+  near(entry(3), {0, -0.03f, 0, 1, 0, 0, 0, 0});        // vertex 4: then frown
+  near(entry(4), {0, 0.2f, 0, 0, 0, 0, 0, 0});          // vertex 5: smile
+
+  const MorphEntries frown_only = build_morph_entries(mesh, std::vector<int32_t>{-1, 0});
+  EXPECT_EQ(frown_only.entry_count, 3u) << "a target bound to no channel is left out";
+  EXPECT_TRUE(build_morph_entries(a->mesh(0), std::vector<int32_t>{-1, -1}).empty());
+  const std::vector<uint8_t> plain = test::make_valid_file();
+  Result<Asset> p = Asset::from_bytes(plain, "plain.ossa");
+  ASSERT_TRUE(p);
+  EXPECT_TRUE(build_morph_entries(p->mesh(0), {}).empty()) << "no targets, no entries";
+}
+
+/// morph_and_skin_cpu at zero weights is skin_cpu; at smile = 1 it is skin_cpu of the same file
+/// with smile's deltas baked into its vertices (quantized on their own bounds), in the bind pose
+/// and in a bent pose.
+void check_cpu_morph(const test::SyntheticSpec& spec, const char* label) {
+  SCOPED_TRACE(label);
+  const std::vector<uint8_t> bytes = test::make_valid_file(spec);
+  Result<Asset> a = Asset::from_bytes(bytes, "morph.ossa");
+  ASSERT_TRUE(a) << a.error().message;
+  const MeshView mesh = a->mesh(0);
+  const size_t n = mesh.vertex_count();
+  Result<MorphBase> base = decode_morph_base(mesh);
+  ASSERT_TRUE(base) << base.error().message;
+  const std::vector<int32_t> channels{0, 1};
+
+  std::vector<glm::mat4> model = bind_model(a->skeleton());
+  for (int pose = 0; pose < 2; ++pose) {
+    if (pose == 1)  // bend the spine and the head
+      for (size_t j = 1; j < model.size(); ++j)
+        model[j] = glm::rotate(glm::mat4(1.0f), 0.3f * static_cast<float>(j), glm::vec3(0.3f, 1.0f, 0.2f)) * model[j];
+    std::vector<glm::mat4> palette(std::max<size_t>(mesh.joints().size(), 1));
+    skinning_matrices(mesh, model, palette);
+    std::vector<float> ref_p(3 * n), ref_n(3 * n), got_p(3 * n), got_n(3 * n);
+    skin_cpu(mesh, palette, SkinningMethod::Linear, {ref_p, ref_n, {}});
+    MorphScratch scratch;
+    const std::vector<float> zero{0.0f, 0.0f};
+    ASSERT_TRUE(morph_and_skin_cpu(mesh, *base, channels, zero, palette, scratch, {got_p, got_n, {}}));
+    for (size_t k = 0; k < 3 * n; ++k) {
+      EXPECT_NEAR(got_p[k], ref_p[k], 1e-5f) << "pose " << pose << " position " << k;
+      EXPECT_NEAR(got_n[k], ref_n[k], 1e-5f) << "pose " << pose << " normal " << k;
+    }
+    const std::vector<float> smile{1.0f, 0.0f};
+    ASSERT_TRUE(morph_and_skin_cpu(mesh, *base, channels, smile, palette, scratch, {got_p, got_n, {}}));
+    test::SyntheticSpec baked_spec = spec;
+    baked_spec.meshes[0].morph_targets.clear();
+    baked_spec.clips[0].morph_weights.clear();
+    for (const auto& [v, dy] : {std::pair<size_t, float>{4, 0.1f}, {5, 0.2f}}) {
+      fb::Vec3& p = baked_spec.meshes[0].vertices[v].position;
+      p = fb::Vec3(p.x(), p.y() + dy, p.z());
+    }
+    const std::vector<uint8_t> baked_bytes = test::make_valid_file(baked_spec);
+    Result<Asset> baked = Asset::from_bytes(baked_bytes, "baked.ossa");
+    ASSERT_TRUE(baked) << baked.error().message;
+    std::vector<glm::mat4> baked_palette(palette.size());
+    skinning_matrices(baked->mesh(0), model, baked_palette);
+    skin_cpu(baked->mesh(0), baked_palette, SkinningMethod::Linear, {ref_p, ref_n, {}});
+    for (size_t k = 0; k < 3 * n; ++k) {
+      EXPECT_NEAR(got_p[k], ref_p[k], 1e-4f) << "pose " << pose << " morphed position " << k;
+      EXPECT_NEAR(got_n[k], ref_n[k], 1e-4f) << "pose " << pose << " morphed normal " << k;
+    }
+  }
+  std::vector<float> small(3);
+  MorphScratch scratch;
+  EXPECT_FALSE(morph_and_skin_cpu(mesh, *base, channels, std::vector<float>{0, 0}, std::vector<glm::mat4>(4), scratch,
+                                  {small, {}, {}}))
+      << "positions too small for the mesh";
+}
+
+TEST(ViewerMorph, CpuMorphIsSkinCpuPlusTheDeltas) {
+  check_cpu_morph(morph_variant(), "quantized");
+  test::SyntheticSpec f = morph_variant();
+  for (const auto& [name, spec] : test::valid_variants()) {
+    if (name != "float32-layout") continue;
+    f.meshes[0].layout = spec.meshes[0].layout;
+    f.meshes[0].vertex_stride = spec.meshes[0].vertex_stride;
+  }
+  check_cpu_morph(f, "float32");
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <utility>
 
+#include <ossa/anim/morph.h>
 #include <ossa/anim/pose_ops.h>
 
 namespace ossa::view {
@@ -34,10 +35,14 @@ Animator make_animator(const Scene& scene, size_t instance_count) {
     inst.local = Pose(joints);
     inst.from_local = Pose(joints);
     inst.model.assign(joints, glm::mat4(1.0f));
+    inst.morph_weights = scene.morph_defaults;
+    inst.from_morph_weights = scene.morph_defaults;
     if (joints > 0) set_bind_pose(scene.skeleton(), inst.local);
     const double phase = static_cast<double>(i) * 0.6180339887;
     inst.time_offset = static_cast<float>(phase - std::floor(phase));  // fraction of a loop; scaled per clip
   }
+  a.morph_overrides.held.assign(scene.morph_channels.size(), 0);
+  a.morph_overrides.value.assign(scene.morph_channels.size(), 0.0f);
   return a;
 }
 
@@ -133,6 +138,50 @@ void produce_local_poses(const Scene& scene, Animator& animator, PoseTimings& ti
     for (AnimInstance& inst : animator.instances) blend(inst.from_local, inst.local, p.fade, inst.local);
     timings.blend_ms += ms_since(t1);
   }
+}
+
+void produce_morph_weights(const Scene& scene, Animator& animator) {
+  const size_t channels = scene.morph_channels.size();
+  if (channels == 0) return;
+  const Playback& p = animator.playback;
+  const bool graph = animator.graph && animator.use_graph && !p.bind_pose;
+  const bool clip = p.clip >= 0 && !p.bind_pose && !(animator.graph && animator.use_graph);
+  const bool fading = clip && p.fade < 1.0f && p.from_clip >= 0;
+  const MorphOverrides& o = animator.morph_overrides;
+  for (size_t i = 0; i < animator.instances.size(); ++i) {
+    AnimInstance& inst = animator.instances[i];
+    std::copy(scene.morph_defaults.begin(), scene.morph_defaults.end(), inst.morph_weights.begin());
+    if (graph && i < animator.graph->instances.size()) {
+      // The graph's output weights (GraphInstance::morph_weights), mapped onto the scene's channels.
+      const std::span<const float> w = animator.graph->instances[i].morph_weights();
+      const std::vector<int32_t>& map = animator.graph->morph_map;
+      for (size_t ch = 0; ch < channels && ch < map.size(); ++ch)
+        if (map[ch] >= 0 && static_cast<size_t>(map[ch]) < w.size()) inst.morph_weights[ch] = w[static_cast<size_t>(map[ch])];
+    }
+    if (clip) {
+      const SceneClip& c = scene.clips[static_cast<size_t>(p.clip)];
+      const float duration = c.clip.duration();
+      (void)sample_morph_weights(c.clip, instance_time(p.time, inst.time_offset * duration, duration, p.loop),
+                                 c.morph_tracks, inst.morph_weights);
+      if (fading) {
+        const SceneClip& from = scene.clips[static_cast<size_t>(p.from_clip)];
+        const float d = from.clip.duration();
+        std::copy(scene.morph_defaults.begin(), scene.morph_defaults.end(), inst.from_morph_weights.begin());
+        (void)sample_morph_weights(from.clip, instance_time(p.from_time, inst.time_offset * d, d, true),
+                                   from.morph_tracks, inst.from_morph_weights);
+        (void)blend_morph_weights(inst.from_morph_weights, inst.morph_weights, p.fade, inst.morph_weights);
+      }
+    }
+    for (size_t ch = 0; ch < channels && ch < o.held.size(); ++ch)
+      if (o.held[ch]) inst.morph_weights[ch] = o.value[ch];
+  }
+}
+
+void hold_morph(Animator& animator, size_t channel, bool held, float weight) {
+  MorphOverrides& o = animator.morph_overrides;
+  if (channel >= o.held.size()) return;
+  o.held[channel] = held ? 1 : 0;
+  o.value[channel] = weight;
 }
 
 void compute_model_poses(const Scene& scene, Animator& animator, PoseTimings& timings) {

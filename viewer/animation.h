@@ -9,8 +9,15 @@
 // A crowd is N instances of the same character playing the same clip at different phases; each
 // has its own sampling caches (ossa/anim/sample.h: one cache per clip and playing instance) and pose
 // storage, allocated when a clip is selected, never per frame.
+//
+// Morph weights follow the same path beside the pose: produce_morph_weights gives every instance
+// its channels' weights (scene.h binds channels by name): the targets' defaults, overwritten by
+// the selected clip's weight tracks at the instance's own time (cross-faded like the pose), then
+// by the channels the user holds (the panel's sliders, --morph). Under a graph the weights are the
+// graph's output weights (GraphInstance::morph_weights), then the held channels.
 #pragma once
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -42,6 +49,13 @@ struct AnimInstance {
   SamplingCache cache, from_cache;
   Pose local, from_local;
   std::vector<glm::mat4> model;  // model-space joint matrices, one per skeleton joint
+  std::vector<float> morph_weights, from_morph_weights;  // one per morph channel (scene.h)
+};
+
+/// Channels the user holds at a weight (panel sliders, --morph); the others follow the clip.
+struct MorphOverrides {
+  std::vector<uint8_t> held;   // one per morph channel
+  std::vector<float> value;
 };
 
 struct Animator {
@@ -50,6 +64,7 @@ struct Animator {
   std::unique_ptr<GraphDriver> graph;  // --graph: one graph instance per AnimInstance
   bool use_graph = false;              // the graph drives the poses (else the clip list does)
   float graph_dt = 0.0f;               // time advance() banked for the next graph update
+  MorphOverrides morph_overrides;
 };
 
 /// Instances with bind-pose storage and phases spread over the clip (instance i starts i * 0.618
@@ -80,6 +95,14 @@ struct PoseTimings {
 /// clip sampled at each instance's time, or the cross-fade of the previous and the selected clip.
 /// Allocation-free (but for the graph's event log).
 void produce_local_poses(const Scene& scene, Animator& animator, PoseTimings& timings);
+
+/// This frame's morph weights of every instance (AnimInstance::morph_weights): defaults, the
+/// selected clip's tracks at each instance's time (cross-faded as the pose is), held channels.
+/// Allocation-free. O(instances * (channels + tracks * log keys)).
+void produce_morph_weights(const Scene& scene, Animator& animator);
+
+/// Holds channel `channel` at `weight` (held = true) or lets the clip drive it again.
+void hold_morph(Animator& animator, size_t channel, bool held, float weight);
 
 /// Local -> model matrices of every instance (AnimInstance::model). Allocation-free.
 void compute_model_poses(const Scene& scene, Animator& animator, PoseTimings& timings);

@@ -89,6 +89,7 @@ Status use_graph(App& app, const std::string& name) {
 
 Status set_crowd(App& app, size_t crowd, float aspect) {
   const Playback previous = app.animator.playback;
+  MorphOverrides held = std::move(app.animator.morph_overrides);  // the held weights survive too
   const bool had_clip = !app.animator.instances.empty();
   // A graph's parameter values survive a crowd change (triggers are one-shot and do not).
   std::vector<std::pair<int, float>> graph_values;
@@ -102,6 +103,7 @@ Status set_crowd(App& app, size_t crowd, float aspect) {
   }
   app.crowd = crowd == 0 ? 1 : crowd;
   app.animator = make_animator(app.scene, app.crowd);
+  if (held.held.size() == app.scene.morph_channels.size()) app.animator.morph_overrides = std::move(held);
 
   // Bind pose bounds of one character, then of the whole crowd.
   Animator& a = app.animator;
@@ -166,6 +168,7 @@ Status step_and_render(App& app, float dt, int width, int height, FrameTimings& 
   PoseTimings pose;
   produce_local_poses(app.scene, app.animator, pose);
   compute_model_poses(app.scene, app.animator, pose);
+  produce_morph_weights(app.scene, app.animator);
   timings.sample_ms += pose.sample_ms;
   timings.blend_ms += pose.blend_ms;
   timings.graph_ms += pose.graph_ms;

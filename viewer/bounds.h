@@ -6,7 +6,9 @@
 // box implausibly larger than the skeleton), and those guesses cut off props and meshes larger than
 // the skeleton; skinning the vertices needs none. It costs one CPU skin of the character, done
 // when the camera is framed (a file is opened, the crowd changes, R is pressed), never per frame:
-// about a millisecond for the largest shared character (AnimeBoy, 22,000 vertices).
+// about a millisecond for the largest shared character (AnimeBoy, 22,000 vertices). Morph targets
+// are left out: the framing is the unmorphed character's, so holding a morph weight (a slider,
+// --morph) never moves the camera and two renders that differ only in weights share their framing.
 #pragma once
 #include <limits>
 #include <span>

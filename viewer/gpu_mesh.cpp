@@ -5,6 +5,7 @@
 #include <string>
 
 #include <ossa/format/vertex_format.h>
+#include "viewer/morphs.h"
 
 namespace ossa::view {
 namespace {
@@ -61,9 +62,40 @@ GLuint float_stream(GLuint location, int components) {
   return b;
 }
 
+/// A texture buffer over a new buffer holding `bytes`.
+void make_texture_buffer(GLenum format, const void* data, size_t bytes, GLuint& buffer, GLuint& texture) {
+  glGenBuffers(1, &buffer);
+  glBindBuffer(GL_TEXTURE_BUFFER, buffer);
+  glBufferData(GL_TEXTURE_BUFFER, static_cast<GLsizeiptr>(bytes), data, GL_STATIC_DRAW);
+  glGenTextures(1, &texture);
+  glBindTexture(GL_TEXTURE_BUFFER, texture);
+  glTexBuffer(GL_TEXTURE_BUFFER, format, buffer);
+  glBindTexture(GL_TEXTURE_BUFFER, 0);
+  glBindBuffer(GL_TEXTURE_BUFFER, 0);
+}
+
+/// The mesh's morph entry lists as two texture buffers (morphs.h build_morph_entries).
+Status upload_morphs(GpuMesh& g, const MeshView& mesh, std::string_view asset_name, std::span<const int32_t> target_channel) {
+  const MorphEntries e = build_morph_entries(mesh, target_channel);
+  if (e.empty()) return {};
+  GLint max_texels = 0;
+  glGetIntegerv(GL_MAX_TEXTURE_BUFFER_SIZE, &max_texels);
+  const size_t texels = e.entry_count * static_cast<size_t>(e.texels_per_entry);
+  if (texels > static_cast<size_t>(max_texels) || mesh.vertex_count() > static_cast<size_t>(max_texels)) {
+    return Error{where(mesh, asset_name) + ": " + std::to_string(texels) + " morph texels exceed this GL's texture buffer (" +
+                 std::to_string(max_texels) + " texels)"};
+  }
+  make_texture_buffer(GL_RG32I, e.ranges.data(), e.ranges.size() * sizeof(int32_t), g.morph_range_buffer,
+                      g.morph_range_texture);
+  make_texture_buffer(GL_RGBA32F, e.texels.data(), e.texels.size() * sizeof(float), g.morph_entry_buffer,
+                      g.morph_entry_texture);
+  g.morph_texels = e.texels_per_entry;
+  return {};
+}
+
 }  // namespace
 
-Result<GpuMesh> create_gpu_mesh(const MeshView& mesh, std::string_view asset_name) {
+Result<GpuMesh> create_gpu_mesh(const MeshView& mesh, std::string_view asset_name, std::span<const int32_t> target_channel) {
   GpuMesh g;
   g.vertex_count = mesh.vertex_count();
   g.index_type = mesh.index_format() == fb::IndexFormat::Uint32 ? GL_UNSIGNED_INT : GL_UNSIGNED_SHORT;
@@ -114,13 +146,22 @@ Result<GpuMesh> create_gpu_mesh(const MeshView& mesh, std::string_view asset_nam
   if (g.has_normals) g.cpu_normals = float_stream(kNormal, 3);
   if (g.has_tangents) g.cpu_tangents = float_stream(kTangent, 4);
   glBindVertexArray(0);
+  if (Status s = upload_morphs(g, mesh, asset_name, target_channel); !s) {
+    destroy_gpu_mesh(g);
+    return s.error();
+  }
   return g;
 }
 
 void destroy_gpu_mesh(GpuMesh& g) {
-  const GLuint buffers[] = {g.vertex_buffer, g.index_buffer, g.cpu_positions, g.cpu_normals, g.cpu_tangents};
+  const GLuint buffers[] = {g.vertex_buffer, g.index_buffer, g.cpu_positions, g.cpu_normals, g.cpu_tangents,
+                            g.morph_range_buffer, g.morph_entry_buffer};
   for (GLuint b : buffers) {
     if (b != 0) glDeleteBuffers(1, &b);
+  }
+  const GLuint textures[] = {g.morph_range_texture, g.morph_entry_texture};
+  for (GLuint t : textures) {
+    if (t != 0) glDeleteTextures(1, &t);
   }
   const GLuint arrays[] = {g.vao, g.cpu_vao};
   for (GLuint a : arrays) {

@@ -9,8 +9,14 @@
 // positions / normals / tangents streamed into their own buffers each frame, with texture
 // coordinates and colours still read from the file's buffer. Those buffers are created empty
 // here and filled by the renderer only when that path is used.
+//
+// A mesh with morph targets also gets its vertex-major entry lists (morphs.h) as two texture
+// buffers, made once here: ranges (RG32I, one texel per vertex, read with gl_VertexID) and
+// entries (RGBA32F, morph_texels per entry). A mesh without targets has neither, and the shader
+// skips the morph loop for it (u_morph_channels = 0).
 #pragma once
 #include <cstdint>
+#include <span>
 #include <string_view>
 
 #include <glm/glm.hpp>
@@ -41,11 +47,19 @@ struct GpuMesh {
 
   // CPU-skinning path: float streams skinned by skin_cpu (empty until used).
   GLuint cpu_vao = 0, cpu_positions = 0, cpu_normals = 0, cpu_tangents = 0;
+
+  // Morph targets (0 when the mesh has none bound to a channel).
+  GLuint morph_range_buffer = 0, morph_range_texture = 0, morph_entry_buffer = 0, morph_entry_texture = 0;
+  int morph_texels = 0;        // texels per entry: 1 positions, 2 + normals, 3 + tangents
+  bool has_morphs() const { return morph_texels > 0; }
 };
 
-/// Uploads one mesh. Errors (naming `asset_name` and the mesh) for layouts the shader cannot
-/// read: a format outside the table, integer joints missing or not integer.
-Result<GpuMesh> create_gpu_mesh(const MeshView& mesh, std::string_view asset_name);
+/// Uploads one mesh, and its morph targets bound through target_channel (target -> channel, as
+/// bind_morph_targets; empty: none). Errors (naming `asset_name` and the mesh) for layouts the
+/// shader cannot read: a format outside the table, integer joints missing or not integer; morph
+/// entries past GL_MAX_TEXTURE_BUFFER_SIZE.
+Result<GpuMesh> create_gpu_mesh(const MeshView& mesh, std::string_view asset_name,
+                                std::span<const int32_t> target_channel = {});
 void destroy_gpu_mesh(GpuMesh& mesh);
 
 /// The constant attribute values the shader sees for arrays a mesh lacks: colour white, joint

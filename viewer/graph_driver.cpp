@@ -1,6 +1,8 @@
 // graph_driver.cpp — see graph_driver.h.
 #include "viewer/graph_driver.h"
 
+#include <algorithm>
+
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -66,6 +68,11 @@ Result<GraphDriver> make_graph_driver(const Scene& scene, std::string_view name,
                  " joints, the character " + std::to_string(scene.joint_count())};
   }
   d.definition = std::make_unique<GraphDefinition>(std::move(*def));
+  const std::span<const std::string_view> graph_channels = d.definition->morph_channels();
+  for (const std::string_view channel : scene.morph_channels) {
+    const auto it = std::find(graph_channels.begin(), graph_channels.end(), channel);
+    d.morph_map.push_back(it == graph_channels.end() ? -1 : static_cast<int32_t>(it - graph_channels.begin()));
+  }
   for (size_t i = 0; i < (instances == 0 ? 1 : instances); ++i) {
     Result<GraphInstance> inst = GraphInstance::create(*d.definition);
     if (!inst) return inst.error();

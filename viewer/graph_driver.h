@@ -29,6 +29,8 @@ struct GraphDriver {
   std::vector<GraphInstance> instances;            // one per crowd instance
   std::deque<std::string> recent_events;           // instance 0's last events, newest first
   double time = 0.0;                               // seconds of graph time played
+  /// Per scene morph channel (Scene::morph_channels): the graph's channel of that name, or -1.
+  std::vector<int32_t> morph_map;
 };
 
 /// Finds graph `name` in the scene's files and instantiates it `instances` times. Instance i > 0

@@ -10,6 +10,7 @@
 namespace ossa::view {
 namespace {
 constexpr float kMaxSeconds = 3600.0f;
+constexpr float kMaxMorphWeight = 1000.0f;  // runtime/loader/validate.cpp kMaxMorphWeight
 }
 
 std::optional<std::pair<int, int>> parse_size(const std::string& text) {
@@ -22,6 +23,17 @@ std::optional<std::pair<int, int>> parse_size(const std::string& text) {
   if (rw.ec != std::errc() || rw.ptr != b + x || rh.ec != std::errc() || rh.ptr != b + text.size()) return std::nullopt;
   if (w < 1 || h < 1 || w > 16384 || h > 16384) return std::nullopt;
   return std::make_pair(w, h);
+}
+
+std::optional<std::pair<std::string, float>> parse_morph(const std::string& text) {
+  const size_t eq = text.rfind('=');
+  if (eq == std::string::npos || eq == 0 || eq + 1 == text.size()) return std::nullopt;
+  float w = 0.0f;
+  const char* b = text.data() + eq + 1;
+  const char* e = text.data() + text.size();
+  const auto r = std::from_chars(b, e, w);
+  if (r.ec != std::errc() || r.ptr != e || !std::isfinite(w) || std::fabs(w) > kMaxMorphWeight) return std::nullopt;
+  return std::make_pair(text.substr(0, eq), w);
 }
 
 ParsedOptions parse_options(int argc, const char* const* argv) {
@@ -54,6 +66,10 @@ ParsedOptions parse_options(int argc, const char* const* argv) {
   app.add_option("--set", o.set, "graph parameter start value, NAME=VALUE (a trigger: NAME); repeatable")
       ->needs("--graph")
       ->allow_extra_args(false);  // one value per --set: the files may follow
+  std::vector<std::string> morphs;
+  app.add_option("--morph", morphs, "hold the morph targets named NAME at WEIGHT (clips no longer drive them); repeatable")
+      ->type_name("NAME=WEIGHT")
+      ->allow_extra_args(false);  // one value per --morph: the files may follow
   app.add_option("--window-frames", o.window_frames, "window mode: exit after N frames (--screenshot captures the window)")
       ->check(CLI::Range(1, 1000000));
   if (const auto exit_now = command.parse(argc, argv)) return {std::nullopt, *exit_now};
@@ -66,6 +82,12 @@ ParsedOptions parse_options(int argc, const char* const* argv) {
     o.height = wh->second;
   }
   o.grid = !no_grid;
+  for (const std::string& m : morphs) {
+    const auto parsed = parse_morph(m);
+    if (!parsed)
+      return {std::nullopt, command.usage_error("--morph: expected NAME=WEIGHT with a finite weight within +-1000, got '" + m + "'")};
+    o.morphs.push_back(*parsed);
+  }
   // A graph cannot seek: headless --time T plays T seconds in 1/60 s steps, so T is bounded (an
   // hour is 216,000 steps); a clip's time wraps, but must still be a number.
   if (!std::isfinite(o.time) || std::fabs(o.time) > kMaxSeconds)

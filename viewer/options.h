@@ -4,7 +4,7 @@
 //             [--bind-pose] [--cpu-skinning] [--crowd N] [--wireframe] [--skeleton] [--no-grid]
 //             [--yaw DEG] [--pitch DEG] [--size WxH] [--msaa N]
 //             [--frames N] [--screenshot OUT.png] [--first-frame-time] [--stats]
-//             [--window-frames N] [--graph NAME [--set PARAM=VALUE ...]]
+//             [--window-frames N] [--graph NAME [--set PARAM=VALUE ...]] [--morph NAME=WEIGHT ...]
 //             [-q | -v] [--version] [--help]
 //
 // With --frames or --screenshot the viewer runs headless (hidden window, offscreen framebuffer):
@@ -14,6 +14,9 @@
 // --graph NAME drives the character with an animation graph found in any of the files; --set
 // gives its parameters start values (a trigger is fired by naming it: --set stop). A graph cannot
 // seek, so headless --time T plays T seconds of the graph in 1/60 s steps before the N frames.
+// --morph NAME=WEIGHT holds a morph target channel (every target of that name) at WEIGHT, as the
+// panel's slider does: clips no longer drive it; repeatable; a name the character lacks is an
+// error listing the names it has.
 // -q prints only errors (no warnings such as a texture left out); -v adds the OpenGL version and
 // renderer and what was loaded. Parsing is separate from running so tests and the bench can build
 // command lines with the same names.
@@ -24,6 +27,7 @@
 #pragma once
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace ossa::view {
@@ -52,6 +56,7 @@ struct ViewerOptions {
   int window_frames = 0;        // window mode: exit after this many frames (0: when closed)
   std::string graph;            // drive the character with this graph
   std::vector<std::string> set; // graph parameter start values, "name=value" (or "trigger")
+  std::vector<std::pair<std::string, float>> morphs;  // --morph: channels held at a weight
   bool quiet = false;           // -q: errors only
   bool verbose = false;         // -v: GL information and what was loaded
 
@@ -65,6 +70,10 @@ struct ParsedOptions {
   int exit_code = 0;
 };
 ParsedOptions parse_options(int argc, const char* const* argv);
+
+/// "smile=0.5" -> ("smile", 0.5); nullopt without a name, an '=' or a finite weight within
+/// +-1000 (the loader's bound on stored weights).
+std::optional<std::pair<std::string, float>> parse_morph(const std::string& text);
 
 /// "640x480" -> (640, 480); nullopt unless both are in 1..16384.
 std::optional<std::pair<int, int>> parse_size(const std::string& text);

@@ -86,6 +86,22 @@ void set_mesh_encoding(const Renderer& r, const GpuMesh& m, bool cpu_skinned) {
   }
 }
 
+/// Morph uniforms and textures for one mesh on the GPU path (none: the shader skips the loop).
+void bind_mesh_morphs(const Renderer& r, const GpuMesh& m, size_t channels) {
+  const auto& u = r.mesh_uniforms;
+  if (!m.has_morphs() || channels == 0) {
+    glUniform1i(u.morph_channels, 0);
+    return;
+  }
+  glUniform1i(u.morph_channels, static_cast<GLint>(channels));
+  glUniform1i(u.morph_texels, m.morph_texels);
+  glActiveTexture(GL_TEXTURE4);
+  glBindTexture(GL_TEXTURE_BUFFER, m.morph_range_texture);
+  glActiveTexture(GL_TEXTURE5);
+  glBindTexture(GL_TEXTURE_BUFFER, m.morph_entry_texture);
+  glActiveTexture(GL_TEXTURE0);
+}
+
 /// Bones (joint to parent) and joints of every instance.
 void build_skeleton_lines(Renderer& r, const Scene& scene, const Animator& animator, std::span<const glm::vec3> offsets,
                           size_t& bone_vertices) {
@@ -141,15 +157,26 @@ Result<Renderer> create_renderer() {
   u.has_normal_map = glGetUniformLocation(p, "u_has_normal_map");
   u.has_specular_map = glGetUniformLocation(p, "u_has_specular_map");
   u.flat_color = glGetUniformLocation(p, "u_flat_color");
+  u.morph_ranges = glGetUniformLocation(p, "u_morph_ranges");
+  u.morph_entries = glGetUniformLocation(p, "u_morph_entries");
+  u.morph_weights = glGetUniformLocation(p, "u_morph_weights");
+  u.morph_channels = glGetUniformLocation(p, "u_morph_channels");
+  u.morph_texels = glGetUniformLocation(p, "u_morph_texels");
   r.line_uniforms.view_projection = glGetUniformLocation(r.line_program, "u_view_projection");
   r.line_uniforms.point_size = glGetUniformLocation(r.line_program, "u_point_size");
 
-  // Texture units: 0 palette, 1 diffuse, 2 normal, 3 specular.
+  // Texture units: 0 palette, 1 diffuse, 2 normal, 3 specular, 4 morph ranges, 5 morph entries,
+  // 6 morph weights (each sampler type on its own unit, as GL requires).
   glUseProgram(p);
   glUniform1i(u.palette, 0);
   glUniform1i(u.diffuse_map, 1);
   glUniform1i(u.normal_map, 2);
   glUniform1i(u.specular_map, 3);
+  glUniform1i(u.morph_ranges, 4);
+  glUniform1i(u.morph_entries, 5);
+  glUniform1i(u.morph_weights, 6);
+  glUniform1i(u.morph_channels, 0);
+  glUniform1i(u.morph_texels, 1);
   glUseProgram(0);
 
   glGenBuffers(1, &r.palette_buffer);
@@ -160,6 +187,13 @@ Result<Renderer> create_renderer() {
   glTexBuffer(GL_TEXTURE_BUFFER, GL_RGBA32F, r.palette_buffer);
   glBindTexture(GL_TEXTURE_BUFFER, 0);
   glGetIntegerv(GL_MAX_TEXTURE_BUFFER_SIZE, &r.max_texels);
+  glGenBuffers(1, &r.morph_weight_buffer);
+  glBindBuffer(GL_TEXTURE_BUFFER, r.morph_weight_buffer);
+  glBufferData(GL_TEXTURE_BUFFER, sizeof(float), nullptr, GL_STREAM_DRAW);
+  glGenTextures(1, &r.morph_weight_texture);
+  glBindTexture(GL_TEXTURE_BUFFER, r.morph_weight_texture);
+  glTexBuffer(GL_TEXTURE_BUFFER, GL_R32F, r.morph_weight_buffer);
+  glBindTexture(GL_TEXTURE_BUFFER, 0);
 
   r.lines_vao = make_line_array(r.lines_buffer);
   r.grid_vao = make_line_array(r.grid_buffer);
@@ -177,6 +211,7 @@ void release_scene(Renderer& r) {
   destroy_materials(r.materials);
   r.bind.clear();
   r.palette_base.clear();
+  r.morph_base.clear();
   r.instance_matrices = 0;
 }
 
@@ -184,11 +219,12 @@ void destroy_renderer(Renderer& r) {
   release_scene(r);
   if (r.mesh_program) glDeleteProgram(r.mesh_program);
   if (r.line_program) glDeleteProgram(r.line_program);
-  const GLuint buffers[] = {r.palette_buffer, r.lines_buffer, r.grid_buffer};
+  const GLuint buffers[] = {r.palette_buffer, r.morph_weight_buffer, r.lines_buffer, r.grid_buffer};
   for (GLuint b : buffers) {
     if (b) glDeleteBuffers(1, &b);
   }
   if (r.palette_texture) glDeleteTextures(1, &r.palette_texture);
+  if (r.morph_weight_texture) glDeleteTextures(1, &r.morph_weight_texture);
   const GLuint arrays[] = {r.lines_vao, r.grid_vao};
   for (GLuint a : arrays) {
     if (a) glDeleteVertexArrays(1, &a);
@@ -203,11 +239,24 @@ Status upload_scene(Renderer& r, const Scene& scene, std::vector<std::string>& w
   const std::string& path = scene.paths.front();
   for (size_t i = 0; i < asset.mesh_count(); ++i) {
     const MeshView view = asset.mesh(i);
-    Result<GpuMesh> g = create_gpu_mesh(view, path);
+    const std::span<const int32_t> targets =
+        i < scene.morph_targets.size() ? std::span<const int32_t>(scene.morph_targets[i]) : std::span<const int32_t>();
+    Result<GpuMesh> g = create_gpu_mesh(view, path, targets);
     if (!g) {
       release_scene(r);
       return g.error();
     }
+    MorphBase base;
+    if (g->has_morphs()) {
+      Result<MorphBase> decoded = decode_morph_base(view);
+      if (!decoded) {
+        destroy_gpu_mesh(*g);
+        release_scene(r);
+        return Error{path + ": " + decoded.error().message};
+      }
+      base = std::move(*decoded);
+    }
+    r.morph_base.push_back(std::move(base));
     r.palette_base.push_back(r.instance_matrices);
     r.instance_matrices += g->palette_slots;
     std::vector<glm::mat4> bind(g->palette_slots);
@@ -269,6 +318,23 @@ Status render_frame(Renderer& r, const Scene& scene, const Animator& animator, s
   glBindBuffer(GL_TEXTURE_BUFFER, r.palette_buffer);
   glBufferData(GL_TEXTURE_BUFFER, static_cast<GLsizeiptr>(r.palette.size() * sizeof(glm::mat4)), r.palette.data(),
                GL_STREAM_DRAW);
+  // Morph weights of every instance, one upload (only when some mesh has targets).
+  const size_t channels = scene.morph_channels.size();
+  const bool morphs = channels > 0 && std::any_of(r.meshes.begin(), r.meshes.end(), [](const GpuMesh& g) { return g.has_morphs(); });
+  if (morphs) {
+    if (instances * channels > static_cast<size_t>(r.max_texels)) {
+      return Error{scene.paths.front() + ": " + std::to_string(instances) + " instances x " + std::to_string(channels) +
+                   " morph channels exceed this GL's texture buffer (" + std::to_string(r.max_texels) + " texels)"};
+    }
+    r.morph_weights.resize(instances * channels);
+    for (size_t i = 0; i < instances; ++i) {
+      const std::vector<float>& w = animator.instances[i].morph_weights;
+      std::copy_n(w.begin(), std::min(w.size(), channels), r.morph_weights.begin() + static_cast<std::ptrdiff_t>(i * channels));
+    }
+    glBindBuffer(GL_TEXTURE_BUFFER, r.morph_weight_buffer);
+    glBufferData(GL_TEXTURE_BUFFER, static_cast<GLsizeiptr>(r.morph_weights.size() * sizeof(float)), r.morph_weights.data(),
+                 GL_STREAM_DRAW);
+  }
   timings.skin_ms += ms_since(t_skin);
 
   // ---- draw
@@ -311,6 +377,8 @@ Status render_frame(Renderer& r, const Scene& scene, const Animator& animator, s
   glUniformMatrix4fv(u.view_projection, 1, GL_FALSE, &view_projection[0][0]);
   glUniform3f(u.camera_position, eye.x, eye.y, eye.z);
   glUniform3f(u.light_direction, light.x, light.y, light.z);
+  glActiveTexture(GL_TEXTURE6);
+  glBindTexture(GL_TEXTURE_BUFFER, r.morph_weight_texture);
   glActiveTexture(GL_TEXTURE0);
   glBindTexture(GL_TEXTURE_BUFFER, r.palette_texture);
   set_default_attributes();
@@ -333,6 +401,7 @@ Status render_frame(Renderer& r, const Scene& scene, const Animator& animator, s
       glUniform1i(u.instance_texels, static_cast<GLint>(4 * r.instance_matrices));
       for (size_t m = 0; m < r.meshes.size(); ++m) {
         set_mesh_encoding(r, r.meshes[m], false);
+        bind_mesh_morphs(r, r.meshes[m], morphs ? channels : 0);
         glUniform1i(u.palette_base, static_cast<GLint>(4 * r.palette_base[m]));
         glBindVertexArray(r.meshes[m].vao);
         draw_submeshes(r, asset.mesh(m), r.meshes[m], static_cast<GLsizei>(instances), shaded);
@@ -341,6 +410,7 @@ Status render_frame(Renderer& r, const Scene& scene, const Animator& animator, s
       // Reference path: skin_cpu per instance and mesh, drawn with the identity palette entry.
       glUniform1i(u.instance_texels, 0);
       glUniform1i(u.palette_base, static_cast<GLint>(4 * (matrices - 1)));
+      glUniform1i(u.morph_channels, 0);  // morphed on the CPU
       for (size_t i = 0; i < instances; ++i) {
         for (size_t m = 0; m < r.meshes.size(); ++m) {
           const GpuMesh& g = r.meshes[m];
@@ -351,7 +421,11 @@ Status render_frame(Renderer& r, const Scene& scene, const Animator& animator, s
           r.skinned_normals.resize(g.has_normals ? 3 * n : 0);
           r.skinned_tangents.resize(g.has_tangents ? 4 * n : 0);
           const std::span<const glm::mat4> palette(r.palette.data() + i * r.instance_matrices + r.palette_base[m], g.palette_slots);
-          skin_cpu(view, palette, SkinningMethod::Linear, {r.skinned_positions, r.skinned_normals, r.skinned_tangents});
+          const SkinnedStreams out{r.skinned_positions, r.skinned_normals, r.skinned_tangents};
+          const bool morphed = g.has_morphs() && m < scene.morph_targets.size() &&
+                               morph_and_skin_cpu(view, r.morph_base[m], scene.morph_targets[m],
+                                                  animator.instances[i].morph_weights, palette, r.morph_scratch, out);
+          if (!morphed) skin_cpu(view, palette, SkinningMethod::Linear, out);
           upload_stream(g.cpu_positions, r.skinned_positions);
           if (g.has_normals) upload_stream(g.cpu_normals, r.skinned_normals);
           if (g.has_tangents) upload_stream(g.cpu_tangents, r.skinned_tangents);

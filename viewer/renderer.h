@@ -6,6 +6,11 @@
 // once for all instances with glDrawElementsInstanced. The --cpu-skinning path instead runs
 // skin_cpu per instance and streams the skinned floats into the mesh's CPU vertex array; it draws
 // through the same shader with an identity palette, so the two paths differ only in who skins.
+//
+// Morph targets: every instance's channel weights (animation.h) go into one R32F texture buffer
+// per frame, beside the palettes, and meshes with targets read them in the vertex shader through
+// their entry lists (gpu_mesh.h, morphs.h). The CPU path morphs and skins those meshes with
+// morph_and_skin_cpu (apply_morphs, then the same linear blend), from vertices decoded once here.
 #pragma once
 #include <cstdint>
 #include <span>
@@ -20,6 +25,7 @@
 #include "viewer/camera.h"
 #include "viewer/gpu_mesh.h"
 #include "viewer/materials.h"
+#include "viewer/morphs.h"
 #include "viewer/scene.h"
 
 namespace ossa::view {
@@ -47,7 +53,8 @@ struct Renderer {
   struct {
     GLint palette, palette_base, instance_texels, normal_encoding, tangent_encoding, direction_prescale,
         view_projection, camera_position, light_direction, diffuse_color, opacity, diffuse_map, normal_map,
-        specular_map, has_diffuse_map, has_normal_map, has_specular_map, flat_color;
+        specular_map, has_diffuse_map, has_normal_map, has_specular_map, flat_color, morph_ranges, morph_entries,
+        morph_weights, morph_channels, morph_texels;
   } mesh_uniforms{};
   struct {
     GLint view_projection, point_size;
@@ -56,6 +63,8 @@ struct Renderer {
   // Palette texture buffer: RGBA32F, 4 texels per matrix; one identity matrix at the end serves
   // the CPU-skinning path.
   GLuint palette_buffer = 0, palette_texture = 0;
+  // Morph weights texture buffer: R32F, instance * channels + channel.
+  GLuint morph_weight_buffer = 0, morph_weight_texture = 0;
   GLint max_texels = 0;
   GLuint lines_vao = 0, lines_buffer = 0, grid_vao = 0, grid_buffer = 0;
   GLsizei grid_vertices = 0;
@@ -69,10 +78,13 @@ struct Renderer {
   std::vector<std::vector<glm::mat4>> bind;  // prepare_bind_matrices, per mesh
   std::vector<uint32_t> palette_base;        // first matrix of each mesh's palette in an instance
   uint32_t instance_matrices = 0;            // matrices per instance (all meshes)
+  std::vector<MorphBase> morph_base;         // per mesh: decoded for the CPU path (empty without targets)
 
   // Per-frame scratch, sized once.
   std::vector<glm::mat4> palette;
   std::vector<float> skinned_positions, skinned_normals, skinned_tangents;
+  std::vector<float> morph_weights;
+  MorphScratch morph_scratch;
   std::vector<LineVertex> lines;
 };
 
@@ -90,7 +102,7 @@ void set_grid(Renderer& r, const Box& area, float ground, float character_radius
 
 /// Draws one frame into the bound framebuffer (viewport width x height). `offsets` places each
 /// instance (crowd); the animator's model matrices must be current. Adds skin/draw timings.
-/// Errors: too many instances x joints for the palette buffer.
+/// Errors: too many instances x joints for the palette buffer (or x morph channels).
 Status render_frame(Renderer& r, const Scene& scene, const Animator& animator, std::span<const glm::vec3> offsets,
                     const OrbitCamera& camera, const ViewToggles& toggles, int width, int height,
                     FrameTimings& timings);

@@ -4,20 +4,41 @@
 #include <filesystem>
 #include <utility>
 
+#include <ossa/anim/morph.h>
+
 namespace ossa::view {
 namespace {
+
+/// The character's morph channels, each mesh's target -> channel table and the default weights.
+void bind_character_morphs(Scene& scene, const Asset& character) {
+  for (size_t m = 0; m < character.mesh_count(); ++m) collect_morph_channels(character.mesh(m), scene.morph_channels);
+  scene.morph_defaults.assign(scene.morph_channels.size(), 0.0f);
+  for (size_t m = 0; m < character.mesh_count(); ++m) {
+    const MeshView mesh = character.mesh(m);
+    std::vector<int32_t> targets(mesh.morph_target_count(), -1);
+    (void)bind_morph_targets(mesh, scene.morph_channels, targets);
+    scene.morph_targets.push_back(std::move(targets));
+  }
+  // In reverse, so that the first mesh's default wins (default_morph_weights: "the first of the
+  // mesh's targets bound to channel c"; across meshes the first mesh).
+  for (size_t m = character.mesh_count(); m-- > 0;)
+    (void)default_morph_weights(character.mesh(m), scene.morph_targets[m], scene.morph_defaults);
+}
 
 /// Appends `asset`'s clips to the scene after checking each binds to the character's skeleton.
 Status add_clips(Scene& scene, Asset asset, const std::string& path, bool is_character) {
   const SkeletonView skeleton = scene.assets.empty() ? asset.skeleton() : scene.skeleton();
   std::vector<SceneClip> added;
+  if (is_character) bind_character_morphs(scene, asset);
   for (size_t c = 0; c < asset.clip_count(); ++c) {
     const ClipView clip = asset.clip(c);
     if (Status s = check_clip_binding(clip, skeleton, path); !s) {
       return Error{s.message() + (is_character ? "" : " (clips added to a character must be cooked for its skeleton)")};
     }
-    SceneClip entry{clip, scene.assets.size(), std::string(clip.name())};
+    SceneClip entry{clip, scene.assets.size(), std::string(clip.name()), {}};
     if (!is_character) entry.label += " (" + std::filesystem::path(path).filename().string() + ")";
+    entry.morph_tracks.assign(clip.morph_track_count(), -1);
+    (void)bind_morph_tracks(clip, scene.morph_channels, entry.morph_tracks);
     added.push_back(std::move(entry));
   }
   if (!is_character && added.empty()) return Error{path + ": no clips to add"};
@@ -71,6 +92,12 @@ Result<bool> file_has_mesh(const std::string& path) {
 }
 
 bool shows_bones_only(const Scene& scene) { return !scene.assets.empty() && scene.character().mesh_count() == 0; }
+
+int find_morph_channel(const Scene& scene, std::string_view name) {
+  for (size_t c = 0; c < scene.morph_channels.size(); ++c)
+    if (scene.morph_channels[c] == name) return static_cast<int>(c);
+  return -1;
+}
 
 int find_clip(const Scene& scene, std::string_view name) {
   for (size_t i = 0; i < scene.clips.size(); ++i) {

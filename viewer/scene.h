@@ -5,10 +5,17 @@
 // files carry no skeleton and bind by skeleton hash, ossa/loader/asset.h check_clip_binding). Assets
 // are kept open for the scene's lifetime: clip views, mesh views and the sampling caches point
 // into their bytes (an Asset's bytes do not move when the Asset does, so a vector of them is fine).
+//
+// Morph targets are bound by name once, here: the character's channels are every distinct target
+// name over its meshes (ossa/anim/morph.h collect_morph_channels), each mesh's targets map to
+// channels, and each clip's weight tracks map to channels as the clip is added (a face clip from
+// another file drives the targets it names; tracks for targets the character lacks are ignored).
 #pragma once
 #include <cstddef>
+#include <cstdint>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <ossa/format/result.h>
@@ -20,12 +27,17 @@ struct SceneClip {
   ClipView clip;
   size_t asset = 0;    // index into Scene::assets
   std::string label;   // "walk" or "walk (walk.ossa)" when it comes from another file
+  std::vector<int32_t> morph_tracks;  // the clip's weight track k -> morph channel, or -1
 };
 
 struct Scene {
   std::vector<Asset> assets;     // [0] is the character
   std::vector<std::string> paths;
   std::vector<SceneClip> clips;
+  // Morph targets of the character (empty when it has none).
+  std::vector<std::string_view> morph_channels;     // names, into the character's bytes
+  std::vector<std::vector<int32_t>> morph_targets;  // per character mesh: target -> channel
+  std::vector<float> morph_defaults;                // per channel: the targets' default weights
 
   const Asset& character() const { return assets.front(); }
   SkeletonView skeleton() const { return assets.front().skeleton(); }
@@ -48,6 +60,9 @@ Result<bool> file_has_mesh(const std::string& path);
 /// True when the character has no mesh: a skeleton-only file (mocap, a rig) shown as its bones,
 /// with the skeleton overlay always on.
 bool shows_bones_only(const Scene& scene);
+
+/// Index of the morph channel named `name`, or -1.
+int find_morph_channel(const Scene& scene, std::string_view name);
 
 /// Index of the clip named `name` (its name in the file, or its label), or -1.
 int find_clip(const Scene& scene, std::string_view name);

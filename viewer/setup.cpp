@@ -47,6 +47,15 @@ Status setup_app(App& app, Scene scene, const ViewerOptions& o, float aspect) {
       if (Status s = set_graph_parameter(*app.animator.graph, parameter, value); !s) return Error{name + ": " + s.message()};
     }
   }
+  for (const auto& [morph, weight] : o.morphs) {
+    const int c = find_morph_channel(app.scene, morph);
+    if (c < 0) {
+      std::string names;
+      for (std::string_view n : app.scene.morph_channels) names += (names.empty() ? "'" : ", '") + std::string(n) + "'";
+      return Error{name + ": no morph target named '" + morph + "' (morph targets: " + (names.empty() ? "none" : names) + ")"};
+    }
+    hold_morph(app.animator, static_cast<size_t>(c), true, weight);
+  }
   Playback& p = app.animator.playback;
   p.bind_pose = o.bind_pose;
   p.speed = o.speed;

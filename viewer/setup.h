@@ -9,8 +9,9 @@ namespace ossa::view {
 /// Applies the view options (camera angles, toggles), opens `scene` into `app` (whose renderer
 /// must exist) and starts playback as asked: --clip (an error lists the clips when the name is
 /// unknown), --time, --speed, --paused, --bind-pose, --graph and its --set values (errors list
-/// the graphs or the parameters there are). Warnings (textures left out) go to stderr unless
-/// --quiet; --verbose adds the GL version and renderer and the loaded scene's counts.
+/// the graphs or the parameters there are), --morph (an error lists the morph targets when the
+/// name is unknown). Warnings (textures left out) go to stderr unless --quiet; --verbose adds the
+/// GL version and renderer and the loaded scene's counts.
 Status setup_app(App& app, Scene scene, const ViewerOptions& options, float aspect);
 
 }  // namespace ossa::view

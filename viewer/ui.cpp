@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <string>
 #include <vector>
 
 #include <imgui.h>
@@ -39,6 +40,31 @@ void clips_panel(App& app, UiState& ui) {
   if (ImGui::SliderFloat("time", &t, 0.0f, std::max(duration, 1e-3f), "%.3f s")) set_time(app.scene, app.animator, t);
   ImGui::SliderFloat("speed", &p.speed, -2.0f, 2.0f, "%.2fx");
   ImGui::SliderFloat("cross-fade", &p.fade_seconds, 0.0f, 1.0f, "%.2f s");
+}
+
+/// One slider per morph channel. A channel left to the clip shows instance 0's live weight (the
+/// slider moves as the clip plays); moving the slider, or ticking its box, holds the channel at
+/// the slider's value; unticking gives it back to the clip.
+void morph_panel(App& app) {
+  Animator& a = app.animator;
+  MorphOverrides& o = a.morph_overrides;
+  const std::vector<float>& live = a.instances.front().morph_weights;
+  for (size_t c = 0; c < app.scene.morph_channels.size() && c < o.held.size() && c < live.size(); ++c) {
+    const std::string name(app.scene.morph_channels[c]);
+    ImGui::PushID(static_cast<int>(c));
+    bool held = o.held[c] != 0;
+    if (ImGui::Checkbox("##hold", &held)) hold_morph(a, c, held, held ? live[c] : o.value[c]);
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("hold this weight (unticked: the clip drives it)");
+    ImGui::SameLine();
+    float w = held ? o.value[c] : live[c];
+    if (ImGui::SliderFloat(name.c_str(), &w, 0.0f, 1.0f, held ? "%.3f (held)" : "%.3f")) hold_morph(a, c, true, w);
+    ImGui::PopID();
+  }
+  if (ImGui::Button("release all")) {
+    for (size_t c = 0; c < o.held.size(); ++c) hold_morph(a, c, false, o.value[c]);
+  }
+  ImGui::SameLine();
+  ImGui::TextDisabled("ctrl+click a slider to type a weight");
 }
 
 void view_panel(App& app, UiState& ui, float aspect) {
@@ -206,6 +232,8 @@ void draw_panels(App& app, UiState& ui, float aspect) {
   ui.graph_slider_touched = false;
   if (ImGui::CollapsingHeader("Graph", app.animator.graph ? ImGuiTreeNodeFlags_DefaultOpen : 0)) graph_panel(app, ui);
   if (ImGui::CollapsingHeader("Clips", app.animator.graph ? 0 : ImGuiTreeNodeFlags_DefaultOpen)) clips_panel(app, ui);
+  if (!app.scene.morph_channels.empty() && ImGui::CollapsingHeader("Morph targets", ImGuiTreeNodeFlags_DefaultOpen))
+    morph_panel(app);
   if (ImGui::CollapsingHeader("View", ImGuiTreeNodeFlags_DefaultOpen)) view_panel(app, ui, aspect);
   if (ImGui::CollapsingHeader("Stats", ImGuiTreeNodeFlags_DefaultOpen)) stats_panel(app, ui);
   if (ImGui::CollapsingHeader("Open")) open_panel(app, ui, aspect);

@@ -1,10 +1,12 @@
-// ui.h — the Dear ImGui panels: clip list and playback, view toggles, crowd, stats, open file.
+// ui.h — the Dear ImGui panels: clip list and playback, morph target weights, view toggles,
+// crowd, stats, open file.
 //
 // Immediate mode: every frame the panels read the App and write back what the user changed, so
 // there is no UI state to keep in sync beyond the text field and the smoothed timings. With a
 // graph, its panel shows one widget per parameter (slider, checkbox, combo, trigger button), each
 // state machine's state and running transition, the weights of the nodes that contributed to the
-// pose, and the events the graph reported.
+// pose, and the events the graph reported. With morph targets, one slider per channel shows the
+// weight the clip gives it live, and holds it where the user moves it (a tick box per channel).
 #pragma once
 #include <string>
 
