@@ -285,36 +285,22 @@ size_t remap_with_targets(const SourceMesh& m, std::vector<unsigned>* remap) {
 SourceMesh weld(const SourceMesh& m, size_t* unused) {
   SourceMesh out = m;
   const size_t n = m.positions.size();
-  if (!m.morph_targets.empty()) {
-    std::vector<unsigned> remap;
-    const size_t unique = remap_with_targets(m, &remap);
-    *unused = static_cast<size_t>(std::count(remap.begin(), remap.end(), ~0u));
-    meshopt_remapIndexBuffer(out.indices.data(), m.indices.data(), m.indices.size(), remap.data());
-    compact(out.positions, remap, unique);
-    compact(out.normals, remap, unique);
-    compact(out.tangents, remap, unique);
-    compact(out.uv0, remap, unique);
-    compact(out.colors, remap, unique);
-    compact(out.joints, remap, unique);
-    compact(out.weights, remap, unique);
-    for (SourceMorphTarget& t : out.morph_targets) {
-      compact(t.positions, remap, unique);
-      compact(t.normals, remap, unique);
-      compact(t.tangents, remap, unique);
-    }
-    return out;
-  }
-  std::vector<meshopt_Stream> streams;
-  add_stream(streams, m.positions);
-  add_stream(streams, m.normals);
-  add_stream(streams, m.tangents);
-  add_stream(streams, m.uv0);
-  add_stream(streams, m.colors);
-  add_stream(streams, m.joints);
-  add_stream(streams, m.weights);
   std::vector<unsigned> remap(n);
-  const size_t unique =
-      meshopt_generateVertexRemapMulti(remap.data(), m.indices.data(), m.indices.size(), n, streams.data(), streams.size());
+  size_t unique = 0;
+  if (!m.morph_targets.empty()) {
+    unique = remap_with_targets(m, &remap);
+  } else {
+    std::vector<meshopt_Stream> streams;
+    add_stream(streams, m.positions);
+    add_stream(streams, m.normals);
+    add_stream(streams, m.tangents);
+    add_stream(streams, m.uv0);
+    add_stream(streams, m.colors);
+    add_stream(streams, m.joints);
+    add_stream(streams, m.weights);
+    unique = meshopt_generateVertexRemapMulti(remap.data(), m.indices.data(), m.indices.size(), n, streams.data(),
+                                              streams.size());
+  }
   std::vector<bool> referenced(n, false);
   for (const uint32_t i : m.indices) referenced[i] = true;
   *unused = static_cast<size_t>(std::count(referenced.begin(), referenced.end(), false));
@@ -326,6 +312,11 @@ SourceMesh weld(const SourceMesh& m, size_t* unused) {
   compact(out.colors, remap, unique);
   compact(out.joints, remap, unique);
   compact(out.weights, remap, unique);
+  for (SourceMorphTarget& t : out.morph_targets) {
+    compact(t.positions, remap, unique);
+    compact(t.normals, remap, unique);
+    compact(t.tangents, remap, unique);
+  }
   return out;
 }
 
