@@ -26,6 +26,7 @@
 #include <ossa/graph/graph.h>
 #include <ossa/format/vertex_codec.h>
 #include <ossa/loader/asset.h>
+#include "blend_shape_fbx.h"
 #include "test_files.h"
 
 namespace fs = std::filesystem;
@@ -334,6 +335,52 @@ TEST(CookMorph, InspectReportsEveryTargetAndTrack) {
   EXPECT_EQ(morphs[0]["vertices"], 3);
   EXPECT_EQ(morphs[0]["stored_bytes"], 3 * (4 + 6 + 6));  // positions and normals
   EXPECT_LE(morphs[0]["position_error_mm"].get<double>(), 0.02);
+}
+
+// ---------------------------------------------------------------------------------------------
+// FBX blend shapes (tests/blend_shape_fbx.h): targets, and per-channel keys out of merged ones.
+
+TEST(CookMorph, FbxBlendShapesAndTheirPerChannelKeysAreCarried) {
+  const fs::path dir = ossa::test::make_temp_dir("morph-fbx");
+  ASSERT_TRUE(ossa::test::write_file(dir / "face.fbx", ossa::test::kBlendShapeFbx));
+  const auto r = run_command((ossa::test::bin_dir() / "ossa-cook").string() + " " + q(dir / "face.fbx") + " -o " +
+                             q(dir / "out") + " -v");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.err.find("dropped"), std::string::npos) << r.err;
+  auto asset = ossa::Asset::open((dir / "out" / "face.ossa").string());
+  ASSERT_TRUE(asset.ok()) << asset.error().message;
+  ASSERT_EQ(asset->mesh_count(), 1u);
+  const ossa::MeshView mesh = asset->mesh(0);
+  EXPECT_EQ(mesh.vertex_count(), 4u) << "FBX's per-corner vertices weld";
+  ASSERT_EQ(mesh.morph_target_count(), 2u);
+  const int smile = mesh.find_morph_target("smile"), frown = mesh.find_morph_target("frown");
+  ASSERT_GE(smile, 0);
+  ASSERT_GE(frown, 0);
+  EXPECT_EQ(mesh.morph_target(static_cast<size_t>(smile)).vertices()->size(), 2u);
+  EXPECT_EQ(mesh.morph_target(static_cast<size_t>(frown)).vertices()->size(), 1u);
+  // The shape moves control points 1 and 3 by (0, 0, 0.5) and (0, 0.25, 0): at weight 1 the
+  // cooked vertices are there.
+  std::vector<glm::vec3> p = positions_of(mesh);
+  std::vector<int32_t> channel(2, -1);
+  channel[static_cast<size_t>(smile)] = 0;
+  ASSERT_TRUE(ossa::apply_morphs(mesh, channel, std::vector<float>{1.0f}, p));
+  EXPECT_TRUE(same_points(p, {{0, 0, 0}, {1, 0, 0.5f}, {0, 1, 0}, {1, 1.25f, 0}}, 1e-4f));
+
+  ASSERT_EQ(asset->clip_count(), 1u);
+  const ossa::ClipView clip = asset->clip(0);
+  EXPECT_EQ(clip.joint_count(), 0u) << "a weights-only clip of a file without joints";
+  ASSERT_EQ(clip.morph_track_count(), 2u);
+  const auto& f = clip.morph_track(0);  // sorted: frown, smile
+  const auto& s = clip.morph_track(1);
+  ASSERT_EQ(flatbuffers::GetStringView(f.name()), "frown");
+  ASSERT_EQ(flatbuffers::GetStringView(s.name()), "smile");
+  const float tol = 1.001e-3f;
+  for (const auto& [t, want_smile, want_frown] : std::vector<std::tuple<float, float, float>>{
+           {0.0f, 0.0f, 0.5f}, {0.5f, 0.5f, -0.25f}, {1.0f, 1.0f, 0.0f}, {1.5f, 0.5f, 0.25f}, {2.0f, 0.0f, 0.5f}}) {
+    EXPECT_NEAR(ossa::sample_morph_track(clip, s, t), want_smile, tol) << t;
+    // At 1 s only smile is keyed: frown is its own keys' line there (-0.25 at 0.5 s to 0.5 at 2 s).
+    EXPECT_NEAR(ossa::sample_morph_track(clip, f, t), want_frown, tol) << t;
+  }
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -29,6 +29,7 @@
 
 #include <ossa/loader/asset.h>
 
+#include "blend_shape_fbx.h"
 #include "test_files.h"
 #include "viewer_harness.h"
 
@@ -528,6 +529,27 @@ TEST_F(ViewerMorph, RobotExpressiveSurprisedChangesTheFaceOnly) {
 
   const ImageDiff paths = compare(surprised, cpu, kPixelThreshold);
   std::printf("RobotExpressive surprised: GPU vs CPU: %.5f differ, mean %.4f\n", paths.differing, paths.mean_abs);
+  EXPECT_LT(paths.differing, kMaxDifferingSame);
+  EXPECT_LT(paths.mean_abs, kMaxMeanSame);
+}
+
+// A blend-shape face without joints (tests/blend_shape_fbx.h): its weights-only clip plays on the
+// targets. At 1 s "smile" is at 1 (corners 1 and 3 moved), at 0 s at 0; GPU and CPU paths agree.
+TEST_F(ViewerMorph, AWeightsOnlyClipPlaysOnAFaceWithoutJoints) {
+  ASSERT_TRUE(write_file(dir_ / "face.fbx", std::string(kBlendShapeFbx)));
+  const CommandResult cooked = run_command(quote((bin_dir() / "ossa-cook").string()) + " " +
+                                           quote((dir_ / "face.fbx").string()) + " -o " + quote(dir_.string()) + " -q");
+  ASSERT_EQ(cooked.exit_code, 0) << cooked.err;
+  const fs::path file = dir_ / "face.ossa";
+  const std::string view = "--clip talk --yaw 0 --pitch 0";
+  const Image rest = shot(file, "face-0", view + " --time 0");
+  const Image smiling = shot(file, "face-1", view + " --time 1");
+  const Image cpu = shot(file, "face-1-cpu", view + " --time 1 --cpu-skinning");
+  ASSERT_FALSE(rest.empty() || smiling.empty() || cpu.empty());
+  const ImageDiff moved = compare(rest, smiling, kPixelThreshold);
+  std::printf("face without joints: 0 s vs 1 s: %.4f differ\n", moved.differing);
+  EXPECT_GT(moved.differing, 0.01) << "the clip's smile weight does not move the quad";
+  const ImageDiff paths = compare(smiling, cpu, kPixelThreshold);
   EXPECT_LT(paths.differing, kMaxDifferingSame);
   EXPECT_LT(paths.mean_abs, kMaxMeanSame);
 }

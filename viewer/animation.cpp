@@ -53,6 +53,11 @@ Status select_clip(const Scene& scene, Animator& animator, int clip, bool crossf
   if (clip >= 0) {
     const ClipView view = scene.clips[static_cast<size_t>(clip)].clip;
     for (size_t i = 0; i < animator.instances.size(); ++i) {
+      // A morph-only clip of a file without joints samples weights only: no pose, no cache.
+      if (scene.joint_count() == 0) {
+        caches.emplace_back();
+        continue;
+      }
       Result<SamplingCache> c = make_sampling_cache(view, scene.skeleton());
       if (!c) return c.error();
       caches.push_back(std::move(*c));

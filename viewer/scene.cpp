@@ -32,7 +32,9 @@ Status add_clips(Scene& scene, Asset asset, const std::string& path, bool is_cha
   if (is_character) bind_character_morphs(scene, asset);
   for (size_t c = 0; c < asset.clip_count(); ++c) {
     const ClipView clip = asset.clip(c);
-    if (Status s = check_clip_binding(clip, skeleton, path); !s) {
+    // Without joints (a blend-shape face), a clip of weights alone plays on the meshes' targets.
+    const bool weights_only = skeleton.empty() && clip.joint_count() == 0 && clip.morph_track_count() > 0;
+    if (Status s = weights_only ? Status{} : check_clip_binding(clip, skeleton, path); !s) {
       return Error{s.message() + (is_character ? "" : " (clips added to a character must be cooked for its skeleton)")};
     }
     SceneClip entry{clip, scene.assets.size(), std::string(clip.name()), {}};

@@ -674,6 +674,16 @@ void assimp_morph_tracks(const aiScene& scene, const aiAnimation& anim, double t
     const aiMeshMorphAnim* ch = anim.mMorphMeshChannels[c];
     if (!ch) continue;
     const aiMesh* mesh = nullptr;
+    // Assimp 5.2.5's FBX importer names the channel "<mesh>*<scene mesh index>".
+    const std::string name = ch->mName.C_Str();
+    const size_t star = name.rfind('*');
+    if (star != std::string::npos && star + 1 < name.size() &&
+        name.find_first_not_of("0123456789", star + 1) == std::string::npos && name.size() - star <= 10) {
+      const unsigned long index = std::stoul(name.substr(star + 1));
+      if (index < scene.mNumMeshes && scene.mMeshes[index] && scene.mMeshes[index]->mNumAnimMeshes &&
+          std::string(scene.mMeshes[index]->mName.C_Str()) == name.substr(0, star))
+        mesh = scene.mMeshes[index];
+    }
     for (unsigned m = 0; m < scene.mNumMeshes && !mesh; ++m)
       if (scene.mMeshes[m] && scene.mMeshes[m]->mNumAnimMeshes && scene.mMeshes[m]->mName == ch->mName)
         mesh = scene.mMeshes[m];
@@ -854,6 +864,11 @@ SourceClip import_clip(const Context& ctx, const NodeGraph& graph, const Rig& ri
   const double tps = ticks_per_second(ctx, anim);
   ClipKeys keys = collect_keys(graph, anim);
   clip.duration = static_cast<float>(keys.end_ticks / tps);
+  size_t conflicts = 0;
+  if (!gltf_clip && ctx.format != SourceFormat::Gltf) {
+    assimp_morph_tracks(*ctx.scene, anim, tps, &clip.morph_weights, &conflicts);
+    for (const SourceMorphTrack& t : clip.morph_weights) clip.duration = std::max(clip.duration, t.times.back());
+  }
   const std::string label = "clip '" + clip.name + "': ";
   bool off_grid = false;
   clip.sample_rate =
@@ -888,12 +903,7 @@ SourceClip import_clip(const Context& ctx, const NodeGraph& graph, const Rig& ri
   if (duplicates) {
     ctx.warn(label + std::to_string(duplicates) + " keys at a time already keyed are dropped");
   }
-  size_t conflicts = 0;
-  if (gltf_clip) {
-    gltf_morph_tracks(*gltf_clip, frame_grid(clip), clip.duration, &clip.morph_weights, &conflicts);
-  } else if (ctx.format != SourceFormat::Gltf) {
-    assimp_morph_tracks(*ctx.scene, anim, tps, &clip.morph_weights, &conflicts);
-  }
+  if (gltf_clip) gltf_morph_tracks(*gltf_clip, frame_grid(clip), clip.duration, &clip.morph_weights, &conflicts);
   std::sort(clip.morph_weights.begin(), clip.morph_weights.end(),
             [](const SourceMorphTrack& a, const SourceMorphTrack& b) { return a.name < b.name; });
   if (conflicts) {
@@ -911,11 +921,9 @@ SourceClip import_clip(const Context& ctx, const NodeGraph& graph, const Rig& ri
 std::vector<SourceClip> import_clips(const Context& ctx, const NodeGraph& graph, const Rig& rig) {
   std::vector<SourceClip> clips;
   const aiScene& scene = *ctx.scene;
-  if (scene.mNumAnimations && rig.skeleton.joints.empty()) {
-    ctx.warn(std::to_string(scene.mNumAnimations) +
-             " animations are dropped: they animate nothing that is a joint");
-    return clips;
-  }
+  // Without joints only morph weights can be animated (a blend-shape face with no skeleton): such
+  // clips are kept with no joint tracks, the others dropped below.
+  const bool no_joints = rig.skeleton.joints.empty();
   std::optional<GltfSamplers> gltf_samplers;
   if (ctx.format == SourceFormat::Gltf && scene.mNumAnimations) {
     gltf_samplers = read_gltf_samplers(ctx, graph, rig);
@@ -927,6 +935,15 @@ std::vector<SourceClip> import_clips(const Context& ctx, const NodeGraph& graph,
     const GltfClip* gltf_clip = gltf_samplers ? &gltf_samplers->clips[a] : nullptr;
     clips.push_back(
         import_clip(ctx, graph, rig, *scene.mAnimations[a], a, gltf_clip, &names, &summary));
+  }
+  if (no_joints) {
+    const size_t before = clips.size();
+    clips.erase(std::remove_if(clips.begin(), clips.end(), [](const SourceClip& c) { return c.morph_weights.empty(); }),
+                clips.end());
+    summary.empty.clear();  // said here instead
+    if (clips.size() < before)
+      ctx.warn(std::to_string(before - clips.size()) +
+               " animations are dropped: they animate nothing that is a joint or a morph target");
   }
   // A file's single clip is its motion: with a generic source name it takes the file's stem, so a
   // library of Mixamo exports is not a library of clips all named "mixamo.com". The source name is
