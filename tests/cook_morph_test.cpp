@@ -437,6 +437,26 @@ TEST(CookMorph, TheGraphBlendsWeightsLayersOnlyWhatALayerDrivesAndSetsThemFromPa
     EXPECT_NEAR(inst->morph_weights()[0], want, 1e-5f) << "mix " << m << " at " << talk_time << " / " << blink_time;
     EXPECT_NEAR(inst->morph_weights()[1], 2.0f * s, 1e-6f) << "the drive sets frown";
   }
+
+  // The same graph with the nod layer naming "smile" in its morph_targets: the layer (weight 1,
+  // a clip without weight tracks, so the defaults) now owns smile: 0.5 whatever the face clips do.
+  std::string named = kFaceGraph;
+  const std::string mask = R"("mask": [{"joint": "root"}])";
+  named.replace(named.find(mask), mask.size(), mask + R"(, "morph_targets": ["smile"])");
+  ASSERT_TRUE(ossa::test::write_file(dir / "named.graph.json", named));
+  const auto r2 = run_command((ossa::test::bin_dir() / "ossa-cook").string() + " " + q(dir / "named.graph.json") +
+                              " -o " + q(dir / "out"));
+  ASSERT_EQ(r2.exit_code, 0) << r2.err;
+  auto named_asset = ossa::Asset::open((dir / "out" / "named.ossa").string());
+  ASSERT_TRUE(named_asset.ok()) << named_asset.error().message;
+  auto named_def = ossa::GraphDefinition::create(*named_asset, "face");
+  ASSERT_TRUE(named_def.ok()) << named_def.error().message;
+  auto named_inst = ossa::GraphInstance::create(*named_def);
+  ASSERT_TRUE(named_inst.ok());
+  for (float dt : {0.25f, 0.5f}) {
+    named_inst->update(dt);
+    EXPECT_NEAR(named_inst->morph_weights()[0], 0.5f, 1e-6f) << "the layer's named target";
+  }
 }
 
 }  // namespace

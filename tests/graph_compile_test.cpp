@@ -318,6 +318,17 @@ TEST_F(GraphCompile, MorphNodeDrivesTargetsFromParameters) {
   EXPECT_HAS(errors(b), at(b, "[]") + "\"drives\" is empty");
   const std::string c = graph(R"({"morph": {"clip": "walk"}, "drives": [{"target": "", "parameter": "lean"}]})");
   EXPECT_HAS(errors(c), "a drive's \"target\" is empty");
+  // A layer may name the morph targets it blends.
+  const GraphDef layered = ok(graph(R"({"layered": {"clip": "walk"}, "layers": [{"node": {"clip": "wave"},
+    "mask": [{"joint": "Head"}], "morph_targets": ["smile", "blink"]}]})")).graph;
+  const auto& layer = std::get<LayeredDef>(layered.nodes[2].kind).layers[0];
+  ASSERT_TRUE(layer.morph_targets.has_value());
+  EXPECT_EQ(*layer.morph_targets, (std::vector<std::string>{"smile", "blink"}));
+  EXPECT_FALSE(std::get<LayeredDef>(ok(graph(R"({"layered": {"clip": "walk"}, "layers": [{"node": {"clip": "wave"},
+    "mask": [{"joint": "Head"}]}]})")).graph.nodes[2].kind).layers[0].morph_targets.has_value());
+  const std::string d = graph(R"({"layered": {"clip": "walk"}, "layers": [{"node": {"clip": "wave"},
+    "mask": [{"joint": "Head"}], "morph_targets": ["smile", ""]}]})");
+  EXPECT_HAS(errors(d), "a morph target name is empty");
 }
 
 TEST_F(GraphCompile, GraphEventsMergeWithTheClipsOwn) {

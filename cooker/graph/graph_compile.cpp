@@ -679,7 +679,8 @@ class GraphCompiler {
         ok = false;
         continue;
       }
-      check_.expect_keys(lv, {"node", "mask", "weight", "weight_parameter", "blend_time", "mesh_space_rotation"},
+      check_.expect_keys(lv, {"node", "mask", "weight", "weight_parameter", "blend_time", "mesh_space_rotation",
+                              "morph_targets"},
                          "a layer");
       LayerDef layer;
       const Value* n = required(lv, "node", "a layer");
@@ -720,6 +721,22 @@ class GraphCompiler {
         ok &= read_float(*t, "a layer's \"blend_time\"", &layer.blend_time, 0.0);
       if (const Value* m = lv.find("mesh_space_rotation"))
         ok &= read_bool(*m, "\"mesh_space_rotation\"", &layer.mesh_space_rotation);
+      if (const Value* mt = lv.find("morph_targets")) {
+        if (!check_.expect(*mt, Type::Array, "a layer's \"morph_targets\" (morph target names)")) {
+          ok = false;
+        } else {
+          layer.morph_targets.emplace();
+          for (const Value& target : mt->items) {
+            if (!check_.expect(target, Type::String, "a morph target name")) {
+              ok = false;
+            } else if (target.string.empty()) {
+              ok = check_.error(target.pos, "a morph target name is empty");
+            } else {
+              layer.morph_targets->push_back(target.string);
+            }
+          }
+        }
+      }
       l.layers.push_back(std::move(layer));
     }
     if (!ok) return -1;

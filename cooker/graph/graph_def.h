@@ -6,6 +6,7 @@
 // Nodes are stored children first: every index a node refers to is smaller than its own.
 #pragma once
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <variant>
 #include <vector>
@@ -60,6 +61,7 @@ struct LayerDef {
   int16_t weight_parameter = -1;
   float blend_time = 0.0f;
   bool mesh_space_rotation = false;
+  std::optional<std::vector<std::string>> morph_targets;  // absent: what the layer's clips drive
 };
 struct LayeredDef {
   uint16_t base = 0;

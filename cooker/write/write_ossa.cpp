@@ -175,8 +175,10 @@ Offset<fb::Node> write_node(FlatBufferBuilder& fbb, const NodeDef& node) {
       std::vector<fb::MaskEntry> mask;
       for (const MaskEntryDef& m : layer.mask) mask.emplace_back(m.joint, m.depth);
       const auto mask_v = fbb.CreateVectorOfStructs(mask);
+      Offset<flatbuffers::Vector<Offset<flatbuffers::String>>> morph_v;
+      if (layer.morph_targets) morph_v = fbb.CreateVectorOfStrings(*layer.morph_targets);
       layers.push_back(fb::CreateLayer(fbb, layer.node, mask_v, layer.weight, layer.weight_parameter,
-                                       layer.blend_time, layer.mesh_space_rotation));
+                                       layer.blend_time, layer.mesh_space_rotation, morph_v));
     }
     const auto layers_v = fbb.CreateVector(layers);
     data = fb::CreateLayeredBlendNode(fbb, l->base, layers_v).Union();

@@ -337,7 +337,14 @@ Result<GraphDefinition> GraphDefinition::create(const Asset& asset, std::string_
     const auto* t = static_cast<const fb::LayeredBlendNode*>(d.nodes[i].table);
     for (const fb::Layer* layer : *t->layers()) {
       std::vector<float> mask(d.channels.size(), 0.0f);
-      mark_driven_channels(d, layer->node(), mask);
+      if (const auto* targets = layer->morph_targets()) {  // named by the graph
+        for (const flatbuffers::String* name : *targets) {
+          const auto it = std::find(d.channels.begin(), d.channels.end(), flatbuffers::GetStringView(name));
+          if (it != d.channels.end()) mask[static_cast<size_t>(it - d.channels.begin())] = 1.0f;
+        }
+      } else {
+        mark_driven_channels(d, layer->node(), mask);
+      }
       d.layer_morphs.push_back(std::move(mask));
     }
   }

@@ -189,6 +189,12 @@ class GraphChecker {
                                           {fb::ParameterType::Float, fb::ParameterType::Bool});
               !st)
             return st;
+          if (const auto* targets = layer.morph_targets()) {
+            if (!spend(uint64_t(targets->size()) * 8)) return over_budget();
+            for (flatbuffers::uoffset_t t = 0; t < targets->size(); ++t)
+              if (flatbuffers::GetStringView(targets->Get(t)).empty())
+                return fail(lat + format(": morph target name %u is empty", t));
+          }
           if (!spend(uint64_t(layer.mask()->size()) * 4)) return over_budget();
           for (const fb::MaskEntry* e : *layer.mask())
             if (e->joint() >= g_.joint_count())

@@ -176,8 +176,9 @@ class GraphInstance {
   ConstPoseSpan pose() const;
   /// The output's morph weights, one per GraphDefinition::morph_channels() entry: clips set the
   /// channels they have tracks for (the defaults elsewhere), and every blend, crossfade, layer and
-  /// additive treats them as it treats joints. A layer blends only the channels its own clips
-  /// drive, so a face layer over a body changes the face and an upper-body layer leaves it.
+  /// additive treats them as it treats joints. A layer blends the targets its Layer.morph_targets
+  /// names, or by default the channels its own clips (or morph nodes) drive, so a face layer over a
+  /// body changes the face and an upper-body layer leaves it.
   std::span<const float> morph_weights() const;
   /// Events crossed in the last update, in the order they were reached.
   std::span<const GraphEvent> events() const;
