@@ -202,7 +202,7 @@ void evaluate_blend_space(State& s, uint16_t n, const NodeInfo& info, const Adva
       clip_weights(s, smp.clip(), t1, tw);
       float sum = 0.0f;
       for (uint32_t i = 0; i <= k; ++i) sum += weights[i];
-      if (k > 0) blend_weights(ow, tw, weights[k] / sum);
+      if (k > 0) blend_morph_weights(ow, tw, weights[k] / sum, ow);
     }
   }
   if (active > 1) blend_n(std::span<const ConstPoseSpan>(poses, active), std::span<const float>(weights, active), out);
@@ -256,7 +256,7 @@ void evaluate_select(State& s, const NodeInfo& info, const Advance& advance, flo
       const std::span<float> tw = scratch_weights(s, depth);
       evaluate(s, child, advance, weight * share, dominant && i == leader, tmp, tw, depth + 1);
       blend(out, tmp, w[i] / (accumulated + w[i]), out);
-      blend_weights(ow, tw, w[i] / (accumulated + w[i]));
+      blend_morph_weights(ow, tw, w[i] / (accumulated + w[i]), ow);
     }
     accumulated += w[i];
   }
@@ -338,7 +338,7 @@ void evaluate_alpha(State& s, const NodeInfo& info, const Advance& advance, floa
   const std::span<float> tw = scratch_weights(s, depth);
   evaluate(s, a.b(), advance, weight * alpha, dominant && alpha >= 0.5f, tmp, tw, depth + 1);
   blend(out, tmp, alpha, out);
-  blend_weights(ow, tw, alpha);
+  blend_morph_weights(ow, tw, alpha, ow);
 }
 
 void evaluate_additive(State& s, const NodeInfo& info, const Advance& advance, float weight, bool dominant,

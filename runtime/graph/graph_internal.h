@@ -180,10 +180,6 @@ void set_phase(GraphInstance::State& s, uint16_t n, float p);
 void evaluate_machine(GraphInstance::State& s, uint16_t n, const Advance& advance, float weight, bool dominant,
                       PoseSpan out, std::span<float> ow, uint32_t depth);
 
-/// Morph weights beside a pose op: out = out + (b - out) * t per channel (a crossfade, a blend).
-inline void blend_weights(std::span<float> out, std::span<const float> b, float t) {
-  for (size_t c = 0; c < out.size(); ++c) out[c] += (b[c] - out[c]) * t;
-}
 /// The scratch weights at `depth` (parallel to the scratch pose there).
 inline std::span<float> scratch_weights(GraphInstance::State& s, uint32_t depth) { return s.scratch->weights[depth]; }
 void restart_machine(GraphInstance::State& s, uint16_t machine);

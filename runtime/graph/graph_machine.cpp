@@ -15,6 +15,7 @@
 #include <cmath>
 
 #include "graph/graph_internal.h"
+#include <ossa/anim/morph.h>
 #include <ossa/anim/pose_ops.h>
 
 namespace ossa::graph_detail {
@@ -265,7 +266,7 @@ void evaluate_machine(State& s, uint16_t n, const Advance& advance, float weight
       const std::span<float> tw = scratch_weights(s, depth);
       evaluate(s, source, both, weight * (1.0f - w), dominant && w < 0.5f, tmp, tw, depth + 1);
       blend(tmp, out, w, out);
-      for (size_t c = 0; c < ow.size(); ++c) ow[c] = tw[c] + (ow[c] - tw[c]) * w;
+      blend_morph_weights(tw, ow, w, ow);
     }
   } else {
     m.elapsed += advance.dt;
