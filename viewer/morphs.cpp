@@ -13,54 +13,12 @@
 #include <ossa/anim/morph.h>
 #include <ossa/format/vertex_codec.h>
 #include <ossa/format/vertex_format.h>
+#include <ossa/skinning/vertex_fetch.h>
 
 namespace ossa::view {
 namespace {
 
 glm::vec3 to_vec3(const fb::Vec3* v) { return v ? glm::vec3(v->x(), v->y(), v->z()) : glm::vec3(0.0f); }
-
-/// One attribute value as OpenGL fetches it; missing components (0, 0, 0, 1).
-glm::vec4 fetch(const uint8_t* p, fb::VertexFormat format) {
-  using F = fb::VertexFormat;
-  glm::vec4 r(0.0f, 0.0f, 0.0f, 1.0f);
-  switch (format) {
-    case F::Float32x2: std::memcpy(&r[0], p, 8); break;
-    case F::Float32x3: std::memcpy(&r[0], p, 12); break;
-    case F::Float32x4: std::memcpy(&r[0], p, 16); break;
-    case F::Unorm16x4: {
-      uint16_t q[4];
-      std::memcpy(q, p, 8);
-      for (int i = 0; i < 4; ++i) r[i] = unorm16_to_float(q[i]);
-      break;
-    }
-    case F::Snorm16x2:
-    case F::Snorm16x4: {
-      const int n = format == F::Snorm16x2 ? 2 : 4;
-      int16_t q[4] = {};
-      std::memcpy(q, p, 2 * static_cast<size_t>(n));
-      for (int i = 0; i < n; ++i) r[i] = snorm16_to_float(q[i]);
-      break;
-    }
-    case F::Float16x2: {
-      uint16_t h[2];
-      std::memcpy(h, p, 4);
-      r[0] = half_to_float(h[0]);
-      r[1] = half_to_float(h[1]);
-      break;
-    }
-    case F::Uint8x4:
-    case F::Unorm8x4:
-      for (int i = 0; i < 4; ++i) r[i] = format == F::Unorm8x4 ? static_cast<float>(p[i]) / 255.0f : p[i];
-      break;
-    case F::Uint16x4: {
-      uint16_t q[4];
-      std::memcpy(q, p, 8);
-      for (int i = 0; i < 4; ++i) r[i] = q[i];
-      break;
-    }
-  }
-  return r;
-}
 
 glm::vec3 octahedral(float x, float y) {
   const Float3 n = octahedral_decode({x, y});
@@ -160,21 +118,21 @@ Result<MorphBase> decode_morph_base(const MeshView& mesh) {
       tangent && (tangent->format() == fb::VertexFormat::Snorm16x4 || vertex_format_info(tangent->format()).components == 2);
   for (size_t v = 0; v < n; ++v) {
     const uint8_t* vertex = bytes + v * stride;
-    b.positions[v] = glm::vec3(fetch(vertex + position->offset(), position->format()));
+    b.positions[v] = glm::vec3(fetch_vertex_attribute(vertex + position->offset(), position->format()));
     if (normal) {
-      const glm::vec4 f = fetch(vertex + normal->offset(), normal->format());
+      const glm::vec4 f = fetch_vertex_attribute(vertex + normal->offset(), normal->format());
       b.normals[v] = normal_octahedral ? octahedral(f.x, f.y) : glm::vec3(f);
     }
     if (tangent) {
-      const glm::vec4 f = fetch(vertex + tangent->offset(), tangent->format());
+      const glm::vec4 f = fetch_vertex_attribute(vertex + tangent->offset(), tangent->format());
       if (tangent_octahedral)
         b.tangents[v] = glm::vec4(octahedral(f.x, f.y), tangent->format() == fb::VertexFormat::Snorm16x4 && f.z < 0.0f ? -1.0f : 1.0f);
       else
         b.tangents[v] = glm::vec4(glm::vec3(f), f.w < 0.0f ? -1.0f : 1.0f);
     }
     if (joints) {
-      b.slots[v] = glm::uvec4(fetch(vertex + joints->offset(), joints->format()));
-      b.weights[v] = fetch(vertex + weights->offset(), weights->format());
+      b.slots[v] = glm::uvec4(fetch_vertex_attribute(vertex + joints->offset(), joints->format()));
+      b.weights[v] = fetch_vertex_attribute(vertex + weights->offset(), weights->format());
     }
   }
   return b;

@@ -244,25 +244,37 @@ void compact(std::vector<T>& stream, const std::vector<unsigned>& remap, size_t 
   stream = std::move(out);
 }
 
-// The mesh with every set of vertices equal in all streams (bit for bit) merged into one, and
-// vertices no triangle references dropped (counted in *unused). O(vertices + indices), hashed.
-// With morph targets the key is every stream's bytes plus every target's deltas: meshoptimizer's
-// multi-stream remap takes at most 16 streams, and a face has 52 targets. Numbered in first use
-// order of the indices, as meshoptimizer numbers them; unreferenced vertices get ~0u.
 template <class T>
 void append_bytes(std::string& key, const std::vector<T>& stream, size_t v) {
   if (!stream.empty()) key.append(reinterpret_cast<const char*>(&stream[v]), sizeof(T));
 }
 
-size_t remap_with_targets(const SourceMesh& m, std::vector<unsigned>* remap) {
-  const size_t n = m.positions.size();
+// Vertices with equal keys share one number, as meshoptimizer's remap numbers them: in first use
+// order of the indices; unreferenced vertices get ~0u. append_key(key, v) appends vertex v's key
+// bytes to an empty string. Returns the number of unique vertices. O(vertices + indices), hashed;
+// for keys meshoptimizer's remap cannot take (its multi-stream remap has at most 16 streams, and a
+// face has 52 morph targets, whose deltas must be part of the key).
+template <class AppendKey>
+size_t remap_by_key(const std::vector<uint32_t>& indices, size_t vertex_count, std::vector<unsigned>* remap,
+                    AppendKey&& append_key) {
   std::unordered_map<std::string, unsigned> first;
-  remap->assign(n, ~0u);
+  remap->assign(vertex_count, ~0u);
   unsigned next = 0;
   std::string key;
-  for (const uint32_t i : m.indices) {
+  for (const uint32_t i : indices) {
     if ((*remap)[i] != ~0u) continue;
     key.clear();
+    append_key(key, static_cast<size_t>(i));
+    const auto [it, inserted] = first.emplace(key, next);
+    if (inserted) ++next;
+    (*remap)[i] = it->second;
+  }
+  return next;
+}
+
+// weld's remap with morph targets: the key is every stream's bytes plus every target's deltas.
+size_t remap_with_targets(const SourceMesh& m, std::vector<unsigned>* remap) {
+  return remap_by_key(m.indices, m.positions.size(), remap, [&m](std::string& key, size_t i) {
     append_bytes(key, m.positions, i);
     append_bytes(key, m.normals, i);
     append_bytes(key, m.tangents, i);
@@ -275,13 +287,11 @@ size_t remap_with_targets(const SourceMesh& m, std::vector<unsigned>* remap) {
       append_bytes(key, t.normals, i);
       append_bytes(key, t.tangents, i);
     }
-    const auto [it, inserted] = first.emplace(key, next);
-    if (inserted) ++next;
-    (*remap)[i] = it->second;
-  }
-  return next;
+  });
 }
 
+// The mesh with every set of vertices equal in all streams (bit for bit) merged into one, and
+// vertices no triangle references dropped (counted in *unused). O(vertices + indices), hashed.
 SourceMesh weld(const SourceMesh& m, size_t* unused) {
   SourceMesh out = m;
   const size_t n = m.positions.size();
@@ -738,21 +748,14 @@ Result<CookedMesh> build_group(const SourceScene& scene, const std::vector<Clean
       unique = meshopt_generateVertexRemap(remap.data(), indices.data(), indices.size(), out.vertices.data(),
                                            vertex_count, layout.stride);
     } else {
-      std::unordered_map<std::string, unsigned> first;
-      std::fill(remap.begin(), remap.end(), ~0u);
-      std::string key;
-      for (const unsigned i : indices) {
-        if (remap[i] != ~0u) continue;
-        key.assign(reinterpret_cast<const char*>(out.vertices.data()) + size_t(i) * layout.stride, layout.stride);
+      unique = remap_by_key(indices, vertex_count, &remap, [&](std::string& key, size_t i) {
+        key.append(reinterpret_cast<const char*>(out.vertices.data()) + i * layout.stride, layout.stride);
         for (const DenseMorph& d : dense) {
           append_bytes(key, d.positions, i);
           append_bytes(key, d.normals, i);
           append_bytes(key, d.tangents, i);
         }
-        const auto [it, inserted] = first.emplace(key, static_cast<unsigned>(unique));
-        if (inserted) ++unique;
-        remap[i] = it->second;
-      }
+      });
     }
     if (unique < vertex_count) {
       for (DenseMorph& d : dense) remap_morph(d, remap, unique);

@@ -71,6 +71,7 @@
 
 #include <ossa/format/vertex_codec.h>
 #include <ossa/format/vertex_format.h>
+#include <ossa/skinning/vertex_fetch.h>
 
 namespace ossa {
 namespace {
@@ -148,53 +149,9 @@ struct Outputs {
 // Portable path: any layout, decoded a batch at a time as OpenGL fetches attributes.
 //
 // Each attribute of a batch of kPortableBatch vertices is decoded in one loop specialized for its
-// format (the cooker's two layouts have their own loops; anything else goes through fetch), into
-// plain float arrays; skinning then runs over those arrays with no format switch per vertex.
-
-/// One attribute value as OpenGL fetches it: normalized formats scaled, missing components
-/// (0, 0, 0, 1). The fallback for formats the cooker does not write.
-glm::vec4 fetch(const uint8_t* p, VertexFormat format) {
-  glm::vec4 r(0.0f, 0.0f, 0.0f, 1.0f);
-  switch (format) {
-    case VertexFormat::Float32x2: std::memcpy(&r[0], p, 8); break;
-    case VertexFormat::Float32x3: std::memcpy(&r[0], p, 12); break;
-    case VertexFormat::Float32x4: std::memcpy(&r[0], p, 16); break;
-    case VertexFormat::Unorm16x4: {
-      uint16_t q[4];
-      std::memcpy(q, p, 8);
-      for (int i = 0; i < 4; ++i) r[i] = unorm16_to_float(q[i]);
-      break;
-    }
-    case VertexFormat::Snorm16x2:
-    case VertexFormat::Snorm16x4: {
-      const int n = format == VertexFormat::Snorm16x2 ? 2 : 4;
-      int16_t q[4];
-      std::memcpy(q, p, 2 * static_cast<size_t>(n));
-      for (int i = 0; i < n; ++i) r[i] = snorm16_to_float(q[i]);
-      break;
-    }
-    case VertexFormat::Float16x2: {
-      uint16_t h[2];
-      std::memcpy(h, p, 4);
-      r[0] = half_to_float(h[0]);
-      r[1] = half_to_float(h[1]);
-      break;
-    }
-    case VertexFormat::Uint8x4:
-      for (int i = 0; i < 4; ++i) r[i] = p[i];
-      break;
-    case VertexFormat::Uint16x4: {
-      uint16_t q[4];
-      std::memcpy(q, p, 8);
-      for (int i = 0; i < 4; ++i) r[i] = q[i];
-      break;
-    }
-    case VertexFormat::Unorm8x4:
-      for (int i = 0; i < 4; ++i) r[i] = static_cast<float>(p[i]) / 255.0f;
-      break;
-  }
-  return r;
-}
+// format (the cooker's two layouts have their own loops; anything else goes through
+// fetch_vertex_attribute, ossa/skinning/vertex_fetch.h), into plain float arrays; skinning then
+// runs over those arrays with no format switch per vertex.
 
 /// v / |v|, or zero for a zero vector (what the fast paths' guarded rsqrt gives too).
 glm::vec3 normalize_or_zero(glm::vec3 v) {
@@ -232,7 +189,8 @@ void decode_positions(const MeshFacts& m, Decoded& d) {
       for (uint32_t i = 0; i < d.n; ++i, p += m.stride) std::memcpy(&d.position[i][0], p, 12);
       break;
     default:
-      for (uint32_t i = 0; i < d.n; ++i, p += m.stride) d.position[i] = glm::vec3(fetch(p, m.position->format()));
+      for (uint32_t i = 0; i < d.n; ++i, p += m.stride)
+        d.position[i] = glm::vec3(fetch_vertex_attribute(p, m.position->format()));
       break;
   }
 }
@@ -252,7 +210,7 @@ void decode_normals(const MeshFacts& m, Decoded& d) {
   } else {
     const bool two = vertex_format_info(f).components == 2;
     for (uint32_t i = 0; i < d.n; ++i, p += m.stride) {
-      const glm::vec4 v = fetch(p, f);
+      const glm::vec4 v = fetch_vertex_attribute(p, f);
       d.normal[i] = two ? octahedral(v.x, v.y) : glm::vec3(v);
     }
   }
@@ -265,7 +223,7 @@ void decode_tangents(const MeshFacts& m, Decoded& d) {
   const VertexFormat f = m.tangent->format();
   const bool octa = f == VertexFormat::Snorm16x4 || vertex_format_info(f).components == 2;
   for (uint32_t i = 0; i < d.n; ++i, p += m.stride) {
-    const glm::vec4 v = fetch(p, f);
+    const glm::vec4 v = fetch_vertex_attribute(p, f);
     if (octa) d.tangent[i] = glm::vec4(octahedral(v.x, v.y), f == VertexFormat::Snorm16x4 && v.z < 0.0f ? -1.0f : 1.0f);
     else d.tangent[i] = glm::vec4(glm::vec3(v), v.w < 0.0f ? -1.0f : 1.0f);
   }
@@ -299,7 +257,7 @@ void decode_influences(const MeshFacts& m, Decoded& d) {
   } else if (wf == VertexFormat::Float32x4) {
     for (uint32_t i = 0; i < d.n; ++i, w += m.stride) std::memcpy(&d.weight[i][0], w, 16);
   } else {
-    for (uint32_t i = 0; i < d.n; ++i, w += m.stride) d.weight[i] = fetch(w, wf);
+    for (uint32_t i = 0; i < d.n; ++i, w += m.stride) d.weight[i] = fetch_vertex_attribute(w, wf);
   }
 }
 
