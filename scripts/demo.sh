@@ -45,6 +45,10 @@ else
   "${xvfb[@]}" "$bin/ossa-view" "${pab[@]}" --clip walk --time 0.6 --size 960x540 --screenshot "$shots/pab-walk.png"
   "${xvfb[@]}" "$bin/ossa-view" "$out/Pab/pab.ossa" --graph pab --set speed=3.13 --set crossed_arms=true --time 2 \
     --size 960x540 --screenshot "$shots/pab-graph-jog-crossed-arms.png"
+  "${xvfb[@]}" "$bin/ossa-view" "$out/Pab/pab.ossa" --graph pab --param look_weight=1 --param look_target=55,165,60 \
+    --param ground_left=15 --time 2 --size 960x540 --show-procedural --screenshot "$shots/pab-graph-look-and-ground.png"
+  "${xvfb[@]}" "$bin/ossa-view" "$out/Fox/fox_tail.ossa" --graph fox --time 1.5 --size 960x540 --show-procedural \
+    --screenshot "$shots/fox-tail-spring.png"
   "${xvfb[@]}" "$bin/ossa-view" "$out/Fox/Fox.ossa" --clip Walk --crowd 9 --time 0.3 --size 960x540 --screenshot "$shots/fox-crowd.png"
   "${xvfb[@]}" "$bin/ossa-view" "$out/CesiumMan/CesiumMan.ossa" --time 0.5 --skeleton --size 960x540 --screenshot "$shots/cesium-man.png"
   echo "demo: screenshots in $shots/ (with a display, scripts/demo.sh opens the viewer instead)"

@@ -101,14 +101,31 @@ TEST_F(PabGraph, CooksIntoACharacterThatLoads) {
   EXPECT_EQ(g.joint_count(), 67);
   ASSERT_EQ(g.clips()->size(), 4u);
   for (size_t c = 0; c < 4; ++c) EXPECT_EQ(g.clips()->Get(static_cast<flatbuffers::uoffset_t>(c))->str(), names[c]);
-  ASSERT_EQ(g.parameters()->size(), 3u);
+  ASSERT_EQ(g.parameters()->size(), 10u);
   EXPECT_EQ(str(g.parameters()->Get(0)->name()), "speed");
   EXPECT_EQ(str(g.parameters()->Get(1)->name()), "crossed_arms");
   EXPECT_EQ(g.parameters()->Get(2)->type(), ossa::fb::ParameterType::Trigger);
+  const ossa::fb::Parameter& look = *g.parameters()->Get(3);
+  EXPECT_EQ(str(look.name()), "look_target");
+  EXPECT_EQ(look.type(), ossa::fb::ParameterType::Vector);
+  ASSERT_NE(look.default_vector(), nullptr);
+  EXPECT_FLOAT_EQ(look.default_vector()->y(), 160.0f) << "1.6 m in Pab's centimetres";
 
-  // Root: a layer of crossed arms over the locomotion machine, from the spine up.
-  const ossa::fb::Node& root = *g.nodes()->Get(g.root());
+  // Root: a look-at over foot placement over foot locking over a layer of crossed arms over the
+  // locomotion machine, from the spine up.
+  const ossa::fb::Node& aim = *g.nodes()->Get(g.root());
   EXPECT_EQ(g.root(), g.nodes()->size() - 1);
+  ASSERT_EQ(aim.data_type(), ossa::fb::NodeData::AimNode);
+  ASSERT_EQ(aim.data_as_AimNode()->chain()->size(), 3u);
+  EXPECT_EQ(aim.data_as_AimNode()->chain()->Get(2)->joint(), find_joint(sk, "Head"));
+  const ossa::fb::Node& feet = *g.nodes()->Get(aim.data_as_AimNode()->input());
+  ASSERT_EQ(feet.data_type(), ossa::fb::NodeData::FootPlacementNode);
+  EXPECT_EQ(feet.data_as_FootPlacementNode()->pelvis(), find_joint(sk, "Hips"));
+  ASSERT_EQ(feet.data_as_FootPlacementNode()->legs()->size(), 2u);
+  const ossa::fb::Node& lock = *g.nodes()->Get(feet.data_as_FootPlacementNode()->input());
+  ASSERT_EQ(lock.data_type(), ossa::fb::NodeData::FootLockNode);
+  EXPECT_EQ(str(lock.data_as_FootLockNode()->legs()->Get(0)->plant_event()), "foot_left");
+  const ossa::fb::Node& root = *g.nodes()->Get(lock.data_as_FootLockNode()->input());
   ASSERT_EQ(root.data_type(), ossa::fb::NodeData::LayeredBlendNode);
   const auto* layered = root.data_as_LayeredBlendNode();
   ASSERT_EQ(layered->layers()->size(), 1u);

@@ -42,7 +42,8 @@ std::string graph(const std::string& root, const std::string& nodes = "{}", cons
 SourceSkeleton make_rig() {
   SourceSkeleton sk;
   for (auto [name, parent] : std::vector<std::pair<const char*, int>>{
-           {"Hips", -1}, {"Spine", 0}, {"Head", 1}, {"LeftArm", 1}, {"RightArm", 1}, {"LeftLeg", 0}}) {
+           {"Hips", -1}, {"Spine", 0}, {"Head", 1}, {"LeftArm", 1}, {"RightArm", 1}, {"LeftLeg", 0},
+           {"LeftKnee", 5}, {"LeftFoot", 6}, {"Tail1", 0}, {"Tail2", 8}}) {
     SourceJoint j;
     j.name = name;
     j.parent = parent;
@@ -95,7 +96,7 @@ TEST_F(GraphCompile, SingleClip) {
   const GraphDef& g = c.graph;
   EXPECT_EQ(g.name, "test");
   EXPECT_EQ(g.skeleton_hash, skeleton_hash_of(rig));
-  EXPECT_EQ(g.joint_count, 6);
+  EXPECT_EQ(g.joint_count, 10);
   EXPECT_EQ(g.clips, (std::vector<std::string>{"walk", "run", "wave"}));  // "clips" order
   ASSERT_EQ(g.parameters.size(), 6u);
   EXPECT_EQ(g.parameters[kSpeed].type, ParamType::Float);
@@ -540,7 +541,7 @@ TEST_F(GraphCompile, ParameterDeclarations) {
   const std::string i = graph(R"({"clip": "walk"})", "{}", R"({"b": {"type": "bool", "default": 1}})");
   EXPECT_HAS(errors(i), at(i, "1}") + "parameter 'b' \"default\" must be a boolean, not a number");
   const std::string j = graph(R"({"clip": "walk"})", "{}", R"({"s": {"default": 1}})");
-  EXPECT_HAS(errors(j), at(j, "{\"default\"") + "parameter 's' needs a \"type\": float, int, bool, enum or trigger");
+  EXPECT_HAS(errors(j), at(j, "{\"default\"") + "parameter 's' needs a \"type\": float, int, bool, enum, trigger or vector");
 }
 
 TEST_F(GraphCompile, DuplicateNamesAreRefused) {
@@ -861,6 +862,91 @@ TEST_F(GraphCompile, ManifestListsWhatToImport) {
   EXPECT_HAS(mbr.error().message, "g.json:1:44: \"skeleton\" needs a \"source\"");
   EXPECT_HAS(mbr.error().message, "\"meshes\" must be a boolean");
   EXPECT_HAS(mbr.error().message, "unknown key \"mesh\"");
+}
+
+// ---- procedural nodes (format v6) ----------------------------------------------------------------
+
+const char* kVectorParams = R"({
+    "speed": {"type": "float", "default": 1, "min": 0, "max": 6},
+    "look": {"type": "vector", "default": [0, 1.5, 2], "space": "world"},
+    "ground": {"type": "float"},
+    "normal": {"type": "vector", "default": [0, 1, 0], "direction": true},
+    "planted": {"type": "bool"}
+  })";
+
+TEST_F(GraphCompile, VectorParametersAndProceduralNodesCompileWithUnitsConverted) {
+  rig.metres_per_unit = 0.01f;  // a rig in centimetres: the file's metres become 100 units
+  const CompiledGraph c = ok(graph(R"({
+    "name": "springs", "spring": {
+      "name": "lock", "foot_lock": {
+        "name": "feet", "foot_placement": {
+          "name": "ik", "two_bone_ik": {"clip": "walk"}, "start": "Hips", "mid": "LeftLeg", "end": "LeftFoot",
+          "target": "look", "pole": [0, 0, 1], "twist": 90, "soften": 0.9},
+        "pelvis": "Hips", "max_pelvis_drop": 0.2,
+        "legs": [{"hip": "Hips", "knee": "LeftLeg", "ankle": "LeftFoot", "ground": "ground", "normal": "normal"}]},
+      "legs": [{"hip": "LeftLeg", "knee": "LeftKnee", "ankle": "LeftFoot", "planted": "planted"}],
+      "release_radius": 0.1},
+    "chains": [{"joints": ["Tail1", "Tail2"], "radius": 0.02}],
+    "colliders": [{"joint": "Hips", "offset": [0, 0.1, 0], "radius": 0.15}]})", "{}", kVectorParams));
+  const GraphDef& g = c.graph;
+  ASSERT_EQ(g.parameters.size(), 5u);
+  EXPECT_EQ(g.parameters[1].type, ParamType::Vector);
+  EXPECT_TRUE(g.parameters[1].world);
+  EXPECT_FLOAT_EQ(g.parameters[1].default_vector[1], 150.0f);
+  EXPECT_FLOAT_EQ(g.parameters[3].default_vector[1], 1.0f) << "a direction is not a length";
+  ASSERT_EQ(g.nodes.size(), 5u);
+  const auto& ik = std::get<TwoBoneIkDef>(g.nodes[1].kind);
+  EXPECT_EQ(ik.start, 0);
+  EXPECT_EQ(ik.mid, 5);
+  EXPECT_EQ(ik.end, 7);
+  EXPECT_EQ(ik.target_parameter, 1);
+  EXPECT_NEAR(ik.twist, 1.5707963f, 1e-6f);
+  const auto& feet = std::get<FootPlacementDef>(g.nodes[2].kind);
+  EXPECT_FLOAT_EQ(feet.max_pelvis_drop, 20.0f);
+  EXPECT_EQ(feet.legs[0].ground_parameter, 2);
+  EXPECT_EQ(feet.legs[0].normal_parameter, 3);
+  const auto& lock = std::get<FootLockDef>(g.nodes[3].kind);
+  EXPECT_FLOAT_EQ(lock.release_radius, 10.0f);
+  EXPECT_EQ(lock.legs[0].planted_parameter, 4);
+  const auto& spring = std::get<SpringDef>(g.nodes[4].kind);
+  ASSERT_EQ(spring.chains.size(), 1u);
+  EXPECT_EQ(spring.chains[0].joints, (std::vector<uint16_t>{8, 9}));
+  EXPECT_FLOAT_EQ(spring.chains[0].gravity[1], -981.0f);  // 9.81 m/s^2 in cm
+  EXPECT_FLOAT_EQ(spring.chains[0].radius, 2.0f);
+  EXPECT_FLOAT_EQ(spring.colliders[0].offset[1], 10.0f);
+  EXPECT_FLOAT_EQ(spring.colliders[0].tail[1], 10.0f);  // a sphere: the tail defaults to the offset
+}
+
+TEST_F(GraphCompile, ProceduralNodeMistakesAreReportedWhereTheyAre) {
+  // A chain whose joints are not ancestors in order.
+  const std::string a = graph(R"({"two_bone_ik": {"clip": "walk"}, "start": "LeftLeg", "mid": "Spine", "end": "Head",
+    "target": "look"})", "{}", kVectorParams);
+  EXPECT_HAS(errors(a), "a two_bone_ik node: joint 'LeftLeg' is not an ancestor of 'Spine'");
+  // The target must be a vector parameter.
+  const std::string b = graph(R"({"aim": {"clip": "walk"}, "chain": [{"joint": "Head"}], "target": "speed"})", "{}",
+                              kVectorParams);
+  EXPECT_HAS(errors(b), "parameter 'speed' is a float; \"target\" needs a vector parameter");
+  // A vector parameter cannot be read by a condition.
+  const std::string c = graph(R"({"state_machine": {"name": "m", "entry": "a", "states": {"a": {"node": {"clip": "walk"}},
+    "b": {"node": {"clip": "run"}}}, "transitions": [{"from": "a", "to": "b", "when": "look > 1"}]}})", "{}", kVectorParams);
+  EXPECT_HAS(errors(c), "'look' is a vector parameter: conditions cannot read it");
+  // A foot lock leg needs a way to know when it is planted.
+  const std::string d = graph(R"({"foot_lock": {"clip": "walk"}, "legs": [{"hip": "LeftLeg", "knee": "LeftKnee",
+    "ankle": "LeftFoot"}]})", "{}", kVectorParams);
+  EXPECT_HAS(errors(d), "a foot_lock leg needs \"planted\" (a parameter) or both \"plant_event\" and \"lift_event\"");
+  // A spring chain lists each joint's child next.
+  const std::string e = graph(R"({"spring": {"clip": "walk"}, "chains": [{"joints": ["Tail1", "Head"]}]})", "{}",
+                              kVectorParams);
+  EXPECT_HAS(errors(e), "spring chain joint 'Head' is not a child of 'Tail1'");
+  // Vector values need three numbers; an unknown space is named.
+  const std::string f = graph(R"({"clip": "walk"})", "{}", R"({"v": {"type": "vector", "default": [1, 2]}})");
+  EXPECT_HAS(errors(f), "needs 3 numbers, not 2");
+  const std::string h = graph(R"({"clip": "walk"})", "{}", R"({"v": {"type": "vector", "space": "screen"}})");
+  EXPECT_HAS(errors(h), "\"space\" is 'screen'; spaces: model, world");
+  // An unknown joint names the node's role and suggests the right one.
+  const std::string k = graph(R"({"two_bone_ik": {"clip": "walk"}, "start": "hips", "mid": "LeftLeg", "end": "LeftFoot",
+    "target": "look"})", "{}", kVectorParams);
+  EXPECT_HAS(errors(k), "unknown joint 'hips' in a two_bone_ik node \"start\" (did you mean 'Hips'?)");
 }
 
 }  // namespace

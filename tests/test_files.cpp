@@ -296,7 +296,8 @@ flatbuffers::Offset<fb::Clip> write_clip(flatbuffers::FlatBufferBuilder& fbb, co
                         value_vector, compression, root_motion, event_vector, track_vector);
 }
 
-/// The synthetic graph (SyntheticSpec::graph): every node kind, parameter type and transition mode.
+/// The synthetic graph (SyntheticSpec::graph): every node kind (the procedural ones on top), parameter
+/// type and transition mode.
 flatbuffers::Offset<fb::Graph> write_graph(flatbuffers::FlatBufferBuilder& fbb, const std::string& clip,
                                            uint64_t skeleton_hash, uint16_t joint_count) {
   using PT = fb::ParameterType;
@@ -308,6 +309,9 @@ flatbuffers::Offset<fb::Graph> write_graph(flatbuffers::FlatBufferBuilder& fbb, 
   params.push_back(fb::CreateParameter(fbb, fbb.CreateString("mode"), PT::Enum, 0.0f, -3.4e38f, 3.4e38f,
                                        fbb.CreateVector(values)));
   params.push_back(fb::CreateParameterDirect(fbb, "count", PT::Int, 0.0f, 0.0f, 3.0f));
+  const fb::Vec3 target_default(0.5f, 1.5f, 0.2f);
+  params.push_back(fb::CreateParameter(fbb, fbb.CreateString("target"), PT::Vector, 0.0f, -3.4e38f, 3.4e38f, 0,
+                                       &target_default, fb::ParameterSpace::World));  // 5
   const auto node = [&](fb::NodeData type, flatbuffers::Offset<void> data) {
     return fb::CreateNode(fbb, fbb.CreateString(""), type, data);
   };
@@ -329,6 +333,30 @@ flatbuffers::Offset<fb::Graph> write_graph(flatbuffers::FlatBufferBuilder& fbb, 
   std::vector<flatbuffers::Offset<fb::Layer>> layers = {
       fb::CreateLayer(fbb, 9, fbb.CreateVectorOfStructs(mask), 1.0f, 1, 0.1f, true)};
   nodes.push_back(node(fb::NodeData::LayeredBlendNode, fb::CreateLayeredBlendNode(fbb, 8, fbb.CreateVector(layers)).Union()));  // 10
+  // Procedural nodes (format v6) over the chain 0 > 1 > 2, one of each kind.
+  const fb::Vec3 pole(0.0f, 0.0f, 1.0f), axis(0.0f, 0.0f, 1.0f), up(0.0f, 1.0f, 0.0f), forward(0.0f, 0.0f, 1.0f);
+  nodes.push_back(node(fb::NodeData::TwoBoneIkNode,
+                       fb::CreateTwoBoneIkNode(fbb, 10, 0, 1, 2, 5, -1, &pole, &axis, 0.1f, 0.95f, 1.0f, 0).Union()));  // 11
+  const std::vector<fb::AimJoint> aim = {{1, 0.5f, 1.0f}, {2, 1.0f, 3.2f}};
+  nodes.push_back(node(fb::NodeData::AimNode, fb::CreateAimNode(fbb, 11, fbb.CreateVectorOfStructs(aim), 5, &forward,
+                                                                 &up, &up, 1.0f, 1).Union()));  // 12
+  const auto leg = [&](bool lock) {
+    return fb::CreateFootLeg(fbb, 0, 1, 2, lock ? -1 : 0, lock ? -1 : 5, lock ? 1 : -1,
+                             fbb.CreateString(lock ? "plant" : ""), fbb.CreateString(lock ? "lift" : ""));
+  };
+  std::vector<flatbuffers::Offset<fb::FootLeg>> place_legs = {leg(false)}, lock_legs = {leg(true)};
+  nodes.push_back(node(fb::NodeData::FootPlacementNode,
+                       fb::CreateFootPlacementNode(fbb, 12, 0, fbb.CreateVector(place_legs), &up, 0.3f).Union()));  // 13
+  nodes.push_back(node(fb::NodeData::FootLockNode,
+                       fb::CreateFootLockNode(fbb, 13, fbb.CreateVector(lock_legs), 0.2f, 0.1f).Union()));  // 14
+  const std::vector<uint16_t> spring_joints = {1, 2};
+  const fb::Vec3 gravity(0.0f, -9.81f, 0.0f);
+  std::vector<flatbuffers::Offset<fb::SpringChainSettings>> chains = {
+      fb::CreateSpringChainSettings(fbb, fbb.CreateVector(spring_joints), 4.0f, 0.4f, &gravity, 0.05f, 0.5f)};
+  const std::vector<fb::SpringColliderShape> colliders = {{0, {0.0f, 0.5f, 0.0f}, {0.0f, 1.0f, 0.0f}, 0.2f}};
+  nodes.push_back(node(fb::NodeData::SpringNode,
+                       fb::CreateSpringNode(fbb, 14, fbb.CreateVector(chains), fbb.CreateVectorOfStructs(colliders),
+                                            1.0f / 120.0f, 10.0f).Union()));  // 15
 
   using Op = fb::ConditionOp;
   const std::vector<fb::ConditionInstr> go = {{Op::Trigger, 2, 0.0f}};
@@ -346,7 +374,7 @@ flatbuffers::Offset<fb::Graph> write_graph(flatbuffers::FlatBufferBuilder& fbb, 
       fb::CreateStateMachine(fbb, fbb.CreateString("m"), fbb.CreateVector(states), 0, fbb.CreateVector(transitions))};
   std::vector<flatbuffers::Offset<flatbuffers::String>> clips = {fbb.CreateString(clip)};
   return fb::CreateGraph(fbb, fbb.CreateString("g"), skeleton_hash, joint_count, fbb.CreateVector(params),
-                         fbb.CreateVector(clips), fbb.CreateVector(nodes), fbb.CreateVector(machines), 10);
+                         fbb.CreateVector(clips), fbb.CreateVector(nodes), fbb.CreateVector(machines), 15);
 }
 
 flatbuffers::Offset<fb::Material> write_material(flatbuffers::FlatBufferBuilder& fbb, const SyntheticMaterial& m) {

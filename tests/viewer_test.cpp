@@ -326,6 +326,161 @@ TEST_F(ViewerGraph, WindowModeShowsTheGraphPanel) {
 }
 
 // ---------------------------------------------------------------------------------------------
+// Procedural nodes (format v6): Pab's graph looks at look_target (an aim over spine, neck and
+// head, weighted by look_weight) and places its feet on per-foot ground (ground_left / _right
+// heights, ground_normal); the Fox graph (assets/Fox/fox_tail.graph.json, cooked here: the fixture
+// does not cook it) springs its tail. Vector parameters are set with --param NAME=X,Y,Z. Pab
+// stands in the crossed-arms pose (speed 0) seen from the front (yaw 0: its left is the image's
+// right), so a change shows where it happens and little elsewhere.
+
+/// Fraction of pixels in rows [y0, y1) differing by more than kPixelThreshold.
+double differing_rows(const Image& a, const Image& b, int y0, int y1) {
+  if (a.width != b.width || a.height != b.height || a.empty() || y1 <= y0) return 1.0;
+  size_t n = 0;
+  for (int y = y0; y < y1; ++y) {
+    for (int x = 0; x < a.width; ++x) {
+      const uint8_t *p = a.at(x, y), *q = b.at(x, y);
+      int worst = 0;
+      for (int c = 0; c < 3; ++c) worst = std::max(worst, std::abs(int(p[c]) - int(q[c])));
+      n += worst > kPixelThreshold ? 1 : 0;
+    }
+  }
+  return static_cast<double>(n) / (static_cast<double>(y1 - y0) * a.width);
+}
+
+bool foreground(const Image& image, int x, int y) {
+  const uint8_t *p = image.at(x, y), *bg = image.at(0, 0);
+  return std::abs(p[0] - bg[0]) > 6 || std::abs(p[1] - bg[1]) > 6 || std::abs(p[2] - bg[2]) > 6;
+}
+
+/// The lowest row holding a silhouette pixel in columns [x0, x1), or -1.
+int lowest_row(const Image& image, int x0, int x1) {
+  for (int y = image.height - 1; y >= 0; --y) {
+    for (int x = std::max(x0, 0); x < std::min(x1, image.width); ++x)
+      if (foreground(image, x, y)) return y;
+  }
+  return -1;
+}
+
+/// The middle column of the silhouette's lowest `rows` rows (between the feet).
+int feet_middle(const Image& image, int rows) {
+  const int bottom = lowest_row(image, 0, image.width);
+  int lo = image.width, hi = -1;
+  for (int y = std::max(bottom - rows, 0); y <= bottom; ++y) {
+    for (int x = 0; x < image.width; ++x) {
+      if (!foreground(image, x, y)) continue;
+      lo = std::min(lo, x);
+      hi = std::max(hi, x);
+    }
+  }
+  return hi < lo ? image.width / 2 : (lo + hi) / 2;
+}
+
+class ViewerProcedural : public Viewer {
+ protected:
+  std::string pab() const { return quote(cooked("Pab/pab.ossa").string()); }
+  /// Pab standing (speed 0: the crossed-arms pose), 2 s in, from the front.
+  Image render_pab(const std::string& tag, const std::string& extra) {
+    return render_file(pab() + " --graph pab --param speed=0 --yaw 0 --pitch 0 --time 2", tag, extra);
+  }
+  Image render_file(const std::string& base, const std::string& tag, const std::string& extra) {
+    const fs::path png = dir_ / (tag + ".png");
+    const std::string args = base + " --no-grid --size 256x256 --screenshot " + quote(png.string()) + " " + extra;
+    const CommandResult r = run_viewer(args);
+    EXPECT_EQ(r.exit_code, 0) << "ossa-view " << args << "\n" << r.err;
+    EXPECT_EQ(r.err.find("GL error"), std::string::npos) << r.err;
+    Image image = load_png(png);
+    EXPECT_FALSE(image.empty()) << "no image at " << png;
+    return image;
+  }
+  /// assets/Fox/fox_tail.graph.json cooked into this test's folder (mesh, clips and graph 'fox').
+  fs::path cook_fox() {
+    const fs::path assets = source_dir() / "assets";
+    const CommandResult r = run_command(quote((bin_dir() / "ossa-cook").string()) + " --quiet " +
+                                        quote((assets / "Fox" / "fox_tail.graph.json").string()) + " --root " +
+                                        quote(assets.string()) + " -o " + quote((dir_ / "cooked").string()));
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    return dir_ / "cooked" / "Fox" / "fox_tail.ossa";
+  }
+};
+
+TEST_F(ViewerProcedural, LookTargetTurnsTheHeadOnly) {
+  const Image ahead = render_pab("ahead", "--param look_target=150,160,100");  // look_weight 0: no aim
+  const Image side = render_pab("side", "--param look_weight=1 --param look_target=150,160,100");
+  const int h = ahead.height;
+  const double upper = differing_rows(ahead, side, 0, h * 3 / 10);
+  const double lower = differing_rows(ahead, side, h / 2, h);
+  std::printf("look: upper 30%% %.4f of pixels differ, lower half %.4f\n", upper, lower);
+  // The camera frames the pose as shown, so a turned head moves the framing by a pixel or so: the
+  // legs differ on their edges (about 1 %), the head and chest several times more.
+  EXPECT_GT(upper, 0.02) << "look_weight 1 does not turn the head towards the side target";
+  EXPECT_LT(lower, upper / 3.0) << "looking aside moved the legs as much as the head";
+}
+
+TEST_F(ViewerProcedural, MalformedVectorIsNamed) {
+  for (const char* bad : {"1,2", "1,2,3,4", "1,x,3", "nan,1,1", "1;2;3", ""}) {
+    const CommandResult r = run_viewer(pab() + " --graph pab --param 'look_target=" + bad + "' --frames 1 --size 32x32");
+    EXPECT_EQ(r.exit_code, 1) << bad << ": " << r.err;
+    EXPECT_NE(r.err.find("look_target"), std::string::npos) << bad << ": " << r.err;
+    EXPECT_NE(r.err.find("three finite numbers"), std::string::npos) << bad << ": " << r.err;
+  }
+  const CommandResult ok = run_viewer(pab() + " --graph pab --param look_target=-1.5,2e2,0 --frames 1 --size 32x32");
+  EXPECT_EQ(ok.exit_code, 0) << ok.err;
+}
+
+TEST_F(ViewerProcedural, RaisedGroundLiftsTheLeftFoot) {
+  const Image flat = render_pab("flat", "");
+  const Image raised = render_pab("raised", "--param ground_left=20");  // 20 cm up under the left foot
+  const int middle = feet_middle(flat, flat.height / 20);
+  // From the front the character's left foot is on the image's right.
+  const int left_flat = lowest_row(flat, middle, flat.width), left_raised = lowest_row(raised, middle, raised.width);
+  const int right_flat = lowest_row(flat, 0, middle), right_raised = lowest_row(raised, 0, middle);
+  std::printf("ground: split at x %d; left foot bottom %d -> %d, right foot %d -> %d\n", middle, left_flat, left_raised,
+              right_flat, right_raised);
+  // The framing follows the pose (a bent knee widens it), so the feet are compared with each other
+  // too: measured 256 px high, the left foot rises 28 px, 24 px more than the right one.
+  EXPECT_LT(left_raised, left_flat - 8) << "the left foot did not go up with its ground";
+  EXPECT_GT((right_raised - left_raised) - (right_flat - left_flat), 8) << "the left foot did not rise above the right";
+  EXPECT_NEAR(right_raised, right_flat, 6) << "the right foot moved";
+}
+
+TEST_F(ViewerProcedural, TiltedGroundIsDrawnUnderTheFeet) {
+  const std::string tilt = "--param ground_normal=0,0.9659,0.2588 --param ground_left=10";
+  const Image plain = render_pab("plain", tilt);
+  const Image shown = render_pab("shown", tilt + " --show-procedural");
+  const int h = plain.height;
+  const double feet = differing_rows(plain, shown, h * 8 / 10, h);
+  const double upper_half = differing_rows(plain, shown, 0, h / 2);
+  std::printf("ground overlay: bottom fifth %.4f of pixels differ, upper half %.4f\n", feet, upper_half);
+  EXPECT_GT(feet, 0.01) << "no ground drawn under the feet";
+  EXPECT_LT(upper_half, feet) << "the ground patches are not under the feet";
+}
+
+TEST_F(ViewerProcedural, SpringMovesTheTailAndIsDrawn) {
+  const fs::path fox = cook_fox();
+  const std::string base = quote(fox.string()) + " --graph fox --time 1.5";
+  const Image spring = render_file(base, "spring", "--param tail_spring=1");
+  const Image stiff = render_file(base, "stiff", "--param tail_spring=0");
+  const Image overlay = render_file(base, "overlay", "--param tail_spring=1 --show-procedural");
+  // Seen at yaw 30 the fox faces left: its head is in the image's left third, its tail right.
+  const ImageDiff d = compare(spring, stiff, kPixelThreshold);
+  size_t head_differs = 0;
+  for (int y = 0; y < spring.height; ++y) {
+    for (int x = 0; x < spring.width / 3; ++x) {
+      int worst = 0;
+      for (int c = 0; c < 3; ++c) worst = std::max(worst, std::abs(int(spring.at(x, y)[c]) - int(stiff.at(x, y)[c])));
+      head_differs += worst > kPixelThreshold ? 1 : 0;
+    }
+  }
+  const double overlay_differs = compare(spring, overlay, kPixelThreshold).differing;
+  std::printf("spring: %.4f of pixels differ (left third: %zu pixels); overlay %.4f\n", d.differing, head_differs,
+              overlay_differs);
+  EXPECT_GT(d.differing, 0.001) << "tail_spring does not move the tail";
+  EXPECT_EQ(head_differs, 0u) << "the spring moved more than the tail";
+  EXPECT_GT(overlay_differs, 0.003) << "--show-procedural drew no chain or colliders";
+}
+
+// ---------------------------------------------------------------------------------------------
 // Morph targets, on synthetic files (tests/test_files.h): the 2 x 3 grid (x in +-0.5, rows at
 // y = 0, 1, 2, skinned to spine / head) with target "smile" moving the head row (vertices 4, 5)
 // +0.4 in x and tilting its normals, and "frown" moving the middle row (2, 3) -0.1 in x (default

@@ -2,6 +2,10 @@
 #include "viewer/app.h"
 
 #include <cmath>
+
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "viewer/procedural_draw.h"
 #include <utility>
 
 namespace ossa::view {
@@ -80,7 +84,10 @@ Status open_loaded_scene(App& app, Scene scene, size_t crowd, float aspect) {
 Status use_graph(App& app, const std::string& name) {
   Result<GraphDriver> g = make_graph_driver(app.scene, name, app.animator.instances.size());
   if (!g) return g.error();
+  for (size_t i = 0; i < g->instances.size() && i < app.offsets.size(); ++i)
+    g->instances[i].set_transform(glm::translate(glm::mat4(1.0f), app.offsets[i]));
   app.animator.graph = std::make_unique<GraphDriver>(std::move(*g));
+  app.active_handle = -1;
   app.animator.use_graph = true;
   app.animator.graph_dt = 0.0f;
   app.graph_name = name;
@@ -93,11 +100,16 @@ Status set_crowd(App& app, size_t crowd, float aspect) {
   const bool had_clip = !app.animator.instances.empty();
   // A graph's parameter values survive a crowd change (triggers are one-shot and do not).
   std::vector<std::pair<int, float>> graph_values;
+  std::vector<std::pair<int, glm::vec3>> graph_vectors;
   const bool used_graph = app.animator.use_graph;
   if (app.animator.graph && !app.animator.graph->instances.empty()) {
     const GraphDriver& g = *app.animator.graph;
     for (size_t p = 0; p < g.definition->parameter_count(); ++p) {
       if (g.definition->parameter_type(p) == fb::ParameterType::Trigger) continue;
+      if (g.definition->parameter_type(p) == fb::ParameterType::Vector) {
+        graph_vectors.emplace_back(static_cast<int>(p), g.instances.front().vector(static_cast<int>(p)));
+        continue;
+      }
       graph_values.emplace_back(static_cast<int>(p), g.instances.front().value(static_cast<int>(p)));
     }
   }
@@ -138,6 +150,7 @@ Status set_crowd(App& app, size_t crowd, float aspect) {
   if (!app.graph_name.empty()) {
     if (Status s = use_graph(app, app.graph_name); !s) return s;
     for (const auto& [index, value] : graph_values) set_graph_value(*app.animator.graph, index, value);
+    for (const auto& [index, value] : graph_vectors) (void)set_graph_vector(*app.animator.graph, index, value);
     app.animator.use_graph = used_graph || graph_values.empty();
   }
   // Mocap has no body and its bind is often a zero pose at the origin (BVH OFFSETs) while the
@@ -180,6 +193,12 @@ Status step_and_render(App& app, float dt, int width, int height, FrameTimings& 
     moved.y = 0.0f;
     app.camera.target += moved - app.follow_applied;
     app.follow_applied = moved;
+  }
+  if (app.toggles.procedural) {
+    const float size = app.bind_box.empty() ? 1.0f : 0.5f * glm::length(app.bind_box.size());
+    build_procedural_overlay(app.animator, app.offsets, size, app.active_handle, app.renderer.overlay);
+  } else {
+    app.renderer.overlay.clear();
   }
   return render_frame(app.renderer, app.scene, app.animator, app.offsets, app.camera, app.toggles, width, height,
                       timings);

@@ -42,6 +42,7 @@ struct App {
   glm::vec3 follow_applied{0.0f};  // how far follow has moved the camera target so far
   std::vector<std::string> messages;  // warnings and errors for the panel / stderr
   std::string graph_name;          // --graph: re-instantiated when the crowd or the files change
+  int active_handle = -1;          // the target gizmo being dragged (ProceduralInfo::targets), or -1
 };
 
 /// Replaces the scene with `paths` (scene.h load_scene), uploads it, builds the crowd and frames
@@ -64,14 +65,17 @@ Status open_or_add(App& app, std::span<const std::string> paths, float aspect);
 void frame_camera(App& app, float aspect);
 
 /// Instantiates graph `name` (graph_driver.h) for every instance and lets it drive the poses.
-/// Errors name the files (the App keeps its previous pose source then).
+/// Errors name the files (the App keeps its previous pose source then). Each graph instance is
+/// told where its character stands (GraphInstance::set_transform: its crowd placement), so
+/// world-space targets, foot locks and springs act where it is drawn.
 Status use_graph(App& app, const std::string& name);
 
 /// Selects a clip by index (-1: none) with an optional cross-fade.
 Status play_clip(App& app, int clip, bool crossfade);
 
 /// Advances playback by dt (when playing), produces this frame's poses, follows the character,
-/// and draws into the bound framebuffer. Timings accumulate into `timings`.
+/// builds the procedural overlays (toggles.procedural, procedural_draw.h) and draws into the
+/// bound framebuffer. Timings accumulate into `timings`.
 Status step_and_render(App& app, float dt, int width, int height, FrameTimings& timings);
 
 }  // namespace ossa::view

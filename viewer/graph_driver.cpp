@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 #include <utility>
 
 namespace ossa::view {
@@ -36,6 +37,7 @@ const char* parameter_type_name(fb::ParameterType type) {
     case fb::ParameterType::Bool: return "bool";
     case fb::ParameterType::Enum: return "enum";
     case fb::ParameterType::Trigger: return "trigger";
+    case fb::ParameterType::Vector: return "vector";
   }
   return "?";
 }
@@ -68,6 +70,7 @@ Result<GraphDriver> make_graph_driver(const Scene& scene, std::string_view name,
                  " joints, the character " + std::to_string(scene.joint_count())};
   }
   d.definition = std::make_unique<GraphDefinition>(std::move(*def));
+  d.procedural = describe_procedural(*d.definition);
   const std::span<const std::string_view> graph_channels = d.definition->morph_channels();
   for (const std::string_view channel : scene.morph_channels) {
     const auto it = std::find(graph_channels.begin(), graph_channels.end(), channel);
@@ -96,11 +99,35 @@ void set_graph_value(GraphDriver& driver, int index, float value) {
       case fb::ParameterType::Bool: g.set_bool(index, value != 0.0f); break;
       case fb::ParameterType::Enum: g.set_enum(index, static_cast<int>(std::lround(value))); break;
       case fb::ParameterType::Trigger: if (value != 0.0f) g.set_trigger(index); break;
+      case fb::ParameterType::Vector: break;  // three numbers: set_graph_vector
     }
   }
 }
 
 void fire_graph_trigger(GraphDriver& driver, int index) { set_graph_value(driver, index, 1.0f); }
+
+bool set_graph_vector(GraphDriver& driver, int index, const glm::vec3& value) {
+  bool all = true;
+  for (GraphInstance& g : driver.instances) all = g.set_vector(index, value) && all;
+  return all;
+}
+
+std::optional<glm::vec3> parse_vector(std::string_view text) {
+  glm::vec3 v(0.0f);
+  const char* p = text.data();
+  const char* const end = text.data() + text.size();
+  for (int k = 0; k < 3; ++k) {
+    if (k > 0) {
+      if (p == end || *p != ',') return std::nullopt;
+      ++p;
+    }
+    const auto r = std::from_chars(p, end, v[k]);
+    if (r.ec != std::errc() || !std::isfinite(v[k])) return std::nullopt;
+    p = r.ptr;
+  }
+  if (p != end) return std::nullopt;
+  return v;
+}
 
 Status set_graph_parameter(GraphDriver& driver, std::string_view name, std::string_view text) {
   const GraphDefinition& def = *driver.definition;
@@ -112,6 +139,12 @@ Status set_graph_parameter(GraphDriver& driver, std::string_view name, std::stri
   }
   const fb::ParameterType type = def.parameter_type(static_cast<size_t>(p));
   const std::string where = "graph '" + driver.name + "' parameter '" + std::string(name) + "' (" + parameter_type_name(type) + ")";
+  if (type == fb::ParameterType::Vector) {
+    const auto v = parse_vector(text);
+    if (!v) return Error{where + ": cannot read '" + std::string(text) + "' as three finite numbers x,y,z"};
+    if (!set_graph_vector(driver, p, *v)) return Error{where + ": value " + std::string(text) + " refused"};
+    return {};
+  }
   float value = 0.0f;
   if (type == fb::ParameterType::Trigger) {
     value = 1.0f;

@@ -10,6 +10,7 @@
 #include <cstddef>
 #include <deque>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -18,6 +19,7 @@
 #include <ossa/format/result.h>
 #include <ossa/graph/graph.h>
 #include <ossa/anim/pose.h>
+#include "viewer/procedural_info.h"
 #include "viewer/scene.h"
 
 namespace ossa::view {
@@ -31,6 +33,8 @@ struct GraphDriver {
   double time = 0.0;                               // seconds of graph time played
   /// Per scene morph channel (Scene::morph_channels): the graph's channel of that name, or -1.
   std::vector<int32_t> morph_map;
+  /// What the procedural nodes read and move, for the overlays and the panel's ground controls.
+  ProceduralInfo procedural;
 };
 
 /// Finds graph `name` in the scene's files and instantiates it `instances` times. Instance i > 0
@@ -43,12 +47,18 @@ Result<GraphDriver> make_graph_driver(const Scene& scene, std::string_view name,
 int graph_parameter(const GraphDriver& driver, std::string_view name);
 
 /// Sets a parameter on every instance from text: floats and ints as numbers, bools as
-/// true/false/1/0, enums by value name or index, triggers fire (any value). Errors name the
-/// parameter (and list the parameters when the name is unknown).
+/// true/false/1/0, enums by value name or index, triggers fire (any value), vectors as three
+/// comma-separated numbers "x,y,z". Errors name the parameter (and list the parameters when the
+/// name is unknown).
 Status set_graph_parameter(GraphDriver& driver, std::string_view name, std::string_view value);
 
 /// Sets parameter `index` to a float value on every instance (the panel's and keyboard's path).
 void set_graph_value(GraphDriver& driver, int index, float value);
+/// Sets Vector parameter `index` on every instance (the panel, the target gizmo); false when an
+/// instance refused it.
+bool set_graph_vector(GraphDriver& driver, int index, const glm::vec3& value);
+/// "1.5,160,-2" -> the vector; nullopt unless exactly three finite numbers.
+std::optional<glm::vec3> parse_vector(std::string_view text);
 /// Fires trigger `index` on every instance.
 void fire_graph_trigger(GraphDriver& driver, int index);
 

@@ -3,9 +3,13 @@
 // GLFW callbacks only record input (into InputState through the window user pointer); files
 // dropped on the window are queued and opened between frames, never inside a callback. Our
 // callbacks are installed before ImGui's GLFW backend, which chains to them, and they ignore the
-// mouse and keyboard while ImGui wants them (a click on the panel is not an orbit).
+// mouse and keyboard while ImGui wants them (a click on the panel is not an orbit). A left press
+// on a procedural target marker (within kPickPixels), or anywhere with Ctrl held (the nearest
+// marker), drags that target in the camera's view plane instead of orbiting
+// (procedural_info.h drag_in_view_plane), setting the parameter on every instance.
 #include "viewer/interactive.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <string>
@@ -19,6 +23,7 @@
 #include "viewer/app.h"
 #include "viewer/gl_util.h"
 #include "viewer/graph_keys.h"
+#include "viewer/procedural_draw.h"
 #include "viewer/setup.h"
 #include "viewer/snapshot.h"
 #include "viewer/ui.h"
@@ -32,11 +37,42 @@ struct InputState {
   GraphKeys graph_keys;
   float aspect = 1.0f;
   bool orbiting = false, panning = false;
+  std::vector<glm::vec3> handles;  // scratch: the target markers' positions when a drag starts
   double last_x = 0.0, last_y = 0.0;
   std::vector<std::string> dropped;
 };
 
 InputState& input_of(GLFWwindow* w) { return *static_cast<InputState*>(glfwGetWindowUserPointer(w)); }
+
+constexpr float kPickPixels = 14.0f;
+
+/// The target marker a left press at the cursor grabs (Ctrl: the nearest anywhere), or -1.
+int grab_handle(GLFWwindow* w, InputState& in, bool ctrl) {
+  App& app = *in.app;
+  if (!app.toggles.procedural || !app.animator.graph || !app.animator.use_graph) return -1;
+  handle_positions(app.animator, app.offsets, in.handles);
+  if (in.handles.empty()) return -1;
+  int width = 1, height = 1;
+  glfwGetWindowSize(w, &width, &height);
+  const glm::vec2 viewport(static_cast<float>(std::max(width, 1)), static_cast<float>(std::max(height, 1)));
+  const glm::mat4 vp = projection_matrix(app.camera, viewport.x / viewport.y) * view_matrix(app.camera);
+  return pick_point(vp, viewport, in.handles, glm::vec2(static_cast<float>(in.last_x), static_cast<float>(in.last_y)),
+                    ctrl ? 1e9f : kPickPixels);
+}
+
+/// Moves the grabbed target by a drag of (dx, dy) window pixels.
+void drag_handle(GLFWwindow* w, App& app, double dx, double dy) {
+  GraphDriver& g = *app.animator.graph;
+  if (app.active_handle < 0 || static_cast<size_t>(app.active_handle) >= g.procedural.targets.size()) return;
+  const TargetHandle& h = g.procedural.targets[static_cast<size_t>(app.active_handle)];
+  const glm::vec3 offset = app.offsets.empty() ? glm::vec3(0.0f) : app.offsets.front();
+  int width = 1, height = 1;
+  glfwGetWindowSize(w, &width, &height);
+  const glm::vec3 p = handle_position(g.instances.front(), h, offset);
+  const glm::vec3 moved = drag_in_view_plane(p, view_matrix(app.camera), app.camera.fov_y, static_cast<float>(height),
+                                             static_cast<float>(dx), static_cast<float>(dy));
+  (void)set_graph_vector(g, h.parameter, handle_value(h, moved, offset));
+}
 
 void step_clip(App& app, int direction) {
   const int n = static_cast<int>(app.scene.clips.size());
@@ -67,12 +103,15 @@ void on_key(GLFWwindow* w, int key, int /*scancode*/, int action, int /*mods*/) 
   }
 }
 
-void on_mouse_button(GLFWwindow* w, int button, int action, int /*mods*/) {
+void on_mouse_button(GLFWwindow* w, int button, int action, int mods) {
   InputState& in = input_of(w);
   const bool pressed = action == GLFW_PRESS;
   if (pressed && ImGui::GetCurrentContext() && ImGui::GetIO().WantCaptureMouse) return;
   glfwGetCursorPos(w, &in.last_x, &in.last_y);
-  if (button == GLFW_MOUSE_BUTTON_LEFT) in.orbiting = pressed;
+  if (button == GLFW_MOUSE_BUTTON_LEFT) {
+    in.app->active_handle = pressed ? grab_handle(w, in, (mods & GLFW_MOD_CONTROL) != 0) : -1;
+    in.orbiting = pressed && in.app->active_handle < 0;
+  }
   if (button == GLFW_MOUSE_BUTTON_RIGHT || button == GLFW_MOUSE_BUTTON_MIDDLE) in.panning = pressed;
 }
 
@@ -83,6 +122,7 @@ void on_cursor(GLFWwindow* w, double x, double y) {
   in.last_y = y;
   int width = 1, height = 1;
   glfwGetWindowSize(w, &width, &height);
+  if (in.app->active_handle >= 0 && in.app->animator.graph) drag_handle(w, *in.app, dx, dy);
   if (in.orbiting) orbit(in.app->camera, static_cast<float>(-dx * 0.01), static_cast<float>(dy * 0.01));
   if (in.panning) pan(in.app->camera, static_cast<float>(dx / height), static_cast<float>(dy / height));
 }

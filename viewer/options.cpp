@@ -63,9 +63,12 @@ ParsedOptions parse_options(int argc, const char* const* argv) {
   app.add_flag("--first-frame-time", o.first_frame_time, "print first-frame-ms once the first frame is finished");
   app.add_flag("--stats", o.stats, "headless: print the average frame-time split");
   app.add_option("--graph", o.graph, "drive the character with the animation graph of this name");
-  app.add_option("--set", o.set, "graph parameter start value, NAME=VALUE (a trigger: NAME); repeatable")
+  app.add_option("--set,--param", o.set, "graph parameter start value, NAME=VALUE (a trigger: NAME; a vector: NAME=X,Y,Z); repeatable")
       ->needs("--graph")
       ->allow_extra_args(false);  // one value per --set: the files may follow
+  app.add_flag("--show-procedural", o.show_procedural,
+               "draw the procedural overlays (targets, ground under the feet, springs) in headless images too")
+      ->needs("--graph");
   std::vector<std::string> morphs;
   app.add_option("--morph", morphs, "hold the morph targets named NAME at WEIGHT (clips no longer drive them); repeatable")
       ->type_name("NAME=WEIGHT")

@@ -4,7 +4,8 @@
 //             [--bind-pose] [--cpu-skinning] [--crowd N] [--wireframe] [--skeleton] [--no-grid]
 //             [--yaw DEG] [--pitch DEG] [--size WxH] [--msaa N]
 //             [--frames N] [--screenshot OUT.png] [--first-frame-time] [--stats]
-//             [--window-frames N] [--graph NAME [--set PARAM=VALUE ...]] [--morph NAME=WEIGHT ...]
+//             [--window-frames N] [--graph NAME [--set|--param PARAM=VALUE ...] [--show-procedural]]
+//             [--morph NAME=WEIGHT ...]
 //             [-q | -v] [--version] [--help]
 //
 // With --frames or --screenshot the viewer runs headless (hidden window, offscreen framebuffer):
@@ -12,7 +13,10 @@
 // --window-frames N runs the window mode (panel included) for N frames and exits, writing the
 // window's last frame to --screenshot if given: how the interactive path is tested.
 // --graph NAME drives the character with an animation graph found in any of the files; --set
-// gives its parameters start values (a trigger is fired by naming it: --set stop). A graph cannot
+// (or its alias --param) gives its parameters start values (a trigger is fired by naming it: --set
+// stop; a vector parameter takes three numbers: --param look_target=150,160,100). --show-procedural
+// draws the procedural nodes' overlays in headless images too: IK / aim targets, the ground
+// under each placed foot, spring chains and colliders (procedural_draw.h). A graph cannot
 // seek, so headless --time T plays T seconds of the graph in 1/60 s steps before the N frames.
 // --morph NAME=WEIGHT holds a morph target channel (every target of that name) at WEIGHT, as the
 // panel's slider does: clips no longer drive it; repeatable; a name the character lacks is an
@@ -55,7 +59,8 @@ struct ViewerOptions {
   bool stats = false;           // headless: print the frame-time split
   int window_frames = 0;        // window mode: exit after this many frames (0: when closed)
   std::string graph;            // drive the character with this graph
-  std::vector<std::string> set; // graph parameter start values, "name=value" (or "trigger")
+  std::vector<std::string> set; // graph parameter start values, "name=value" (or "trigger"; a vector "name=x,y,z")
+  bool show_procedural = false; // headless: draw the procedural overlays (the window shows them by default)
   std::vector<std::pair<std::string, float>> morphs;  // --morph: channels held at a weight
   bool quiet = false;           // -q: errors only
   bool verbose = false;         // -v: GL information and what was loaded

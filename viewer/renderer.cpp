@@ -123,6 +123,31 @@ void build_skeleton_lines(Renderer& r, const Scene& scene, const Animator& anima
   }
 }
 
+/// The procedural overlays (r.overlay): the ground patches depth-tested (the feet hide them where
+/// they stand on them), then targets, springs and colliders on top, as the skeleton is.
+void draw_overlay(Renderer& r, const glm::mat4& view_projection) {
+  const OverlayGeometry& o = r.overlay;
+  glUseProgram(r.line_program);
+  glUniformMatrix4fv(r.line_uniforms.view_projection, 1, GL_FALSE, &view_projection[0][0]);
+  glBindVertexArray(r.lines_vao);
+  if (!o.ground_fill.empty()) {
+    upload_lines(r.lines_buffer, o.ground_fill);
+    glDepthMask(GL_FALSE);
+    glDrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(o.ground_fill.size()));
+    glDepthMask(GL_TRUE);
+  }
+  if (!o.ground_lines.empty()) {
+    upload_lines(r.lines_buffer, o.ground_lines);
+    glDrawArrays(GL_LINES, 0, static_cast<GLsizei>(o.ground_lines.size()));
+  }
+  if (!o.on_top.empty()) {
+    upload_lines(r.lines_buffer, o.on_top);
+    glDisable(GL_DEPTH_TEST);
+    glDrawArrays(GL_LINES, 0, static_cast<GLsizei>(o.on_top.size()));
+    glEnable(GL_DEPTH_TEST);
+  }
+}
+
 }  // namespace
 
 Result<Renderer> create_renderer() {
@@ -455,6 +480,7 @@ Status render_frame(Renderer& r, const Scene& scene, const Animator& animator, s
     glDisable(GL_PROGRAM_POINT_SIZE);
     glEnable(GL_DEPTH_TEST);
   }
+  if (!r.overlay.empty()) draw_overlay(r, view_projection);
   glBindVertexArray(0);
   glUseProgram(0);
   glEndQuery(GL_TIME_ELAPSED);

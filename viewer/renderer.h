@@ -35,6 +35,7 @@ struct ViewToggles {
   bool skeleton = false;
   bool grid = true;
   bool cpu_skinning = false;
+  bool procedural = false;  // the procedural nodes' overlays (procedural_draw.h)
 };
 
 /// Milliseconds spent in each stage of a frame (CPU time; gpu_ms from a timer query, a frame
@@ -46,6 +47,20 @@ struct FrameTimings {
 struct LineVertex {
   glm::vec3 position;
   glm::vec4 color;
+};
+
+/// Overlay geometry rebuilt on the CPU each frame (procedural_draw.h fills it; empty: nothing
+/// drawn). The vectors keep their capacity, so a steady overlay allocates nothing per frame.
+struct OverlayGeometry {
+  std::vector<LineVertex> ground_fill;   // GL_TRIANGLES, translucent, depth-tested
+  std::vector<LineVertex> ground_lines;  // GL_LINES, depth-tested
+  std::vector<LineVertex> on_top;        // GL_LINES over everything: targets, springs, colliders
+  void clear() {
+    ground_fill.clear();
+    ground_lines.clear();
+    on_top.clear();
+  }
+  bool empty() const { return ground_fill.empty() && ground_lines.empty() && on_top.empty(); }
 };
 
 struct Renderer {
@@ -86,6 +101,7 @@ struct Renderer {
   std::vector<float> morph_weights;
   MorphScratch morph_scratch;
   std::vector<LineVertex> lines;
+  OverlayGeometry overlay;  // drawn last by render_frame when not empty
 };
 
 /// Programs, the palette texture buffer, line buffers, timer queries. Errors carry the shader log.

@@ -18,6 +18,7 @@ Status setup_app(App& app, Scene scene, const ViewerOptions& o, float aspect) {
   app.toggles.wireframe = o.wireframe;
   app.toggles.skeleton = o.skeleton;
   app.toggles.grid = o.grid;
+  app.toggles.procedural = o.show_procedural || !o.headless();  // on in the window, asked for in images
   if (Status s = open_loaded_scene(app, std::move(scene), o.crowd, aspect); !s) return s;
   if (!o.quiet)
     for (const std::string& w : app.messages) std::fprintf(stderr, "ossa-view: warning: %s\n", w.c_str());

@@ -132,6 +132,11 @@ void graph_parameters(GraphDriver& g, UiState& ui) {
         ImGui::SameLine();
         ImGui::TextDisabled(v != 0.0f ? "(trigger, set)" : "(trigger)");
         break;
+      case fb::ParameterType::Vector: {
+        glm::vec3 x = first.vector(p);
+        if (ImGui::DragFloat3(label.c_str(), &x.x, 0.01f)) (void)set_graph_vector(g, p, x);
+        break;
+      }
     }
   }
 }
@@ -163,6 +168,54 @@ void graph_status(const GraphDriver& g) {
   for (const std::string& e : g.recent_events) ImGui::TextUnformatted(e.c_str());
 }
 
+/// The procedural nodes' controls: the overlay toggle, the targets (dragged in the view with
+/// Ctrl + left-drag, or a left-drag that starts on a marker), and, with foot placement, the
+/// ground: a tilt about the character's x axis (sets every leg's normal parameter) and a height
+/// per foot (the legs' ground parameters).
+void procedural_panel(App& app) {
+  GraphDriver& g = *app.animator.graph;
+  const ProceduralInfo& info = g.procedural;
+  if (info.empty()) return;
+  const GraphDefinition& d = *g.definition;
+  const GraphInstance& first = g.instances.front();
+  ImGui::Separator();
+  ImGui::TextDisabled("procedural");
+  ImGui::Checkbox("show procedural", &app.toggles.procedural);
+  for (const TargetHandle& h : info.targets) {
+    const glm::vec3 v = first.vector(h.parameter);
+    const bool reached = !h.pole && h.node >= 0 && first.reached(static_cast<size_t>(h.node));
+    ImGui::Text("%s %s (%.1f %.1f %.1f)%s", h.pole ? "pole" : "target", h.name.c_str(), v.x, v.y, v.z,
+                h.pole ? "" : reached ? "  reached" : "  not reached");
+  }
+  if (!info.targets.empty()) {
+    ImGui::PushStyleColor(ImGuiCol_Text, ImGui::GetStyleColorVec4(ImGuiCol_TextDisabled));
+    ImGui::TextWrapped("drag a marker (ctrl+drag: the nearest one) to move it in the view plane");
+    ImGui::PopStyleColor();
+  }
+  if (info.legs.empty()) return;
+  const float size = app.bind_box.empty() ? 1.0f : app.bind_box.size().y;
+  int normal = -1;
+  for (const FootLegInfo& leg : info.legs) normal = normal >= 0 ? normal : leg.normal;
+  if (normal >= 0) {
+    float tilt = tilt_degrees(first.vector(normal));
+    if (ImGui::SliderFloat("ground tilt", &tilt, -25.0f, 25.0f, "%.1f deg")) {
+      for (const FootLegInfo& leg : info.legs)
+        if (leg.normal >= 0) (void)set_graph_vector(g, leg.normal, tilted_normal(tilt));
+    }
+  }
+  for (const FootLegInfo& leg : info.legs) {
+    if (leg.ground < 0) continue;
+    const fb::Parameter& param = *d.graph().parameters()->Get(static_cast<flatbuffers::uoffset_t>(leg.ground));
+    const bool bounded = param.min_value() > -1e6f && param.max_value() < 1e6f && param.min_value() < param.max_value();
+    const float lo = bounded ? param.min_value() : -0.3f * size, hi = bounded ? param.max_value() : 0.3f * size;
+    float h = first.value(leg.ground);
+    ImGui::PushID(leg.ground);
+    if (ImGui::SliderFloat(leg.left ? "ground height left" : "ground height right", &h, lo, hi, "%.2f"))
+      set_graph_value(g, leg.ground, h);
+    ImGui::PopID();
+  }
+}
+
 void graph_panel(App& app, UiState& ui) {
   Animator& a = app.animator;
   if (!a.graph) {
@@ -184,6 +237,7 @@ void graph_panel(App& app, UiState& ui) {
   if (a.graph->instances.empty()) return;
   ImGui::Text("graph '%s'", a.graph->name.c_str());
   graph_parameters(*a.graph, ui);
+  procedural_panel(app);
   ImGui::PushStyleColor(ImGuiCol_Text, ImGui::GetStyleColorVec4(ImGuiCol_TextDisabled));
   ImGui::TextWrapped("keys: W walk, Shift+W run (release to stop), C crossed arms");
   ImGui::PopStyleColor();
@@ -239,7 +293,7 @@ void draw_panels(App& app, UiState& ui, float aspect) {
   if (ImGui::CollapsingHeader("Open")) open_panel(app, ui, aspect);
   if (!ui.status.empty()) ImGui::TextColored(ImVec4(1.0f, 0.4f, 0.4f, 1.0f), "%s", ui.status.c_str());
   for (const std::string& m : app.messages) ImGui::TextColored(ImVec4(1.0f, 0.8f, 0.3f, 1.0f), "%s", m.c_str());
-  ImGui::TextDisabled("drag: orbit  right-drag: pan  wheel: zoom");
+  ImGui::TextDisabled("drag: orbit  right-drag: pan  wheel: zoom  ctrl+drag: move a target");
   ImGui::TextDisabled("space: play/pause  B: bind pose  up/down: clip");
   ImGui::End();
 }

@@ -250,6 +250,8 @@ class ConditionParser {
       switch (param.type) {
         case ParamType::Bool: emit(CondOp::Bool, p16); return true;
         case ParamType::Trigger: emit(CondOp::Trigger, p16); return true;
+        case ParamType::Vector:
+          return fail(name.offset, "'" + param.name + "' is a vector parameter: conditions cannot read it");
         case ParamType::Enum:
           return fail(name.offset, "'" + param.name + "' is an enum parameter: compare it with one of its values (" +
                                        param.name +
@@ -264,6 +266,8 @@ class ConditionParser {
     const Token lit = tok_;
     const bool equality = op.op == CondOp::Equal || op.op == CondOp::NotEqual;
     switch (param.type) {
+      case ParamType::Vector:
+        return fail(name.offset, "'" + param.name + "' is a vector parameter: conditions cannot read it");
       case ParamType::Trigger:
         return fail(name.offset,
                     "'" + param.name + "' is a trigger: it cannot be compared, write it alone (" + param.name + ")");
@@ -319,6 +323,7 @@ const char* type_word(ParamType t) {
     case ParamType::Bool: return "bool";
     case ParamType::Enum: return "enum";
     case ParamType::Trigger: return "trigger";
+    case ParamType::Vector: return "vector";
   }
   return "?";
 }

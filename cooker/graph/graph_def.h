@@ -5,6 +5,7 @@
 // nodes, states), so serialization is a copy and tests can build graphs in C++ without JSON.
 // Nodes are stored children first: every index a node refers to is smaller than its own.
 #pragma once
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -13,7 +14,7 @@
 
 namespace ossa::cook {
 
-enum class ParamType : uint8_t { Float = 0, Int = 1, Bool = 2, Enum = 3, Trigger = 4 };
+enum class ParamType : uint8_t { Float = 0, Int = 1, Bool = 2, Enum = 3, Trigger = 4, Vector = 5 };
 
 struct GraphParameter {
   std::string name;
@@ -21,6 +22,8 @@ struct GraphParameter {
   float default_value = 0.0f;
   float min_value = -3.4e38f, max_value = 3.4e38f;
   std::vector<std::string> enum_values;
+  float default_vector[3] = {0.0f, 0.0f, 0.0f};  // Vector, in the rig's units
+  bool world = false;                            // Vector: world space (else model space)
 };
 
 /// Same numbering as fb::ConditionOp.
@@ -96,8 +99,70 @@ struct MorphWeightsDef {
   std::vector<MorphDriveDef> drives;
 };
 
+// Procedural nodes (format v6). Lengths in the rig's units, angles in radians (the compiler converts
+// the graph file's metres and degrees).
+using Vec3Def = std::array<float, 3>;
+struct TwoBoneIkDef {
+  uint16_t input = 0, start = 0, mid = 0, end = 0;
+  uint16_t target_parameter = 0;
+  int16_t pole_parameter = -1;
+  Vec3Def pole{0.0f, 0.0f, 0.0f};
+  Vec3Def mid_axis{0.0f, 0.0f, 1.0f};
+  float twist = 0.0f, soften = 1.0f, weight = 1.0f;
+  int16_t weight_parameter = -1;
+};
+struct AimJointDef {
+  uint16_t joint = 0;
+  float weight = 1.0f, max_angle = 3.14159265f;
+};
+struct AimDef {
+  uint16_t input = 0;
+  std::vector<AimJointDef> chain;
+  uint16_t target_parameter = 0;
+  Vec3Def forward{0.0f, 0.0f, 1.0f}, up{0.0f, 1.0f, 0.0f}, pole{0.0f, 0.0f, 0.0f};
+  float weight = 1.0f;
+  int16_t weight_parameter = -1;
+};
+struct FootLegDef {
+  uint16_t hip = 0, knee = 0, ankle = 0;
+  int16_t ground_parameter = -1, normal_parameter = -1, planted_parameter = -1;
+  std::string plant_event, lift_event;
+};
+struct FootPlacementDef {
+  uint16_t input = 0, pelvis = 0;
+  std::vector<FootLegDef> legs;
+  Vec3Def up{0.0f, 1.0f, 0.0f};
+  float max_pelvis_drop = 0.0f, align = 1.0f, soften = 1.0f, weight = 1.0f;
+  int16_t weight_parameter = -1;
+};
+struct FootLockDef {
+  uint16_t input = 0;
+  std::vector<FootLegDef> legs;
+  float release_radius = 0.0f, blend_time = 0.0f, weight = 1.0f;
+  int16_t weight_parameter = -1;
+};
+struct SpringChainDef {
+  std::vector<uint16_t> joints;
+  float stiffness = 4.0f, drag = 0.4f;
+  Vec3Def gravity{0.0f, 0.0f, 0.0f};
+  float radius = 0.0f, tail_length = 0.0f;
+};
+struct SpringColliderDef {
+  uint16_t joint = 0;
+  Vec3Def offset{0.0f, 0.0f, 0.0f}, tail{0.0f, 0.0f, 0.0f};
+  float radius = 0.0f;
+};
+struct SpringDef {
+  uint16_t input = 0;
+  std::vector<SpringChainDef> chains;
+  std::vector<SpringColliderDef> colliders;
+  float step = 1.0f / 120.0f, teleport_distance = 0.0f, weight = 1.0f;
+  int16_t weight_parameter = -1;
+};
+
 using NodeKind = std::variant<ClipNodeDef, BlendAlphaDef, SelectDef, LayeredDef, BlendSpaceDef, AdditiveDef,
-                              StateMachineRefDef, MorphWeightsDef>;
+                              StateMachineRefDef, MorphWeightsDef, TwoBoneIkDef, AimDef, FootPlacementDef,
+                              FootLockDef, SpringDef>;
 
 struct NodeDef {
   std::string name;

@@ -154,6 +154,19 @@ Offset<fb::Clip> write_clip(FlatBufferBuilder& fbb, const CompressedClip& clip, 
                         events_v, tracks_v);
 }
 
+fb::Vec3 vec3(const Vec3Def& v) { return fb::Vec3(v[0], v[1], v[2]); }
+
+Offset<flatbuffers::Vector<Offset<fb::FootLeg>>> write_legs(FlatBufferBuilder& fbb, const std::vector<FootLegDef>& legs) {
+  std::vector<Offset<fb::FootLeg>> out;
+  for (const FootLegDef& leg : legs) {
+    const auto plant = leg.plant_event.empty() ? Offset<flatbuffers::String>() : fbb.CreateString(leg.plant_event);
+    const auto lift = leg.lift_event.empty() ? Offset<flatbuffers::String>() : fbb.CreateString(leg.lift_event);
+    out.push_back(fb::CreateFootLeg(fbb, leg.hip, leg.knee, leg.ankle, leg.ground_parameter, leg.normal_parameter,
+                                    leg.planted_parameter, plant, lift));
+  }
+  return fbb.CreateVector(out);
+}
+
 Offset<fb::Node> write_node(FlatBufferBuilder& fbb, const NodeDef& node) {
   const auto name = fbb.CreateString(node.name);
   fb::NodeData type = fb::NodeData::NONE;
@@ -203,6 +216,52 @@ Offset<fb::Node> write_node(FlatBufferBuilder& fbb, const NodeDef& node) {
     }
     const auto drives_v = fbb.CreateVector(drives);
     data = fb::CreateMorphWeightsNode(fbb, w->input, drives_v).Union();
+  } else if (const auto* t = std::get_if<TwoBoneIkDef>(&node.kind)) {
+    type = fb::NodeData::TwoBoneIkNode;
+    const fb::Vec3 pole = vec3(t->pole), axis = vec3(t->mid_axis);
+    data = fb::CreateTwoBoneIkNode(fbb, t->input, t->start, t->mid, t->end, t->target_parameter, t->pole_parameter,
+                                   &pole, &axis, t->twist, t->soften, t->weight, t->weight_parameter)
+               .Union();
+  } else if (const auto* aim = std::get_if<AimDef>(&node.kind)) {
+    type = fb::NodeData::AimNode;
+    std::vector<fb::AimJoint> chain;
+    for (const AimJointDef& j : aim->chain) chain.emplace_back(j.joint, j.weight, j.max_angle);
+    const auto chain_v = fbb.CreateVectorOfStructs(chain);
+    const fb::Vec3 forward = vec3(aim->forward), up = vec3(aim->up), pole = vec3(aim->pole);
+    data = fb::CreateAimNode(fbb, aim->input, chain_v, aim->target_parameter, &forward, &up, &pole, aim->weight,
+                             aim->weight_parameter)
+               .Union();
+  } else if (const auto* f = std::get_if<FootPlacementDef>(&node.kind)) {
+    type = fb::NodeData::FootPlacementNode;
+    const auto legs_v = write_legs(fbb, f->legs);
+    const fb::Vec3 up = vec3(f->up);
+    data = fb::CreateFootPlacementNode(fbb, f->input, f->pelvis, legs_v, &up, f->max_pelvis_drop, f->align, f->soften,
+                                       f->weight, f->weight_parameter)
+               .Union();
+  } else if (const auto* lock = std::get_if<FootLockDef>(&node.kind)) {
+    type = fb::NodeData::FootLockNode;
+    const auto legs_v = write_legs(fbb, lock->legs);
+    data = fb::CreateFootLockNode(fbb, lock->input, legs_v, lock->release_radius, lock->blend_time, lock->weight,
+                                  lock->weight_parameter)
+               .Union();
+  } else if (const auto* sp = std::get_if<SpringDef>(&node.kind)) {
+    type = fb::NodeData::SpringNode;
+    std::vector<Offset<fb::SpringChainSettings>> chains;
+    for (const SpringChainDef& chain : sp->chains) {
+      const auto joints_v = fbb.CreateVector(chain.joints);
+      const fb::Vec3 gravity = vec3(chain.gravity);
+      chains.push_back(fb::CreateSpringChainSettings(fbb, joints_v, chain.stiffness, chain.drag, &gravity, chain.radius,
+                                                     chain.tail_length));
+    }
+    const auto chains_v = fbb.CreateVector(chains);
+    std::vector<fb::SpringColliderShape> colliders;
+    for (const SpringColliderDef& col : sp->colliders)
+      colliders.emplace_back(col.joint, vec3(col.offset), vec3(col.tail), col.radius);
+    const auto colliders_v = colliders.empty() ? Offset<flatbuffers::Vector<const fb::SpringColliderShape*>>()
+                                               : fbb.CreateVectorOfStructs(colliders);
+    data = fb::CreateSpringNode(fbb, sp->input, chains_v, colliders_v, sp->step, sp->teleport_distance, sp->weight,
+                                sp->weight_parameter)
+               .Union();
   }
   return fb::CreateNode(fbb, name, type, data);
 }
@@ -235,8 +294,11 @@ Offset<fb::Graph> write_graph(FlatBufferBuilder& fbb, const GraphDef& graph) {
     const auto param_name = fbb.CreateString(p.name);
     const auto values = p.enum_values.empty() ? Offset<Vector<Offset<flatbuffers::String>>>()
                                               : fbb.CreateVectorOfStrings(p.enum_values);
+    const bool vector = p.type == ParamType::Vector;
+    const fb::Vec3 default_vector(p.default_vector[0], p.default_vector[1], p.default_vector[2]);
     parameters.push_back(fb::CreateParameter(fbb, param_name, static_cast<fb::ParameterType>(p.type), p.default_value,
-                                             p.min_value, p.max_value, values));
+                                             p.min_value, p.max_value, values, vector ? &default_vector : nullptr,
+                                             p.world ? fb::ParameterSpace::World : fb::ParameterSpace::Model));
   }
   const auto parameters_v = fbb.CreateVector(parameters);
   const auto clips_v = fbb.CreateVectorOfStrings(graph.clips);

@@ -26,6 +26,26 @@ const fb::Clip* find_clip(const Asset& asset, std::string_view name) {
   return nullptr;
 }
 
+/// Whether joint a is b or one of b's ancestors.
+bool ancestor_of(std::span<const int16_t> parents, uint32_t a, uint32_t b) {
+  for (int j = static_cast<int>(b); j >= 0; j = parents[static_cast<size_t>(j)])
+    if (static_cast<uint32_t>(j) == a) return true;
+  return false;
+}
+
+/// The chain a > b > c (each a strict ancestor of the next), or an error naming the joints.
+std::string chain_error(const SkeletonView& skeleton, std::initializer_list<uint32_t> joints) {
+  const auto parents = skeleton.parents();
+  const uint32_t* prev = nullptr;
+  for (const uint32_t& j : joints) {
+    if (prev && (*prev == j || !ancestor_of(parents, *prev, j)))
+      return "joint '" + std::string(skeleton.joint_name(*prev)) + "' is not an ancestor of '" +
+             std::string(skeleton.joint_name(j)) + "'";
+    prev = &j;
+  }
+  return {};
+}
+
 }  // namespace
 
 size_t graph_count(const Asset& asset) {
@@ -80,6 +100,12 @@ uint32_t scratch_needed(const GraphDefinition::Impl& def, uint16_t n) {
     }
     case Kind::Morph:
       return scratch_needed(def, static_cast<const fb::MorphWeightsNode*>(info.table)->input());
+    case Kind::TwoBoneIk:
+    case Kind::Aim:
+    case Kind::FootPlacement:
+    case Kind::FootLock:
+    case Kind::Spring:
+      return scratch_needed(def, procedural_input(info));
   }
   return 0;
 }
@@ -137,6 +163,12 @@ void mark_driven_channels(const GraphDefinition::Impl& d, uint16_t n, std::vecto
         if (const int32_t c = d.drive_channels[info.aux + k]; c >= 0) mask[static_cast<size_t>(c)] = 1.0f;
       return;
     }
+    case Kind::TwoBoneIk:
+    case Kind::Aim:
+    case Kind::FootPlacement:
+    case Kind::FootLock:
+    case Kind::Spring:
+      return mark_driven_channels(d, procedural_input(info), mask);
   }
 }
 
@@ -303,6 +335,81 @@ Result<GraphDefinition> GraphDefinition::create(const Asset& asset, std::string_
           const auto it = std::find(d.channels.begin(), d.channels.end(), flatbuffers::GetStringView(drive->target()));
           d.drive_channels.push_back(it == d.channels.end() ? -1 : static_cast<int32_t>(it - d.channels.begin()));
         }
+        break;
+      }
+      case fb::NodeData::TwoBoneIkNode: {
+        info.kind = Kind::TwoBoneIk;
+        const auto* t = node.data_as_TwoBoneIkNode();
+        info.table = t;
+        if (std::string e = chain_error(d.skeleton, {t->start(), t->mid(), t->end()}); !e.empty())
+          return Error{where + ": node " + std::to_string(i) + " (two-bone IK): " + e};
+        d.float_count += 1;  // reached
+        d.procedural = true;
+        break;
+      }
+      case fb::NodeData::AimNode: {
+        info.kind = Kind::Aim;
+        const auto* t = node.data_as_AimNode();
+        info.table = t;
+        for (flatbuffers::uoffset_t k = 1; k < t->chain()->size(); ++k)
+          if (std::string e = chain_error(d.skeleton, {t->chain()->Get(k - 1)->joint(), t->chain()->Get(k)->joint()});
+              !e.empty())
+            return Error{where + ": node " + std::to_string(i) + " (aim): " + e};
+        d.float_count += 1;  // reached
+        d.procedural = true;
+        break;
+      }
+      case fb::NodeData::FootPlacementNode:
+      case fb::NodeData::FootLockNode: {
+        const bool lock = node.data_type() == fb::NodeData::FootLockNode;
+        const auto* legs = lock ? node.data_as_FootLockNode()->legs() : node.data_as_FootPlacementNode()->legs();
+        for (const fb::FootLeg* leg : *legs)
+          if (std::string e = chain_error(d.skeleton, {leg->hip(), leg->knee(), leg->ankle()}); !e.empty())
+            return Error{where + ": node " + std::to_string(i) + " (foot " + (lock ? "lock" : "placement") + "): " + e};
+        d.procedural = true;
+        if (!lock) {
+          info.kind = Kind::FootPlacement;
+          info.table = node.data_as_FootPlacementNode();
+          break;
+        }
+        info.kind = Kind::FootLock;
+        const auto* t = node.data_as_FootLockNode();
+        info.table = t;
+        info.aux = static_cast<uint32_t>(d.leg_events.size());
+        d.float_count += 9 * t->legs()->size();  // per leg: graph_procedural.cpp kLockFloats
+        for (const fb::FootLeg* leg : *t->legs()) {
+          d.leg_events.push_back(flatbuffers::GetStringView(leg->plant_event()));
+          d.leg_events.push_back(flatbuffers::GetStringView(leg->lift_event()));
+        }
+        break;
+      }
+      case fb::NodeData::SpringNode: {
+        info.kind = Kind::Spring;
+        const auto* t = node.data_as_SpringNode();
+        info.table = t;
+        info.aux = static_cast<uint32_t>(d.springs.size());
+        info.samples = static_cast<uint32_t>(d.colliders.size());
+        for (const fb::SpringChainSettings* c : *t->chains()) {
+          SpringSettings settings;
+          settings.stiffness = c->stiffness();
+          settings.drag = c->drag();
+          settings.gravity = c->gravity() ? glm::vec3(c->gravity()->x(), c->gravity()->y(), c->gravity()->z()) : glm::vec3(0.0f);
+          settings.radius = c->radius();
+          settings.tail_length = c->tail_length();
+          settings.step = t->step();
+          settings.teleport_distance = t->teleport_distance();
+          const std::vector<uint16_t> joints(c->joints()->begin(), c->joints()->end());
+          auto chain = make_spring_chain(parents, joints, settings);
+          if (!chain) return Error{where + ": node " + std::to_string(i) + ": " + chain.error().message};
+          d.springs.push_back(std::move(*chain));
+        }
+        std::vector<SpringCollider> colliders;
+        if (const auto* shapes = t->colliders())
+          for (const fb::SpringColliderShape* c : *shapes)
+            colliders.push_back(SpringCollider{c->joint(), glm::vec3(c->offset().x(), c->offset().y(), c->offset().z()),
+                                               glm::vec3(c->tail().x(), c->tail().y(), c->tail().z()), c->radius()});
+        d.colliders.push_back(std::move(colliders));
+        d.procedural = true;
         break;
       }
       default:

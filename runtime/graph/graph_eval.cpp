@@ -394,6 +394,12 @@ void evaluate(State& s, uint16_t n, const Advance& advance, float weight, bool d
       return evaluate_machine(s, n, advance, weight, dominant, out, ow, depth);
     case Kind::Morph:
       return evaluate_morph(s, info, advance, weight, dominant, out, ow, depth);
+    case Kind::TwoBoneIk:
+    case Kind::Aim:
+    case Kind::FootPlacement:
+    case Kind::FootLock:
+    case Kind::Spring:
+      return evaluate_procedural(s, n, advance, weight, dominant, out, ow, depth);
   }
 }
 
@@ -444,6 +450,12 @@ void restart(State& s, uint16_t n) {
       return restart_machine(s, info.machine);
     case Kind::Morph:
       return restart(s, static_cast<const fb::MorphWeightsNode*>(info.table)->input());
+    case Kind::TwoBoneIk:
+    case Kind::Aim:
+    case Kind::FootPlacement:
+    case Kind::FootLock:
+    case Kind::Spring:
+      return restart_procedural(s, n);
   }
 }
 
@@ -484,6 +496,12 @@ Cycle cycle(const State& s, uint16_t n) {
       return machine_cycle(s, info.machine);
     case Kind::Morph:
       return cycle(s, static_cast<const fb::MorphWeightsNode*>(info.table)->input());
+    case Kind::TwoBoneIk:
+    case Kind::Aim:
+    case Kind::FootPlacement:
+    case Kind::FootLock:
+    case Kind::Spring:
+      return cycle(s, procedural_input(info));
   }
   return {};
 }
@@ -526,6 +544,12 @@ void set_phase(State& s, uint16_t n, float p) {
       return set_machine_phase(s, info.machine, p);
     case Kind::Morph:
       return set_phase(s, static_cast<const fb::MorphWeightsNode*>(info.table)->input(), p);
+    case Kind::TwoBoneIk:
+    case Kind::Aim:
+    case Kind::FootPlacement:
+    case Kind::FootLock:
+    case Kind::Spring:
+      return set_phase(s, procedural_input(info), p);
   }
 }
 

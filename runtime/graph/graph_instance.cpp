@@ -16,6 +16,8 @@ using namespace graph_detail;
 
 namespace {
 
+constexpr float kMaxVector = 1e6f;  // coordinates kept where products stay finite
+
 const fb::Parameter* parameter_at(const GraphDefinition::Impl& d, int i) {
   if (i < 0 || static_cast<size_t>(i) >= d.graph->parameters()->size()) return nullptr;
   return d.graph->parameters()->Get(static_cast<flatbuffers::uoffset_t>(i));
@@ -37,6 +39,10 @@ std::unique_ptr<GraphScratch::Buffers> make_buffers(const GraphDefinition::Impl&
   b->weights.assign(d.scratch_depth, std::vector<float>(d.channels.size(), 0.0f));
   b->model_base.resize(d.joints);
   b->model_layer.resize(d.joints);
+  if (d.procedural) {
+    b->model.resize(d.joints);
+    b->moved.resize(d.joints);
+  }
   return b;
 }
 
@@ -107,6 +113,8 @@ Result<GraphInstance> GraphInstance::create(const GraphDefinition& definition, s
   }
   s->output = Pose(d.joints);
   s->morph = d.default_weights;
+  s->vectors.assign(param_count, glm::vec3(0.0f));
+  s->springs = d.springs;  // each instance its own chain state, copied from the checked prototypes
   s->event_capacity = event_capacity;
   s->events.reserve(event_capacity);
   GraphInstance instance(std::move(s));
@@ -154,6 +162,42 @@ bool GraphInstance::set_trigger(int parameter) {
   return true;
 }
 
+bool GraphInstance::set_vector(int parameter, const glm::vec3& value) {
+  const fb::Parameter* p = parameter_at(*state_->def, parameter);
+  if (!p || p->type() != fb::ParameterType::Vector) return false;
+  if (!std::isfinite(value.x) || !std::isfinite(value.y) || !std::isfinite(value.z)) return false;
+  state_->vectors[static_cast<size_t>(parameter)] = glm::clamp(value, glm::vec3(-kMaxVector), glm::vec3(kMaxVector));
+  return true;
+}
+
+glm::vec3 GraphInstance::vector(int parameter) const {
+  if (!parameter_at(*state_->def, parameter)) return glm::vec3(std::numeric_limits<float>::quiet_NaN());
+  return state_->vectors[static_cast<size_t>(parameter)];
+}
+
+bool GraphInstance::set_transform(const glm::mat4& model_to_world) {
+  for (int c = 0; c < 4; ++c)
+    for (int r = 0; r < 4; ++r)
+      if (!std::isfinite(model_to_world[c][r])) return false;
+  const glm::mat4 inverse = glm::inverse(model_to_world);
+  for (int c = 0; c < 4; ++c)
+    for (int r = 0; r < 4; ++r)
+      if (!std::isfinite(inverse[c][r])) return false;  // singular
+  state_->transform = model_to_world;
+  state_->inverse_transform = inverse;
+  return true;
+}
+
+const glm::mat4& GraphInstance::transform() const { return state_->transform; }
+
+bool GraphInstance::reached(size_t node) const {
+  const State& s = *state_;
+  if (node >= s.def->nodes.size()) return false;
+  const NodeInfo& info = s.def->nodes[node];
+  if (info.kind != Kind::TwoBoneIk && info.kind != Kind::Aim) return false;
+  return s.node_weights[node] > 0.0f && s.floats[info.floats] != 0.0f;
+}
+
 float GraphInstance::value(int parameter) const {
   if (!parameter_at(*state_->def, parameter)) return std::numeric_limits<float>::quiet_NaN();
   return state_->params[static_cast<size_t>(parameter)];
@@ -162,8 +206,12 @@ float GraphInstance::value(int parameter) const {
 void GraphInstance::reset() {
   State& s = *state_;
   const auto& params = *s.def->graph->parameters();
-  for (flatbuffers::uoffset_t i = 0; i < params.size(); ++i)
-    s.params[i] = params.Get(i)->type() == fb::ParameterType::Trigger ? 0.0f : params.Get(i)->default_value();
+  for (flatbuffers::uoffset_t i = 0; i < params.size(); ++i) {
+    const fb::Parameter& p = *params.Get(i);
+    s.params[i] = p.type() == fb::ParameterType::Trigger ? 0.0f : p.default_value();
+    const fb::Vec3* v = p.type() == fb::ParameterType::Vector ? p.default_vector() : nullptr;
+    s.vectors[i] = v ? glm::vec3(v->x(), v->y(), v->z()) : glm::vec3(0.0f);
+  }
   for (size_t m = 0; m < s.machines.size(); ++m) restart_machine(s, static_cast<uint16_t>(m));
   restart(s, s.def->graph->root());
   std::fill(s.node_weights.begin(), s.node_weights.end(), 0.0f);

@@ -15,12 +15,17 @@
 #include <glm/gtc/quaternion.hpp>
 
 #include <ossa/anim/blend_space.h>
+#include <ossa/anim/spring.h>
+#include <ossa/loader/validate.h>
 #include <ossa/graph/graph.h>
 #include <ossa/anim/sample.h>
 
 namespace ossa::graph_detail {
 
-enum class Kind : uint8_t { Clip, BlendAlpha, Select, Layered, BlendSpace, Additive, Machine, Morph };
+enum class Kind : uint8_t {
+  Clip, BlendAlpha, Select, Layered, BlendSpace, Additive, Machine, Morph,
+  TwoBoneIk, Aim, FootPlacement, FootLock, Spring,  // procedural: graph_procedural.cpp
+};
 
 struct NodeInfo {
   Kind kind = Kind::Clip;
@@ -28,7 +33,9 @@ struct NodeInfo {
   uint32_t floats = 0;          // offset of this node's variable state in State::floats
   uint32_t caches = 0;          // first sampling cache (clip: 1, blend space: one per sample)
   uint32_t aux = 0;             // layered: first mask (Impl::masks); blend space: 2D space index;
-                                // morph: first drive channel (Impl::drive_channels)
+                                // morph: first drive channel (Impl::drive_channels);
+                                // spring: first chain (State::springs), foot lock: first leg's
+                                // events (Impl::leg_events)
   uint32_t samples = 0;         // blend space: first entry in Impl::sample_x / sample_duration
   uint16_t machine = 0;         // Machine: index into Impl::machines
   int32_t held = -1;            // Clip with rate 0 and no rate parameter: index into Impl::held
@@ -86,6 +93,12 @@ struct GraphDefinition::Impl {
   std::vector<std::vector<int32_t>> clip_channels; // per clip: each weight track's channel, or -1
   std::vector<std::vector<float>> layer_morphs;    // parallel to masks: 1 on channels the layer drives
   std::vector<int32_t> drive_channels;             // morph nodes' drives, in order: channel or -1
+  // Procedural nodes: spring chains made (and checked) once, copied into each instance; each spring
+  // node's colliders; each foot lock leg's plant and lift event names.
+  std::vector<SpringChain> springs;                   // every spring node's chains, in node order
+  std::vector<std::vector<SpringCollider>> colliders; // per spring node, indexed by NodeInfo::samples
+  std::vector<std::string_view> leg_events;           // per foot lock leg: plant, lift ("" none)
+  bool procedural = false;                            // any procedural node: model matrices needed
 };
 
 namespace graph_detail {
@@ -127,6 +140,11 @@ struct GraphScratch::Buffers {
   std::vector<std::vector<float>> weights;  // parallel to poses: morph channel weights
   // Mesh-space layering: model rotations of base and layer along a mask's chain, one per joint.
   std::vector<glm::quat> model_base, model_layer;
+  // Procedural nodes: the pose's model matrices, and which joints a correction moved.
+  std::vector<glm::mat4> model;
+  std::vector<uint8_t> moved;
+  const float* model_pose = nullptr;  // the pose `model` matches (set by the procedural node that
+                                      // built it; null when partly stale)
 };
 
 struct GraphInstance::State {
@@ -143,6 +161,10 @@ struct GraphInstance::State {
   std::vector<graph_detail::MachineState> machines;
   Pose output;
   std::vector<float> morph;         // output morph channel weights
+  std::vector<glm::vec3> vectors;   // Vector parameters' values (one slot per parameter)
+  glm::mat4 transform{1.0f};        // model to world, set by the host (set_transform)
+  glm::mat4 inverse_transform{1.0f};
+  std::vector<SpringChain> springs; // every spring node's chains' state
   std::vector<GraphEvent> events;   // capacity reserved; size() = events of the last update
   size_t event_capacity = 0;
   size_t dropped = 0;
@@ -175,6 +197,14 @@ struct Cycle {
 Cycle cycle(const GraphInstance::State& s, uint16_t n);
 /// Moves every clip of the subtree to normalized phase p.
 void set_phase(GraphInstance::State& s, uint16_t n, float p);
+
+/// Procedural nodes (graph_procedural.cpp): evaluate the input, then correct the pose in model space.
+void evaluate_procedural(GraphInstance::State& s, uint16_t n, const Advance& advance, float weight, bool dominant,
+                         PoseSpan out, std::span<float> ow, uint32_t depth);
+/// The node's input (every procedural node has exactly one).
+uint16_t procedural_input(const NodeInfo& info);
+/// Back to the animated pose: foot locks released, spring chains restarted at the next update.
+void restart_procedural(GraphInstance::State& s, uint16_t n);
 
 /// State machine node (graph_machine.cpp).
 void evaluate_machine(GraphInstance::State& s, uint16_t n, const Advance& advance, float weight, bool dominant,

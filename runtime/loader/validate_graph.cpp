@@ -110,6 +110,12 @@ class GraphChecker {
       case fb::ParameterType::Trigger:
         if (v != 0.0f && v != 1.0f) return fail(at + format(": default %g must be 0 or 1", v));
         break;
+      case fb::ParameterType::Vector:
+        if (const fb::Vec3* d = p.default_vector(); d && !(vector_ok(*d)))
+          return fail(at + ": default vector must be finite and within +-1e6");
+        if (static_cast<unsigned>(p.space()) > static_cast<unsigned>(fb::ParameterSpace::MAX))
+          return fail(at + format(" has unknown space %u", static_cast<unsigned>(p.space())));
+        break;
       case fb::ParameterType::Enum: {
         const size_t n = p.enum_values() ? p.enum_values()->size() : 0;
         if (n == 0) return fail(at + ": an enum needs at least one value");
@@ -140,6 +146,36 @@ class GraphChecker {
   static bool weight_ok(float v) { return std::isfinite(v) && std::fabs(v) <= kMaxWeight; }
   static bool time_ok(float v) { return std::isfinite(v) && v >= 0.0f && v <= kMaxSeconds; }
   static bool coordinate_ok(float v) { return std::isfinite(v) && std::fabs(v) <= kMaxCoordinate; }
+  static bool vector_ok(const fb::Vec3& v) {
+    return coordinate_ok(v.x()) && coordinate_ok(v.y()) && coordinate_ok(v.z());
+  }
+  static bool vector_ok(const fb::Vec3* v) { return !v || vector_ok(*v); }
+  Status check_joint(const std::string& at, const char* what, uint32_t j) const {
+    if (j >= g_.joint_count()) return fail(at + format(": %s joint %u is out of range (%u joints)", what, j, g_.joint_count()));
+    return {};
+  }
+  Status check_weight(const std::string& at, float weight, int16_t parameter) {
+    if (!std::isfinite(weight) || weight < 0.0f || weight > 1.0f) return fail(at + ": weight must be within [0, 1]");
+    return check_param_ref(at + " weight", parameter, true, {fb::ParameterType::Float, fb::ParameterType::Bool});
+  }
+  Status check_legs(const std::string& at, const flatbuffers::Vector<flatbuffers::Offset<fb::FootLeg>>& legs) {
+    if (legs.size() == 0 || legs.size() > kMaxFootLegs)
+      return fail(at + format(": %u legs; a foot node needs 1 to %u", legs.size(), kMaxFootLegs));
+    for (flatbuffers::uoffset_t k = 0; k < legs.size(); ++k) {
+      const fb::FootLeg& leg = *legs.Get(k);
+      const std::string lat = at + format(" leg %u", k);
+      if (Status st = check_joint(lat, "hip", leg.hip()); !st) return st;
+      if (Status st = check_joint(lat, "knee", leg.knee()); !st) return st;
+      if (Status st = check_joint(lat, "ankle", leg.ankle()); !st) return st;
+      if (Status st = check_param_ref(lat + " ground", leg.ground_parameter(), true, {fb::ParameterType::Float}); !st) return st;
+      if (Status st = check_param_ref(lat + " normal", leg.normal_parameter(), true, {fb::ParameterType::Vector}); !st) return st;
+      if (Status st = check_param_ref(lat + " planted", leg.planted_parameter(), true,
+                                      {fb::ParameterType::Float, fb::ParameterType::Bool});
+          !st)
+        return st;
+    }
+    return {};
+  }
   static constexpr float kMaxRate = 1000.0f, kMaxWeight = 100.0f, kMaxSeconds = 1e6f, kMaxCoordinate = 1e6f;
 
   Status check_node(size_t n) {
@@ -251,6 +287,90 @@ class GraphChecker {
             return st;
         }
         return {};
+      }
+      case fb::NodeData::TwoBoneIkNode: {
+        const auto& t = *node.data_as_TwoBoneIkNode();
+        if (Status st = child(n, t.input(), "input"); !st) return st;
+        if (Status st = check_joint(at, "start", t.start()); !st) return st;
+        if (Status st = check_joint(at, "mid", t.mid()); !st) return st;
+        if (Status st = check_joint(at, "end", t.end()); !st) return st;
+        if (Status st = check_param_ref(at + " target", t.target_parameter(), false, {fb::ParameterType::Vector}); !st) return st;
+        if (Status st = check_param_ref(at + " pole", t.pole_parameter(), true, {fb::ParameterType::Vector}); !st) return st;
+        if (!vector_ok(t.pole()) || !vector_ok(t.mid_axis()) || !finite(t.twist()) || std::fabs(t.twist()) > 100.0f)
+          return fail(at + ": pole, mid axis and twist must be finite and within bounds");
+        if (!(t.soften() > 0.0f && t.soften() <= 1.0f)) return fail(at + ": soften must be within (0, 1]");
+        return check_weight(at, t.weight(), t.weight_parameter());
+      }
+      case fb::NodeData::AimNode: {
+        const auto& a = *node.data_as_AimNode();
+        if (Status st = child(n, a.input(), "input"); !st) return st;
+        const auto& chain = *a.chain();
+        if (!spend(uint64_t(chain.size()) * 12)) return over_budget();
+        if (chain.size() == 0 || chain.size() > kMaxSpringJoints)
+          return fail(at + format(": an aim chain has %u joints; it needs 1 to %u", chain.size(), kMaxSpringJoints));
+        for (flatbuffers::uoffset_t k = 0; k < chain.size(); ++k) {
+          const fb::AimJoint& j = *chain.Get(k);
+          if (Status st = check_joint(at, "aim", j.joint()); !st) return st;
+          if (!(j.weight() >= 0.0f && j.weight() <= 1.0f) || !(j.max_angle() >= 0.0f && j.max_angle() <= 100.0f))
+            return fail(at + format(": aim joint %u: weight must be within [0, 1] and max angle within [0, 100]", k));
+        }
+        if (Status st = check_param_ref(at + " target", a.target_parameter(), false, {fb::ParameterType::Vector}); !st) return st;
+        if (!vector_ok(a.forward()) || !vector_ok(a.up()) || !vector_ok(a.pole()))
+          return fail(at + ": forward, up and pole must be finite and within +-1e6");
+        return check_weight(at, a.weight(), a.weight_parameter());
+      }
+      case fb::NodeData::FootPlacementNode: {
+        const auto& f = *node.data_as_FootPlacementNode();
+        if (Status st = child(n, f.input(), "input"); !st) return st;
+        if (Status st = check_joint(at, "pelvis", f.pelvis()); !st) return st;
+        if (!spend(uint64_t(f.legs()->size()) * 32)) return over_budget();
+        if (Status st = check_legs(at, *f.legs()); !st) return st;
+        if (!vector_ok(f.up()) || !coordinate_ok(f.max_pelvis_drop()) || !(f.align() >= 0.0f && f.align() <= 1.0f))
+          return fail(at + ": up, pelvis drop and align must be finite (align within [0, 1])");
+        if (!(f.soften() > 0.0f && f.soften() <= 1.0f)) return fail(at + ": soften must be within (0, 1]");
+        return check_weight(at, f.weight(), f.weight_parameter());
+      }
+      case fb::NodeData::FootLockNode: {
+        const auto& f = *node.data_as_FootLockNode();
+        if (Status st = child(n, f.input(), "input"); !st) return st;
+        if (!spend(uint64_t(f.legs()->size()) * 32)) return over_budget();
+        if (Status st = check_legs(at, *f.legs()); !st) return st;
+        if (!(f.release_radius() > 0.0f) || !coordinate_ok(f.release_radius()) || !time_ok(f.blend_time()))
+          return fail(at + ": release radius must be positive and finite, blend time within [0, 1e6] s");
+        return check_weight(at, f.weight(), f.weight_parameter());
+      }
+      case fb::NodeData::SpringNode: {
+        const auto& sp = *node.data_as_SpringNode();
+        if (Status st = child(n, sp.input(), "input"); !st) return st;
+        const auto& chains = *sp.chains();
+        if (chains.size() == 0) return fail(at + ": a spring node has no chains");
+        if (!spend(uint64_t(chains.size()) * 32)) return over_budget();
+        for (flatbuffers::uoffset_t k = 0; k < chains.size(); ++k) {
+          const fb::SpringChainSettings& c = *chains.Get(k);
+          const std::string cat = at + format(" chain %u", k);
+          if (!spend(uint64_t(c.joints()->size()) * 2)) return over_budget();
+          if (c.joints()->size() == 0 || c.joints()->size() > kMaxSpringJoints)
+            return fail(cat + format(": %u joints; a chain needs 1 to %u", c.joints()->size(), kMaxSpringJoints));
+          for (uint16_t j : *c.joints())
+            if (Status st = check_joint(cat, "chain", j); !st) return st;
+          if (!(c.stiffness() >= 0.0f && c.stiffness() <= 1e4f) || !(c.drag() >= 0.0f && c.drag() <= 1.0f) ||
+              !vector_ok(c.gravity()) || !(c.radius() >= 0.0f) || !coordinate_ok(c.radius()) ||
+              !(c.tail_length() >= 0.0f) || !coordinate_ok(c.tail_length()))
+            return fail(cat + ": stiffness within [0, 1e4], drag within [0, 1], gravity, radius and tail length finite and not negative");
+        }
+        if (const auto* colliders = sp.colliders()) {
+          if (!spend(uint64_t(colliders->size()) * 32)) return over_budget();
+          for (flatbuffers::uoffset_t k = 0; k < colliders->size(); ++k) {
+            const fb::SpringColliderShape& c = *colliders->Get(k);
+            if (Status st = check_joint(at + format(" collider %u", k), "its", c.joint()); !st) return st;
+            if (!vector_ok(c.offset()) || !vector_ok(c.tail()) || !(c.radius() >= 0.0f) || !coordinate_ok(c.radius()))
+              return fail(at + format(" collider %u: offset, tail and radius must be finite (radius not negative)", k));
+          }
+        }
+        if (!(sp.step() >= 1e-4f && sp.step() <= 1.0f)) return fail(at + ": step must be within [1e-4, 1] s");
+        if (!(sp.teleport_distance() >= 0.0f) || !coordinate_ok(sp.teleport_distance()))
+          return fail(at + ": teleport distance must be finite and not negative");
+        return check_weight(at, sp.weight(), sp.weight_parameter());
       }
       case fb::NodeData::StateMachineNode: {
         const uint16_t m = node.data_as_StateMachineNode()->machine();

@@ -251,6 +251,11 @@ json describe_graph(const fb::Graph& g) {
   for (const fb::Parameter* p : *g.parameters()) {
     json item{{"name", str(p->name())}, {"type", fb::EnumNameParameterType(p->type())},
               {"default", round6(p->default_value())}};
+    if (p->type() == fb::ParameterType::Vector) {
+      const fb::Vec3* v = p->default_vector();
+      item["default"] = v ? json::array({round6(v->x()), round6(v->y()), round6(v->z())}) : json::array({0, 0, 0});
+      item["space"] = fb::EnumNameParameterSpace(p->space());
+    }
     if (p->enum_values()) {
       json values = json::array();
       for (const flatbuffers::String* v : *p->enum_values()) values.push_back(str(v));

@@ -33,6 +33,14 @@
 // their difference from the defaults, an inertialized switch decays the jump linearly, and a layer
 // blends the channels its own clips drive.
 //
+// Procedural nodes (format v6) post-process their input's pose in model space: two-bone IK, aim
+// over a chain, foot placement on per-foot ground planes, foot locking and spring chains (ossa/anim
+// ik.h and spring.h do the solving). Vector parameters give their targets; set_transform gives
+// where the character stands, so locks and springs act in world space. Their state (locked feet,
+// spring tails) is per instance, reserved at creation. reset(), or a state restarting their
+// subtree, puts them back on the animated pose; a spring node's teleport_distance does so when the
+// character jumps further than that in one update.
+//
 // Events: a clip player reports the events its clip crosses in [previous time, new time) (wrapped
 // across loops, reversed for negative rates), only when it lies on the dominant path: at every blend
 // the child with the most weight (ties: the later child, i.e. a transition's target) passes dominance
@@ -161,8 +169,21 @@ class GraphInstance {
   bool set_enum(int parameter, int value);
   /// Sets a trigger; it stays set until a transition whose condition reads it fires.
   bool set_trigger(int parameter);
-  /// Any parameter's current value as stored (bools and triggers 0 / 1). NaN for a bad index.
+  /// Sets a Vector parameter (a point or direction, in the space the parameter declares: the
+  /// character's model space, or world space carried through set_transform). Non-finite values
+  /// are refused; coordinates are clamped to +-1e6.
+  bool set_vector(int parameter, const glm::vec3& value);
+  /// A Vector parameter's value as set (zero for other types; NaN for a bad index).
+  glm::vec3 vector(int parameter) const;
+  /// Any parameter's current value as stored (bools and triggers 0 / 1; 0 for vectors). NaN for a
+  /// bad index.
   float value(int parameter) const;
+
+  /// The character's model-to-world transform, set by the host before update() whenever the
+  /// character moves: world-space Vector parameters, foot locks and spring chains go through it.
+  /// Refuses (false) a matrix with a non-finite entry or no inverse. Identity until set.
+  bool set_transform(const glm::mat4& model_to_world);
+  const glm::mat4& transform() const;
 
   /// Advances by dt seconds (>= 0) and evaluates the output pose. Allocation-free. The first form
   /// uses the instance's own scratch (it must have one); the second a shared one.
@@ -187,6 +208,9 @@ class GraphInstance {
   MachineStatus machine_status(size_t machine) const;
   /// The weight a node contributed to the output in the last update (0 when it was not evaluated).
   float node_weight(size_t node) const;
+  /// Whether a two-bone IK or aim node reached its target at full weight in the last update
+  /// (false for other nodes, and for one not evaluated).
+  bool reached(size_t node) const;
   /// A node's normalized phase in [0, 1] (its leading clip's time / duration), for tools and tests.
   float node_phase(size_t node) const;
 

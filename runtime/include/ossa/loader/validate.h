@@ -43,6 +43,10 @@ namespace ossa {
 /// verify_buffer passes it. Vertex/index/texture data must be 16-byte aligned in memory.
 Status validate_file(const fb::File& file, std::string_view name, size_t buffer_size = 0);
 
+/// Procedural graph nodes (format v6): joints per spring chain, legs per foot placement or lock node.
+inline constexpr uint32_t kMaxSpringJoints = 64;
+inline constexpr uint32_t kMaxFootLegs = 8;
+
 /// The graph checks (validate_graph.cpp), run by validate_file for each of File.graphs: every index
 /// in range (parameters, clips, joints, nodes, machines, states), parameter types fit their uses,
 /// nodes children first with one referrer each and at most kMaxGraphDepth levels deep, each
