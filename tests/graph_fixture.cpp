@@ -1,12 +1,15 @@
 // graph_fixture.cpp — see graph_fixture.h.
 #include "graph_fixture.h"
 
+#include <gtest/gtest.h>
+
 #include <cstdio>
 #include <memory>
 
 #include "cooker/import/import_scene.h"
 #include "cooker/write/write_ossa.h"
 #include "test_files.h"
+#include <ossa/anim/pose_ops.h>
 
 namespace ossa::test {
 namespace fs = std::filesystem;
@@ -98,6 +101,29 @@ uint16_t clip_node(GraphDef& g, uint16_t clip, float rate, bool loop) {
   c.rate = rate;
   c.loop = loop;
   return add_node(g, c, g.clips[clip]);
+}
+
+std::vector<glm::mat4> Played::model() const {
+  std::vector<glm::mat4> m(def->joint_count());
+  local_to_model(def->skeleton().parents(), inst->pose(), m);
+  return m;
+}
+
+Played play(const PabRig& rig, const cook::GraphDef& g,
+            const std::map<std::string, std::vector<cook::SourceEvent>>& events) {
+  Played p;
+  auto asset = make_graph_file(rig, {g}, events);
+  EXPECT_TRUE(asset.ok()) << (asset.ok() ? "" : asset.error().message);
+  if (!asset.ok()) return p;
+  p.asset = std::make_unique<Asset>(std::move(*asset));
+  auto def = GraphDefinition::create(*p.asset, g.name);
+  EXPECT_TRUE(def.ok()) << (def.ok() ? "" : def.error().message);
+  if (!def.ok()) return p;
+  p.def = std::make_unique<GraphDefinition>(std::move(*def));
+  auto inst = GraphInstance::create(*p.def);
+  EXPECT_TRUE(inst.ok()) << (inst.ok() ? "" : inst.error().message);
+  if (inst.ok()) p.inst = std::make_unique<GraphInstance>(std::move(*inst));
+  return p;
 }
 
 }  // namespace ossa::test

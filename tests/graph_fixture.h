@@ -7,13 +7,21 @@
 // writer ossa-cook uses, and opens it with the runtime's verified loader.
 #pragma once
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "cooker/clip/clip_compress.h"
 #include "cooker/graph/graph_def.h"
 #include "cooker/import/source_scene.h"
+#include <glm/glm.hpp>
+#include <ossa/graph/graph.h>
 #include <ossa/loader/asset.h>
+
+/// In a test: `rig` is Pab's rig, or the test is skipped when assets/Pab is missing.
+#define NEED_RIG()                                            \
+  const ::ossa::test::PabRig* rig = ::ossa::test::pab_rig(); \
+  if (!rig) GTEST_SKIP() << "assets/Pab not found or did not import"
 
 namespace ossa::test {
 
@@ -43,5 +51,21 @@ uint16_t add_node(cook::GraphDef& g, cook::NodeKind kind, std::string name = "")
 uint16_t add_param(cook::GraphDef& g, std::string name, cook::ParamType type, float value = 0.0f,
                    std::vector<std::string> enum_values = {});
 uint16_t clip_node(cook::GraphDef& g, uint16_t clip, float rate = 1.0f, bool loop = true);
+
+/// A loaded graph: the file, its definition and one instance (in that order, so each outlives
+/// what points at it), with the output's model matrices rebuilt by local_to_model on demand.
+struct Played {
+  std::unique_ptr<Asset> asset;
+  std::unique_ptr<GraphDefinition> def;
+  std::unique_ptr<GraphInstance> inst;
+  int param(std::string_view name) const { return def->find_parameter(name); }
+  std::vector<glm::mat4> model() const;
+  glm::vec3 position(int joint) const { return glm::vec3(model()[static_cast<size_t>(joint)][3]); }
+};
+
+/// Writes `g` over the rig (make_graph_file), binds it and makes one instance; a failing step is a
+/// test failure (GoogleTest's EXPECT) and leaves the later members null.
+Played play(const PabRig& rig, const cook::GraphDef& g,
+            const std::map<std::string, std::vector<cook::SourceEvent>>& events = {});
 
 }  // namespace ossa::test

@@ -27,38 +27,9 @@ namespace {
 using namespace ossa::cook;
 using test::PabRig;
 
-#define NEED_RIG()                                     \
-  const PabRig* rig = test::pab_rig();                 \
-  if (!rig) GTEST_SKIP() << "assets/Pab not found or did not import"
 
-struct Played {
-  std::unique_ptr<Asset> asset;
-  std::unique_ptr<GraphDefinition> def;
-  std::unique_ptr<GraphInstance> inst;
-  int param(std::string_view name) const { return def->find_parameter(name); }
-  std::vector<glm::mat4> model() const {
-    std::vector<glm::mat4> m(def->joint_count());
-    local_to_model(def->skeleton().parents(), inst->pose(), m);
-    return m;
-  }
-  glm::vec3 position(int joint) const { return glm::vec3(model()[static_cast<size_t>(joint)][3]); }
-};
-
-Played play(const PabRig& rig, const GraphDef& g, const std::map<std::string, std::vector<SourceEvent>>& events = {}) {
-  Played p;
-  auto asset = test::make_graph_file(rig, {g}, events);
-  EXPECT_TRUE(asset.ok()) << (asset.ok() ? "" : asset.error().message);
-  if (!asset.ok()) return p;
-  p.asset = std::make_unique<Asset>(std::move(*asset));
-  auto def = GraphDefinition::create(*p.asset, g.name);
-  EXPECT_TRUE(def.ok()) << (def.ok() ? "" : def.error().message);
-  if (!def.ok()) return p;
-  p.def = std::make_unique<GraphDefinition>(std::move(*def));
-  auto inst = GraphInstance::create(*p.def);
-  EXPECT_TRUE(inst.ok()) << (inst.ok() ? "" : inst.error().message);
-  if (inst.ok()) p.inst = std::make_unique<GraphInstance>(std::move(*inst));
-  return p;
-}
+using test::Played;
+using test::play;
 
 uint16_t vector_param(GraphDef& g, const std::string& name, glm::vec3 value = glm::vec3(0.0f), bool world = false) {
   const uint16_t p = test::add_param(g, name, ParamType::Vector);

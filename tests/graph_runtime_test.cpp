@@ -27,34 +27,9 @@ namespace {
 using namespace ossa::cook;
 using test::PabRig;
 
-#define NEED_RIG()                                              \
-  const PabRig* rig = test::pab_rig();                          \
-  if (!rig) GTEST_SKIP() << "assets/Pab not found or did not import"
 
-/// A loaded graph: the file, its definition and one instance (in that order, so each outlives
-/// what points at it).
-struct Played {
-  std::unique_ptr<Asset> asset;
-  std::unique_ptr<GraphDefinition> def;
-  std::unique_ptr<GraphInstance> inst;
-  int param(std::string_view name) const { return def->find_parameter(name); }
-};
-
-Played play(const PabRig& rig, const GraphDef& g, const std::map<std::string, std::vector<SourceEvent>>& events = {}) {
-  Played p;
-  auto asset = test::make_graph_file(rig, {g}, events);
-  EXPECT_TRUE(asset.ok()) << (asset.ok() ? "" : asset.error().message);
-  if (!asset.ok()) return p;
-  p.asset = std::make_unique<Asset>(std::move(*asset));
-  auto def = GraphDefinition::create(*p.asset, g.name);
-  EXPECT_TRUE(def.ok()) << (def.ok() ? "" : def.error().message);
-  if (!def.ok()) return p;
-  p.def = std::make_unique<GraphDefinition>(std::move(*def));
-  auto inst = GraphInstance::create(*p.def);
-  EXPECT_TRUE(inst.ok()) << (inst.ok() ? "" : inst.error().message);
-  if (inst.ok()) p.inst = std::make_unique<GraphInstance>(std::move(*inst));
-  return p;
-}
+using test::Played;
+using test::play;
 
 /// Two states playing clips a and b, a -> b on trigger "go" with the given mode and duration, and
 /// b -> c (if c >= 0) on trigger "next".

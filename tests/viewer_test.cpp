@@ -79,19 +79,24 @@ std::string files_of(const Sample& s, const char* layout) {
   return out;
 }
 
-/// Renders `sample` with extra options into a PNG in `dir`; fails the test on a non-zero exit or
-/// any GL error message, and returns the image.
-Image render(const Sample& sample, const fs::path& dir, const std::string& tag, const std::string& extra,
-             const char* layout = "quantized") {
-  const fs::path png = dir / (tag + ".png");
-  std::string args = files_of(sample, layout) + "--size 256x256 --no-grid --screenshot " + quote(png.string()) + " " + extra;
-  if (*sample.clip) args += std::string(" --clip ") + quote(sample.clip);
+/// Runs ossa-view with `args` (which write a screenshot to `png`); fails the test on a non-zero
+/// exit or any GL error message, and returns the image.
+Image screenshot(const std::string& args, const fs::path& png) {
   const CommandResult r = run_viewer(args);
   EXPECT_EQ(r.exit_code, 0) << "ossa-view " << args << "\n" << r.err;
   EXPECT_EQ(r.err.find("GL error"), std::string::npos) << r.err;
   Image image = load_png(png);
   EXPECT_FALSE(image.empty()) << "no image at " << png;
   return image;
+}
+
+/// Renders `sample` with extra options into a PNG in `dir` (see screenshot).
+Image render(const Sample& sample, const fs::path& dir, const std::string& tag, const std::string& extra,
+             const char* layout = "quantized") {
+  const fs::path png = dir / (tag + ".png");
+  std::string args = files_of(sample, layout) + "--size 256x256 --no-grid --screenshot " + quote(png.string()) + " " + extra;
+  if (*sample.clip) args += std::string(" --clip ") + quote(sample.clip);
+  return screenshot(args, png);
 }
 
 class ViewerSample : public ::testing::TestWithParam<Sample> {
@@ -385,13 +390,7 @@ class ViewerProcedural : public Viewer {
   }
   Image render_file(const std::string& base, const std::string& tag, const std::string& extra) {
     const fs::path png = dir_ / (tag + ".png");
-    const std::string args = base + " --no-grid --size 256x256 --screenshot " + quote(png.string()) + " " + extra;
-    const CommandResult r = run_viewer(args);
-    EXPECT_EQ(r.exit_code, 0) << "ossa-view " << args << "\n" << r.err;
-    EXPECT_EQ(r.err.find("GL error"), std::string::npos) << r.err;
-    Image image = load_png(png);
-    EXPECT_FALSE(image.empty()) << "no image at " << png;
-    return image;
+    return screenshot(base + " --no-grid --size 256x256 --screenshot " + quote(png.string()) + " " + extra, png);
   }
   /// assets/Fox/fox_tail.graph.json cooked into this test's folder (mesh, clips and graph 'fox').
   fs::path cook_fox() {

@@ -7,12 +7,17 @@
 // allocation: the state vectors are sized in make_spring_chain.
 #include <ossa/anim/spring.h>
 
+#include "internal/rotation.h"
+
 #include <algorithm>
 #include <cmath>
 #include <string>
 
 namespace ossa {
 namespace {
+
+using detail::from_to;
+using detail::orientation;
 
 constexpr int kMaxStepsPerUpdate = 64;  // a longer dt (a hitch, a debugger pause) is dropped
 
@@ -25,25 +30,7 @@ glm::mat4 compose(const Transform& t) {
   return m;
 }
 
-// Rotation of a matrix with scale divided out (columns normalized; no shear assumed).
-glm::quat orientation(const glm::mat4& m) {
-  glm::mat3 r(m);
-  for (int c = 0; c < 3; ++c) {
-    const float len = glm::length(r[c]);
-    r[c] = len > 1e-12f ? r[c] / len : glm::vec3(c == 0, c == 1, c == 2);
-  }
-  return glm::normalize(glm::quat_cast(r));
-}
 
-glm::quat from_to(const glm::vec3& a, const glm::vec3& b) {
-  const float c = glm::dot(a, b);
-  if (c < -1.0f + 1e-6f) {
-    const glm::vec3 other = std::fabs(a.x) < 0.9f ? glm::vec3(1, 0, 0) : glm::vec3(0, 1, 0);
-    return glm::angleAxis(3.14159265f, glm::normalize(glm::cross(a, other)));
-  }
-  const glm::vec3 x = glm::cross(a, b);
-  return glm::normalize(glm::quat(1.0f + c, x.x, x.y, x.z));
-}
 
 glm::mat4 base_of(const SpringChain& chain, std::span<const int16_t> parents, std::span<const glm::mat4> model) {
   const int16_t p = parents[chain.joints.front()];

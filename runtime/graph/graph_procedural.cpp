@@ -18,11 +18,15 @@
 #include <iterator>
 
 #include "graph/graph_internal.h"
+#include "internal/rotation.h"
 #include <ossa/anim/ik.h>
 #include <ossa/anim/pose_ops.h>
 
 namespace ossa::graph_detail {
 namespace {
+
+using detail::from_to;
+using detail::orientation;
 
 using State = GraphInstance::State;
 
@@ -61,32 +65,14 @@ glm::mat4 local_matrix(ConstPoseSpan p, uint32_t j) {
   return m;
 }
 
-/// Rotation of a model matrix with its scale divided out (no shear).
-glm::quat orientation(const glm::mat4& m) {
-  glm::mat3 r(m);
-  for (int c = 0; c < 3; ++c) {
-    const float len = glm::length(r[c]);
-    r[c] = len > 1e-12f ? r[c] / len : glm::vec3(c == 0, c == 1, c == 2);
-  }
-  return glm::normalize(glm::quat_cast(r));
-}
 
-/// The shortest rotation taking unit a onto unit b.
-glm::quat from_to(const glm::vec3& a, const glm::vec3& b) {
-  const float c = glm::dot(a, b);
-  if (c < -1.0f + 1e-6f) {
-    const glm::vec3 other = std::fabs(a.x) < 0.9f ? glm::vec3(1, 0, 0) : glm::vec3(0, 1, 0);
-    return glm::angleAxis(3.14159265f, glm::normalize(glm::cross(a, other)));
-  }
-  const glm::vec3 x = glm::cross(a, b);
-  return glm::normalize(glm::quat(1.0f + c, x.x, x.y, x.z));
-}
 
-/// Recomputes the model matrices of `joint` and its descendants from the local pose. O(joints
-/// after `joint`): one forward sweep (parents first) marking the subtree.
-void refresh_below(State& s, ConstPoseSpan pose, uint32_t joint) {
+/// Calls visit(j, parent) for `joint` and each of its descendants, parents first: one forward
+/// sweep over the joints after it (parents come first), marking the subtree in the scratch.
+/// O(joints after `joint`).
+template <typename Visit>
+void for_subtree(State& s, uint32_t joint, Visit&& visit) {
   const auto parents = s.def->skeleton.parents();
-  std::vector<glm::mat4>& model = s.scratch->model;
   std::vector<uint8_t>& moved = s.scratch->moved;
   const uint32_t n = s.def->joints;
   std::fill(moved.begin() + joint, moved.begin() + n, uint8_t{0});
@@ -94,25 +80,24 @@ void refresh_below(State& s, ConstPoseSpan pose, uint32_t joint) {
     const int p = parents[j];
     if (j != joint && (p < static_cast<int>(joint) || !moved[static_cast<size_t>(p)])) continue;
     moved[j] = 1;
-    model[j] = p >= 0 ? model[static_cast<size_t>(p)] * local_matrix(pose, j) : local_matrix(pose, j);
+    visit(j, p);
   }
+}
+
+/// Recomputes the model matrices of `joint` and its descendants from the local pose.
+void refresh_below(State& s, ConstPoseSpan pose, uint32_t joint) {
+  std::vector<glm::mat4>& model = s.scratch->model;
+  for_subtree(s, joint, [&](uint32_t j, int p) {
+    model[j] = p >= 0 ? model[static_cast<size_t>(p)] * local_matrix(pose, j) : local_matrix(pose, j);
+  });
 }
 
 /// Adds a model-space offset to the translation of `joint` and every descendant: what moving
 /// `joint` by that offset does to their model matrices (a pure translation of the subtree), at a
-/// fraction of refresh_below's cost. O(joints after `joint`).
+/// fraction of refresh_below's cost.
 void translate_below(State& s, uint32_t joint, const glm::vec3& offset) {
-  const auto parents = s.def->skeleton.parents();
   std::vector<glm::mat4>& model = s.scratch->model;
-  std::vector<uint8_t>& moved = s.scratch->moved;
-  const uint32_t n = s.def->joints;
-  std::fill(moved.begin() + joint, moved.begin() + n, uint8_t{0});
-  for (uint32_t j = joint; j < n; ++j) {
-    const int p = parents[j];
-    if (j != joint && (p < static_cast<int>(joint) || !moved[static_cast<size_t>(p)])) continue;
-    moved[j] = 1;
-    model[j][3] += glm::vec4(offset, 0.0f);
-  }
+  for_subtree(s, joint, [&](uint32_t j, int) { model[j][3] += glm::vec4(offset, 0.0f); });
 }
 
 /// Recomputes the model matrices on the path from `from` (included) down to its descendant `to`
