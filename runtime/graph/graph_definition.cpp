@@ -376,7 +376,7 @@ Result<GraphDefinition> GraphDefinition::create(const Asset& asset, std::string_
         const auto* t = node.data_as_FootLockNode();
         info.table = t;
         info.aux = static_cast<uint32_t>(d.leg_events.size());
-        d.float_count += 9 * t->legs()->size();  // per leg: graph_procedural.cpp kLockFloats
+        d.float_count += 1 + 9 * t->legs()->size();  // a flag, then per leg (graph_procedural.cpp kLockFloats)
         for (const fb::FootLeg* leg : *t->legs()) {
           d.leg_events.push_back(flatbuffers::GetStringView(leg->plant_event()));
           d.leg_events.push_back(flatbuffers::GetStringView(leg->lift_event()));

@@ -161,14 +161,15 @@ struct GraphInstance::State {
   std::vector<graph_detail::MachineState> machines;
   Pose output;
   std::vector<float> morph;         // output morph channel weights
-  std::vector<glm::vec3> vectors;   // Vector parameters' values (one slot per parameter)
-  glm::mat4 transform{1.0f};        // model to world, set by the host (set_transform)
-  glm::mat4 inverse_transform{1.0f};
-  std::vector<SpringChain> springs; // every spring node's chains' state
   std::vector<GraphEvent> events;   // capacity reserved; size() = events of the last update
   size_t event_capacity = 0;
   size_t dropped = 0;
   uint64_t update_counter = 0;
+  // Procedural nodes only, last so that the fields every update reads stay on the lines they had:
+  std::vector<glm::vec3> vectors;   // Vector parameters' values (one slot per parameter)
+  glm::mat4 transform{1.0f};        // model to world, set by the host (set_transform)
+  glm::mat4 inverse_transform{1.0f};
+  std::vector<SpringChain> springs; // every spring node's chains' state
 };
 
 namespace graph_detail {

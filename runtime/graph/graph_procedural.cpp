@@ -162,10 +162,13 @@ bool solve_two_bone(State& s, PoseSpan out, uint32_t start, uint32_t mid, uint32
 
 void two_bone(State& s, const NodeInfo& info, PoseSpan out) {
   const auto& t = *static_cast<const fb::TwoBoneIkNode*>(info.table);
-  float& reached = s.floats[info.floats];
-  reached = 0.0f;
   const float w = node_weight_of(s, t.weight(), t.weight_parameter());
-  if (!(w > 0.0f)) return;
+  float& reached = s.floats[info.floats];
+  if (!(w > 0.0f)) {
+    if (reached != 0.0f) reached = 0.0f;  // a crowd with the node off writes nothing
+    return;
+  }
+  reached = 0.0f;
   model_of(s, out);
   const glm::vec3 start(s.scratch->model[t.start()][3]);
   const glm::vec3 pole = t.pole_parameter() >= 0 ? model_point(s, t.pole_parameter()) - start
@@ -179,10 +182,13 @@ void two_bone(State& s, const NodeInfo& info, PoseSpan out) {
 
 void aim(State& s, const NodeInfo& info, PoseSpan out) {
   const auto& a = *static_cast<const fb::AimNode*>(info.table);
-  float& reached = s.floats[info.floats];
-  reached = 0.0f;
   const float w = node_weight_of(s, a.weight(), a.weight_parameter());
-  if (!(w > 0.0f)) return;
+  float& reached = s.floats[info.floats];
+  if (!(w > 0.0f)) {
+    if (reached != 0.0f) reached = 0.0f;  // a crowd with the node off writes nothing
+    return;
+  }
+  reached = 0.0f;
   std::vector<glm::mat4>& model = s.scratch->model;
   model_of(s, out);
   const glm::vec3 target = model_point(s, a.target_parameter());
@@ -290,33 +296,38 @@ void foot_placement(State& s, const NodeInfo& info, PoseSpan out) {
 
 // ---- foot locking ----
 
-/// Per leg, in State::floats: locked, blend, planted (from events), the locked world point (3) and
-/// the last model-space target (3).
+/// In State::floats: an "any state" flag, then per leg: locked, blend, planted (from events), the
+/// locked world point (3) and the last model-space target (3).
 constexpr uint32_t kLockFloats = 9;
 
 void foot_lock(State& s, const NodeInfo& info, const Advance& advance, PoseSpan out) {
   const auto& f = *static_cast<const fb::FootLockNode*>(info.table);
   const float w = node_weight_of(s, f.weight(), f.weight_parameter());
   const auto& legs = *f.legs();
+  float& active = s.floats[info.floats];  // any leg state set: cleared once when the node goes off
+  if (!(w > 0.0f)) {
+    // Off: nothing locked, nothing to blend out, nothing tracked (a crowd with the node off reads
+    // one float). Turned on mid-stride, a leg driven by events locks from its next plant event.
+    if (active != 0.0f) std::fill_n(&s.floats[info.floats], 1 + legs.size() * kLockFloats, 0.0f);
+    return;
+  }
+  active = 1.0f;
   // Planted from events: the last plant / lift event crossed so far (events of this update from
-  // the input subtree are already in s.events, in the order they were reached). Tracked at any
-  // weight, so raising the weight mid-stride knows which feet are down.
+  // the input subtree are already in s.events, in the order they were reached).
   for (flatbuffers::uoffset_t i = 0; i < legs.size(); ++i) {
-    float* st = &s.floats[info.floats + i * kLockFloats];
+    float* st = &s.floats[info.floats + 1 + i * kLockFloats];
     const std::string_view plant = s.def->leg_events[info.aux + 2 * i], lift = s.def->leg_events[info.aux + 2 * i + 1];
     for (const GraphEvent& e : s.events) {
       if (!plant.empty() && e.name == plant) st[2] = 1.0f;
       if (!lift.empty() && e.name == lift) st[2] = 0.0f;
     }
-    if (!(w > 0.0f)) st[0] = st[1] = 0.0f;  // off: nothing locked, nothing to blend out
   }
-  if (!(w > 0.0f)) return;
   std::vector<glm::mat4>& model = s.scratch->model;
   model_of(s, out);
   const float radius = f.release_radius();
   for (flatbuffers::uoffset_t i = 0; i < legs.size(); ++i) {
     const fb::FootLeg& leg = *legs.Get(i);
-    float* st = &s.floats[info.floats + i * kLockFloats];
+    float* st = &s.floats[info.floats + 1 + i * kLockFloats];
     const bool planted = leg.planted_parameter() >= 0 ? s.params[static_cast<size_t>(leg.planted_parameter())] > 0.5f
                                                       : st[2] > 0.5f;
     const glm::vec3 ankle(model[leg.ankle()][3]);
@@ -418,7 +429,7 @@ void restart_procedural(State& s, uint16_t n) {
   restart(s, procedural_input(info));
   if (info.kind == Kind::FootLock) {
     const uint32_t legs = static_cast<const fb::FootLockNode*>(info.table)->legs()->size();
-    std::fill_n(&s.floats[info.floats], legs * kLockFloats, 0.0f);
+    std::fill_n(&s.floats[info.floats], 1 + legs * kLockFloats, 0.0f);
   } else if (info.kind == Kind::Spring) {
     const uint32_t chains = static_cast<const fb::SpringNode*>(info.table)->chains()->size();
     for (uint32_t k = 0; k < chains; ++k) {
