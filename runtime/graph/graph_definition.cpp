@@ -417,6 +417,22 @@ Result<GraphDefinition> GraphDefinition::create(const Asset& asset, std::string_
     }
   }
 
+  for (NodeInfo& info : d.nodes) {  // procedural nodes: input and weight decoded once
+    const auto decode = [&info](const auto* t) {
+      info.input = t->input();
+      info.weight = t->weight();
+      info.weight_parameter = t->weight_parameter();
+    };
+    switch (info.kind) {
+      case Kind::TwoBoneIk: decode(static_cast<const fb::TwoBoneIkNode*>(info.table)); break;
+      case Kind::Aim: decode(static_cast<const fb::AimNode*>(info.table)); break;
+      case Kind::FootPlacement: decode(static_cast<const fb::FootPlacementNode*>(info.table)); break;
+      case Kind::FootLock: decode(static_cast<const fb::FootLockNode*>(info.table)); break;
+      case Kind::Spring: decode(static_cast<const fb::SpringNode*>(info.table)); break;
+      default: break;
+    }
+  }
+
   if (const auto* machines = g->machines()) {
     d.machines.resize(machines->size());
     for (flatbuffers::uoffset_t m = 0; m < machines->size(); ++m) {

@@ -39,6 +39,11 @@ struct NodeInfo {
   uint32_t samples = 0;         // blend space: first entry in Impl::sample_x / sample_duration
   uint16_t machine = 0;         // Machine: index into Impl::machines
   int32_t held = -1;            // Clip with rate 0 and no rate parameter: index into Impl::held
+  // Procedural nodes: their input and weight, decoded once so that a node at weight 0 costs a
+  // parameter read, not table lookups.
+  uint16_t input = 0;
+  int16_t weight_parameter = -1;
+  float weight = 1.0f;
 };
 
 /// A transition's condition and the triggers it consumes, decoded.

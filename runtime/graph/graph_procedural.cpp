@@ -39,8 +39,8 @@ glm::vec3 vec_or(const fb::Vec3* v, const glm::vec3& fallback) {
 }
 
 /// The node's weight: weight * (weight parameter's value), in [0, 1].
-float node_weight_of(const State& s, float weight, int16_t parameter) {
-  return clamp01(weight * (parameter >= 0 ? s.params[static_cast<size_t>(parameter)] : 1.0f));
+float node_weight_of(const State& s, const NodeInfo& info) {
+  return clamp01(info.weight * (info.weight_parameter >= 0 ? s.params[static_cast<size_t>(info.weight_parameter)] : 1.0f));
 }
 
 /// A Vector parameter as a model-space point / direction.
@@ -162,7 +162,7 @@ bool solve_two_bone(State& s, PoseSpan out, uint32_t start, uint32_t mid, uint32
 
 void two_bone(State& s, const NodeInfo& info, PoseSpan out) {
   const auto& t = *static_cast<const fb::TwoBoneIkNode*>(info.table);
-  const float w = node_weight_of(s, t.weight(), t.weight_parameter());
+  const float w = node_weight_of(s, info);
   float& reached = s.floats[info.floats];
   if (!(w > 0.0f)) {
     if (reached != 0.0f) reached = 0.0f;  // a crowd with the node off writes nothing
@@ -182,7 +182,7 @@ void two_bone(State& s, const NodeInfo& info, PoseSpan out) {
 
 void aim(State& s, const NodeInfo& info, PoseSpan out) {
   const auto& a = *static_cast<const fb::AimNode*>(info.table);
-  const float w = node_weight_of(s, a.weight(), a.weight_parameter());
+  const float w = node_weight_of(s, info);
   float& reached = s.floats[info.floats];
   if (!(w > 0.0f)) {
     if (reached != 0.0f) reached = 0.0f;  // a crowd with the node off writes nothing
@@ -232,7 +232,7 @@ struct LegTarget {
 
 void foot_placement(State& s, const NodeInfo& info, PoseSpan out) {
   const auto& f = *static_cast<const fb::FootPlacementNode*>(info.table);
-  const float w = node_weight_of(s, f.weight(), f.weight_parameter());
+  const float w = node_weight_of(s, info);
   if (!(w > 0.0f)) return;
   std::vector<glm::mat4>& model = s.scratch->model;
   const auto parents = s.def->skeleton.parents();
@@ -302,7 +302,7 @@ constexpr uint32_t kLockFloats = 9;
 
 void foot_lock(State& s, const NodeInfo& info, const Advance& advance, PoseSpan out) {
   const auto& f = *static_cast<const fb::FootLockNode*>(info.table);
-  const float w = node_weight_of(s, f.weight(), f.weight_parameter());
+  const float w = node_weight_of(s, info);
   const auto& legs = *f.legs();
   float& active = s.floats[info.floats];  // any leg state set: cleared once when the node goes off
   if (!(w > 0.0f)) {
@@ -359,7 +359,7 @@ void foot_lock(State& s, const NodeInfo& info, const Advance& advance, PoseSpan 
 
 void springs(State& s, const NodeInfo& info, const Advance& advance, PoseSpan out) {
   const auto& sp = *static_cast<const fb::SpringNode*>(info.table);
-  const float w = node_weight_of(s, sp.weight(), sp.weight_parameter());
+  const float w = node_weight_of(s, info);
   std::vector<glm::mat4>& model = s.scratch->model;
   const auto parents = s.def->skeleton.parents();
   model_of(s, out);
@@ -395,16 +395,7 @@ void springs(State& s, const NodeInfo& info, const Advance& advance, PoseSpan ou
 
 }  // namespace
 
-uint16_t procedural_input(const NodeInfo& info) {
-  switch (info.kind) {
-    case Kind::TwoBoneIk: return static_cast<const fb::TwoBoneIkNode*>(info.table)->input();
-    case Kind::Aim: return static_cast<const fb::AimNode*>(info.table)->input();
-    case Kind::FootPlacement: return static_cast<const fb::FootPlacementNode*>(info.table)->input();
-    case Kind::FootLock: return static_cast<const fb::FootLockNode*>(info.table)->input();
-    case Kind::Spring: return static_cast<const fb::SpringNode*>(info.table)->input();
-    default: return 0;
-  }
-}
+uint16_t procedural_input(const NodeInfo& info) { return info.input; }
 
 void evaluate_procedural(State& s, uint16_t n, const Advance& advance, float weight, bool dominant, PoseSpan out,
                          std::span<float> ow, uint32_t depth) {
