@@ -78,7 +78,17 @@ Status select_clip(const Scene& scene, Animator& animator, int clip, bool crossf
   }
   p.clip = clip;
   p.time = 0.0f;
+  p.loop_start = p.loop_end = 0.0f;
   return {};
+}
+
+float loop_time(float time, float lo, float hi) {
+  if (!(hi > lo) || !std::isfinite(time)) return lo;
+  if (time >= lo && time <= hi) return time;
+  const float length = hi - lo;
+  float r = std::fmod(time - lo, length);
+  if (r < 0.0f) r += length;
+  return lo + r;
 }
 
 float clip_duration(const Scene& scene, const Animator& animator) { return duration_of(scene, animator.playback.clip); }
@@ -87,7 +97,12 @@ void advance(const Scene& scene, Animator& animator, float dt) {
   Playback& p = animator.playback;
   if (!p.playing) return;
   if (animator.graph && animator.use_graph && !p.bind_pose) animator.graph_dt += dt * std::max(p.speed, 0.0f);
-  if (p.clip >= 0) p.time = advance_time(p.time, dt, p.speed, duration_of(scene, p.clip), p.loop);
+  if (p.clip >= 0) {
+    const float duration = duration_of(scene, p.clip);
+    const float end = std::min(p.loop_end, duration);
+    p.time = p.loop && end > p.loop_start ? loop_time(p.time + dt * p.speed, p.loop_start, end)
+                                          : advance_time(p.time, dt, p.speed, duration, p.loop);
+  }
   if (p.fade < 1.0f) {
     p.from_time = advance_time(p.from_time, dt, p.speed, duration_of(scene, p.from_clip), true);
     p.fade = p.fade_seconds > 0.0f ? std::min(1.0f, p.fade + dt / p.fade_seconds) : 1.0f;

@@ -37,6 +37,10 @@ struct Playback {
   bool playing = true;
   bool loop = true;
   bool bind_pose = false;   // show the skeleton's bind pose instead of the clip
+  // The timeline's loop range (layout.h): with loop on, playback wraps within [loop_start,
+  // loop_end] when loop_end > loop_start; otherwise over the whole clip. Reset by select_clip.
+  float loop_start = 0.0f;
+  float loop_end = 0.0f;
   // Cross-fade from the previously selected clip, which keeps playing until the fade ends.
   int from_clip = -1;
   float from_time = 0.0f;
@@ -78,9 +82,13 @@ Status select_clip(const Scene& scene, Animator& animator, int clip, bool crossf
 /// Duration of the selected clip (0 without one).
 float clip_duration(const Scene& scene, const Animator& animator);
 
-/// Moves time by dt * speed when playing (wrapping or clamping as playback.loop says) and the
+/// Moves time by dt * speed when playing (wrapping or clamping as playback.loop says; with loop on
+/// and a loop range, wrapping within it) and the
 /// cross-fade by dt; banks dt * max(speed, 0) for the graph (graphs only run forwards).
 void advance(const Scene& scene, Animator& animator, float dt);
+
+/// `time` wrapped into [lo, hi] (a time inside stays as it is, hi included); `lo` when hi <= lo.
+float loop_time(float time, float lo, float hi);
 
 /// Sets the clip time (scrub, --time): wrapped or clamped into the clip.
 void set_time(const Scene& scene, Animator& animator, float time);

@@ -146,6 +146,8 @@ Status set_crowd(App& app, size_t crowd, float aspect) {
     p.playing = previous.playing;
     p.loop = previous.loop;
     p.bind_pose = previous.bind_pose;
+    p.loop_start = previous.loop_start;
+    p.loop_end = previous.loop_end;
   }
   if (!app.graph_name.empty()) {
     if (Status s = use_graph(app, app.graph_name); !s) return s;

@@ -1,4 +1,8 @@
 // interactive.h — ossa-view in a window: orbit camera, keyboard, Dear ImGui panels, drag and drop.
+//
+// The scene is drawn beside the panel (layout.h), files and sources are opened and cooked behind
+// a loading indicator (cook_job.h), and the window may start with no file at all (the panel's
+// file browser). --window-frames N counts frames once no open or cook is pending.
 #pragma once
 #include "viewer/options.h"
 

@@ -37,13 +37,13 @@ std::optional<std::pair<std::string, float>> parse_morph(const std::string& text
 }
 
 ParsedOptions parse_options(int argc, const char* const* argv) {
-  cli::Command command("ossa-view", "ossa-view: look at cooked .ossa characters and play their clips (GLFW + OpenGL 3.3)",
+  cli::Command command("ossa-view", "ossa-view: look at cooked .ossa characters and play their clips; the window also cooks sources dropped on it (GLFW + OpenGL 3.3)",
                        "when the files could not be shown (a file refused, a name not found, a GL error)");
   CLI::App& app = command.app();
   ViewerOptions o;
   std::string size;
   bool no_grid = false;
-  app.add_option("files", o.files, "a character .ossa, then any clip files cooked for its skeleton")->required();
+  app.add_option("files", o.files, "a character .ossa, then any clip files cooked for its skeleton (the window may start without)");
   app.add_option("--clip", o.clip, "start with this clip (its name)");
   app.add_option("--time", o.time, "clip time in seconds (headless: of the captured frame)");
   app.add_option("--speed", o.speed, "playback rate");
@@ -75,7 +75,18 @@ ParsedOptions parse_options(int argc, const char* const* argv) {
       ->allow_extra_args(false);  // one value per --morph: the files may follow
   app.add_option("--window-frames", o.window_frames, "window mode: exit after N frames (--screenshot captures the window)")
       ->check(CLI::Range(1, 1000000));
+  std::string panel;
+  app.add_option("--panel", panel, "window: start with the panel open or collapsed (Tab toggles it)")
+      ->check(CLI::IsMember({"open", "collapsed"}));
+  app.add_option("--ui-scale", o.ui_scale, "window: panel text and widget size (default: the monitor's content scale)")
+      ->check(CLI::Range(0.5f, 4.0f));
+  app.add_option("--browse", o.browse, "window: start the panel's file browser in this folder");
+  app.add_option("--cook-and-open", o.cook_and_open,
+                 "window: cook this source (FBX, glTF, GLB, DAE, BVH, OBJ) with ossa-cook in the background, then open it; "
+                 "repeatable")
+      ->allow_extra_args(false);
   if (const auto exit_now = command.parse(argc, argv)) return {std::nullopt, *exit_now};
+  o.panel_collapsed = panel == "collapsed";
   o.quiet = command.quiet();
   o.verbose = command.verbose();
   if (!size.empty()) {
@@ -98,6 +109,11 @@ ParsedOptions parse_options(int argc, const char* const* argv) {
                                               std::to_string(static_cast<int>(kMaxSeconds)) + ", got " +
                                               std::to_string(o.time))};
   if (!o.screenshot.empty() && o.frames == 0 && o.window_frames == 0) o.frames = 1;
+  if (o.files.empty() && o.headless())
+    return {std::nullopt, command.usage_error("files is required: a character .ossa to render (only the window may start "
+                                              "without one)")};
+  if (o.headless() && (!o.cook_and_open.empty() || !o.browse.empty()))
+    return {std::nullopt, command.usage_error("--cook-and-open and --browse are for the window (use --window-frames N)")};
   return {o, 0};
 }
 

@@ -6,7 +6,9 @@
 //             [--frames N] [--screenshot OUT.png] [--first-frame-time] [--stats]
 //             [--window-frames N] [--graph NAME [--set|--param PARAM=VALUE ...] [--show-procedural]]
 //             [--morph NAME=WEIGHT ...]
+//             [--panel open|collapsed] [--ui-scale S] [--browse DIR] [--cook-and-open SOURCE ...]
 //             [-q | -v] [--version] [--help]
+//   ossa-view [--browse DIR] [--cook-and-open SOURCE ...] [...]     (the window, no file yet)
 //
 // With --frames or --screenshot the viewer runs headless (hidden window, offscreen framebuffer):
 // it renders N frames 1/60 s apart ending at --time, writes the last one as a PNG, and exits.
@@ -21,6 +23,17 @@
 // --morph NAME=WEIGHT holds a morph target channel (every target of that name) at WEIGHT, as the
 // panel's slider does: clips no longer drive it; repeatable; a name the character lacks is an
 // error listing the names it has.
+// The window's panel is a sidebar the scene is laid out beside (layout.h); --panel collapsed starts
+// with it hidden (Tab toggles it), --ui-scale S sizes its text and widgets (default: the monitor's
+// content scale, ui_scale_for). --browse DIR starts the panel's file browser in DIR (default: the
+// first file's folder, else the current directory) with its section open. --cook-and-open SOURCE
+// cooks a source file (FBX, glTF, GLB, DAE, BVH, OBJ) with ossa-cook in the background, as a
+// dropped source is, and opens the result; repeatable. The window needs no file to start: without
+// one it shows the browser (and what --cook-and-open makes once cooked).
+// With --window-frames N, the N frames are counted once no cook or open is pending, so a test
+// captures the cooked character; a failed cook is the panel's error status, which makes the exit
+// status 1 (the message, the cooker's own, on stderr). -v also prints the layout of the captured
+// frame ("layout: panel P, scene X Y W H, timeline H") and what was cooked and opened, with times.
 // -q prints only errors (no warnings such as a texture left out); -v adds the OpenGL version and
 // renderer and what was loaded. Parsing is separate from running so tests and the bench can build
 // command lines with the same names.
@@ -62,6 +75,10 @@ struct ViewerOptions {
   std::vector<std::string> set; // graph parameter start values, "name=value" (or "trigger"; a vector "name=x,y,z")
   bool show_procedural = false; // headless: draw the procedural overlays (the window shows them by default)
   std::vector<std::pair<std::string, float>> morphs;  // --morph: channels held at a weight
+  bool panel_collapsed = false; // --panel collapsed: the window starts with the panel hidden
+  float ui_scale = 0.0f;        // --ui-scale: panel size factor (0: from the monitor's content scale)
+  std::string browse;           // --browse: the file browser's first folder (empty: the default)
+  std::vector<std::string> cook_and_open;  // --cook-and-open: sources cooked in the background, then opened
   bool quiet = false;           // -q: errors only
   bool verbose = false;         // -v: GL information and what was loaded
 

@@ -86,6 +86,9 @@ struct Renderer {
   GLuint timer_queries[2] = {0, 0};
   bool timer_pending[2] = {false, false};
   unsigned frame_index = 0;
+  // Where render_frame's width x height viewport starts in the bound framebuffer: the window's
+  // scene region beside the panel (layout.h); (0, 0) offscreen. The clear is scissored to it.
+  int viewport_x = 0, viewport_y = 0;
 
   // The scene on the GPU.
   std::vector<GpuMesh> meshes;

@@ -10,8 +10,7 @@
 
 namespace ossa::view {
 
-Status setup_app(App& app, Scene scene, const ViewerOptions& o, float aspect) {
-  const std::string name = o.files.front();
+void apply_view_options(App& app, const ViewerOptions& o) {
   app.angles.yaw = glm::radians(o.yaw_degrees);
   app.angles.pitch = glm::radians(o.pitch_degrees);
   app.toggles.cpu_skinning = o.cpu_skinning;
@@ -19,6 +18,11 @@ Status setup_app(App& app, Scene scene, const ViewerOptions& o, float aspect) {
   app.toggles.skeleton = o.skeleton;
   app.toggles.grid = o.grid;
   app.toggles.procedural = o.show_procedural || !o.headless();  // on in the window, asked for in images
+}
+
+Status setup_app(App& app, Scene scene, const ViewerOptions& o, float aspect) {
+  const std::string name = o.files.front();
+  apply_view_options(app, o);
   if (Status s = open_loaded_scene(app, std::move(scene), o.crowd, aspect); !s) return s;
   if (!o.quiet)
     for (const std::string& w : app.messages) std::fprintf(stderr, "ossa-view: warning: %s\n", w.c_str());

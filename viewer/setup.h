@@ -14,4 +14,8 @@ namespace ossa::view {
 /// GL version and renderer and the loaded scene's counts.
 Status setup_app(App& app, Scene scene, const ViewerOptions& options, float aspect);
 
+/// The view options alone (camera angles, toggles): what setup_app applies first, and all the
+/// window applies when it starts with no file (it opens them later, from the browser or a cook).
+void apply_view_options(App& app, const ViewerOptions& options);
+
 }  // namespace ossa::view

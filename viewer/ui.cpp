@@ -2,6 +2,7 @@
 #include "viewer/ui.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <string>
@@ -255,15 +256,43 @@ void stats_panel(const App& app, const UiState& ui) {
   ImGui::Text("draw %.3f ms (CPU)   GPU %.3f ms", t.draw_ms, t.gpu_ms);
 }
 
-void open_panel(App& app, UiState& ui, float aspect) {
+void open_panel(UiState& ui) {
   ImGui::InputText("##path", ui.open_path, sizeof ui.open_path);
   ImGui::SameLine();
-  if (ImGui::Button("Open") && ui.open_path[0] != '\0') {
-    const std::vector<std::string> paths{ui.open_path};
-    const Status s = open_or_add(app, paths, aspect);
-    ui.status = s ? std::string() : s.message();
+  if (ImGui::Button("Open") && ui.open_path[0] != '\0') request_paths(ui.work, {ui.open_path});
+  ImGui::TextDisabled("a character replaces the scene; clip files add clips; sources (FBX, glTF, ...) are cooked first "
+                      "(or drop files here)");
+}
+
+/// A turning arc: the loading indicator's spinner.
+void spinner(ImDrawList* dl, ImVec2 centre, float radius, ImU32 colour) {
+  const float start = static_cast<float>(ImGui::GetTime()) * 6.0f;
+  dl->PathClear();
+  for (int i = 0; i <= 24; ++i) {
+    const float a = start + static_cast<float>(i) / 24.0f * 4.5f;
+    dl->PathLineTo(ImVec2(centre.x + std::cos(a) * radius, centre.y + std::sin(a) * radius));
   }
-  ImGui::TextDisabled("a character replaces the scene; clip files add clips (or drop files here)");
+  dl->PathStroke(colour, false, std::max(2.0f, radius * 0.25f));
+}
+
+/// "loading NAME..." / "cooking NAME  1.2 s" with a spinner, in the middle of the scene.
+void loading_indicator(const UiState& ui, const SceneLayout& layout) {
+  const auto text = indicator_text(ui.work);
+  if (!text) return;
+  ImDrawList* dl = ImGui::GetForegroundDrawList();
+  const float s = ui.ui_scale, radius = 12.0f * s;
+  const ImVec2 size = ImGui::CalcTextSize(text->c_str());
+  const float w = size.x + 2.0f * radius + 30.0f * s, h = std::max(size.y, 2.0f * radius) + 20.0f * s;
+  const ImVec2 c(layout.scene.x + 0.5f * layout.scene.width, layout.scene.y + 0.5f * layout.scene.height);
+  dl->AddRectFilled(ImVec2(c.x - 0.5f * w, c.y - 0.5f * h), ImVec2(c.x + 0.5f * w, c.y + 0.5f * h), IM_COL32(20, 22, 26, 230),
+                    6.0f * s);
+  spinner(dl, ImVec2(c.x - 0.5f * w + 10.0f * s + radius, c.y), radius, IM_COL32(120, 170, 240, 255));
+  dl->AddText(ImVec2(c.x - 0.5f * w + 20.0f * s + 2.0f * radius, c.y - 0.5f * size.y), IM_COL32(235, 235, 235, 255),
+              text->c_str());
+}
+
+void files_panel(UiState& ui) {
+  if (const auto chosen = browser_panel(ui.browser)) request_paths(ui.work, {chosen->string()});
 }
 
 }  // namespace
@@ -278,24 +307,61 @@ void record_frame(UiState& ui, const FrameTimings& f, double frame_ms) {
   smooth(ui.frame_ms, frame_ms);
 }
 
-void draw_panels(App& app, UiState& ui, float aspect) {
-  ImGui::SetNextWindowPos(ImVec2(10, 10), ImGuiCond_FirstUseEver);
-  ImGui::SetNextWindowSize(ImVec2(380, 0), ImGuiCond_FirstUseEver);
-  const std::string title = std::filesystem::path(app.scene.paths.front()).filename().string() + "###ossa";
-  ImGui::Begin(title.c_str());
+float panel_width(const UiState& ui) { return ui.panel_open ? std::round(380.0f * ui.ui_scale) : 0.0f; }
+
+void draw_panels(App& app, UiState& ui, const SceneLayout& layout) {
+  const float aspect = layout.aspect;
+  const ImGuiIO& io = ImGui::GetIO();
   ui.graph_slider_touched = false;
-  if (ImGui::CollapsingHeader("Graph", app.animator.graph ? ImGuiTreeNodeFlags_DefaultOpen : 0)) graph_panel(app, ui);
-  if (ImGui::CollapsingHeader("Clips", app.animator.graph ? 0 : ImGuiTreeNodeFlags_DefaultOpen)) clips_panel(app, ui);
-  if (!app.scene.morph_channels.empty() && ImGui::CollapsingHeader("Morph targets", ImGuiTreeNodeFlags_DefaultOpen))
-    morph_panel(app);
-  if (ImGui::CollapsingHeader("View", ImGuiTreeNodeFlags_DefaultOpen)) view_panel(app, ui, aspect);
-  if (ImGui::CollapsingHeader("Stats", ImGuiTreeNodeFlags_DefaultOpen)) stats_panel(app, ui);
-  if (ImGui::CollapsingHeader("Open")) open_panel(app, ui, aspect);
-  if (!ui.status.empty()) ImGui::TextColored(ImVec4(1.0f, 0.4f, 0.4f, 1.0f), "%s", ui.status.c_str());
-  for (const std::string& m : app.messages) ImGui::TextColored(ImVec4(1.0f, 0.8f, 0.3f, 1.0f), "%s", m.c_str());
-  ImGui::TextDisabled("drag: orbit  right-drag: pan  wheel: zoom  ctrl+drag: move a target");
-  ImGui::TextDisabled("space: play/pause  B: bind pose  up/down: clip");
-  ImGui::End();
+  if (!ui.panel_open) {
+    ImGui::SetNextWindowPos(ImVec2(6.0f * ui.ui_scale, 6.0f * ui.ui_scale));
+    ImGui::Begin("##show-panel", nullptr, ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_AlwaysAutoResize |
+                                              ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoMove);
+    if (ImGui::Button(">> panel (Tab)")) ui.panel_open = true;
+    ImGui::End();
+  } else {
+    ImGui::SetNextWindowPos(ImVec2(0.0f, 0.0f));
+    ImGui::SetNextWindowSize(ImVec2(panel_width(ui), io.DisplaySize.y));
+    const std::string title =
+        (app.scene.paths.empty() ? std::string("ossa-view") : std::filesystem::path(app.scene.paths.front()).filename().string()) +
+        "###ossa";
+    ImGui::Begin(title.c_str(), nullptr, ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse |
+                                             ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoBringToFrontOnFocus);
+    if (ImGui::SmallButton("<< hide panel (Tab)")) ui.panel_open = false;
+    const bool scene = !app.scene.assets.empty();
+    if (scene) {
+      if (ImGui::CollapsingHeader("Graph", app.animator.graph ? ImGuiTreeNodeFlags_DefaultOpen : 0)) graph_panel(app, ui);
+      if (ImGui::CollapsingHeader("Clips", app.animator.graph ? 0 : ImGuiTreeNodeFlags_DefaultOpen)) clips_panel(app, ui);
+      if (!app.scene.morph_channels.empty() && ImGui::CollapsingHeader("Morph targets", ImGuiTreeNodeFlags_DefaultOpen))
+        morph_panel(app);
+      if (ImGui::CollapsingHeader("View", ImGuiTreeNodeFlags_DefaultOpen)) view_panel(app, ui, aspect);
+      if (ImGui::CollapsingHeader("Stats", ImGuiTreeNodeFlags_DefaultOpen)) stats_panel(app, ui);
+    }
+    if (ImGui::CollapsingHeader("Files", scene && !ui.browser.open_section ? 0 : ImGuiTreeNodeFlags_DefaultOpen))
+      files_panel(ui);
+    if (ImGui::CollapsingHeader("Open")) open_panel(ui);
+    if (const auto busy_text = indicator_text(ui.work)) ImGui::TextDisabled("%s", busy_text->c_str());
+    if (!ui.status.empty()) {
+      ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1.0f, 0.4f, 0.4f, 1.0f));
+      ImGui::TextWrapped("%s", ui.status.c_str());
+      ImGui::PopStyleColor();
+    }
+    for (const std::string& m : app.messages) ImGui::TextColored(ImVec4(1.0f, 0.8f, 0.3f, 1.0f), "%s", m.c_str());
+    ImGui::PushStyleColor(ImGuiCol_Text, ImGui::GetStyleColorVec4(ImGuiCol_TextDisabled));
+    ImGui::TextWrapped("drag: orbit  right-drag: pan  wheel: zoom  ctrl+drag: move a target");
+    ImGui::TextWrapped("space: play/pause  B: bind pose  up/down: clip  Tab: panel");
+    ImGui::PopStyleColor();
+    ImGui::End();
+  }
+  if (!app.scene.assets.empty()) timeline_panel(app, ui.timeline, layout.timeline, ui.ui_scale);
+  if (app.scene.assets.empty() && !indicator_text(ui.work)) {  // an empty window says what to do
+    const char* hint = "drop an .ossa file here, or a source to cook\n(FBX, glTF, GLB, DAE, BVH, OBJ),\nor pick one in the panel's Files";
+    const ImVec2 size = ImGui::CalcTextSize(hint);
+    ImGui::GetForegroundDrawList()->AddText(ImVec2(layout.scene.x + 0.5f * (layout.scene.width - size.x),
+                                                   layout.scene.y + 0.5f * (layout.scene.height - size.y)),
+                                            IM_COL32(170, 170, 170, 255), hint);
+  }
+  loading_indicator(ui, layout);
 }
 
 }  // namespace ossa::view

@@ -1,5 +1,12 @@
 // ui.h — the Dear ImGui panels: clip list and playback, morph target weights, view toggles,
-// crowd, stats, open file.
+// crowd, stats, a file browser (file_browser.h) and the open field; the loading indicator.
+//
+// The panel is a sidebar pinned to the window's left edge, full height, its width scaled with the
+// UI scale (layout.h): the scene is drawn in the rest of the window, so the panel never hides the
+// character. "Hide panel" (or Tab) collapses it to a small button and gives the scene the whole
+// width. A click on an .ossa in the browser, or Open, is a request (cook_job.h): the indicator
+// says "loading NAME..." for a frame before the open runs; a source file is cooked in the
+// background, the indicator showing a spinner, the elapsed time and the file name.
 //
 // Immediate mode: every frame the panels read the App and write back what the user changed, so
 // there is no UI state to keep in sync beyond the text field and the smoothed timings. With a
@@ -11,6 +18,9 @@
 #include <string>
 
 #include "viewer/app.h"
+#include "viewer/file_browser.h"
+#include "viewer/layout.h"
+#include "viewer/cook_job.h"
 
 namespace ossa::view {
 
@@ -20,12 +30,22 @@ struct UiState {
   double frame_ms = 0.0;     // smoothed wall time between frames
   std::string status;        // last error, shown in red until the next success
   bool graph_slider_touched = false;  // the user moved a graph's `speed` this frame
+  bool panel_open = true;    // false: collapsed to a button, the scene takes the whole window
+  float ui_scale = 1.0f;     // layout.h ui_scale_for, or --ui-scale
+  FileBrowser browser;
+  TimelineState timeline;
+  PendingWork work;          // opens and cooks in progress
 };
+
+/// The panel's width in window units for the UI state (0 when collapsed).
+float panel_width(const UiState& ui);
 
 /// Folds one frame's timings into the smoothed ones.
 void record_frame(UiState& ui, const FrameTimings& frame, double frame_ms);
 
-/// Builds this frame's panels (between ImGui::NewFrame and ImGui::Render).
-void draw_panels(App& app, UiState& ui, float aspect);
+/// Builds this frame's panels (between ImGui::NewFrame and ImGui::Render): the sidebar (or, when
+/// collapsed, the button that opens it), the timeline under the scene and the loading indicator
+/// over it. `layout` is this frame's (layout.h); its aspect frames the camera.
+void draw_panels(App& app, UiState& ui, const SceneLayout& layout);
 
 }  // namespace ossa::view
