@@ -6,6 +6,7 @@
 #include <cstring>
 #include <filesystem>
 #include <map>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -87,6 +88,8 @@ void mesh_nodes(const aiNode* node, std::map<unsigned, const aiNode*>& out) {
   for (unsigned i = 0; i < node->mNumChildren; ++i) mesh_nodes(node->mChildren[i], out);
 }
 
+uint64_t g_texture_bytes = 0;  // RGBA8 level 0 and the mips glGenerateMipmap makes
+
 GLuint decode(const unsigned char* bytes, int size) {
   int w = 0, h = 0, c = 0;
   stbi_set_flip_vertically_on_load(1);
@@ -99,15 +102,32 @@ GLuint decode(const unsigned char* bytes, int size) {
   glGenerateMipmap(GL_TEXTURE_2D);
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
   stbi_image_free(p);
+  for (int lw = w, lh = h;; lw = std::max(1, lw / 2), lh = std::max(1, lh / 2)) {
+    g_texture_bytes += static_cast<uint64_t>(lw) * static_cast<uint64_t>(lh) * 4;
+    if (lw == 1 && lh == 1) break;
+  }
   return t;
 }
 
+GLuint load_diffuse_texture(const aiScene& scene, const aiString& path, const std::filesystem::path& dir);
+
+/// The material's diffuse map, decoded once per distinct path (meshes sharing a material, or
+/// materials sharing an image, share the texture, as any viewer would).
+std::map<std::string, GLuint> g_loaded;  // one source's textures by path (cleared per source)
+
 GLuint diffuse_texture(const aiScene& scene, const aiMaterial& material, const std::filesystem::path& dir) {
+  std::map<std::string, GLuint>& loaded = g_loaded;
   aiString path;
   if (material.GetTexture(aiTextureType_DIFFUSE, 0, &path) != AI_SUCCESS &&
       material.GetTexture(aiTextureType_BASE_COLOR, 0, &path) != AI_SUCCESS) {
     return 0;
   }
+  const auto [it, added] = loaded.emplace(path.C_Str(), 0);
+  if (added) it->second = load_diffuse_texture(scene, path, dir);
+  return it->second;
+}
+
+GLuint load_diffuse_texture(const aiScene& scene, const aiString& path, const std::filesystem::path& dir) {
   if (const aiTexture* t = scene.GetEmbeddedTexture(path.C_Str())) {
     if (t->mHeight == 0) return decode(reinterpret_cast<const unsigned char*>(t->pcData), static_cast<int>(t->mWidth));
     return 0;  // raw texels: not in the samples
@@ -121,14 +141,10 @@ GLuint diffuse_texture(const aiScene& scene, const aiMaterial& material, const s
   return decode(bytes.data(), static_cast<int>(bytes.size()));
 }
 
-Status run(const std::string& source, int width, int height, int samples, std::chrono::steady_clock::time_point start) {
-  view::WindowOptions wo;
-  wo.width = 64;
-  wo.height = 64;
-  wo.visible = false;
-  Result<view::Window> window = view::create_window(wo);
-  if (!window) return window.error();
-
+/// Imports `source`, uploads it and draws one frame into a new offscreen target (a context must be
+/// current), finished with glFinish.
+Status draw_source(const std::string& source, int width, int height, int samples) {
+  g_loaded.clear();
   Assimp::Importer importer;
   importer.SetPropertyBool(AI_CONFIG_IMPORT_FBX_PRESERVE_PIVOTS, false);
   // What a plain Assimp viewer asks for: the cooker's flags plus welding, normals and 4 weights.
@@ -260,6 +276,44 @@ Status run(const std::string& source, int width, int height, int samples, std::c
   }
   glFinish();
   if (Status s = view::check_gl("the Assimp frame"); !s) return Error{source + ": " + s.message()};
+  return {};
+}
+
+/// One window and context, then each source in turn as a viewer opening them one after another.
+Status run(std::span<const std::string> sources, int width, int height, int samples,
+           std::chrono::steady_clock::time_point start) {
+  view::WindowOptions wo;
+  wo.width = 64;
+  wo.height = 64;
+  wo.visible = false;
+  Result<view::Window> window = view::create_window(wo);
+  if (!window) return window.error();
+  for (const std::string& source : sources)
+    if (Status s = draw_source(source, width, height, samples); !s) return s;
+  const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  std::printf("texture-bytes %llu\n", static_cast<unsigned long long>(g_texture_bytes));
+  std::printf("first-frame-ms %.3f\n", ms);
+  std::fflush(stdout);
+  return {};
+}
+
+/// The floor both sides stand on: the same hidden window, context and offscreen framebuffer,
+/// cleared and finished, with nothing loaded and nothing drawn.
+Status run_empty(int width, int height, int samples, std::chrono::steady_clock::time_point start) {
+  view::WindowOptions wo;
+  wo.width = 64;
+  wo.height = 64;
+  wo.visible = false;
+  Result<view::Window> window = view::create_window(wo);
+  if (!window) return window.error();
+  Result<view::Offscreen> target = view::create_offscreen(width, height, samples);
+  if (!target) return target.error();
+  view::bind_offscreen(*target);
+  glViewport(0, 0, width, height);
+  glClearColor(0.17f, 0.18f, 0.2f, 1.0f);
+  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  glFinish();
+  if (Status s = view::check_gl("the empty frame"); !s) return s;
   const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   std::printf("first-frame-ms %.3f\n", ms);
   std::fflush(stdout);
@@ -268,9 +322,17 @@ Status run(const std::string& source, int width, int height, int samples, std::c
 
 }  // namespace
 
-int run_assimp_first_frame(const std::string& source, int width, int height, int samples) {
+int run_empty_first_frame(int width, int height, int samples) {
   const auto start = std::chrono::steady_clock::now();
-  const Status s = run(source, width, height, samples, start);
+  const Status s = run_empty(width, height, samples, start);
+  if (s) return 0;
+  std::fprintf(stderr, "ossa-bench-first-frame: %s\n", s.message().c_str());
+  return 1;
+}
+
+int run_assimp_first_frame(std::span<const std::string> sources, int width, int height, int samples) {
+  const auto start = std::chrono::steady_clock::now();
+  const Status s = run(sources, width, height, samples, start);
   if (s) return 0;
   std::fprintf(stderr, "ossa-bench-first-frame: %s\n", s.message().c_str());
   return 1;

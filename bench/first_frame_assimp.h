@@ -8,12 +8,24 @@
 // frame into the same offscreen framebuffer the viewer's headless mode uses. Everything a cooked
 // file makes unnecessary is here, and nothing more.
 #pragma once
+#include <span>
 #include <string>
 
 namespace ossa::bench {
 
-/// Runs the child: prints "first-frame-ms X" (since main) once the frame is finished, returns the
-/// exit status (1 with a message on stderr on failure).
-int run_assimp_first_frame(const std::string& source, int width, int height, int samples);
+/// Runs the child: prints "texture-bytes N" and "first-frame-ms X" (since main) once the frame is
+/// finished, returns the exit status (1 with a message on stderr on failure). With several
+/// sources, one context shows each in turn (one frame each, as a viewer opening them one after
+/// another) and the time is to the last frame.
+int run_assimp_first_frame(std::span<const std::string> sources, int width, int height, int samples);
+
+/// The cooked side of the same: one context, each .ossa file opened with the viewer's own code
+/// (load_scene, setup_app: upload, textures) and one frame drawn. Same output.
+int run_ossa_first_frame(std::span<const std::string> files, int width, int height, int samples);
+
+/// The floor under both: a child that makes the same hidden window, context and offscreen
+/// framebuffer, clears it, finishes and prints "first-frame-ms X". What a side takes beyond this
+/// is the work it does for its asset.
+int run_empty_first_frame(int width, int height, int samples);
 
 }  // namespace ossa::bench

@@ -23,6 +23,7 @@
 #include "cooker/mesh/mesh_build.h"
 #include "cooker/clip/root_motion.h"
 #include "cooker/write/write_ossa.h"
+#include "cooker/texture/texture_cook.h"
 #include <ossa/format/hash.h>
 #include <ossa/loader/asset.h>
 
@@ -47,6 +48,7 @@ std::string CookOptions::canonical() const {
     s += buf;
   }
   if (root_motion) s += std::string(";root_motion=") + "xyz"[up_axis % 3];
+  if (textures != TextureOutput::Compressed) s += std::string(";textures=") + texture_output_name(textures);
   if (metres_per_unit > 0.0f) {
     char unit[64];
     std::snprintf(unit, sizeof unit, ";unit=%gm", static_cast<double>(metres_per_unit));
@@ -292,6 +294,10 @@ void cook_into(CookRecord& record, const fs::path& input, const fs::path& output
   auto clips = detail::cook_clips(*scene, options, record, input.string());
   if (!clips) {
     record.error = clips.error().message;
+    return;
+  }
+  if (Status st = cook_textures(*scene, options.textures, input.string(), record.texture_records); !st) {
+    record.error = st.message();
     return;
   }
 

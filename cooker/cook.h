@@ -19,8 +19,16 @@
 
 namespace ossa::cook {
 
+/// What the cooker makes of a texture (--texture-format; cooker/texture/texture_cook.h).
+enum class TextureOutput : uint8_t {
+  Compressed,  // "bc": mip chains in BC1 / BC3 / BC4 / BC5 by role (the default)
+  Rgba8,       // "rgba8": mip chains of uncompressed RGBA8
+  Source,      // "source": the source's PNG / JPEG bytes, decoded by the loader
+};
+
 struct CookOptions {
   bool float_vertices = false;
+  TextureOutput textures = TextureOutput::Compressed;  // --texture-format
   ClipCompressionOptions clips;       // --clip-tolerance, --no-clip-compression
   bool root_motion = false;           // --root-motion: extract root motion from every clip
   uint8_t up_axis = 1;                // --up-axis: 0 x, 1 y, 2 z
@@ -61,6 +69,20 @@ struct MorphRecord {
   float normal_error_deg = 0.0f;
 };
 
+/// One distinct texture as cooked (a source image used twice for one role is cooked once).
+struct TextureRecord {
+  std::string name;                   // the image's file name, or the embedded image's name
+  std::string role;                   // "diffuse", "normal", "specular"
+  std::string encoding;               // "BC1", "BC3", "BC4", "BC5", "RGBA8", "source"
+  bool srgb = false;
+  uint32_t width = 0, height = 0, mips = 0;
+  uint64_t source_bytes = 0;          // the encoded image as the source had it
+  uint64_t cooked_bytes = 0;          // what the file stores for it
+  uint64_t gpu_rgba8_bytes = 0;       // RGBA8 + a full mip chain: what decoding the source puts on a GPU
+  float psnr_db = 0.0f;               // level 0 against the source, over the channels kept (99: exact)
+  float normal_mean_deg = 0.0f, normal_max_deg = 0.0f;  // normal maps: angle to the source's normals
+};
+
 /// One line of the --report file (docs/schemas/ossa-cook-report.schema.json).
 ///
 /// A failed cook keeps what it learnt before it stopped: the counts are filled in as each stage
@@ -83,6 +105,7 @@ struct CookRecord {
   double seconds = 0.0;
   std::vector<ClipRecord> clip_records;  // one per clip compressed before any failure
   std::vector<MorphRecord> morph_records;  // one per morph target, once meshes are built
+  std::vector<TextureRecord> texture_records;  // one per distinct embedded texture, once textures are cooked
   /// Every file the cook read or looked for (absolute paths, sorted), as far as it got; for an
   /// up-to-date output, the inputs its provenance lists. The depfile and --list-inputs print these.
   std::vector<InputFile> inputs_read;

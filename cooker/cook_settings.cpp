@@ -1,5 +1,6 @@
 // cook_settings.cpp — reading and layering ossa.cook.json / <stem>.cook.json (see cook_settings.h).
 #include "cooker/cook_settings.h"
+#include "cooker/texture/texture_cook.h"
 
 #include <fnmatch.h>
 
@@ -20,13 +21,14 @@ constexpr std::string_view kFolderFile = "ossa.cook.json";
 
 const std::initializer_list<std::string_view> kSettingKeys = {
     "float_vertices", "clip_compression", "clip_tolerance_mm", "root_motion", "up_axis", "skeleton", "clip_names",
-    "metres_per_unit"};
+    "metres_per_unit", "texture_format"};
 
 /// One layer of settings, checked; applied in order.
 struct Layer {
   std::optional<bool> float_vertices, clip_compression, root_motion;
   std::optional<double> clip_tolerance_mm, metres_per_unit;
   std::optional<uint8_t> up_axis;
+  std::optional<TextureOutput> texture_format;
   std::optional<fs::path> skeleton;  // resolved against the settings file's folder
   std::map<std::string, std::string> clip_names;
 };
@@ -64,6 +66,11 @@ void read_layer(json::Checker& check, const json::Value& object, const fs::path&
       if (check.expect(v, json::Type::String, what)) {
         if (v.string == "x" || v.string == "y" || v.string == "z") layer.up_axis = uint8_t(v.string[0] - 'x');
         else check.error(v.pos, what + " must be \"x\", \"y\" or \"z\"");
+      }
+    } else if (m.key == "texture_format") {
+      if (check.expect(v, json::Type::String, what)) {
+        if (auto t = parse_texture_output(v.string)) layer.texture_format = *t;
+        else check.error(v.pos, what + " must be \"bc\", \"rgba8\" or \"source\"");
       }
     } else if (m.key == "skeleton") {
       std::string path;
@@ -128,7 +135,7 @@ Result<std::vector<Layer>> read_settings(const fs::path& file, bool folder, cons
     }
   } else {
     check.expect_keys(root, {"ossa_cook", "float_vertices", "clip_compression", "clip_tolerance_mm", "root_motion", "metres_per_unit",
-                             "up_axis", "skeleton", "clip_names"},
+                             "up_axis", "skeleton", "clip_names", "texture_format"},
                       "a cook settings file");
     read_layer(check, root, dir, layers.emplace_back());
   }
@@ -159,6 +166,7 @@ Status apply_cook_settings(const fs::path& input, CookOptions& options, AppliedS
       if (l.clip_tolerance_mm) options.clips.tolerance_metres = static_cast<float>(*l.clip_tolerance_mm / 1000.0);
       if (l.root_motion) options.root_motion = *l.root_motion;
       if (l.up_axis) options.up_axis = *l.up_axis;
+      if (l.texture_format) options.textures = *l.texture_format;
       if (l.metres_per_unit) options.metres_per_unit = static_cast<float>(*l.metres_per_unit);
       if (l.skeleton) skeleton = l.skeleton;
       for (const auto& [from, to] : l.clip_names) applied.clip_names[from] = to;

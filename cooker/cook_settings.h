@@ -8,7 +8,8 @@
 // Later layers win: command line, folder defaults, each matching folder entry, the stem file. A
 // setting is one of: "float_vertices", "clip_compression" (booleans), "clip_tolerance_mm"
 // (number), "root_motion" (boolean), "up_axis" ("x" | "y" | "z"), "skeleton" (a cooked .ossa rig,
-// relative to the settings file), "clip_names" ({"source clip": "new name"}).
+// relative to the settings file), "clip_names" ({"source clip": "new name"}), "texture_format"
+// ("bc" | "rgba8" | "source").
 //
 // Both files are read through the cook's input log (looked for on every cook, absent or not), so
 // they are inputs of the cook key and the depfile like any source: editing, adding or removing one

@@ -6,6 +6,12 @@
 // open, inconsistently wound, or placed by a mirroring bind matrix (which flips the winding but
 // not the transformed normal). A non-zero u_flat_color.a replaces shading
 // with that colour (wireframe overlay).
+//
+// Lighting is computed in linear light: colour maps are sampled through sRGB formats (the GPU
+// decodes them), colours and vertex colours are linear (as glTF defines them), and the result is
+// encoded to sRGB here, explicitly, rather than through GL_FRAMEBUFFER_SRGB, so the window, the
+// offscreen framebuffer and the panel drawn over them need no sRGB-capable format. A normal map
+// gives x and y (a BC5 map holds nothing else) and z is rebuilt as sqrt(1 - x^2 - y^2).
 #version 330 core
 
 in vec3 v_position;
@@ -32,6 +38,11 @@ const float kAmbient = 0.1;
 const float kSpecularStrength = 0.5;
 const float kShininess = 32.0;
 
+vec3 linear_to_srgb(vec3 c) {
+  c = clamp(c, 0.0, 1.0);
+  return mix(c * 12.92, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(vec3(0.0031308), c));
+}
+
 void main() {
   if (u_flat_color.a > 0.0) {
     o_color = u_flat_color;
@@ -43,7 +54,8 @@ void main() {
   if (u_has_normal_map && dot(v_tangent.xyz, v_tangent.xyz) > 0.0) {
     vec3 t = normalize(v_tangent.xyz - n * dot(n, v_tangent.xyz));
     vec3 b = cross(n, t) * v_tangent.w;
-    vec3 m = texture(u_normal_map, v_uv).xyz * 2.0 - 1.0;
+    vec2 xy = texture(u_normal_map, v_uv).xy * 2.0 - 1.0;
+    vec3 m = vec3(xy, sqrt(max(0.0, 1.0 - dot(xy, xy))));
     n = normalize(mat3(t, b, n) * m);
   }
 
@@ -55,5 +67,6 @@ void main() {
   float specular = kSpecularStrength * pow(max(dot(v, reflect(-l, n)), 0.0), kShininess);
   if (u_has_specular_map) specular *= texture(u_specular_map, v_uv).r;
 
-  o_color = vec4((kAmbient + diffuse + specular) * colour, u_opacity);
+  vec3 linear = (kAmbient + diffuse + specular) * colour;
+  o_color = vec4(linear_to_srgb(linear), u_opacity);
 }

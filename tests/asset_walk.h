@@ -30,6 +30,7 @@
 #include <ossa/format/vertex_format.h>
 #include <ossa/version.h>
 #include <ossa/loader/asset.h>
+#include <ossa/loader/texture.h>
 #include <ossa/graph/graph.h>
 #include <ossa/anim/pose.h>
 #include <ossa/anim/sample.h>
@@ -444,6 +445,23 @@ class AssetWalker {
         text(t->path(), where + " texture path");
         text(t->mime(), where + " texture mime");
         touch(scalars(t->data()), where + " texture data");
+        // A cooked chain: every level inside the data, packed in order, of the size its encoding
+        // and level give, and together exactly the data (ossa/loader/texture.h).
+        const TextureView view{t};
+        uint64_t next = 0;
+        for (uint32_t k = 0; k < view.mip_count(); ++k) {
+          const TextureLevel level = view.level(k);
+          const std::string lw = where + " texture level " + std::to_string(k);
+          if (level.width != std::max(1u, view.width() >> k) || level.height != std::max(1u, view.height() >> k))
+            fail(lw, "has the wrong size");
+          if (level.bytes.size() != texture_level_bytes(view.encoding(), level.width, level.height) || level.bytes.empty())
+            fail(lw, "has the wrong byte count");
+          if (level.bytes.data() != view.data().data() + next) fail(lw, "is not where the previous level ended");
+          next += level.bytes.size();
+          touch(level.bytes, lw);
+        }
+        if (view.gpu_ready() && next != view.data().size()) fail(where + " texture", "levels do not cover its data");
+        if (!view.gpu_ready() && view.mip_count() != 0) fail(where + " texture", "source bytes with levels");
       }
     }
   }

@@ -40,6 +40,7 @@
 #include <ossa/format/hash.h>
 #include <ossa/version.h>
 #include <ossa/loader/asset.h>
+#include <ossa/loader/texture.h>
 #include "test_files.h"
 
 namespace ossa::test {
@@ -160,7 +161,7 @@ TEST(ValidFile, AcceptedFromBytes) {
   EXPECT_TRUE(check_clip_binding(asset->clip(0), asset->skeleton(), "valid.ossa").ok());
   ASSERT_EQ(asset->material_count(), 1u);
   ASSERT_NE(asset->material(0).textures(), nullptr);
-  EXPECT_EQ(asset->material(0).textures()->size(), 2u);
+  EXPECT_EQ(asset->material(0).textures()->size(), 3u);
 }
 
 TEST(ValidFile, AcceptedFromDisk) {
@@ -923,6 +924,62 @@ TEST(Clip, BindingToAnotherRigRejected) {
   const Status status = check_clip_binding(asset->clip(0), asset->skeleton(), "other-rig.ossa");
   EXPECT_FALSE(status.ok());
   EXPECT_TRUE(explains(status.message(), "other-rig.ossa", {{"walk"}, {"hash", "skeleton", "rig"}}));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Cooked textures (format v7): the chain's bytes must be exactly what its encoding and size give.
+
+const Keywords kTexture = {{"skin", "material 0"}, {"texture 2", "Specular"}};
+
+TEST(Texture, ChainBytesMustMatch) {
+  SyntheticSpec spec;
+  spec.materials[0].textures[2].data->push_back(0);  // one byte past the chain
+  EXPECT_TRUE(rejects(spec, with(kTexture, {"40 bytes", "41"})));
+  spec.materials[0].textures[2].data->resize(32);  // the last level missing
+  EXPECT_TRUE(rejects(spec, with(kTexture, {"40 bytes", "32"})));
+}
+
+TEST(Texture, MipCountWithinTheFullChain) {
+  SyntheticSpec spec;
+  spec.materials[0].textures[2].mip_count = 5;  // 8 x 4 has 4 levels
+  EXPECT_TRUE(rejects(spec, with(kTexture, {"mip levels"})));
+  spec.materials[0].textures[2].mip_count = 0;
+  EXPECT_TRUE(rejects(spec, with(kTexture, {"mip levels"})));
+}
+
+TEST(Texture, SizeWithinLimits) {
+  SyntheticSpec spec;
+  spec.materials[0].textures[2].width = 0;
+  EXPECT_TRUE(rejects(spec, with(kTexture, {"texels"})));
+  spec.materials[0].textures[2].width = 8;
+  spec.materials[0].textures[2].height = 1u << 20;  // a huge claim over 40 bytes
+  EXPECT_TRUE(rejects(spec, with(kTexture, {"texels"})));
+}
+
+TEST(Texture, UnknownEncodingAndSourceWithLevels) {
+  SyntheticSpec spec;
+  spec.materials[0].textures[2].encoding = static_cast<fb::TextureEncoding>(42);
+  EXPECT_TRUE(rejects(spec, with(kTexture, {"encoding"})));
+  SyntheticSpec source;
+  source.materials[0].textures[0].mip_count = 3;  // PNG bytes do not have levels
+  EXPECT_TRUE(rejects(source, {{"skin", "material 0"}, {"texture 0", "Diffuse"}, {"mip levels"}}));
+}
+
+TEST(Texture, EveryEncodingsChainAccepted) {
+  // Each encoding at an odd size: level sizes round up to whole blocks (or texels for RGBA8).
+  for (const auto e : {fb::TextureEncoding::Rgba8, fb::TextureEncoding::Bc1, fb::TextureEncoding::Bc3,
+                       fb::TextureEncoding::Bc4, fb::TextureEncoding::Bc5}) {
+    SyntheticSpec spec;
+    SyntheticTexture& t = spec.materials[0].textures[2];
+    t.encoding = e;
+    t.width = 13;
+    t.height = 5;
+    t.mip_count = static_cast<uint8_t>(texture_full_mip_count(13, 5));
+    t.data = std::vector<uint8_t>(static_cast<size_t>(texture_chain_bytes(e, 13, 5, t.mip_count)), 0x5a);
+    EXPECT_TRUE(accepts(make_valid_file(spec))) << fb::EnumNameTextureEncoding(e);
+    t.data->pop_back();
+    EXPECT_TRUE(rejects(spec, with(kTexture, {"bytes"}))) << fb::EnumNameTextureEncoding(e);
+  }
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -294,7 +294,8 @@ TEST(CookFidelity, AbsoluteWindowsTexturePathIsFoundByNameAndTgaEmbeddedAsPng) {
   const fs::path dir = ossa::test::make_temp_dir("fidelity-texture");
   ASSERT_TRUE(ossa::test::write_file(dir / "skin.tga", tiny_tga()));
   write_obj_with_texture(dir, "quad", "C:\\Users\\artist\\textures\\skin.tga");
-  const auto r = run_command(cook_cmd() + " " + q(dir / "quad.obj") + " -o " + q(dir / "out") + " -v");
+  // Kept as source bytes, so the conversion to PNG shows; the default cook is checked below.
+  const auto r = run_command(cook_cmd() + " " + q(dir / "quad.obj") + " -o " + q(dir / "out") + " -v --texture-format source");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(count_of(r.err, "is absolute, looked up as 'skin.tga' next to the source"), 1u) << r.err;
   EXPECT_EQ(count_of(r.err, "is a TGA image, embedded as PNG"), 1u) << r.err;
@@ -313,6 +314,13 @@ TEST(CookFidelity, AbsoluteWindowsTexturePathIsFoundByNameAndTgaEmbeddedAsPng) {
   EXPECT_EQ(png[1], 'P');
   EXPECT_EQ(png[2], 'N');
   EXPECT_EQ(png[3], 'G');
+  // By default the TGA's texels become a GPU-ready chain like any other image.
+  const auto bc = run_command(cook_cmd() + " " + q(dir / "quad.obj") + " -o " + q(dir / "bc"));
+  ASSERT_EQ(bc.exit_code, 0) << bc.err;
+  auto cooked = ossa::Asset::open((dir / "bc" / "quad.ossa").string());
+  ASSERT_TRUE(cooked.ok()) << cooked.error().message;
+  EXPECT_NE(cooked->material(0).textures()->Get(0)->encoding(), ossa::fb::TextureEncoding::Source);
+  EXPECT_GE(cooked->material(0).textures()->Get(0)->mip_count(), 1u);
 }
 
 TEST(CookFidelity, ATextFileNamedTgaIsRefusedByName) {

@@ -317,6 +317,21 @@ TEST(CookIsolation, RecordRoundTripsEveryField) {
   m.position_error_mm = 0.0199f;
   m.normal_error_deg = 0.0625f;
   r.morph_records = {m, ossa::cook::MorphRecord{}};
+  ossa::cook::TextureRecord t;
+  t.name = "skin.png";
+  t.role = "normal";
+  t.encoding = "BC5";
+  t.srgb = true;
+  t.width = 1024;
+  t.height = 512;
+  t.mips = 11;
+  t.source_bytes = 123456;
+  t.cooked_bytes = 699064;
+  t.gpu_rgba8_bytes = 2796200;
+  t.psnr_db = 41.25f;
+  t.normal_mean_deg = 0.5f;
+  t.normal_max_deg = 3.75f;
+  r.texture_records = {t, ossa::cook::TextureRecord{}};
   r.inputs_read = {{"/src/walk.fbx", 0xfedcba9876543210ull, (uint64_t{1} << 33) + 1, true},
                    {"/src/walk.events.json", 0, 0, false}};
   r.cook_key = 0x8000000000000001ull;
@@ -361,6 +376,23 @@ TEST(CookIsolation, RecordRoundTripsEveryField) {
     EXPECT_EQ(a.stored_bytes, b.stored_bytes);
     EXPECT_EQ(a.position_error_mm, b.position_error_mm);
     EXPECT_EQ(a.normal_error_deg, b.normal_error_deg);
+  }
+  ASSERT_EQ(back->texture_records.size(), 2u);
+  for (size_t i = 0; i < 2; ++i) {
+    const ossa::cook::TextureRecord &a = back->texture_records[i], &b = r.texture_records[i];
+    EXPECT_EQ(a.name, b.name);
+    EXPECT_EQ(a.role, b.role);
+    EXPECT_EQ(a.encoding, b.encoding);
+    EXPECT_EQ(a.srgb, b.srgb);
+    EXPECT_EQ(a.width, b.width);
+    EXPECT_EQ(a.height, b.height);
+    EXPECT_EQ(a.mips, b.mips);
+    EXPECT_EQ(a.source_bytes, b.source_bytes);
+    EXPECT_EQ(a.cooked_bytes, b.cooked_bytes);
+    EXPECT_EQ(a.gpu_rgba8_bytes, b.gpu_rgba8_bytes);
+    EXPECT_EQ(a.psnr_db, b.psnr_db);
+    EXPECT_EQ(a.normal_mean_deg, b.normal_mean_deg);
+    EXPECT_EQ(a.normal_max_deg, b.normal_max_deg);
   }
   ASSERT_EQ(back->clip_records.size(), 2u);
   for (size_t i = 0; i < 2; ++i) {

@@ -173,21 +173,31 @@ TEST_F(CookSandbox, TexturesMustBeTheImagesTheyClaimToBe) {
     EXPECT_NE(r.err.find("texture '" + cases[i][0] + "' " + expected[i]), std::string::npos) << r.err;
     EXPECT_FALSE(fs::exists(dir / "out" / "t.ossa")) << cases[i][0];
   }
-  // A real PNG under a .jpg name is embedded as what it is.
+  // A real PNG under a .jpg name is embedded as what it is (kept as source bytes: image/png), and
+  // cooked by default into a BC1 chain of its 2 x 2 texels.
   ASSERT_TRUE(ossa::test::write_file(tree / "chars" / "real.jpg", png));
   ASSERT_TRUE(ossa::test::write_file(tree / "chars" / "t.gltf", triangle_gltf("tri.bin", "real.jpg")));
-  const auto r = cook(tree / "chars" / "t.gltf");
-  ASSERT_EQ(r.exit_code, 0) << r.err;
-  auto a = ossa::Asset::open((dir / "out" / "t.ossa").string());
-  ASSERT_TRUE(a.ok());
-  size_t embedded = 0;
-  for (const auto* m : *a->file().materials())
-    if (m->textures())
-      for (const auto* t : *m->textures()) {
-        EXPECT_EQ(t->mime()->str(), "image/png");
-        embedded += t->data() ? 1 : 0;
-      }
-  EXPECT_EQ(embedded, 1u);
+  for (const char* format : {"source", "bc"}) {
+    const auto r = cook(tree / "chars" / "t.gltf", std::string("--force --texture-format ") + format);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    auto a = ossa::Asset::open((dir / "out" / "t.ossa").string());
+    ASSERT_TRUE(a.ok());
+    size_t embedded = 0;
+    for (const auto* m : *a->file().materials())
+      if (m->textures())
+        for (const auto* t : *m->textures()) {
+          if (std::string(format) == "source") {
+            EXPECT_EQ(flatbuffers::GetStringView(t->mime()), "image/png");
+            EXPECT_EQ(t->encoding(), ossa::fb::TextureEncoding::Source);
+          } else {
+            EXPECT_EQ(t->encoding(), ossa::fb::TextureEncoding::Bc1);
+            EXPECT_EQ(t->width(), 2u);
+            EXPECT_EQ(t->mip_count(), 2u);
+          }
+          embedded += t->data() ? 1 : 0;
+        }
+    EXPECT_EQ(embedded, 1u) << format;
+  }
 }
 
 // A huge but finite value in a source is named at import (it used to surface as "internal error,

@@ -117,6 +117,40 @@ TEST_F(CookSettings, ASkeletonSettingCooksAgainstThatRig) {
   EXPECT_FALSE(ossa::Asset::open((out / "RiggedSimple.ossa").string())->skeleton().empty());
 }
 
+TEST_F(CookSettings, TextureFormatPerFileAndOnTheCommandLine) {
+  fs::copy_file(asset("Fox/Fox.glb"), src / "Fox.glb");
+  const auto encoding_of = [&](const char* name) {
+    auto a = ossa::Asset::open((out / name).string());
+    EXPECT_TRUE(a.ok()) << name;
+    return a.ok() ? std::string(ossa::fb::EnumNameTextureEncoding(a->material(0).textures()->Get(0)->encoding())) : "";
+  };
+  ASSERT_EQ(cook(), 0) << err;
+  EXPECT_EQ(encoding_of("Fox.ossa"), "Bc1");
+  EXPECT_EQ(options_of("Fox.ossa"), "vertices=quantized;clips=0.0001m@0.1m");  // the default is not spelt out
+  // The report states what the texture became.
+  bool reported = false;
+  for (const auto& r : report["records"])
+    if (fs::path(r["input"].get<std::string>()).filename() == "Fox.glb") {
+      ASSERT_EQ(r["textures_cooked"].size(), 1u) << r.dump();
+      EXPECT_EQ(r["textures_cooked"][0]["encoding"], "BC1");
+      EXPECT_EQ(r["textures_cooked"][0]["srgb"], true);
+      EXPECT_GT(r["textures_cooked"][0]["psnr_db"].get<double>(), 35.0);
+      reported = true;
+    }
+  EXPECT_TRUE(reported);
+  write("Fox.cook.json", R"({"ossa_cook": 1, "texture_format": "source"})");
+  ASSERT_EQ(cook(), 0) << err;
+  EXPECT_EQ(encoding_of("Fox.ossa"), "Source");
+  EXPECT_EQ(options_of("Fox.ossa"), "vertices=quantized;clips=0.0001m@0.1m;textures=source");
+  fs::remove(src / "Fox.cook.json");
+  ASSERT_EQ(cook("--texture-format rgba8"), 0) << err;
+  EXPECT_EQ(encoding_of("Fox.ossa"), "Rgba8");
+  write("Fox.cook.json", R"({"ossa_cook": 1, "texture_format": "dxt"})");
+  EXPECT_EQ(cook(), 1);
+  EXPECT_NE(err.find("\"texture_format\" must be \"bc\", \"rgba8\" or \"source\""), std::string::npos) << err;
+  EXPECT_EQ(run_command(cook_cmd() + " " + q(src) + " -o " + q(out) + " --texture-format dxt").exit_code, 2);
+}
+
 TEST_F(CookSettings, MistakesNameTheSettingsFileLineAndColumnAndFailOnlyTheirInputs) {
   write("walk.cook.json", "{\"ossa_cook\": 1,\n  \"clip_tolerence_mm\": 1, \"up_axis\": \"w\"}");
   EXPECT_EQ(cook(), 1);

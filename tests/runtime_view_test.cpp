@@ -26,6 +26,7 @@
 #include <ossa/anim/sample.h>
 #include <ossa/loader/allocator.h>
 #include <ossa/loader/asset.h>
+#include <ossa/loader/texture.h>
 #include "test_files.h"
 
 namespace ossa {
@@ -230,12 +231,36 @@ TEST(RuntimeView, ClipAndMaterialViewsReturnWhatWasWritten) {
   EXPECT_EQ(m.name()->str(), spec.materials[0].name);
   EXPECT_EQ(m.shininess(), spec.materials[0].shininess);
   ASSERT_NE(m.textures(), nullptr);
-  ASSERT_EQ(m.textures()->size(), 2u);
+  ASSERT_EQ(m.textures()->size(), 3u);
   const fb::Texture& png = *m.textures()->Get(0);
   ASSERT_NE(png.data(), nullptr);
   EXPECT_EQ(png.data()->size(), spec.materials[0].textures[0].data->size());
   EXPECT_TRUE(aligned16(png.data()->Data()));
   EXPECT_EQ(m.textures()->Get(1)->path()->str(), "textures/skin_normal.png");
+  EXPECT_FALSE(TextureView{&png}.gpu_ready());
+  EXPECT_EQ(TextureView{&png}.mip_count(), 0u);
+
+  // The cooked BC4 chain: 8 x 4, 4 x 2, 2 x 1, 1 x 1, each a span into the file right after the last.
+  const TextureView bc4{m.textures()->Get(2)};
+  ASSERT_TRUE(bc4.gpu_ready());
+  EXPECT_EQ(bc4.encoding(), fb::TextureEncoding::Bc4);
+  EXPECT_FALSE(bc4.srgb());
+  ASSERT_EQ(bc4.mip_count(), 4u);
+  EXPECT_EQ(bc4.data().size(), test::kBc4Chain.size());
+  EXPECT_TRUE(aligned16(bc4.data().data()));
+  const uint32_t sizes[4][3] = {{8, 4, 16}, {4, 2, 8}, {2, 1, 8}, {1, 1, 8}};
+  size_t offset = 0;
+  for (uint32_t k = 0; k < 4; ++k) {
+    const TextureLevel level = bc4.level(k);
+    EXPECT_EQ(level.width, sizes[k][0]);
+    EXPECT_EQ(level.height, sizes[k][1]);
+    ASSERT_EQ(level.bytes.size(), sizes[k][2]);
+    EXPECT_EQ(level.bytes.data(), bc4.data().data() + offset);
+    EXPECT_TRUE(std::equal(level.bytes.begin(), level.bytes.end(), test::kBc4Chain.begin() + static_cast<ptrdiff_t>(offset)));
+    offset += level.bytes.size();
+  }
+  EXPECT_TRUE(bc4.level(4).bytes.empty());  // past the chain
+  EXPECT_EQ(texture_chain_bytes(fb::TextureEncoding::Bc4, 8, 4, 4), test::kBc4Chain.size());
 }
 
 TEST(RuntimeView, AbsentOptionalPartsGiveEmptyViews) {

@@ -383,7 +383,7 @@ flatbuffers::Offset<fb::Material> write_material(flatbuffers::FlatBufferBuilder&
     const auto path = t.path.empty() ? 0 : fbb.CreateString(t.path);
     const auto mime = t.mime.empty() ? 0 : fbb.CreateString(t.mime);
     const auto data = t.data ? aligned_bytes(fbb, *t.data) : 0;
-    textures.push_back(fb::CreateTexture(fbb, t.role, path, mime, data));
+    textures.push_back(fb::CreateTexture(fbb, t.role, path, mime, data, t.encoding, t.srgb, t.width, t.height, t.mip_count));
   }
   const auto name = fbb.CreateString(m.name);
   const auto texture_vector = fbb.CreateVector(textures);
@@ -439,9 +439,24 @@ std::vector<SyntheticAnimated> SyntheticClip::default_animated() {
           channel(3, fb::Channel::Scale, 32, {0, 8, 23, 30}, {{1, 1, 1}, {1, 1, 1}, {1.2f, 1.2f, 1.2f}, {1.2f, 1.2f, 1.2f}})};
 }
 
+namespace {
+/// Five BC4 blocks: endpoints 255 / 0 then 3-bit indices, distinct per block so a byte flip shows.
+std::vector<uint8_t> bc4_chain() {
+  std::vector<uint8_t> out;
+  for (uint8_t b = 0; b < 5; ++b) {
+    const uint8_t block[8] = {255, 0, static_cast<uint8_t>(0x49 * (b + 1)), 0x92, 0x24, 0x49, 0x92, static_cast<uint8_t>(b)};
+    out.insert(out.end(), block, block + 8);
+  }
+  return out;
+}
+}  // namespace
+const std::vector<uint8_t> kBc4Chain = bc4_chain();
+
 std::vector<SyntheticTexture> SyntheticMaterial::default_textures() {
   return {{fb::TextureRole::Diffuse, "", "image/png", std::vector<uint8_t>(std::begin(kTinyPng), std::end(kTinyPng))},
-          {fb::TextureRole::Normal, "textures/skin_normal.png", "", std::nullopt}};
+          {fb::TextureRole::Normal, "textures/skin_normal.png", "", std::nullopt},
+          // A cooked BC4 chain 8 x 4 -> 4 x 2 -> 2 x 1 -> 1 x 1: blocks of 8 bytes, 2 + 1 + 1 + 1 of them.
+          {fb::TextureRole::Specular, "", "", kBc4Chain, fb::TextureEncoding::Bc4, false, 8, 4, 4}};
 }
 
 uint32_t SyntheticSpec::default_version() { return kFormatVersion; }

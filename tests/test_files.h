@@ -171,7 +171,15 @@ struct SyntheticTexture {
   std::string path;                 // empty: field left out
   std::string mime;                 // empty: field left out
   std::optional<std::vector<uint8_t>> data;
+  // A cooked mip chain (format v7; ossa/loader/texture.h): Source leaves the rest out.
+  fb::TextureEncoding encoding = fb::TextureEncoding::Source;
+  bool srgb = false;
+  uint32_t width = 0, height = 0;
+  uint8_t mip_count = 0;
 };
+
+/// The default material's cooked specular map: a BC4 chain from 8 x 4 texels (40 bytes).
+extern const std::vector<uint8_t> kBc4Chain;
 
 struct SyntheticMaterial {
   std::string name = "skin";

@@ -10,9 +10,12 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <map>
+#include <set>
 
 #include <stb_image.h>
 
+#include <ossa/loader/texture.h>
 #include "runtime/internal/message.h"
 
 namespace ossa::view {
@@ -25,8 +28,9 @@ constexpr int kMaxTextureSide = 16384;
 constexpr uint64_t kMaxTexturePixels = uint64_t{64} << 20;
 constexpr uint64_t kMaxTextureFileBytes = uint64_t{256} << 20;
 
-/// Decodes an encoded image into an RGBA8 texture with mipmaps; 0 on failure (`why` says).
-GLuint decode_texture(const uint8_t* bytes, size_t size, std::string& why) {
+/// Decodes an encoded image (a texture cooked with --texture-format source, or one referenced by
+/// path) into an RGBA8 texture (sRGB for colour) with mipmaps; 0 on failure (`why` says).
+GLuint decode_texture(const uint8_t* bytes, size_t size, bool srgb, uint64_t& gpu_bytes, std::string& why) {
   if (size > static_cast<size_t>(INT_MAX)) {
     why = "image too large";
     return 0;
@@ -54,13 +58,79 @@ GLuint decode_texture(const uint8_t* bytes, size_t size, std::string& why) {
   glGenTextures(1, &t);
   glBindTexture(GL_TEXTURE_2D, t);
   glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, w, h, 0, GL_RGBA, GL_UNSIGNED_BYTE, pixels);
+  glTexImage2D(GL_TEXTURE_2D, 0, srgb ? GL_SRGB8_ALPHA8 : GL_RGBA8, w, h, 0, GL_RGBA, GL_UNSIGNED_BYTE, pixels);
   glGenerateMipmap(GL_TEXTURE_2D);
+  gpu_bytes += texture_chain_bytes(fb::TextureEncoding::Rgba8, static_cast<uint32_t>(w), static_cast<uint32_t>(h),
+                                   texture_full_mip_count(static_cast<uint32_t>(w), static_cast<uint32_t>(h)));
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_REPEAT);
   stbi_image_free(pixels);
+  return t;
+}
+
+/// The GL internal format of a cooked encoding, or 0 where this context cannot sample it (S3TC is
+/// an extension, though every desktop driver has it; RGTC is core since GL 3.0).
+GLenum gl_format(fb::TextureEncoding encoding, bool srgb) {
+  static const bool s3tc = epoxy_has_gl_extension("GL_EXT_texture_compression_s3tc");
+  static const bool s3tc_srgb = s3tc && (epoxy_has_gl_extension("GL_EXT_texture_sRGB") ||
+                                         epoxy_has_gl_extension("GL_EXT_texture_compression_s3tc_srgb"));
+  switch (encoding) {
+    case fb::TextureEncoding::Rgba8: return srgb ? GL_SRGB8_ALPHA8 : GL_RGBA8;
+    case fb::TextureEncoding::Bc1:
+      if (srgb) return s3tc_srgb ? GL_COMPRESSED_SRGB_S3TC_DXT1_EXT : 0;
+      return s3tc ? GL_COMPRESSED_RGB_S3TC_DXT1_EXT : 0;
+    case fb::TextureEncoding::Bc3:
+      if (srgb) return s3tc_srgb ? GL_COMPRESSED_SRGB_ALPHA_S3TC_DXT5_EXT : 0;
+      return s3tc ? GL_COMPRESSED_RGBA_S3TC_DXT5_EXT : 0;
+    case fb::TextureEncoding::Bc4: return GL_COMPRESSED_RED_RGTC1;
+    case fb::TextureEncoding::Bc5: return GL_COMPRESSED_RG_RGTC2;
+    default: return 0;
+  }
+}
+
+/// Uploads a cooked mip chain level by level straight from the file's bytes: no decode, no
+/// mipmap generation. A BC4 (grey) map is swizzled to R, R, R so the shader reads it like any
+/// other; a BC5 normal map gives x and y, and the shader rebuilds z. 0 on failure (`why` says).
+GLuint upload_cooked(const TextureView& view, uint64_t& gpu_bytes, std::string& why) {
+  const GLenum format = gl_format(view.encoding(), view.srgb());
+  if (format == 0) {
+    why = std::string("this OpenGL driver cannot sample ") + fb::EnumNameTextureEncoding(view.encoding()) +
+          (view.srgb() ? " sRGB" : "") + " textures (no GL_EXT_texture_compression_s3tc)";
+    return 0;
+  }
+  GLuint t = 0;
+  glGenTextures(1, &t);
+  glBindTexture(GL_TEXTURE_2D, t);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_BASE_LEVEL, 0);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAX_LEVEL, static_cast<GLint>(view.mip_count()) - 1);
+  for (uint32_t k = 0; k < view.mip_count(); ++k) {
+    const TextureLevel level = view.level(k);
+    const auto w = static_cast<GLsizei>(level.width), h = static_cast<GLsizei>(level.height);
+    if (view.encoding() == fb::TextureEncoding::Rgba8) {
+      glTexImage2D(GL_TEXTURE_2D, static_cast<GLint>(k), static_cast<GLint>(format), w, h, 0, GL_RGBA, GL_UNSIGNED_BYTE,
+                   level.bytes.data());
+    } else {
+      glCompressedTexImage2D(GL_TEXTURE_2D, static_cast<GLint>(k), format, w, h, 0,
+                             static_cast<GLsizei>(level.bytes.size()), level.bytes.data());
+    }
+    gpu_bytes += level.bytes.size();
+  }
+  if (view.encoding() == fb::TextureEncoding::Bc4) {
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_SWIZZLE_G, GL_RED);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_SWIZZLE_B, GL_RED);
+  }
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_REPEAT);
+  if (glGetError() != GL_NO_ERROR) {
+    glDeleteTextures(1, &t);
+    why = "the driver refused its mip levels";
+    return 0;
+  }
   return t;
 }
 
@@ -113,18 +183,26 @@ bool read_texture_file(const std::string& asset_path, const std::string& named, 
   return true;
 }
 
-GLuint load_texture(const fb::Texture& texture, const std::string& asset_path, std::vector<std::string>& warnings) {
+GLuint load_texture(const fb::Texture& texture, const std::string& asset_path, uint64_t& gpu_bytes,
+                    std::vector<std::string>& warnings) {
   std::string why;
   std::string what;
   GLuint t = 0;
-  if (texture.data() != nullptr && texture.data()->size() > 0) {
+  const TextureView view{&texture};
+  // Colour maps are sRGB: sampled through an sRGB format, they come back linear for lighting.
+  const bool colour = texture.role() == fb::TextureRole::Diffuse;
+  if (view.gpu_ready()) {
     what = "embedded texture";
-    t = decode_texture(texture.data()->data(), texture.data()->size(), why);
+    t = upload_cooked(view, gpu_bytes, why);
+  } else if (texture.data() != nullptr && texture.data()->size() > 0) {
+    what = "embedded texture";
+    t = decode_texture(texture.data()->data(), texture.data()->size(), colour, gpu_bytes, why);
   } else if (texture.path() != nullptr && texture.path()->size() > 0) {
     const std::filesystem::path p = std::filesystem::path(asset_path).parent_path() / texture.path()->str();
     what = "texture " + detail::printable(p.string(), 400);
     std::vector<uint8_t> bytes;
-    if (read_texture_file(asset_path, texture.path()->str(), bytes, why)) t = decode_texture(bytes.data(), bytes.size(), why);
+    if (read_texture_file(asset_path, texture.path()->str(), bytes, why))
+      t = decode_texture(bytes.data(), bytes.size(), colour, gpu_bytes, why);
   } else {
     return 0;
   }
@@ -137,6 +215,7 @@ GLuint load_texture(const fb::Texture& texture, const std::string& asset_path, s
 std::vector<GpuMaterial> create_materials(const Asset& asset, const std::string& asset_path,
                                           std::vector<std::string>& warnings) {
   std::vector<GpuMaterial> out;
+  std::map<const fb::Texture*, GLuint> shared;
   for (size_t i = 0; i < asset.material_count(); ++i) {
     const fb::Material& m = asset.material(i);
     GpuMaterial g;
@@ -149,7 +228,14 @@ std::vector<GpuMaterial> create_materials(const Asset& asset, const std::string&
                        : t->role() == fb::TextureRole::Specular ? &g.specular_map
                                                                 : nullptr;
         if (slot == nullptr || *slot != 0) continue;
-        *slot = load_texture(*t, asset_path, warnings);
+        // Materials sharing a texture table share its GL texture (format v7 writes one table per
+        // distinct image and role).
+        if (const auto it = shared.find(t); it != shared.end()) {
+          *slot = it->second;
+          continue;
+        }
+        *slot = load_texture(*t, asset_path, g.texture_bytes, warnings);
+        if (*slot != 0) shared.emplace(t, *slot);
       }
     }
     // A material whose colour is black but which has a diffuse map means "the map is the colour".
@@ -161,13 +247,20 @@ std::vector<GpuMaterial> create_materials(const Asset& asset, const std::string&
 }
 
 void destroy_materials(std::vector<GpuMaterial>& materials) {
+  std::set<GLuint> deleted;  // shared textures are deleted once
   for (GpuMaterial& m : materials) {
     const GLuint textures[] = {m.diffuse_map, m.normal_map, m.specular_map};
     for (GLuint t : textures) {
-      if (t != 0) glDeleteTextures(1, &t);
+      if (t != 0 && deleted.insert(t).second) glDeleteTextures(1, &t);
     }
   }
   materials.clear();
+}
+
+uint64_t texture_bytes(const std::vector<GpuMaterial>& materials) {
+  uint64_t total = 0;
+  for (const GpuMaterial& m : materials) total += m.texture_bytes;
+  return total;
 }
 
 }  // namespace ossa::view

@@ -242,6 +242,29 @@ nlohmann::ordered_json report_json(const std::vector<CookRecord>& records, const
       clips.push_back(std::move(cj));
     }
     j["clip_compression"] = std::move(clips);
+    if (!r.texture_records.empty()) {
+      nlohmann::ordered_json textures = nlohmann::ordered_json::array();
+      for (const TextureRecord& t : r.texture_records) {
+        nlohmann::ordered_json tj;
+        tj["name"] = t.name;
+        tj["role"] = t.role;
+        tj["encoding"] = t.encoding;
+        tj["srgb"] = t.srgb;
+        tj["width"] = t.width;
+        tj["height"] = t.height;
+        tj["mips"] = t.mips;
+        tj["source_bytes"] = t.source_bytes;
+        tj["cooked_bytes"] = t.cooked_bytes;
+        tj["gpu_rgba8_bytes"] = t.gpu_rgba8_bytes;
+        tj["psnr_db"] = t.psnr_db;
+        if (t.role == "normal") {
+          tj["normal_mean_deg"] = t.normal_mean_deg;
+          tj["normal_max_deg"] = t.normal_max_deg;
+        }
+        textures.push_back(std::move(tj));
+      }
+      j["textures_cooked"] = std::move(textures);
+    }
     if (!r.morph_records.empty()) {
       nlohmann::ordered_json morphs = nlohmann::ordered_json::array();
       for (const MorphRecord& m : r.morph_records) {

@@ -41,6 +41,7 @@
 #include "cooker/cli/batch.h"
 #include "cooker/cli/worker.h"
 #include "cooker/cook.h"
+#include "cooker/texture/texture_cook.h"
 #include "runtime/internal/message.h"
 #include "runtime/tools/cli/cli.h"
 
@@ -126,6 +127,16 @@ void print_details(const CookRecord& r) {
                  shown(m.name).c_str(), shown(m.mesh).c_str(), m.vertices, static_cast<double>(m.position_error_mm),
                  static_cast<double>(m.normal_error_deg), m.raw_bytes, m.stored_bytes,
                  m.stored_bytes > 0 ? static_cast<double>(m.raw_bytes) / m.stored_bytes : 0.0);
+  for (const TextureRecord& t : r.texture_records) {
+    std::fprintf(stderr, "    texture '%s' (%s): %u x %u, %s%s, %u mips, %s -> %s (GPU: %s, RGBA8 + mips %s), PSNR %.1f dB",
+                 shown(t.name).c_str(), t.role.c_str(), t.width, t.height, t.encoding.c_str(), t.srgb ? " sRGB" : "",
+                 t.mips, human_bytes(t.source_bytes).c_str(), human_bytes(t.cooked_bytes).c_str(),
+                 human_bytes(t.cooked_bytes).c_str(), human_bytes(t.gpu_rgba8_bytes).c_str(), static_cast<double>(t.psnr_db));
+    if (t.role == "normal")
+      std::fprintf(stderr, ", normals off by %.2f deg mean, %.2f max", static_cast<double>(t.normal_mean_deg),
+                   static_cast<double>(t.normal_max_deg));
+    std::fprintf(stderr, "\n");
+  }
   for (const ClipRecord& c : r.clip_records)
     std::fprintf(stderr, "    clip '%s': %u frames, %u joints, max error %.4f mm (mean %.4f mm, at '%s'), %u -> %u bytes (%.1f:1)\n",
                  shown(c.name).c_str(), c.frames, c.joints, static_cast<double>(c.max_error_mm),
@@ -174,6 +185,12 @@ int main(int argc, char** argv) {
   app.add_option("--report", report_path, "write a JSON record per input to this file (docs/JSON.md)");
   app.add_option("--skeleton", skeleton_path, "cook clip-only files against this cooked skeleton (.ossa)");
   app.add_flag("--float-vertices", float_vertices, "store vertices as float32 instead of quantized");
+  std::string texture_format = "bc";
+  app.add_option("--texture-format", texture_format,
+                 "textures as GPU-ready mip chains, block-compressed by role (bc: BC1/BC3 colour in sRGB, BC5 "
+                 "normal maps, BC4 grey maps; the default), uncompressed mip chains (rgba8), or the source's "
+                 "PNG/JPEG bytes as read (source)")
+      ->check(CLI::IsMember({"bc", "rgba8", "source"}));
   app.add_option("--clip-tolerance", clip_tolerance_mm,
                  "largest model-space error of any joint, in millimetres at 10 cm from it (default 0.1)")
       ->check(CLI::Range(1e-6, 1e4));
@@ -202,6 +219,7 @@ int main(int argc, char** argv) {
 
   CookOptions options;
   options.float_vertices = float_vertices;
+  options.textures = *parse_texture_output(texture_format);
   options.clips.enabled = !lossless_clips;
   options.clips.tolerance_metres = static_cast<float>(clip_tolerance_mm / 1000.0);
   options.root_motion = root_motion;

@@ -41,11 +41,14 @@ using Clock = std::chrono::steady_clock;
 // back without it. Sizes are checked on the one platform the cooker is built for (64-bit
 // libstdc++); a field that fits in padding slips through, so the round-trip test is the other half.
 #if defined(__GLIBCXX__) && defined(__LP64__)
-static_assert(sizeof(CookRecord) == 312,
+static_assert(sizeof(CookRecord) == 336,
               "CookRecord changed: extend record_to_json / record_from_json (cooker/cli/worker.cpp) and "
               "the round trip in tests/cook_isolation_test.cpp, then update this size");
 static_assert(sizeof(MorphRecord) == 88,
               "MorphRecord changed: extend record_to_json / record_from_json (cooker/cli/worker.cpp) and "
+              "the round trip in tests/cook_isolation_test.cpp, then update this size");
+static_assert(sizeof(TextureRecord) == 152,
+              "TextureRecord changed: extend record_to_json / record_from_json (cooker/cli/worker.cpp) and "
               "the round trip in tests/cook_isolation_test.cpp, then update this size");
 static_assert(sizeof(ClipRecord) == 88,
               "ClipRecord changed: extend record_to_json / record_from_json (cooker/cli/worker.cpp) and "
@@ -83,6 +86,21 @@ json record_to_json(const CookRecord& r) {
                       {"stored_bytes", m.stored_bytes},
                       {"position_error_mm", m.position_error_mm},
                       {"normal_error_deg", m.normal_error_deg}});
+  json textures = json::array();
+  for (const TextureRecord& t : r.texture_records)
+    textures.push_back({{"name", t.name},
+                        {"role", t.role},
+                        {"encoding", t.encoding},
+                        {"srgb", t.srgb},
+                        {"width", t.width},
+                        {"height", t.height},
+                        {"mips", t.mips},
+                        {"source_bytes", t.source_bytes},
+                        {"cooked_bytes", t.cooked_bytes},
+                        {"gpu_rgba8_bytes", t.gpu_rgba8_bytes},
+                        {"psnr_db", t.psnr_db},
+                        {"normal_mean_deg", t.normal_mean_deg},
+                        {"normal_max_deg", t.normal_max_deg}});
   json clips = json::array();
   for (const ClipRecord& c : r.clip_records)
     clips.push_back({{"name", c.name},
@@ -115,6 +133,7 @@ json record_to_json(const CookRecord& r) {
           {"seconds", r.seconds},
           {"clip_records", std::move(clips)},
           {"morph_records", std::move(morphs)},
+          {"texture_records", std::move(textures)},
           {"inputs_read", std::move(inputs)},
           {"cook_key", r.cook_key},
           {"up_to_date", r.up_to_date}};
@@ -154,6 +173,25 @@ std::optional<CookRecord> record_from_json(const json& j) {
       read_field(cj, "mean_error_mm", c.mean_error_mm);
       read_field(cj, "worst_joint", c.worst_joint);
       r.clip_records.push_back(std::move(c));
+    }
+    if (const auto it = j.find("texture_records"); it != j.end() && it->is_array()) {
+      for (const json& tj : *it) {
+        TextureRecord t;
+        read_field(tj, "name", t.name);
+        read_field(tj, "role", t.role);
+        read_field(tj, "encoding", t.encoding);
+        read_field(tj, "srgb", t.srgb);
+        read_field(tj, "width", t.width);
+        read_field(tj, "height", t.height);
+        read_field(tj, "mips", t.mips);
+        read_field(tj, "source_bytes", t.source_bytes);
+        read_field(tj, "cooked_bytes", t.cooked_bytes);
+        read_field(tj, "gpu_rgba8_bytes", t.gpu_rgba8_bytes);
+        read_field(tj, "psnr_db", t.psnr_db);
+        read_field(tj, "normal_mean_deg", t.normal_mean_deg);
+        read_field(tj, "normal_max_deg", t.normal_max_deg);
+        r.texture_records.push_back(std::move(t));
+      }
     }
     if (const auto it = j.find("morph_records"); it != j.end() && it->is_array()) {
       for (const json& mj : *it) {

@@ -20,6 +20,7 @@
 #include "cooker/json/json_source.h"
 #include "cooker/mesh/mesh_build.h"
 #include "cooker/write/write_ossa.h"
+#include "cooker/texture/texture_cook.h"
 #include <ossa/format/hash.h>
 
 namespace ossa::cook::detail {
@@ -196,6 +197,10 @@ void cook_graph(CookRecord& record, const fs::path& input, const fs::path& outpu
   auto clips = cook_clips(character, options, record, input.string());
   if (!clips) {
     record.error = clips.error().message;
+    return;
+  }
+  if (Status st = cook_textures(character, options.textures, input.string(), record.texture_records); !st) {
+    record.error = st.message();
     return;
   }
 

@@ -2,15 +2,13 @@
 #include "cooker/import/image_check.h"
 
 #include <cstdio>
+#include <cstring>
 #include <limits>
 
 // stb_image, private to this file (STB_IMAGE_STATIC): the viewer links its own copy, and a program
-// that links both (ossa-bench-first-frame) must not see two definitions. PNG and JPEG only.
+// that links both (ossa-bench-first-frame) must not see two definitions. Every format it reads.
 #define STB_IMAGE_STATIC
 #define STB_IMAGE_IMPLEMENTATION
-#define STBI_ONLY_PNG
-#define STBI_ONLY_JPEG
-#define STBI_ONLY_TGA
 #define STBI_NO_STDIO
 #if defined(__GNUC__)
 #pragma GCC diagnostic push
@@ -83,25 +81,68 @@ void append_bytes(void* context, void* data, int size) {
 
 }  // namespace
 
-Result<std::vector<uint8_t>> tga_to_png(std::span<const uint8_t> bytes) {
+const char* other_image_format(std::span<const uint8_t> bytes, bool named_tga) {
+  const auto starts = [&](const char* sig, size_t n) {
+    return bytes.size() >= n && std::memcmp(bytes.data(), sig, n) == 0;
+  };
+  if (starts("BM", 2)) return "BMP";
+  if (starts("GIF87a", 6) || starts("GIF89a", 6)) return "GIF";
+  if (starts("8BPS", 4)) return "PSD";
+  if (starts("#?RADIANCE", 10) || starts("#?RGBE", 6)) return "HDR";
+  if (starts("\x53\x80\xF6\x34", 4)) return "PIC";
+  if (bytes.size() >= 2 && bytes[0] == 'P' && (bytes[1] == '5' || bytes[1] == '6')) return "PNM";
+  if (named_tga) return "TGA";
+  return nullptr;
+}
+
+Result<std::vector<uint8_t>> other_to_png(std::span<const uint8_t> bytes, bool named_tga) {
+  const char* kind = other_image_format(bytes, named_tga);
+  if (kind == nullptr) {
+    char start[64];
+    const auto at = [&](size_t i) { return i < bytes.size() ? bytes[i] : 0; };
+    std::snprintf(start, sizeof start, "%02x %02x %02x %02x", at(0), at(1), at(2), at(3));
+    return Error{std::string("is not an image format the cooker reads (its bytes start ") + start + ")"};
+  }
+  const std::string name = kind;
   if (bytes.size() > static_cast<size_t>(std::numeric_limits<int>::max())) return Error{"is too large to decode"};
   const auto* data = reinterpret_cast<const stbi_uc*>(bytes.data());
   const int size = static_cast<int>(bytes.size());
   int w = 0, h = 0, channels = 0;
-  // stbi_info's TGA test reads the header only: a text file named .tga fails it here.
+  // stbi_info reads the header only: a text file named .tga fails it here.
   if (!stbi_info_from_memory(data, size, &w, &h, &channels))
-    return Error{"is not a TGA image (its header is not a TGA header)"};
+    return Error{"is not a " + name + " image (its header is not a " + name + " header)"};
   if (w <= 0 || h <= 0 || w > kMaxImageSide || h > kMaxImageSide ||
       static_cast<uint64_t>(w) * static_cast<uint64_t>(h) > kMaxImagePixels)
     return Error{"claims " + std::to_string(w) + " x " + std::to_string(h) + " pixels, over the limit of " +
                  std::to_string(kMaxImageSide) + " per side and " + std::to_string(kMaxImagePixels) + " pixels"};
   stbi_uc* pixels = stbi_load_from_memory(data, size, &w, &h, &channels, 0);
-  if (pixels == nullptr) return Error{std::string("does not decode as TGA: ") + stbi_failure_reason()};
+  if (pixels == nullptr) return Error{"does not decode as " + name + ": " + stbi_failure_reason()};
   std::vector<uint8_t> png;
   const int ok = stbi_write_png_to_func(append_bytes, &png, w, h, channels, pixels, w * channels);
   stbi_image_free(pixels);
   if (!ok || png.empty()) return Error{"could not be converted to PNG"};
   return png;
+}
+
+Result<DecodedImage> decode_rgba(std::span<const uint8_t> bytes) {
+  if (bytes.size() > static_cast<size_t>(std::numeric_limits<int>::max())) return Error{"is too large to decode"};
+  const auto* data = reinterpret_cast<const stbi_uc*>(bytes.data());
+  const int size = static_cast<int>(bytes.size());
+  int w = 0, h = 0, channels = 0;
+  if (!stbi_info_from_memory(data, size, &w, &h, &channels)) return Error{std::string("does not decode: ") + stbi_failure_reason()};
+  if (w <= 0 || h <= 0 || w > kMaxImageSide || h > kMaxImageSide ||
+      static_cast<uint64_t>(w) * static_cast<uint64_t>(h) > kMaxImagePixels)
+    return Error{"claims " + std::to_string(w) + " x " + std::to_string(h) + " pixels, over the limit"};
+  stbi_set_flip_vertically_on_load_thread(1);  // this thread's loads only: the format stores rows bottom-up
+  stbi_uc* pixels = stbi_load_from_memory(data, size, &w, &h, &channels, 4);
+  stbi_set_flip_vertically_on_load_thread(0);
+  if (pixels == nullptr) return Error{std::string("does not decode: ") + stbi_failure_reason()};
+  DecodedImage out;
+  out.width = static_cast<uint32_t>(w);
+  out.height = static_cast<uint32_t>(h);
+  out.rgba.assign(pixels, pixels + static_cast<size_t>(w) * static_cast<size_t>(h) * 4);
+  stbi_image_free(pixels);
+  return out;
 }
 
 }  // namespace ossa::cook

@@ -25,12 +25,25 @@ struct ImageInfo {
   int width = 0, height = 0;
 };
 
-/// A TGA texture (no signature of its own: allowed only where the file name says .tga, and then
-/// its header must pass stb_image's TGA test and it must decode) converted to the PNG the format
-/// embeds, so a game's loader still sees only PNG and JPEG. The pixels are kept exactly (PNG is
-/// lossless; stb_image_write's encoder is deterministic, so the cook stays byte-reproducible).
-/// Bounded like check_image before any pixel is allocated. O(pixels).
-Result<std::vector<uint8_t>> tga_to_png(std::span<const uint8_t> bytes);
+/// The format of an image that is neither PNG nor JPEG but that the cooker reads (BMP, GIF, PSD,
+/// HDR, PIC, PNM by their signatures; TGA, which has none, only where `named_tga`: the file name
+/// says .tga), or null.
+const char* other_image_format(std::span<const uint8_t> bytes, bool named_tga);
+
+/// Such an image converted to the PNG the format embeds for `--texture-format source`, so a game's
+/// loader still sees only PNG and JPEG (HDR is tone-mapped to 8 bits by stb_image; GIF keeps its
+/// first frame; PSD its composite). Bounded like check_image before any pixel is allocated; the
+/// header must pass stb_image's test for that format and the image must decode. Deterministic
+/// (stb_image_write), so the cook stays byte-reproducible. O(pixels).
+Result<std::vector<uint8_t>> other_to_png(std::span<const uint8_t> bytes, bool named_tga);
+
+/// An image decoded to RGBA8, rows bottom to top (as the format stores texture levels).
+struct DecodedImage {
+  uint32_t width = 0, height = 0;
+  std::vector<uint8_t> rgba;
+};
+/// Decodes any image check_image or other_to_png accepted. O(pixels).
+Result<DecodedImage> decode_rgba(std::span<const uint8_t> bytes);
 
 /// Checks `bytes` as above. The error says what is wrong ("not a PNG or JPEG image (starts with
 /// ...)", "claims 20000 x 20000 pixels", "does not decode: <reason>"), without a file name: the

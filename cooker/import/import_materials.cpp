@@ -65,7 +65,9 @@ bool ends_with_tga(std::string name) {
 }
 
 /// Takes `bytes` as the texture's data: a PNG or JPEG as it is (identified by its bytes and fully
-/// decoded, image_check.h); a TGA, where the name says .tga, converted to PNG with a warning.
+/// decoded, image_check.h); any other format stb_image reads (BMP, GIF, PSD, HDR, PIC, PNM, and
+/// TGA where the name says .tga) converted to PNG with a warning, losslessly: the texture stage
+/// (cooker/texture) then cooks every image from the same two encodings.
 /// Anything else fails the input, named by `what` ("texture 'x.png'").
 bool accept_image(const Context& ctx, std::vector<uint8_t> bytes, bool named_tga, const std::string& label,
                   const std::string& what, SourceTexture* out) {
@@ -75,13 +77,13 @@ bool accept_image(const Context& ctx, std::vector<uint8_t> bytes, bool named_tga
     out->data = std::move(bytes);
     return true;
   }
-  if (named_tga) {
-    auto png = tga_to_png(bytes);
+  if (const char* kind = other_image_format(bytes, named_tga)) {
+    auto png = other_to_png(bytes, named_tga);
     if (!png) {
       ctx.fail(label + ": " + what + " " + png.error().message);
       return false;
     }
-    ctx.warn(label + ": " + what + " is a TGA image, embedded as PNG (same pixels)");
+    ctx.warn(label + ": " + what + " is a " + kind + " image, embedded as PNG (same pixels)");
     out->mime = "image/png";
     out->data = std::move(*png);
     return true;
@@ -98,6 +100,7 @@ bool embedded(const Context& ctx, const aiTexture& tex, const std::string& label
   const auto* begin = reinterpret_cast<const uint8_t*>(tex.pcData);
   const std::string name = tex.mFilename.C_Str();
   const bool tga = ends_with_tga(name) || std::string(tex.achFormatHint) == "tga";
+  out->name = name;
   // no path: an embedded image's name (glTF's "Image_0") is not a file
   return accept_image(ctx, std::vector<uint8_t>(begin, begin + tex.mWidth), tga, label,
                       "embedded texture '" + name + "'", out);
@@ -124,7 +127,9 @@ bool find_texture(const Context& ctx, const aiMaterial& mat, std::initializer_li
   if (!found || file.length == 0) return false;
   out->role = role;
   if (const aiTexture* tex = ctx.scene->GetEmbeddedTexture(file.C_Str())) {
-    return embedded(ctx, *tex, label, out);
+    const bool ok = embedded(ctx, *tex, label, out);
+    if (out->name.empty()) out->name = file.C_Str();  // glTF's "*0": the image's index
+    return ok;
   }
   std::string path = portable(file.C_Str());
   if (path.rfind('*', 0) == 0) {
@@ -140,6 +145,7 @@ bool find_texture(const Context& ctx, const aiMaterial& mat, std::initializer_li
     path = name;
   }
   out->path = path;
+  out->name = path;
   std::vector<uint8_t> bytes;
   if (!read_external(ctx, path, &bytes, label)) {
     ctx.warn(label + ": texture '" + path + "' cannot be read, only its path is kept");

@@ -123,8 +123,19 @@ enum class TextureRole : uint8_t { Diffuse = 0, Normal = 1, Specular = 2 };
 struct SourceTexture {
   TextureRole role = TextureRole::Diffuse;
   std::string path;                      // relative to the source file, when external
+  std::string name;                      // for messages and the report: the path, or the embedded image's name
   std::string mime;                      // "image/png", "image/jpeg" when embedded
-  std::vector<uint8_t> data;             // encoded bytes as the source had them, when embedded
+  std::vector<uint8_t> data;             // encoded bytes as the source had them, when embedded;
+                                         // after the texture stage, in `encoding`
+  // Set by the texture stage (cooker/texture/texture_cook.h); the format's Texture fields.
+  uint8_t encoding = 0;                  // fb::TextureEncoding; 0: Source (data as read)
+  bool srgb = false;
+  uint32_t width = 0, height = 0;
+  uint8_t mip_count = 0;
+  /// >= 0: this texture is the same image in the same role as the scene's texture number
+  /// `same_as` (counting every material's textures in order), which holds the data; the writer
+  /// stores one Texture table for both.
+  int32_t same_as = -1;
 };
 
 struct SourceMaterial {

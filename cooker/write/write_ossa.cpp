@@ -312,15 +312,28 @@ Offset<fb::Graph> write_graph(FlatBufferBuilder& fbb, const GraphDef& graph) {
                          machines_v, graph.root);
 }
 
-Offset<fb::Material> write_material(FlatBufferBuilder& fbb, const SourceMaterial& material) {
+/// `written` holds the Texture table of every texture written so far, in the scene's order
+/// (SourceTexture::same_as counts the same way): a repeat refers to its first use's table.
+Offset<fb::Material> write_material(FlatBufferBuilder& fbb, const SourceMaterial& material,
+                                    std::vector<Offset<fb::Texture>>& written) {
   const auto name = fbb.CreateString(material.name);
   std::vector<Offset<fb::Texture>> textures;
   for (const SourceTexture& t : material.textures) {
+    if (t.same_as >= 0 && static_cast<size_t>(t.same_as) < written.size()) {
+      const Offset<fb::Texture> shared = written[static_cast<size_t>(t.same_as)];
+      written.push_back(shared);
+      textures.push_back(shared);
+      continue;
+    }
     // Absent rather than empty: a referenced texture has no data, an embedded one may have no path.
     const auto path = t.path.empty() ? Offset<flatbuffers::String>() : fbb.CreateString(t.path);
     const auto mime = t.mime.empty() ? Offset<flatbuffers::String>() : fbb.CreateString(t.mime);
     const auto data = t.data.empty() ? Offset<Vector<uint8_t>>() : aligned_bytes(fbb, t.data);
-    textures.push_back(fb::CreateTexture(fbb, static_cast<fb::TextureRole>(t.role), path, mime, data));
+    const Offset<fb::Texture> table =
+        fb::CreateTexture(fbb, static_cast<fb::TextureRole>(t.role), path, mime, data,
+                          static_cast<fb::TextureEncoding>(t.encoding), t.srgb, t.width, t.height, t.mip_count);
+    written.push_back(table);
+    textures.push_back(table);
   }
   const auto textures_v = fbb.CreateVector(textures);
   const fb::Vec3 ambient = vec3(material.ambient), diffuse = vec3(material.diffuse), specular = vec3(material.specular);
@@ -361,7 +374,9 @@ std::vector<uint8_t> write_ossa(const SourceScene& scene, std::span<const Cooked
   const auto clips_v = fbb.CreateVector(clip_offsets);
 
   std::vector<Offset<fb::Material>> material_offsets;
-  for (const SourceMaterial& material : scene.materials) material_offsets.push_back(write_material(fbb, material));
+  std::vector<Offset<fb::Texture>> written_textures;
+  for (const SourceMaterial& material : scene.materials)
+    material_offsets.push_back(write_material(fbb, material, written_textures));
   const auto materials_v = fbb.CreateVector(material_offsets);
 
   // Named first: the order of evaluation of function arguments is unspecified, the bytes must not be.

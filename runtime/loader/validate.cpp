@@ -30,6 +30,7 @@
 #include <ossa/format/clip_codec.h>
 #include <ossa/format/hash.h>
 #include <ossa/format/vertex_format.h>
+#include <ossa/loader/texture.h>
 #include "internal/message.h"
 
 namespace ossa {
@@ -769,6 +770,34 @@ class Validator {
 
   // ---- materials ----
 
+  /// A cooked mip chain (texture.h): a known encoding, a size within kMaxTextureSide, a mip
+  /// count from 1 to the full chain, and data exactly the chain's bytes. A Source texture carries
+  /// no size or levels. O(mip count).
+  static Status check_texture(const fb::Texture& t, size_t data_size) {
+    const fb::TextureEncoding e = t.encoding();
+    if (static_cast<unsigned>(e) > static_cast<unsigned>(fb::TextureEncoding::MAX))
+      return Error{format("unknown encoding %u", static_cast<unsigned>(e))};
+    if (e == fb::TextureEncoding::Source) {
+      if (t.mip_count() != 0) return Error{"source bytes cannot have mip levels"};
+      return {};
+    }
+    const char* name = fb::EnumNameTextureEncoding(e);
+    if (data_size == 0) return Error{format("%s texture has no data", name)};
+    if (t.width() == 0 || t.height() == 0 || t.width() > kMaxTextureSide || t.height() > kMaxTextureSide)
+      return Error{format("%s texture is %u x %u texels (each side must be 1 to %u)", name, t.width(), t.height(),
+                          kMaxTextureSide)};
+    const uint32_t full = texture_full_mip_count(t.width(), t.height());
+    if (t.mip_count() == 0 || t.mip_count() > full)
+      return Error{format("%u mip levels for %u x %u texels (1 to %u)", static_cast<unsigned>(t.mip_count()), t.width(),
+                          t.height(), full)};
+    const uint64_t expected = texture_chain_bytes(e, t.width(), t.height(), t.mip_count());
+    if (expected != data_size)
+      return Error{format("%s chain of %u levels from %u x %u is %llu bytes, the data is %zu", name,
+                          static_cast<unsigned>(t.mip_count()), t.width(), t.height(),
+                          static_cast<unsigned long long>(expected), data_size)};
+    return {};
+  }
+
   Status check_material(const fb::Material& m, size_t material_index) {
     const std::string where = label("material", material_index, m.name());
     const struct {
@@ -793,6 +822,8 @@ class Validator {
       if (data_size != 0 && reinterpret_cast<uintptr_t>(t.data()->Data()) % 16 != 0)
         return fail(where, format("texture %u (%s): embedded data is not 16-byte aligned", k,
                                   fb::EnumNameTextureRole(t.role())));
+      if (Status s = check_texture(t, data_size); !s)
+        return fail(where, format("texture %u (%s): %s", k, fb::EnumNameTextureRole(t.role()), s.message().c_str()));
     }
     return {};
   }

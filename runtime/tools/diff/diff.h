@@ -144,6 +144,9 @@ struct ClipSection {
 struct TextureFact {
   std::string role, path, mime;
   uint64_t bytes = 0, hash = 0;  // embedded bytes and their FNV-1a 64 (0 bytes: referenced by path)
+  std::string encoding;          // "Source", "Bc1", ... (format v7)
+  bool srgb = false;
+  uint32_t width = 0, height = 0, mips = 0;
 };
 
 struct MaterialItem {

@@ -35,6 +35,11 @@ std::vector<TextureFact> textures_of(const fb::Material& m) {
       f.role = fb::EnumNameTextureRole(t->role());
       f.path = str(t->path());
       f.mime = str(t->mime());
+      f.encoding = fb::EnumNameTextureEncoding(t->encoding());
+      f.srgb = t->srgb();
+      f.width = t->width();
+      f.height = t->height();
+      f.mips = t->mip_count();
       if (const auto* data = t->data()) {
         f.bytes = data->size();
         f.hash = hash_bytes(data->data(), data->size());
@@ -78,6 +83,11 @@ MaterialItem compare_material(Context& c, const std::string& label, const fb::Ma
     if (ta[i].role != tb[i].role) changed(which + " role", ta[i].role + " -> " + tb[i].role);
     if (ta[i].path != tb[i].path) changed(which + " path", quote_name(ta[i].path) + " -> " + quote_name(tb[i].path));
     if (ta[i].mime != tb[i].mime) changed(which + " mime", quote_name(ta[i].mime) + " -> " + quote_name(tb[i].mime));
+    const auto shape = [](const TextureFact& t) {
+      return t.encoding + (t.srgb ? " sRGB " : " ") + std::to_string(t.width) + " x " + std::to_string(t.height) + ", " +
+             std::to_string(t.mips) + " mips";
+    };
+    if (shape(ta[i]) != shape(tb[i])) changed(which + " encoding", shape(ta[i]) + " -> " + shape(tb[i]));
     if (ta[i].bytes != tb[i].bytes || ta[i].hash != tb[i].hash)
       changed(which + " data", std::to_string(ta[i].bytes) + " bytes -> " + std::to_string(tb[i].bytes) +
                                    " bytes, " + detail::format("hash %016llx -> %016llx",

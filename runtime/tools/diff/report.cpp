@@ -108,7 +108,9 @@ json clips_json(const ClipSection& s) {
 json textures_json(const std::vector<TextureFact>& textures) {
   json out = json::array();
   for (const TextureFact& t : textures)
-    out.push_back(json{{"role", t.role}, {"path", t.path}, {"mime", t.mime}, {"bytes", t.bytes}, {"hash", hex16(t.hash)}});
+    out.push_back(json{{"role", t.role},     {"path", t.path},     {"mime", t.mime},     {"bytes", t.bytes},
+                       {"hash", hex16(t.hash)}, {"encoding", t.encoding}, {"srgb", t.srgb}, {"width", t.width},
+                       {"height", t.height}, {"mips", t.mips}});
   return out;
 }
 

@@ -302,7 +302,12 @@ json describe_material(const fb::Material& m) {
       textures.push_back(json{{"role", fb::EnumNameTextureRole(t->role())},
                               {"mime", str(t->mime())},
                               {"bytes", count_of(t->data())},
-                              {"path", str(t->path())}});
+                              {"path", str(t->path())},
+                              {"encoding", fb::EnumNameTextureEncoding(t->encoding())},
+                              {"srgb", t->srgb()},
+                              {"width", t->width()},
+                              {"height", t->height()},
+                              {"mips", static_cast<unsigned>(t->mip_count())}});
   }
   return json{{"name", str(m.name())},
               {"ambient", vec3(m.ambient())},
@@ -536,7 +541,10 @@ std::string describe_text(const json& d) {
     line("  shininess      " + text(m["shininess"]) + ", opacity " + text(m["opacity"]));
     for (const json& t : m["textures"]) {
       std::string where;
-      if (t["bytes"].get<size_t>() > 0)
+      if (t["bytes"].get<size_t>() > 0 && t["encoding"].get<std::string>() != "Source")
+        where = text(t["encoding"]) + (t["srgb"].get<bool>() ? " sRGB " : " ") + text(t["width"]) + " x " + text(t["height"]) +
+                ", " + text(t["mips"]) + " mips, " + text(t["bytes"]) + " bytes embedded";
+      else if (t["bytes"].get<size_t>() > 0)
         where = text(t["bytes"]) + " bytes embedded" + (t["mime"].get<std::string>().empty() ? "" : " (" + text(t["mime"]) + ")");
       if (!t["path"].get<std::string>().empty()) where += (where.empty() ? "" : ", ") + ("path '" + text(t["path"]) + "'");
       line(format("  texture %-6s %s", text(t["role"]).c_str(), where.c_str()));

@@ -24,7 +24,9 @@
 // slot < slot count (and Weights needs Joints); a mesh with joint slots needs a skeleton in the
 // same file; a clip bound (by hash) to the file's skeleton has its joint count; submesh index
 // counts are multiples of 3 and materials < max(1, material count); textures have a known role
-// and embedded data or a path; vertex, index and texture bytes are 16-byte aligned in memory.
+// and embedded data or a path; vertex, index and texture bytes are 16-byte aligned in memory; a
+// cooked texture has a known encoding, sides of 1..kMaxTextureSide, 1 to a full chain of mip
+// levels and exactly that chain's bytes (texture.h).
 #pragma once
 #include <cstddef>
 #include <string_view>
