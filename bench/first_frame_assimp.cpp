@@ -282,29 +282,18 @@ Status draw_source(const std::string& source, int width, int height, int samples
 /// One window and context, then each source in turn as a viewer opening them one after another.
 Status run(std::span<const std::string> sources, int width, int height, int samples,
            std::chrono::steady_clock::time_point start) {
-  view::WindowOptions wo;
-  wo.width = 64;
-  wo.height = 64;
-  wo.visible = false;
-  Result<view::Window> window = view::create_window(wo);
+  Result<view::Window> window = child_window();
   if (!window) return window.error();
   for (const std::string& source : sources)
     if (Status s = draw_source(source, width, height, samples); !s) return s;
-  const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-  std::printf("texture-bytes %llu\n", static_cast<unsigned long long>(g_texture_bytes));
-  std::printf("first-frame-ms %.3f\n", ms);
-  std::fflush(stdout);
+  print_first_frame(g_texture_bytes, start);
   return {};
 }
 
 /// The floor both sides stand on: the same hidden window, context and offscreen framebuffer,
 /// cleared and finished, with nothing loaded and nothing drawn.
 Status run_empty(int width, int height, int samples, std::chrono::steady_clock::time_point start) {
-  view::WindowOptions wo;
-  wo.width = 64;
-  wo.height = 64;
-  wo.visible = false;
-  Result<view::Window> window = view::create_window(wo);
+  Result<view::Window> window = child_window();
   if (!window) return window.error();
   Result<view::Offscreen> target = view::create_offscreen(width, height, samples);
   if (!target) return target.error();
@@ -314,28 +303,41 @@ Status run_empty(int width, int height, int samples, std::chrono::steady_clock::
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
   glFinish();
   if (Status s = view::check_gl("the empty frame"); !s) return s;
-  const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-  std::printf("first-frame-ms %.3f\n", ms);
-  std::fflush(stdout);
+  print_first_frame(0, start);
   return {};
 }
 
 }  // namespace
 
+Result<view::Window> child_window() {
+  view::WindowOptions wo;
+  wo.width = 64;
+  wo.height = 64;
+  wo.visible = false;
+  return view::create_window(wo);
+}
+
+void print_first_frame(uint64_t texture_bytes, std::chrono::steady_clock::time_point start) {
+  const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  std::printf("texture-bytes %llu\n", static_cast<unsigned long long>(texture_bytes));
+  std::printf("first-frame-ms %.3f\n", ms);
+  std::fflush(stdout);
+}
+
+int exit_status(const Status& status) {
+  if (status) return 0;
+  std::fprintf(stderr, "ossa-bench-first-frame: %s\n", status.message().c_str());
+  return 1;
+}
+
 int run_empty_first_frame(int width, int height, int samples) {
   const auto start = std::chrono::steady_clock::now();
-  const Status s = run_empty(width, height, samples, start);
-  if (s) return 0;
-  std::fprintf(stderr, "ossa-bench-first-frame: %s\n", s.message().c_str());
-  return 1;
+  return exit_status(run_empty(width, height, samples, start));
 }
 
 int run_assimp_first_frame(std::span<const std::string> sources, int width, int height, int samples) {
   const auto start = std::chrono::steady_clock::now();
-  const Status s = run(sources, width, height, samples, start);
-  if (s) return 0;
-  std::fprintf(stderr, "ossa-bench-first-frame: %s\n", s.message().c_str());
-  return 1;
+  return exit_status(run(sources, width, height, samples, start));
 }
 
 }  // namespace ossa::bench

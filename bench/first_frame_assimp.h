@@ -8,8 +8,13 @@
 // frame into the same offscreen framebuffer the viewer's headless mode uses. Everything a cooked
 // file makes unnecessary is here, and nothing more.
 #pragma once
+#include <chrono>
+#include <cstdint>
 #include <span>
 #include <string>
+
+#include <ossa/format/result.h>
+#include "viewer/window.h"
 
 namespace ossa::bench {
 
@@ -27,5 +32,15 @@ int run_ossa_first_frame(std::span<const std::string> files, int width, int heig
 /// framebuffer, clears it, finishes and prints "first-frame-ms X". What a side takes beyond this
 /// is the work it does for its asset.
 int run_empty_first_frame(int width, int height, int samples);
+
+// What every child shares.
+
+/// The hidden 64 x 64 window with the 3.3 core context each child makes first.
+Result<view::Window> child_window();
+/// The child's report: "texture-bytes N", then "first-frame-ms X" since `start` (the parent stops
+/// reading at the second line).
+void print_first_frame(uint64_t texture_bytes, std::chrono::steady_clock::time_point start);
+/// 0 for success, else 1 with the message on stderr.
+int exit_status(const Status& status);
 
 }  // namespace ossa::bench

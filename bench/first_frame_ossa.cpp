@@ -26,11 +26,7 @@ namespace {
 
 Status run(std::span<const std::string> files, int width, int height, int samples,
            std::chrono::steady_clock::time_point start) {
-  view::WindowOptions wo;
-  wo.width = 64;
-  wo.height = 64;
-  wo.visible = false;
-  Result<view::Window> window = view::create_window(wo);
+  Result<view::Window> window = child_window();
   if (!window) return window.error();
   Result<view::Renderer> renderer = view::create_renderer();
   if (!renderer) return renderer.error();
@@ -58,10 +54,7 @@ Status run(std::span<const std::string> files, int width, int height, int sample
     if (Status s = view::check_gl(file); !s) return s;
     texture_bytes += view::texture_bytes(app.renderer.materials);
   }
-  const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-  std::printf("texture-bytes %llu\n", static_cast<unsigned long long>(texture_bytes));
-  std::printf("first-frame-ms %.3f\n", ms);
-  std::fflush(stdout);
+  print_first_frame(texture_bytes, start);
   return {};
 }
 
@@ -69,10 +62,7 @@ Status run(std::span<const std::string> files, int width, int height, int sample
 
 int run_ossa_first_frame(std::span<const std::string> files, int width, int height, int samples) {
   const auto start = std::chrono::steady_clock::now();
-  const Status s = run(files, width, height, samples, start);
-  if (s) return 0;
-  std::fprintf(stderr, "ossa-bench-first-frame: %s\n", s.message().c_str());
-  return 1;
+  return exit_status(run(files, width, height, samples, start));
 }
 
 }  // namespace ossa::bench

@@ -84,12 +84,7 @@ class ViewerMorph : public Viewer {
   Image shot(const fs::path& file, const std::string& tag, const std::string& extra) {
     const fs::path png = dir_ / (tag + ".png");
     const std::string args = quote(file.string()) + " -q --no-grid --size 256x256 --screenshot " + quote(png.string()) + " " + extra;
-    const CommandResult r = run_viewer(args);
-    EXPECT_EQ(r.exit_code, 0) << "ossa-view " << args << "\n" << r.err;
-    EXPECT_EQ(r.err.find("GL error"), std::string::npos) << r.err;
-    Image image = load_png(png);
-    EXPECT_FALSE(image.empty()) << "no image at " << png;
-    return image;
+    return screenshot(args, png);
   }
 };
 

@@ -25,6 +25,7 @@
 #include "viewer/morphs.h"
 #include "viewer/options.h"
 #include "viewer/scene.h"
+#include "viewer_unit_common.h"
 
 namespace fs = std::filesystem;
 using namespace ossa;
@@ -32,12 +33,7 @@ using namespace ossa::view;
 
 namespace {
 
-#ifndef OSSA_TEST_VIEWER_COOKED_DIR
-#define OSSA_TEST_VIEWER_COOKED_DIR "viewer-cooked"
-#endif
-fs::path cooked(const char* rel) {
-  return fs::path(test::env_or("OSSA_VIEWER_COOKED", OSSA_TEST_VIEWER_COOKED_DIR)) / "quantized" / rel;
-}
+fs::path cooked(const char* rel) { return test::viewer_unit_cooked(rel); }
 
 ParsedOptions parse(std::vector<const char*> args) {
   args.insert(args.begin(), "ossa-view");

@@ -23,6 +23,7 @@
 #include "viewer/layout.h"
 #include "viewer/options.h"
 #include "viewer/scene.h"
+#include "viewer_unit_common.h"
 
 namespace fs = std::filesystem;
 using namespace ossa;
@@ -30,12 +31,7 @@ using namespace ossa::view;
 
 namespace {
 
-#ifndef OSSA_TEST_VIEWER_COOKED_DIR
-#define OSSA_TEST_VIEWER_COOKED_DIR "viewer-cooked"
-#endif
-fs::path cooked(const char* rel) {
-  return fs::path(test::env_or("OSSA_VIEWER_COOKED", OSSA_TEST_VIEWER_COOKED_DIR)) / "quantized" / rel;
-}
+fs::path cooked(const char* rel) { return test::viewer_unit_cooked(rel); }
 
 TEST(ViewerLayout, SceneTakesWhatThePanelAndTimelineLeave) {
   const SceneLayout l = compute_layout(800, 500, 800, 500, 380.0f, 56.0f);
