@@ -102,18 +102,21 @@ void translate_below(State& s, uint32_t joint, const glm::vec3& offset) {
 
 /// Recomputes the model matrices on the path from `from` (included) down to its descendant `to`
 /// only: an aim chain needs its own joints, not the arms hanging off the neck. Leaves the other
-/// descendants stale (the node then marks the matrices unusable for the next node).
+/// descendants stale (the node then marks the matrices unusable for the next node). The path is
+/// marked in the scratch's joint flags (free outside for_subtree) walking up from `to`, then
+/// refreshed in index order, which is parents first: no bound on the rig's depth, no allocation.
+/// O(depth + to - from).
 void refresh_path(State& s, ConstPoseSpan pose, uint32_t from, uint32_t to) {
   const auto parents = s.def->skeleton.parents();
   std::vector<glm::mat4>& model = s.scratch->model;
-  uint32_t path[kMaxGraphDepth + 256];
-  uint32_t count = 0;
-  for (int j = static_cast<int>(to); j >= 0 && count < std::size(path); j = parents[static_cast<size_t>(j)]) {
-    path[count++] = static_cast<uint32_t>(j);
+  std::vector<uint8_t>& on_path = s.scratch->moved;
+  for (int j = static_cast<int>(to); j >= 0; j = parents[static_cast<size_t>(j)]) {
+    on_path[static_cast<size_t>(j)] = 1;
     if (static_cast<uint32_t>(j) == from) break;
   }
-  while (count-- > 0) {
-    const uint32_t j = path[count];
+  for (uint32_t j = from; j <= to; ++j) {
+    if (!on_path[j]) continue;
+    on_path[j] = 0;
     const int p = parents[j];
     model[j] = p >= 0 ? model[static_cast<size_t>(p)] * local_matrix(pose, j) : local_matrix(pose, j);
   }
@@ -158,39 +161,44 @@ bool solve_two_bone(State& s, PoseSpan out, uint32_t start, uint32_t mid, uint32
   return o.reached;
 }
 
+/// What an IK or aim node does first: its weight, and its `reached` flag cleared. Null when the
+/// weight is 0: the node then passes its input through, and writes the flag only if it was set
+/// (a crowd with the node off writes nothing). Otherwise the pose's model matrices are built.
+float* begin_reaching(State& s, const NodeInfo& info, PoseSpan out, float& weight) {
+  weight = node_weight_of(s, info);
+  float& reached = s.floats[info.floats];
+  if (!(weight > 0.0f)) {
+    if (reached != 0.0f) reached = 0.0f;
+    return nullptr;
+  }
+  reached = 0.0f;
+  model_of(s, out);
+  return &reached;
+}
+
 // ---- two-bone IK ----
 
 void two_bone(State& s, const NodeInfo& info, PoseSpan out) {
   const auto& t = *static_cast<const fb::TwoBoneIkNode*>(info.table);
-  const float w = node_weight_of(s, info);
-  float& reached = s.floats[info.floats];
-  if (!(w > 0.0f)) {
-    if (reached != 0.0f) reached = 0.0f;  // a crowd with the node off writes nothing
-    return;
-  }
-  reached = 0.0f;
-  model_of(s, out);
+  float w = 0.0f;
+  float* reached = begin_reaching(s, info, out, w);
+  if (reached == nullptr) return;
   const glm::vec3 start(s.scratch->model[t.start()][3]);
   const glm::vec3 pole = t.pole_parameter() >= 0 ? model_point(s, t.pole_parameter()) - start
                                                  : vec_or(t.pole(), glm::vec3(0.0f));
   const bool ok = solve_two_bone(s, out, t.start(), t.mid(), t.end(), model_point(s, t.target_parameter()), pole,
                                  vec_or(t.mid_axis(), glm::vec3(0.0f, 0.0f, 1.0f)), t.twist(), t.soften(), w);
-  reached = ok && w >= 1.0f ? 1.0f : 0.0f;
+  *reached = ok && w >= 1.0f ? 1.0f : 0.0f;
 }
 
 // ---- aim ----
 
 void aim(State& s, const NodeInfo& info, PoseSpan out) {
   const auto& a = *static_cast<const fb::AimNode*>(info.table);
-  const float w = node_weight_of(s, info);
-  float& reached = s.floats[info.floats];
-  if (!(w > 0.0f)) {
-    if (reached != 0.0f) reached = 0.0f;  // a crowd with the node off writes nothing
-    return;
-  }
-  reached = 0.0f;
+  float w = 0.0f;
+  float* reached = begin_reaching(s, info, out, w);
+  if (reached == nullptr) return;
   std::vector<glm::mat4>& model = s.scratch->model;
-  model_of(s, out);
   const glm::vec3 target = model_point(s, a.target_parameter());
   const glm::vec3 forward = vec_or(a.forward(), glm::vec3(0.0f, 0.0f, 1.0f));
   const glm::vec3 up = vec_or(a.up(), glm::vec3(0.0f, 1.0f, 0.0f));
@@ -219,7 +227,7 @@ void aim(State& s, const NodeInfo& info, PoseSpan out) {
     if (j == last) last_reached = o.reached;
   }
   s.scratch->model_pose = nullptr;  // only the chain's own matrices are current
-  reached = last_reached && w >= 1.0f ? 1.0f : 0.0f;
+  *reached = last_reached && w >= 1.0f ? 1.0f : 0.0f;
 }
 
 // ---- foot placement ----
