@@ -7,9 +7,16 @@
 // decodes with stb_image and mips with glGenerateMipmap, in sRGB like the others). Differences
 // between them are the block compression's error and the two mip filters' (the cooker's area
 // filter in linear light against the driver's box filter), small against what a texture left out
-// or sampled wrongly (un-flipped rows, sRGB decoded twice, BC5 z missing) does to the image.
+// or sampled wrongly (un-flipped rows, sRGB decoded twice) does to the image. A generated quad
+// with flat and tilted normal maps checks the BC5 path (x, y stored; z rebuilt by the shader),
+// which no sample has.
 #include <cstdio>
 #include <string>
+#include <vector>
+
+#include <stb_image_write.h>
+
+#include <ossa/loader/asset.h>
 
 #include "viewer_test_common.h"
 
@@ -92,6 +99,87 @@ TEST_P(ViewerTexture, GpuMemoryIsTheFilesChains) {
   EXPECT_EQ(bytes_of("quantized"), GetParam().bc_bytes);
   EXPECT_EQ(bytes_of("rgba8-textures"), GetParam().rgba8_bytes);
   EXPECT_EQ(bytes_of("source-textures"), GetParam().rgba8_bytes);
+}
+
+/// A flat 8 x 8 RGB PNG of one colour (the test writes its normal maps with it).
+std::vector<uint8_t> solid_png(uint8_t r, uint8_t g, uint8_t b) {
+  std::vector<uint8_t> texels;
+  for (int i = 0; i < 64; ++i) texels.insert(texels.end(), {r, g, b});
+  std::vector<uint8_t> out;
+  stbi_write_png_to_func([](void* ctx, void* data, int size) {
+    auto* o = static_cast<std::vector<uint8_t>*>(ctx);
+    o->insert(o->end(), static_cast<uint8_t*>(data), static_cast<uint8_t*>(data) + size);
+  }, &out, 8, 8, 3, texels.data(), 24);
+  return out;
+}
+
+/// A 2 x 2 unit quad facing +Z (positions, normals, texture coordinates, 6 indices) with a grey
+/// material and, when `normal_map` is given, that image as its normal texture.
+std::string quad_gltf(const std::string& normal_map) {
+  std::string j = R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+    "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "NORMAL": 1, "TEXCOORD_0": 2}, "indices": 3, "material": 0}]}],
+    "buffers": [{"uri": "quad.bin", "byteLength": 140}],
+    "bufferViews": [{"buffer": 0, "byteLength": 48}, {"buffer": 0, "byteOffset": 48, "byteLength": 48},
+                    {"buffer": 0, "byteOffset": 96, "byteLength": 32}, {"buffer": 0, "byteOffset": 128, "byteLength": 12}],
+    "accessors": [{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [-1, -1, 0], "max": [1, 1, 0]},
+                  {"bufferView": 1, "componentType": 5126, "count": 4, "type": "VEC3"},
+                  {"bufferView": 2, "componentType": 5126, "count": 4, "type": "VEC2"},
+                  {"bufferView": 3, "componentType": 5123, "count": 6, "type": "SCALAR"}],)";
+  if (normal_map.empty()) return j + R"("materials": [{"pbrMetallicRoughness": {"baseColorFactor": [0.6, 0.6, 0.6, 1]}}]})";
+  return j + R"("images": [{"uri": ")" + normal_map + R"("}], "textures": [{"source": 0}],
+    "materials": [{"pbrMetallicRoughness": {"baseColorFactor": [0.6, 0.6, 0.6, 1]}, "normalTexture": {"index": 0}}]})";
+}
+
+// A BC5 normal map holds x and y only; the shader rebuilds z. A flat map (0, 0, 1) must then light
+// the quad exactly as no map does, and a tilted one as its source image decoded at load does.
+// Measured (128 x 128, facing the quad): centre pixel 189 plain, 189 flat (BC and source), 100
+// tilted (BC and source).
+TEST_F(Viewer, Bc5NormalMapsRebuildZ) {
+  const fs::path src = dir_ / "src";
+  fs::create_directories(src);
+  const float geometry[] = {-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0,  // positions
+                            0,  0,  1, 0, 0,  1, 0, 0, 1, 0,  0, 1,  // normals
+                            0,  1,  1, 1, 1,  0, 0, 0};              // texture coordinates
+  const uint16_t indices[] = {0, 1, 2, 0, 2, 3};
+  std::vector<uint8_t> bin(reinterpret_cast<const uint8_t*>(geometry), reinterpret_cast<const uint8_t*>(geometry) + sizeof geometry);
+  bin.insert(bin.end(), reinterpret_cast<const uint8_t*>(indices), reinterpret_cast<const uint8_t*>(indices) + sizeof indices);
+  ASSERT_EQ(bin.size(), 140u);
+  ASSERT_TRUE(write_file(src / "quad.bin", bin));
+  ASSERT_TRUE(write_file(src / "flat.png", solid_png(128, 128, 255)));
+  ASSERT_TRUE(write_file(src / "tilt.png", solid_png(128, 38, 218)));  // about 45 degrees away from the light
+  ASSERT_TRUE(write_file(src / "plain.gltf", quad_gltf("")));
+  ASSERT_TRUE(write_file(src / "flat.gltf", quad_gltf("flat.png")));
+  ASSERT_TRUE(write_file(src / "tilt.gltf", quad_gltf("tilt.png")));
+  const std::string cook = quote((bin_dir() / "ossa-cook").string());
+  const auto bc = run_command(cook + " -q " + quote(src.string()) + " -o " + quote((dir_ / "bc").string()));
+  ASSERT_EQ(bc.exit_code, 0) << bc.err;
+  const auto source = run_command(cook + " -q --texture-format source " + quote(src.string()) + " -o " +
+                                  quote((dir_ / "source").string()));
+  ASSERT_EQ(source.exit_code, 0) << source.err;
+  auto tilt_asset = Asset::open((dir_ / "bc" / "tilt.ossa").string());
+  ASSERT_TRUE(tilt_asset.ok()) << tilt_asset.error().message;
+  ASSERT_EQ(tilt_asset->material(0).textures()->Get(0)->encoding(), fb::TextureEncoding::Bc5);
+  const auto shot = [&](const char* layout, const char* name) {
+    const fs::path png = dir_ / (std::string(layout) + "-" + name + ".png");
+    return screenshot(quote((dir_ / layout / (std::string(name) + ".ossa")).string()) +
+                          " -q --no-grid --size 128x128 --yaw 0 --pitch 0 --screenshot " + quote(png.string()),
+                      png);
+  };
+  const Image plain = shot("bc", "plain");
+  const ImageDiff flat = compare(plain, shot("bc", "flat"), kPixelThreshold);
+  const ImageDiff flat_source = compare(plain, shot("source", "flat"), kPixelThreshold);
+  const Image tilt_bc = shot("bc", "tilt");
+  const ImageDiff tilted = compare(plain, tilt_bc, kPixelThreshold);
+  const ImageDiff tilt_vs_source = compare(tilt_bc, shot("source", "tilt"), kPixelThreshold);
+  std::printf("flat BC5 vs no map: %.4f differ, mean %.3f; flat source: %.4f, %.3f; tilted vs no map: %.4f, %.3f; "
+              "tilted BC5 vs source: %.4f, %.3f\n", flat.differing, flat.mean_abs, flat_source.differing,
+              flat_source.mean_abs, tilted.differing, tilted.mean_abs, tilt_vs_source.differing, tilt_vs_source.mean_abs);
+  EXPECT_LT(flat.differing, 0.002);
+  EXPECT_LT(flat.mean_abs, 0.5);
+  EXPECT_LT(flat_source.mean_abs, 0.5);
+  EXPECT_GT(tilted.differing, 0.3) << "the tilted normal map does not change the lighting";
+  EXPECT_LT(tilt_vs_source.differing, 0.002);
+  EXPECT_LT(tilt_vs_source.mean_abs, 0.5);
 }
 
 std::string textured_name(const ::testing::TestParamInfo<Textured>& i) { return i.param.name; }
