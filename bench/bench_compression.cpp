@@ -27,6 +27,7 @@
 #include "cooker/clip/clip_compress.h"
 #include "cooker/cook.h"
 #include "cooker/import/import_scene.h"
+#include "bench/machine.h"
 
 namespace fs = std::filesystem;
 using namespace ossa::cook;
@@ -90,6 +91,7 @@ int main(int argc, char** argv) {
     settings.back().tolerance_metres = static_cast<float>(extra_tolerance_mm / 1000.0);
   }
 
+  std::printf("# %s\n", ossa::bench::machine_line().c_str());
   std::printf("asset\tclip\tjoints\traw_bytes\tcooked_bytes\tratio\tmax_error_mm\tmean_error_mm\ttolerance_mm\n");
   int status = 0;
   for (const std::string& asset : assets) {

@@ -40,6 +40,7 @@
 #include "bench/first_frame_assimp.h"
 #include "cooker/cook.h"
 #include "viewer/options.h"
+#include "bench/machine.h"
 
 extern char** environ;
 namespace fs = std::filesystem;
@@ -230,6 +231,7 @@ int main(int argc, char** argv) {
   const std::string viewer = (self_dir() / "ossa-view").string();
   const std::string self = (self_dir() / "ossa-bench-first-frame").string();
   const std::string size = std::to_string(width) + "x" + std::to_string(height), msaa = std::to_string(samples);
+  std::printf("# %s\n", ossa::bench::machine_line().c_str());
   std::printf("# first frame, process start to glFinish, median of %d runs, %s, MSAA %s\n", runs, size.c_str(), msaa.c_str());
   std::printf("# texture MiB: GPU memory of the textures each side uploaded (cooked: the file's mip chains;\n"
               "# assimp: RGBA8 + glGenerateMipmap's chain)\n");

@@ -36,6 +36,7 @@
 
 #include "cooker/cook.h"
 #include <ossa/graph/graph.h>
+#include "bench/machine.h"
 
 namespace fs = std::filesystem;
 using namespace ossa;
@@ -189,6 +190,7 @@ int main(int argc, char** argv) {
   // locking) at weight 0, where they cost a parameter read each.
   for (const char* off : {"look_weight", "feet_on_ground", "foot_lock"})
     if (const int q = def->find_parameter(off); q >= 0) plain.fixed.emplace_back(q, 0.0f);
+  std::printf("# %s\n", ossa::bench::machine_line().c_str());
   std::printf("graph '%s' of %s: %u joints, %zu nodes, %zu state machines, %zu clips; %d frames of %.1f ms\n",
               graph_name.c_str(), file.c_str(), def->joint_count(), def->node_count(), def->machine_count(),
               def->clip_count(), frames, 1000.0 * kDt);

@@ -33,6 +33,7 @@
 #include "cooker/cook.h"
 #include "cooker/import/import_scene.h"
 #include <ossa/loader/asset.h>
+#include "bench/machine.h"
 
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
@@ -90,6 +91,7 @@ int main(int argc, char** argv) {
   }
   const fs::path tmp = fs::temp_directory_path() / ("ossa-bench-load-" + std::to_string(::getpid()));
   int status = 0;
+  std::printf("# %s\n", ossa::bench::machine_line().c_str());
   std::printf("asset\tsource_bytes\tcooked_bytes\tassimp_import_ms\tossa_open_ms\tread_ms\topen_over_read\tspeedup\n");
   for (size_t i = 0; i < assets.size(); ++i) {
     const fs::path& src = assets[i];

@@ -33,19 +33,12 @@
 #include "cooker/import/import_scene.h"
 #include "cooker/mesh/mesh_build.h"
 #include "cooker/write/write_ossa.h"
+#include "bench/machine.h"
 
 using Clock = std::chrono::steady_clock;
 using namespace ossa::cook;
 
 namespace {
-
-std::string cpu_model() {
-  std::ifstream in("/proc/cpuinfo");
-  std::string line;
-  while (std::getline(in, line))
-    if (line.rfind("model name", 0) == 0) return line.substr(line.find(':') + 2);
-  return "unknown";
-}
 
 /// Deterministic xorshift, so every run generates the same face.
 struct Rng {
@@ -209,7 +202,7 @@ int main(int argc, char** argv) {
     }
   }
   if (source.empty() || generated < 1 || generated > 1024) return usage();
-  std::printf("# cpu: %s\n", cpu_model().c_str());
+  std::printf("# %s\n", ossa::bench::machine_line().c_str());
   auto scene = import_scene(source);
   if (!scene) {
     std::fprintf(stderr, "ossa-bench-morph: %s\n", scene.error().message.c_str());
