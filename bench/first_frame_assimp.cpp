@@ -141,6 +141,17 @@ GLuint load_diffuse_texture(const aiScene& scene, const aiString& path, const st
   return decode(bytes.data(), static_cast<int>(bytes.size()));
 }
 
+/// A new offscreen target of the frame's size, bound and cleared to the viewer's background.
+Result<view::Offscreen> cleared_target(int width, int height, int samples) {
+  Result<view::Offscreen> target = view::create_offscreen(width, height, samples);
+  if (!target) return target;
+  view::bind_offscreen(*target);
+  glViewport(0, 0, width, height);
+  glClearColor(0.17f, 0.18f, 0.2f, 1.0f);
+  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  return target;
+}
+
 /// Imports `source`, uploads it and draws one frame into a new offscreen target (a context must be
 /// current), finished with glFinish.
 Status draw_source(const std::string& source, int width, int height, int samples) {
@@ -241,12 +252,8 @@ Status draw_source(const std::string& source, int width, int height, int samples
   glBindTexture(GL_TEXTURE_BUFFER, palette_texture);
   glTexBuffer(GL_TEXTURE_BUFFER, GL_RGBA32F, palette_buffer);
 
-  Result<view::Offscreen> target = view::create_offscreen(width, height, samples);
+  Result<view::Offscreen> target = cleared_target(width, height, samples);
   if (!target) return target.error();
-  view::bind_offscreen(*target);
-  glViewport(0, 0, width, height);
-  glClearColor(0.17f, 0.18f, 0.2f, 1.0f);
-  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
   glEnable(GL_DEPTH_TEST);
   const float aspect = static_cast<float>(width) / static_cast<float>(height);
   const view::OrbitCamera camera = view::frame_box(bounds, 0.52f, 0.17f, aspect);
@@ -295,12 +302,8 @@ Status run(std::span<const std::string> sources, int width, int height, int samp
 Status run_empty(int width, int height, int samples, std::chrono::steady_clock::time_point start) {
   Result<view::Window> window = child_window();
   if (!window) return window.error();
-  Result<view::Offscreen> target = view::create_offscreen(width, height, samples);
+  Result<view::Offscreen> target = cleared_target(width, height, samples);
   if (!target) return target.error();
-  view::bind_offscreen(*target);
-  glViewport(0, 0, width, height);
-  glClearColor(0.17f, 0.18f, 0.2f, 1.0f);
-  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
   glFinish();
   if (Status s = view::check_gl("the empty frame"); !s) return s;
   print_first_frame(0, start);

@@ -128,10 +128,10 @@ void print_details(const CookRecord& r) {
                  static_cast<double>(m.normal_error_deg), m.raw_bytes, m.stored_bytes,
                  m.stored_bytes > 0 ? static_cast<double>(m.raw_bytes) / m.stored_bytes : 0.0);
   for (const TextureRecord& t : r.texture_records) {
-    std::fprintf(stderr, "    texture '%s' (%s): %u x %u, %s%s, %u mips, %s -> %s (GPU: %s, RGBA8 + mips %s), PSNR %.1f dB",
+    std::fprintf(stderr, "    texture '%s' (%s): %u x %u, %s%s, %u mips, %s -> %s (decoded RGBA8 + mips: %s), PSNR %.1f dB",
                  shown(t.name).c_str(), t.role.c_str(), t.width, t.height, t.encoding.c_str(), t.srgb ? " sRGB" : "",
                  t.mips, human_bytes(t.source_bytes).c_str(), human_bytes(t.cooked_bytes).c_str(),
-                 human_bytes(t.cooked_bytes).c_str(), human_bytes(t.gpu_rgba8_bytes).c_str(), static_cast<double>(t.psnr_db));
+                 human_bytes(t.gpu_rgba8_bytes).c_str(), static_cast<double>(t.psnr_db));
     if (t.role == "normal")
       std::fprintf(stderr, ", normals off by %.2f deg mean, %.2f max", static_cast<double>(t.normal_mean_deg),
                    static_cast<double>(t.normal_max_deg));

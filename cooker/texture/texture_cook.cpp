@@ -156,39 +156,36 @@ const char* texture_output_name(TextureOutput output) {
 
 Status cook_textures(SourceScene& scene, TextureOutput output, const std::string& label,
                      std::vector<TextureRecord>& records) {
-  // (role, size, hash) -> the first texture with those bytes; equal keys are compared in full.
-  std::map<std::tuple<uint8_t, size_t, uint64_t>, std::vector<std::pair<int32_t, SourceTexture*>>> seen;
-  std::vector<std::vector<uint8_t>> originals;  // bytes as read of each first use, for the comparisons
-  int32_t ordinal = -1;
-  for (SourceMaterial& m : scene.materials) {
-    for (SourceTexture& t : m.textures) {
-      ++ordinal;
-      if (t.data.empty()) continue;  // known by path only
-      const auto key = std::make_tuple(static_cast<uint8_t>(t.role), t.data.size(), hash_bytes(t.data.data(), t.data.size()));
-      auto& candidates = seen[key];
-      bool repeat = false;
-      for (const auto& [first, cooked] : candidates) {
-        if (originals[static_cast<size_t>(cooked->same_as)] == t.data) {  // same_as holds the originals index until the end
-          t.same_as = first;
-          t.data.clear();
-          t.data.shrink_to_fit();
-          repeat = true;
-          break;
-        }
+  // First every repeat is found while all bytes are still as read: (role, size, hash) -> the
+  // first uses with that key, compared in full. Then only first uses are cooked.
+  std::vector<SourceTexture*> all;
+  for (SourceMaterial& m : scene.materials)
+    for (SourceTexture& t : m.textures) all.push_back(&t);
+  std::map<std::tuple<uint8_t, size_t, uint64_t>, std::vector<int32_t>> seen;
+  for (size_t i = 0; i < all.size(); ++i) {
+    SourceTexture& t = *all[i];
+    t.same_as = -1;
+    if (t.data.empty()) continue;  // known by path only
+    auto& firsts = seen[{static_cast<uint8_t>(t.role), t.data.size(), hash_bytes(t.data.data(), t.data.size())}];
+    for (const int32_t first : firsts)
+      if (all[static_cast<size_t>(first)]->data == t.data) {
+        t.same_as = first;
+        break;
       }
-      if (repeat) continue;
-      std::vector<uint8_t> original = t.data;
+    if (t.same_as < 0) firsts.push_back(static_cast<int32_t>(i));
+  }
+  for (SourceMaterial& m : scene.materials)
+    for (SourceTexture& t : m.textures) {
+      if (t.same_as >= 0) {
+        t.data.clear();  // the writer stores the first use's table for it
+        t.data.shrink_to_fit();
+        continue;
+      }
+      if (t.data.empty()) continue;
       auto r = cook_one(t, output);
       if (!r) return Error{label + ": material '" + m.name + "': texture '" + t.name + "' " + r.error().message};
       records.push_back(std::move(*r));
-      t.same_as = static_cast<int32_t>(originals.size());
-      originals.push_back(std::move(original));
-      candidates.emplace_back(ordinal, &t);
     }
-  }
-  // First uses point at nothing.
-  for (auto& [key, candidates] : seen)
-    for (auto& [first, cooked] : candidates) cooked->same_as = -1;
   return {};
 }
 
