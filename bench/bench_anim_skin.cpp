@@ -16,6 +16,11 @@
 #include <benchmark/benchmark.h>
 
 #include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <memory>
+#include <optional>
 #include <random>
 #include <span>
 #include <vector>
@@ -92,6 +97,20 @@ BENCHMARK(BM_SkinPositions);
 void BM_SkinFull(benchmark::State& state) { skin_loop(state, ossa::SkinningMethod::Linear, true); }
 BENCHMARK(BM_SkinFull);
 
+/// BM_SkinFull without the final normalization (SkinnedStreams::renormalize = false): the work
+/// ozz-animation's SkinningJob does, which never normalizes (a renderer normalizes in its shader).
+void BM_SkinFullUnnormalized(benchmark::State& state) {
+  SkinBench& b = skin_bench();
+  const ossa::SkinnedStreams out{b.positions, b.normals, b.tangents, false};
+  for (auto _ : state) {
+    ossa::skin_cpu(b.mesh, b.palette, ossa::SkinningMethod::Linear, out);
+    benchmark::DoNotOptimize(b.positions.data());
+    benchmark::ClobberMemory();
+  }
+  set_ns_per_vertex(state, b.vertices);
+}
+BENCHMARK(BM_SkinFullUnnormalized);
+
 /// One implementation: Arg(0) positions-only / Arg(1) full, Arg(isa).
 void BM_SkinByIsa(benchmark::State& state) {
   const ossa::SkinningIsa previous = ossa::skinning_isa();
@@ -103,6 +122,69 @@ void BM_SkinByIsa(benchmark::State& state) {
   ossa::set_skinning_isa(previous);
 }
 BENCHMARK(BM_SkinByIsa)->ArgNames({"full", "isa"})->ArgsProduct({{0, 1}, {0, 1, 2}});
+
+/// Arnaud as cooked (its vertices ordered by influence class: skin_cpu runs one loop per class
+/// range) and a copy whose classes are dealt out in turn, each class keeping its order (what a
+/// file cooked before the ordering, or by another tool, looks like: skin_cpu classifies every
+/// batch). Same vertices, same palette, one run: the ratio is what the ordering buys.
+struct DealtArnaud {
+  std::vector<uint8_t> bytes;
+  std::optional<ossa::Asset> asset;
+};
+
+const ossa::MeshView& dealt_arnaud() {
+  static const auto dealt = [] {
+    const ossa::bench::BenchData& data = ossa::bench::bench_data();
+    auto d = std::make_unique<DealtArnaud>();
+    const std::span<const uint8_t> file = data.arnaud.bytes();
+    const ossa::MeshView mesh = data.arnaud.mesh(0);
+    d->bytes.assign(file.begin(), file.end());
+    const size_t at = static_cast<size_t>(mesh.vertex_bytes().data() - file.data());
+    const size_t stride = mesh.vertex_stride();
+    const uint32_t weights = mesh.attribute(ossa::fb::VertexSemantic::Weights)->offset();
+    // The class runs of the cooked order, then one vertex of each in turn.
+    std::vector<std::vector<uint32_t>> runs;
+    uint32_t last_word = 0;
+    for (uint32_t v = 0; v < mesh.vertex_count(); ++v) {
+      uint32_t w;
+      std::memcpy(&w, mesh.vertex_bytes().data() + v * stride + weights, 4);
+      const uint32_t word_class = w == 255u ? 0u : 1u + (w >= (1u << 8)) + (w >= (1u << 16)) + (w >= (1u << 24));
+      if (runs.empty() || word_class != last_word) runs.emplace_back();
+      runs.back().push_back(v);
+      last_word = word_class;
+    }
+    size_t out = 0;
+    for (size_t i = 0; out < mesh.vertex_count(); ++i)
+      for (const auto& run : runs)
+        if (i < run.size())
+          std::memcpy(d->bytes.data() + at + out++ * stride, mesh.vertex_bytes().data() + run[i] * stride, stride);
+    auto a = ossa::Asset::from_bytes(d->bytes, "arnaud-dealt");
+    if (!a) {
+      std::fprintf(stderr, "bench: %s\n", a.error().message.c_str());
+      std::exit(1);
+    }
+    d->asset.emplace(std::move(*a));
+    return d;
+  }();
+  static const ossa::MeshView mesh = dealt->asset->mesh(0);
+  return mesh;
+}
+
+/// Arg(ordered): 1 arnaud as cooked, 0 the dealt copy; Arg(full): normals too.
+void BM_SkinOrder(benchmark::State& state) {
+  SkinBench& b = skin_bench();
+  const ossa::MeshView mesh = state.range(0) != 0 ? b.mesh : dealt_arnaud();
+  const bool directions = state.range(1) != 0;
+  const ossa::SkinnedStreams out{b.positions, directions ? std::span<float>(b.normals) : std::span<float>(),
+                                 directions ? std::span<float>(b.tangents) : std::span<float>()};
+  for (auto _ : state) {
+    ossa::skin_cpu(mesh, b.palette, ossa::SkinningMethod::Linear, out);
+    benchmark::DoNotOptimize(b.positions.data());
+    benchmark::ClobberMemory();
+  }
+  set_ns_per_vertex(state, b.vertices);
+}
+BENCHMARK(BM_SkinOrder)->ArgNames({"ordered", "full"})->ArgsProduct({{0, 1}, {0, 1}});
 
 void BM_SkinDualQuaternionFull(benchmark::State& state) { skin_loop(state, ossa::SkinningMethod::DualQuaternion, true); }
 BENCHMARK(BM_SkinDualQuaternionFull);

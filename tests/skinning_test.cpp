@@ -74,6 +74,15 @@ const char* isa_name(ossa::SkinningIsa isa) {
 }
 
 /// Selects an implementation for a scope, and puts the previous one back.
+/// The class the fast paths give these weight bytes: 0 one influence of weight 255, else 1 + the
+/// index of the last non-zero weight (all zero: 1). The cooker orders vertices by it.
+int influence_class(const std::array<uint8_t, 4>& w) {
+  if (w[0] == 255 && w[1] == 0 && w[2] == 0 && w[3] == 0) return 0;
+  for (int k = 3; k > 0; --k)
+    if (w[static_cast<size_t>(k)] != 0) return k + 1;
+  return 1;
+}
+
 class IsaScope {
  public:
   explicit IsaScope(ossa::SkinningIsa isa) : previous_(ossa::skinning_isa()) { ossa::set_skinning_isa(isa); }
@@ -262,13 +271,14 @@ std::vector<glm::mat4> palette_of(const ossa::MeshView& mesh, const std::vector<
 }
 
 /// Skins every stream the mesh has. NaN-filled outputs, so an unwritten value cannot pass.
-Skinned skin(const ossa::MeshView& mesh, std::span<const glm::mat4> palette, ossa::SkinningMethod method) {
+Skinned skin(const ossa::MeshView& mesh, std::span<const glm::mat4> palette, ossa::SkinningMethod method,
+             bool renormalize = true) {
   const size_t n = mesh.vertex_count();
   Skinned s;
   s.positions.assign(3 * n, NAN);
   if (mesh.attribute(VertexSemantic::Normal)) s.normals.assign(3 * n, NAN);
   if (mesh.attribute(VertexSemantic::Tangent)) s.tangents.assign(4 * n, NAN);
-  ossa::skin_cpu(mesh, palette, method, {s.positions, s.normals, s.tangents});
+  ossa::skin_cpu(mesh, palette, method, {s.positions, s.normals, s.tangents, renormalize});
   return s;
 }
 
@@ -365,6 +375,27 @@ class SkinAsset : public ::testing::TestWithParam<AssetCase> {
   const Cooked* data_ = nullptr;
 };
 
+TEST_P(SkinAsset, CookedVerticesAreOrderedByInfluenceClass) {
+  // The cooker's promise to skin_cpu's range loops: classes never decrease along the vertex
+  // buffer, so each class is one contiguous range (the loops check it anyway).
+  for (size_t i = 0; i < data_->asset->mesh_count(); ++i) {
+    const ossa::MeshView mesh = data_->asset->mesh(i);
+    const ossa::fb::VertexAttribute* w = mesh.attribute(VertexSemantic::Weights);
+    if (w == nullptr) continue;
+    ASSERT_EQ(w->format(), VertexFormat::Unorm8x4);
+    int last = 0, classes = 0;
+    for (uint32_t v = 0; v < mesh.vertex_count(); ++v) {
+      std::array<uint8_t, 4> q;
+      std::memcpy(q.data(), mesh.vertex_bytes().data() + size_t(v) * mesh.vertex_stride() + w->offset(), 4);
+      const int c = influence_class(q);
+      ASSERT_GE(c, last) << GetParam().name << " mesh " << i << " vertex " << v;
+      classes += c != last || v == 0;
+      last = c;
+    }
+    EXPECT_GE(classes, 1);
+  }
+}
+
 TEST_P(SkinAsset, BindPoseReproducesCookedMesh) {
   // In the bind pose every palette entry is the mesh's placement in model space (model *
   // inverse_bind, the identity for a mesh bound where it stands), so skinning gives the
@@ -396,6 +427,36 @@ TEST_P(SkinAsset, PosedMatchesDoublePrecisionReference) {
       EXPECT_LE(e.normal, 1e-5) << isa_name(isa) << " mesh " << mesh.name();
       EXPECT_LE(e.tangent, 1e-5) << isa_name(isa) << " mesh " << mesh.name();
       RecordProperty(std::string("relative_position_error_") + isa_name(isa), std::to_string(e.position / ref.scale));
+    }
+  }
+}
+
+TEST_P(SkinAsset, UnnormalizedDirectionsAreTheNormalizedOnesScaled) {
+  // renormalize = false skips only the final normalization: every implementation and method
+  // gives the same positions, and directions that normalize to the renormalized ones. On a posed
+  // character some come out measurably shorter than unit (blended rotations shrink vectors), so
+  // the pass really was skipped.
+  const Poses pose = make_pose(data_->skeleton(), 0.6f, 11);
+  for (size_t mi = 0; mi < data_->asset->mesh_count(); ++mi) {
+    const ossa::MeshView mesh = data_->asset->mesh(mi);
+    const auto palette = palette_of(mesh, pose.model);
+    for (ossa::SkinningIsa isa : available_isas()) {
+      IsaScope scope(isa);
+      for (ossa::SkinningMethod method : {ossa::SkinningMethod::Linear, ossa::SkinningMethod::DualQuaternion}) {
+        const Skinned unit = skin(mesh, palette, method), raw = skin(mesh, palette, method, false);
+        ASSERT_EQ(unit.positions, raw.positions) << isa_name(isa);
+        double worst = 0.0, shortest = 1.0;
+        for (uint32_t v = 0; v < mesh.vertex_count(); ++v) {
+          const glm::vec3 r = raw.normal(v);
+          const float len = glm::length(r);
+          shortest = std::min(shortest, double(len));
+          if (len > 0.0f) worst = std::max(worst, double(glm::length(r / len - unit.normal(v))));
+        }
+        EXPECT_LE(worst, 2e-6) << isa_name(isa) << " method " << int(method);
+        if (method == ossa::SkinningMethod::Linear) {
+          EXPECT_LT(shortest, 0.999) << isa_name(isa);
+        }
+      }
     }
   }
 }
@@ -567,6 +628,33 @@ std::vector<std::pair<std::string, std::vector<uint8_t>>> synthetic_files() {
   }
   out.emplace_back("many-vertices", ossa::test::make_valid_file(many));
   out.emplace_back("many-vertices-tangents", with_tangents(many));
+
+  // The same vertices ordered by influence class, as the cooker orders them: the fast paths run
+  // one loop per class range (no classification).
+  ossa::test::SyntheticSpec ordered = many;
+  std::vector<ossa::test::SyntheticVertex>& ov = ordered.meshes[0].vertices;
+  std::stable_sort(ov.begin(), ov.end(), [](const auto& a, const auto& b) {
+    return influence_class(a.weights) < influence_class(b.weights);
+  });
+  out.emplace_back("ordered-by-class", ossa::test::make_valid_file(ordered));
+  out.emplace_back("ordered-by-class-tangents", with_tangents(ordered));
+  // Ordered as far as the order probe looks, then broken: a four-influence vertex inside the
+  // two-influence range (that range's loop must notice and hand the rest to the classified path),
+  // and a rigid vertex inside the three-influence range (which blends it correctly as it is).
+  ossa::test::SyntheticSpec broken = ordered;
+  std::vector<ossa::test::SyntheticVertex>& bv = broken.meshes[0].vertices;
+  const auto first_of = [&bv](int c) {
+    return std::find_if(bv.begin(), bv.end(), [c](const auto& v) { return influence_class(v.weights) == c; });
+  };
+  std::iter_swap(first_of(2) + 40, first_of(4) + 3);
+  std::iter_swap(first_of(3) + 10, first_of(0) + 100);
+  out.emplace_back("ordered-then-broken", ossa::test::make_valid_file(broken));
+  // Every vertex of one class but the last, which needs all four influences.
+  ossa::test::SyntheticSpec last = ordered;
+  std::vector<ossa::test::SyntheticVertex>& lv = last.meshes[0].vertices;
+  lv.erase(std::remove_if(lv.begin(), lv.end(), [](const auto& v) { return influence_class(v.weights) != 2; }), lv.end());
+  lv.back().weights = {10, 20, 30, 195};
+  out.emplace_back("one-class-then-four", ossa::test::make_valid_file(last));
   return out;
 }
 

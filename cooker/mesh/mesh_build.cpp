@@ -10,7 +10,9 @@
 //      concatenate each group into one vertex/index buffer, one submesh per source mesh (vertex
 //      colours do not split a group: members without colours are white in it);
 //   5. build the group's joint palette: the distinct (joint, inverse bind) pairs its vertices use;
-//   6. reorder with meshoptimizer: vertex cache per submesh, then vertex fetch over the whole mesh;
+//   6. reorder with meshoptimizer: vertex cache per submesh, then vertex fetch over the whole mesh,
+//      then (skinned meshes) a stable partition by influence class, so CPU skinning runs over
+//      uniform ranges (influence_class_order);
 //   7. encode the interleaved quantized (or float32) layout.
 //
 // Decisions worth knowing, and why:
@@ -376,6 +378,34 @@ std::array<uint8_t, 4> quantize_weights(const glm::vec4& w) {
   return q;
 }
 
+/// The influence class skin_cpu's fast path gives a vertex (runtime/skinning/skinning.cpp): 0 for
+/// one influence of weight 255 (the palette matrix as it is), else 1 + the index of the last
+/// non-zero quantized weight (all-zero: 1).
+int influence_class(const std::array<uint8_t, 4>& q) {
+  if (q[0] == 255 && q[1] == 0 && q[2] == 0 && q[3] == 0) return 0;
+  for (int k = 3; k > 0; --k)
+    if (q[static_cast<size_t>(k)] != 0) return k + 1;
+  return 1;
+}
+
+/// A renumbering (remap[old] = new) that orders vertices by influence class, keeping the fetch
+/// order inside each class (a stable partition): skin_cpu then runs one loop per class over a
+/// contiguous range instead of sorting every batch into classes (ozz-animation splits its skinning
+/// jobs by influence count the same way). The GPU's vertex fetch still walks each class in first-use
+/// order; the index buffer now jumps between at most five ranges.
+std::vector<unsigned> influence_class_order(const std::vector<glm::vec4>& weights) {
+  std::array<unsigned, 6> start{};
+  std::vector<uint8_t> cls(weights.size());
+  for (size_t v = 0; v < weights.size(); ++v) {
+    cls[v] = static_cast<uint8_t>(influence_class(quantize_weights(weights[v])));
+    ++start[cls[v] + 1u];
+  }
+  for (size_t c = 1; c < start.size(); ++c) start[c] += start[c - 1];
+  std::vector<unsigned> remap(weights.size());
+  for (size_t v = 0; v < weights.size(); ++v) remap[v] = start[cls[v]]++;
+  return remap;
+}
+
 // ---------------------------------------------------------------------------------------------
 // One merged mesh
 
@@ -604,25 +634,32 @@ Result<CookedMesh> build_group(const SourceScene& scene, const std::vector<Clean
       meshopt_optimizeVertexCache(optimized.data(), local.data(), local.size(), count);
       for (size_t i = 0; i < optimized.size(); ++i) indices[sub.first_index() + i] = optimized[i] + base;
     }
+    const auto renumber = [&](const std::vector<unsigned>& remap, size_t unique) {
+      meshopt_remapIndexBuffer(indices.data(), indices.data(), indices.size(), remap.data());
+      compact(s.positions, remap, unique);
+      compact(s.normals, remap, unique);
+      compact(s.tangents, remap, unique);
+      compact(s.uv0, remap, unique);
+      compact(s.colors, remap, unique);
+      compact(s.slots, remap, unique);
+      compact(s.weights, remap, unique);
+      for (MorphStreams& t : s.targets) {
+        compact(t.positions, remap, unique);
+        compact(t.normals, remap, unique);
+        compact(t.tangents, remap, unique);
+      }
+    };
     std::vector<unsigned> remap(vertex_count);
     const size_t unique = meshopt_optimizeVertexFetchRemap(remap.data(), indices.data(), indices.size(), vertex_count);
-    meshopt_remapIndexBuffer(indices.data(), indices.data(), indices.size(), remap.data());
-    compact(s.positions, remap, unique);
-    compact(s.normals, remap, unique);
-    compact(s.tangents, remap, unique);
-    compact(s.uv0, remap, unique);
-    compact(s.colors, remap, unique);
-    compact(s.slots, remap, unique);
-    compact(s.weights, remap, unique);
-    for (MorphStreams& t : s.targets) {
-      compact(t.positions, remap, unique);
-      compact(t.normals, remap, unique);
-      compact(t.tangents, remap, unique);
-    }
+    renumber(remap, unique);
     if (unique < vertex_count)
       warnings.push_back("mesh '" + out.name + "': dropped " + std::to_string(vertex_count - unique) +
                          " vertices only degenerate triangles used");
     vertex_count = unique;
+    if (attrs.skinned) {
+      remap = influence_class_order(s.weights);
+      renumber(remap, vertex_count);
+    }
   }
 
   const auto after = meshopt_analyzeVertexCache(indices.data(), indices.size(), vertex_count, kCacheSize, 0, 0);

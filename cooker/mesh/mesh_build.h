@@ -5,7 +5,8 @@
 // mesh is welded (vertices equal in every attribute merged: the importer leaves that to this stage)
 // and cleaned (degenerate triangles dropped and counted), given normals by OpenMesh when it has none
 // (area-weighted vertex normals: the one job where OpenMesh earns its place), reordered with
-// meshoptimizer (vertex cache per submesh, then vertex fetch over the whole mesh), and written in the
+// meshoptimizer (vertex cache per submesh, then vertex fetch over the whole mesh; skinned meshes
+// then ordered by influence class, fetch order kept inside each class), and written in the
 // quantized layout of the design (positions unorm16 in the bounds, octahedral normals/tangents,
 // half-float UVs, 8-bit joint slots where <= 256 joints, unorm8 weights summing to 255) or float32
 // with MeshOptions::float_vertices.

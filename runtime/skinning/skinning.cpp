@@ -16,10 +16,11 @@
 //   which auto-vectorized clones do not produce.
 // - Influence counts vary from vertex to vertex with no pattern (Pab's arnaud: 35% one, 41% two,
 //   18% three, 6% four; consecutive vertices differ 32% of the time), so a branch per vertex on
-//   the count mispredicts often, and always blending four doubles the work. Vertices are therefore
-//   classified per batch, branch-free, and each class runs a loop specialized for it (see "Fast
-//   paths" below), including a class for single influences of weight 255 that uses the palette
-//   matrix as it is.
+//   the count mispredicts often, and always blending four doubles the work. Each class runs a loop
+//   specialized for it (see "Fast paths" below), including a class for single influences of weight
+//   255 that uses the palette matrix as it is. The cooker orders a skinned mesh's vertices by class
+//   (as ozz-animation splits skinning jobs by influence count), so each class is one contiguous
+//   range, checked as it is skinned; a file in any other order is classified per batch, branch-free.
 //
 // The de-quantizing affine D (translate(position_offset) * scale(position_scale)) is folded into
 // the palette for positions. Directions must not see D's scale, so they are pre-multiplied by its
@@ -36,9 +37,10 @@
 //
 // Costs: skinning_matrices O(slots). skin_cpu O(vertices * influences), allocation-free (stack
 // buffers: ~18 KB on the fast path, ~22 KB for dual quaternions), no virtual calls, no
-// per-vertex branches on the fast path. Measured on Pab's arnaud (3748 vertices, this repo's
-// ossa-bench-anim, Zen 4 VM): ~2.8 ns per vertex for positions, ~5 ns with normals; portable
-// ~18 / ~32 ns; dual quaternions ~70 ns.
+// per-vertex branches on the fast path. Measured on Pab's arnaud (3748 vertices, ossa-bench-anim's
+// BM_SkinOrder, Zen 5 VM at ~3.2 GHz): ~2.1 ns per vertex for positions, ~4.2 ns with normals, as
+// cooked (class-ordered); ~2.9 / ~5.2 ns classified per batch; portable ~20 / ~31 ns; dual
+// quaternions ~60 ns.
 #include <ossa/skinning/skinning.h>
 
 #include <algorithm>
@@ -48,6 +50,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <type_traits>
 
 #include "internal/cpu.h"
 
@@ -138,12 +141,22 @@ constexpr std::array<float, 256> make_weight_table() {
 }
 alignas(64) constexpr std::array<float, 256> kWeight = make_weight_table();
 
+/// v / |v|, or zero for a zero vector (what the fast paths' guarded rsqrt gives too).
+glm::vec3 normalize_or_zero(glm::vec3 v) {
+  const float len2 = glm::dot(v, v);
+  return len2 > 0.0f ? v * (1.0f / std::sqrt(len2)) : glm::vec3(0.0f);
+}
+
 /// Where skin_cpu writes; null streams are not written.
 struct Outputs {
   float* positions = nullptr;
   float* normals = nullptr;
   float* tangents = nullptr;
+  bool renormalize = true;  // SkinnedStreams::renormalize
 };
+
+/// A transformed direction as the caller asked for it: unit length, or as transformed.
+inline glm::vec3 finish_direction(glm::vec3 v, const Outputs& out) { return out.renormalize ? normalize_or_zero(v) : v; }
 
 // ---------------------------------------------------------------------------------------------
 // Portable path: any layout, decoded a batch at a time as OpenGL fetches attributes.
@@ -153,11 +166,6 @@ struct Outputs {
 // fetch_vertex_attribute, ossa/skinning/vertex_fetch.h), into plain float arrays; skinning then
 // runs over those arrays with no format switch per vertex.
 
-/// v / |v|, or zero for a zero vector (what the fast paths' guarded rsqrt gives too).
-glm::vec3 normalize_or_zero(glm::vec3 v) {
-  const float len2 = glm::dot(v, v);
-  return len2 > 0.0f ? v * (1.0f / std::sqrt(len2)) : glm::vec3(0.0f);
-}
 
 glm::vec3 octahedral(float x, float y) {
   const Float3 n = octahedral_decode({x, y});
@@ -294,12 +302,12 @@ void skin_linear_portable(const MeshFacts& m, const glm::mat4* palette, Outputs 
       }
       if (out.normals != nullptr) {
         const glm::vec3 n = d.normal[i] * m.direction_prescale;
-        const glm::vec3 r = normalize_or_zero(c0 * n.x + c1 * n.y + c2 * n.z);
+        const glm::vec3 r = finish_direction(c0 * n.x + c1 * n.y + c2 * n.z, out);
         std::memcpy(out.normals + 3 * v, &r[0], 12);
       }
       if (out.tangents != nullptr) {
         const glm::vec3 t = glm::vec3(d.tangent[i]) * m.direction_prescale;
-        const glm::vec4 r(normalize_or_zero(c0 * t.x + c1 * t.y + c2 * t.z), d.tangent[i].w);
+        const glm::vec4 r(finish_direction(c0 * t.x + c1 * t.y + c2 * t.z, out), d.tangent[i].w);
         std::memcpy(out.tangents + 4 * v, &r[0], 16);
       }
     }
@@ -385,11 +393,11 @@ void skin_dual_quaternion(const MeshFacts& m, std::span<const glm::mat4> palette
         std::memcpy(out.positions + 3 * v, &moved[0], 12);
       }
       if (out.normals != nullptr) {
-        const glm::vec3 n = normalize_or_zero(real * (stretch * d.normal[i]));
+        const glm::vec3 n = finish_direction(real * (stretch * d.normal[i]), out);
         std::memcpy(out.normals + 3 * v, &n[0], 12);
       }
       if (out.tangents != nullptr) {
-        const glm::vec4 r(normalize_or_zero(real * (stretch * glm::vec3(d.tangent[i]))), d.tangent[i].w);
+        const glm::vec4 r(finish_direction(real * (stretch * glm::vec3(d.tangent[i])), out), d.tangent[i].w);
         std::memcpy(out.tangents + 4 * v, &r[0], 16);
       }
     }
@@ -609,18 +617,19 @@ OSSA_TARGET_AVX2 void decode_directions(const FastMesh& m, Batch& b) {
 
 /// Blended matrix of the first K influences (K = 0: the first slot's matrix as it is), as
 /// columns 0-1 and 2-3.
-template <int K, Slots kSlots>
+/// `wb` receives the vertex's four weight bytes (loaded for K = 0 only when kNeedWeights).
+template <int K, Slots kSlots, bool kNeedWeights>
 OSSA_TARGET_AVX2 inline void blend_matrix(const float* palette, const uint8_t* vx, uint32_t off_joints,
-                                          uint32_t off_weights, __m256& a01, __m256& a23) {
+                                          uint32_t off_weights, __m256& a01, __m256& a23, uint32_t& wb) {
   uint64_t sb;
-  uint32_t wb = 0;
+  wb = 0;
   if constexpr (kSlots == Slots::Packed) {
     const uint64_t both = load_u64(vx + off_joints);
     sb = both & 0xffffffffu;
     wb = static_cast<uint32_t>(both >> 32);
   } else {
     sb = kSlots == Slots::Wide ? load_u64(vx + off_joints) : load_u32(vx + off_joints);
-    if constexpr (K > 0) wb = load_u32(vx + off_weights);
+    if constexpr (K > 0 || kNeedWeights) wb = load_u32(vx + off_weights);
   }
   const float* p0 = palette + 16 * slot_of<kSlots>(sb, 0);
   if constexpr (K == 0) {
@@ -651,11 +660,13 @@ OSSA_TARGET_AVX2 inline void blend_matrix(const float* palette, const uint8_t* v
   }
 }
 
-/// c0 * v.x + c1 * v.y + c2 * v.z + c3 * v.w (the permutes read v's lanes 0-3 only).
-OSSA_TARGET_AVX2 inline __m128 transform(__m256 a01, __m256 a23, __m128 v4) {
-  const __m256 v = _mm256_castps128_ps256(v4);
-  const __m256 xy = _mm256_permutevar8x32_ps(v, _mm256_setr_epi32(0, 0, 0, 0, 1, 1, 1, 1));
-  const __m256 zw = _mm256_permutevar8x32_ps(v, _mm256_setr_epi32(2, 2, 2, 2, 3, 3, 3, 3));
+/// c0 * v.x + c1 * v.y + c2 * v.z + c3 * v.w for the blended columns a01 = (c0, c1), a23 = (c2, c3)
+/// and v given in both 128-bit lanes (x, y, z, w, x, y, z, w): in-lane permutes only (vpermilps),
+/// which a broadcast or duplicating load sets up for free. (Lane-crossing vpermps from one xmm
+/// measured ~10% slower per vertex on Zen 5.)
+OSSA_TARGET_AVX2 inline __m128 transform_dup(__m256 a01, __m256 a23, __m256 v) {
+  const __m256 xy = _mm256_permutevar_ps(v, _mm256_setr_epi32(0, 0, 0, 0, 1, 1, 1, 1));
+  const __m256 zw = _mm256_permutevar_ps(v, _mm256_setr_epi32(2, 2, 2, 2, 3, 3, 3, 3));
   const __m256 t = _mm256_fmadd_ps(a23, zw, _mm256_mul_ps(a01, xy));
   return _mm_add_ps(_mm256_castps256_ps128(t), _mm256_extractf128_ps(t, 1));
 }
@@ -665,39 +676,68 @@ OSSA_TARGET_AVX2 inline void store3(float* out, __m128 r) {
   _mm_store_ss(out + 2, _mm_movehl_ps(r, r));
 }
 
-template <int K, Slots kSlots, bool kPositions, bool kNormals, bool kTangents>
-OSSA_TARGET_AVX2 void skin_class(const uint32_t* list, uint32_t n, const float* palette, const FastMesh& mesh,
-                                 const Batch& b, Outputs out) {
+/// Stores xyz of r at out. A range loop writes vertices in increasing order, so it may store all
+/// 16 bytes (one store, no shuffle) when another vertex follows: the stray w lands on the next
+/// vertex's x, which that vertex overwrites later. The last vertex of the buffer stores 12.
+template <bool kRange>
+OSSA_TARGET_AVX2 inline void store_xyz(float* out, __m128 r, bool another_follows) {
+  if (kRange && another_follows) _mm_storeu_ps(out, r);
+  else store3(out, r);
+}
+
+/// Whether a vertex with weight bytes wb may be skinned by class K's loop: K = 0 needs the single
+/// weight 255; K = 1..3 needs every weight past influence K - 1 zero (a lower class blends its zero
+/// weights harmlessly); K = 4 takes anything. Accumulated as bits that must stay zero.
+template <int K>
+inline uint32_t outside_class(uint32_t wb) {
+  if constexpr (K == 0) return wb ^ 255u;
+  else if constexpr (K < 4) return wb >> (8 * K);
+  else return 0;
+}
+
+/// Class K's loop over n vertices: list[i] (a batch's class list), or first + i when kRange (a
+/// mesh ordered by class). Returns the OR of outside_class<K> over the vertices (kRange only;
+/// non-zero: some vertex did not belong to the range, and its outputs are wrong).
+template <int K, bool kRange, Slots kSlots, bool kPositions, bool kNormals, bool kTangents>
+OSSA_TARGET_AVX2 uint32_t skin_class(const uint32_t* list, uint32_t first, uint32_t n, const float* palette,
+                                     const FastMesh& mesh, const Batch& b, Outputs out) {
   // Locals, so that the output stores cannot make the compiler reload them.
   const uint8_t* const base = mesh.base;
   const size_t stride = mesh.stride;
   const uint32_t off_position = mesh.off_position, off_joints = mesh.off_joints, off_weights = mesh.off_weights;
+  const uint32_t count = mesh.count;
   float* const positions = out.positions;
   float* const normals = out.normals;
   float* const tangents = out.tangents;
   const float(*const normal)[4] = b.normal - b.first;
   const float(*const tangent)[4] = b.tangent - b.first;
-  const __m128 scale = _mm_setr_ps(1.0f / 65535.0f, 1.0f / 65535.0f, 1.0f / 65535.0f, 0.0f);
-  const __m128 w_one = _mm_setr_ps(0.0f, 0.0f, 0.0f, 1.0f);
+  const __m256 scale = _mm256_setr_ps(1.0f / 65535.0f, 1.0f / 65535.0f, 1.0f / 65535.0f, 0.0f, 1.0f / 65535.0f,
+                                      1.0f / 65535.0f, 1.0f / 65535.0f, 0.0f);
+  const __m256 w_one = _mm256_setr_ps(0.0f, 0.0f, 0.0f, 1.0f, 0.0f, 0.0f, 0.0f, 1.0f);
+  uint32_t outside = 0;
   for (uint32_t i = 0; i < n; ++i) {
-    const uint32_t v = list[i];
+    const uint32_t v = kRange ? first + i : list[i];
     const uint8_t* vx = base + v * stride;
     __m256 a01, a23;
-    blend_matrix<K, kSlots>(palette, vx, off_joints, off_weights, a01, a23);
+    uint32_t wb;
+    blend_matrix<K, kSlots, kRange>(palette, vx, off_joints, off_weights, a01, a23, wb);
+    if constexpr (kRange) outside |= outside_class<K>(wb);
     if constexpr (kPositions) {
-      const __m128i q = _mm_cvtepu16_epi32(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(vx + off_position)));
-      const __m128 p = _mm_fmadd_ps(_mm_cvtepi32_ps(q), scale, w_one);  // (x, y, z, 1)
-      store3(positions + 3 * static_cast<size_t>(v), transform(a01, a23, p));
+      // The four unorm16 words twice (one duplicating load), widened: (x, y, z, 1) in both lanes.
+      const __m128i q2 = _mm_castpd_si128(_mm_loaddup_pd(reinterpret_cast<const double*>(vx + off_position)));
+      const __m256 p = _mm256_fmadd_ps(_mm256_cvtepi32_ps(_mm256_cvtepu16_epi32(q2)), scale, w_one);
+      store_xyz<kRange>(positions + 3 * static_cast<size_t>(v), transform_dup(a01, a23, p), v + 1 < count);
     }
     if constexpr (kNormals)
-      store3(normals + 3 * static_cast<size_t>(v), transform(a01, a23, _mm_load_ps(normal[v])));
+      store_xyz<kRange>(normals + 3 * static_cast<size_t>(v), transform_dup(a01, a23, _mm256_broadcast_ps(reinterpret_cast<const __m128*>(normal[v]))), v + 1 < count);
     if constexpr (kTangents) {
       const __m128 t = _mm_load_ps(tangent[v]);
       // w of t is the sign: transform xyz only, then put the sign back.
-      const __m128 r = transform(a01, a23, _mm_blend_ps(t, _mm_setzero_ps(), 0x8));
+      const __m128 r = transform_dup(a01, a23, _mm256_blend_ps(_mm256_broadcast_ps(reinterpret_cast<const __m128*>(tangent[v])), _mm256_setzero_ps(), 0x88));
       _mm_storeu_ps(tangents + 4 * static_cast<size_t>(v), _mm_blend_ps(r, t, 0x8));
     }
   }
+  return outside;
 }
 
 // ---- renormalization of the batch's outputs ----
@@ -758,21 +798,28 @@ OSSA_TARGET_AVX2 void normalize_xyz_w(float* p, uint32_t n) {
   }
 }
 
-template <Slots kSlots, bool kPositions, bool kNormals, bool kTangents>
-OSSA_TARGET_AVX2 void skin_batch(const float* palette, const FastMesh& m, const Batch& b, Outputs out) {
-  skin_class<0, kSlots, kPositions, kNormals, kTangents>(b.lists[0], b.count[0], palette, m, b, out);
-  skin_class<1, kSlots, kPositions, kNormals, kTangents>(b.lists[1], b.count[1], palette, m, b, out);
-  skin_class<2, kSlots, kPositions, kNormals, kTangents>(b.lists[2], b.count[2], palette, m, b, out);
-  skin_class<3, kSlots, kPositions, kNormals, kTangents>(b.lists[3], b.count[3], palette, m, b, out);
-  skin_class<4, kSlots, kPositions, kNormals, kTangents>(b.lists[4], b.count[4], palette, m, b, out);
+template <bool kNormals, bool kTangents>
+OSSA_TARGET_AVX2 void normalize_batch(const Batch& b, Outputs out) {
+  if (!out.renormalize) return;
   if constexpr (kNormals) normalize_xyz(out.normals + 3 * static_cast<size_t>(b.first), b.n);
   if constexpr (kTangents) normalize_xyz_w(out.tangents + 4 * static_cast<size_t>(b.first), b.n);
 }
 
 template <Slots kSlots, bool kPositions, bool kNormals, bool kTangents>
-OSSA_TARGET_AVX2 void skin_fast(const float* palette, const FastMesh& m, Outputs out, bool avx512) {
+OSSA_TARGET_AVX2 void skin_batch(const float* palette, const FastMesh& m, const Batch& b, Outputs out) {
+  skin_class<0, false, kSlots, kPositions, kNormals, kTangents>(b.lists[0], 0, b.count[0], palette, m, b, out);
+  skin_class<1, false, kSlots, kPositions, kNormals, kTangents>(b.lists[1], 0, b.count[1], palette, m, b, out);
+  skin_class<2, false, kSlots, kPositions, kNormals, kTangents>(b.lists[2], 0, b.count[2], palette, m, b, out);
+  skin_class<3, false, kSlots, kPositions, kNormals, kTangents>(b.lists[3], 0, b.count[3], palette, m, b, out);
+  skin_class<4, false, kSlots, kPositions, kNormals, kTangents>(b.lists[4], 0, b.count[4], palette, m, b, out);
+  normalize_batch<kNormals, kTangents>(b, out);
+}
+
+/// Vertices [first, count) batch by batch, each classified first (any vertex order).
+template <Slots kSlots, bool kPositions, bool kNormals, bool kTangents>
+OSSA_TARGET_AVX2 void skin_classified(const float* palette, const FastMesh& m, Outputs out, bool avx512, uint32_t first) {
   Batch b;
-  for (uint32_t first = 0; first < m.count; first += kBatch) {
+  for (; first < m.count; first += kBatch) {
     b.first = first;
     b.n = std::min(kBatch, m.count - first);
     if (avx512) classify_avx512(m, b);
@@ -780,6 +827,80 @@ OSSA_TARGET_AVX2 void skin_fast(const float* palette, const FastMesh& m, Outputs
     if constexpr (kNormals || kTangents) decode_directions<kTangents>(m, b);
     skin_batch<kSlots, kPositions, kNormals, kTangents>(palette, m, b, out);
   }
+}
+
+// ---- meshes ordered by influence class ----
+//
+// The cooker orders a skinned mesh's vertices by class (cooker/mesh/mesh_build.cpp,
+// influence_class_order), so the classes are five contiguous ranges and each runs its loop straight
+// through: no classification pass, no lists, outputs written in order. Nothing is trusted: the
+// range ends come from a binary search that assumes the order, and every range loop checks each
+// vertex it skins against its class (outside_class, one shift and OR on bytes it loads anyway).
+// A range that fails is redone, with everything after it, by the classified path; a mesh whose
+// first kOrderProbe vertices are out of order (an older cook, another tool's file) goes there
+// from the start, so it pays a 64-vertex probe and nothing else.
+
+constexpr uint32_t kOrderProbe = 64;
+
+inline uint32_t weight_word(const FastMesh& m, uint32_t v) {
+  return load_u32(m.base + static_cast<size_t>(v) * m.stride + m.off_weights);
+}
+
+/// The class skin_batch would give these weight bytes (see kClasses).
+inline int class_of(uint32_t w) {
+  if (w == 255u) return 0;
+  return 1 + (w >= (1u << 8)) + (w >= (1u << 16)) + (w >= (1u << 24));
+}
+
+/// Whether the first kOrderProbe vertices' classes never decrease.
+inline bool ordered_start(const FastMesh& m) {
+  const uint32_t n = std::min(m.count, kOrderProbe);
+  int last = 0;
+  for (uint32_t v = 0; v < n; ++v) {
+    const int c = class_of(weight_word(m, v));
+    if (c < last) return false;
+    last = c;
+  }
+  return true;
+}
+
+/// First vertex in [lo, count) whose class exceeds c, assuming classes never decrease.
+inline uint32_t class_end(const FastMesh& m, uint32_t lo, int c) {
+  uint32_t hi = m.count;
+  while (lo < hi) {
+    const uint32_t mid = lo + (hi - lo) / 2;
+    if (class_of(weight_word(m, mid)) > c) hi = mid;
+    else lo = mid + 1;
+  }
+  return lo;
+}
+
+template <Slots kSlots, bool kPositions, bool kNormals, bool kTangents>
+OSSA_TARGET_AVX2 void skin_fast(const float* palette, const FastMesh& m, Outputs out, bool avx512) {
+  if (!ordered_start(m)) {
+    skin_classified<kSlots, kPositions, kNormals, kTangents>(palette, m, out, avx512, 0);
+    return;
+  }
+  Batch b;
+  uint32_t begin = 0;
+  const auto run = [&](auto k) -> bool {
+    constexpr int K = decltype(k)::value;
+    const uint32_t end = K == kClasses - 1 ? m.count : class_end(m, begin, K);
+    for (b.first = begin; b.first < end; b.first += kBatch) {
+      b.n = std::min(kBatch, end - b.first);
+      if constexpr (kNormals || kTangents) decode_directions<kTangents>(m, b);
+      if (skin_class<K, true, kSlots, kPositions, kNormals, kTangents>(nullptr, b.first, b.n, palette, m, b, out) != 0) {
+        skin_classified<kSlots, kPositions, kNormals, kTangents>(palette, m, out, avx512, b.first);
+        return false;
+      }
+      normalize_batch<kNormals, kTangents>(b, out);
+    }
+    begin = end;
+    return true;
+  };
+  run(std::integral_constant<int, 0>{}) && run(std::integral_constant<int, 1>{}) &&
+      run(std::integral_constant<int, 2>{}) && run(std::integral_constant<int, 3>{}) &&
+      run(std::integral_constant<int, 4>{});
 }
 
 template <Slots kSlots, bool kPositions>
@@ -926,6 +1047,7 @@ void skin_cpu(const MeshView& mesh, std::span<const glm::mat4> palette, Skinning
   // fit (or, with too small a palette, everything) rather than read or write out of bounds.
   const size_t n = m.count;
   Outputs o;
+  o.renormalize = out.renormalize;
   if (!out.positions.empty()) {
     assert(out.positions.size() >= 3 * n);
     if (out.positions.size() >= 3 * n) o.positions = out.positions.data();

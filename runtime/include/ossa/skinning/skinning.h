@@ -45,11 +45,17 @@ struct SkinnedStreams {
   std::span<float> positions;
   std::span<float> normals;
   std::span<float> tangents;
+  /// Normals and tangents come out unit length (true), or as the blended matrix transforms them
+  /// (false: within a few percent of unit length where neighbouring joints' rotations differ, as
+  /// blended rotations shrink vectors). A renderer that normalizes in its shaders anyway saves
+  /// the pass (~0.4 ns a vertex with normals on arnaud; ozz-animation's SkinningJob never
+  /// normalizes).
+  bool renormalize = true;
 };
 
 /// Skins every vertex of `mesh` with `palette` (from skinning_matrices), decoding the quantized
 /// or float layout. Normals and tangents are transformed by the blended matrix's linear part and
-/// renormalized; since the palette holds D, directions are first divided by position_scale, so
+/// renormalized (unless out.renormalize is false); since the palette holds D, directions are first divided by position_scale, so
 /// they see model * inverse_bind only (a GPU shader must do the same). Tangent w is the stored
 /// bitangent sign (+-1). All-zero weights give zero outputs. Sizes are preconditions (asserted;
 /// a release build skips a stream that does not fit, or everything for a too-small palette).
