@@ -9,19 +9,12 @@
 #include <memory>
 #include <string>
 
-#include <benchmark/benchmark.h>
-
-#include "bench/machine.h"
 #include "cooker/cook.h"
 
 namespace ossa::bench {
 namespace fs = std::filesystem;
 
 namespace {
-
-// Google Benchmark prints custom context in its header: the CPU model and the code paths taken
-// (machine.h) head every ossa-bench-anim run, console or JSON.
-const bool kMachineContext = (benchmark::AddCustomContext("machine", machine_line()), true);
 
 Asset open_or_die(const fs::path& p) {
   auto a = Asset::open(p.string());

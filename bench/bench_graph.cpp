@@ -1,6 +1,7 @@
 // bench_graph.cpp — ossa-bench-graph: how many characters can play the Pab sample graph per frame.
 //
 //   ossa-bench-graph [--file CHARACTER.ossa --graph NAME] [--frames N] [--repeat N] [--characters N]
+//                    [--clone baseline|avx2|avx512]   (bench/machine.h)
 //
 // Without --file it cooks assets/Pab/pab.graph.json (the sample graph: a walk/jog/run blend space,
 // a sprint state, a standing pose, crossed arms layered on the upper body, every transition mode)
@@ -134,6 +135,11 @@ int main(int argc, char** argv) {
   std::string file, graph_name;
   int frames = 300, repeat = 5;
   std::vector<size_t> counts = {1, 100, 1000};
+  std::string clone_error;
+  if (!ossa::bench::apply_clone(argc, argv, &clone_error)) {
+    std::fprintf(stderr, "ossa-bench-graph: %s\n", clone_error.c_str());
+    return 2;
+  }
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--file" && i + 1 < argc) file = argv[++i];
@@ -142,7 +148,7 @@ int main(int argc, char** argv) {
     else if (a == "--repeat" && i + 1 < argc) repeat = std::max(1, std::atoi(argv[++i]));
     else if (a == "--characters" && i + 1 < argc) counts = {static_cast<size_t>(std::max(1, std::atoi(argv[++i])))};
     else {
-      std::fprintf(stderr, "usage: ossa-bench-graph [--file CHARACTER.ossa --graph NAME] [--frames N] [--repeat N] [--characters N]\n");
+      std::fprintf(stderr, "usage: ossa-bench-graph [--file CHARACTER.ossa --graph NAME] [--frames N] [--repeat N] [--characters N] [--clone baseline|avx2|avx512]\n");
       return 2;
     }
   }

@@ -4,6 +4,9 @@
 #include <fstream>
 #include <thread>
 
+#include <cstring>
+
+#include <ossa/anim/vector_isa.h>
 #include <ossa/skinning/skinning.h>
 
 namespace ossa::bench {
@@ -24,11 +27,8 @@ std::string cpuinfo(const std::string& key) {
 }
 
 const char* vector_clone() {
-#if defined(__x86_64__) && defined(__ELF__) && (defined(__GNUC__) || defined(__clang__)) && !defined(OSSA_NO_TARGET_CLONES)
-  return __builtin_cpu_supports("avx2") ? "avx2" : "baseline";
-#else
-  return "baseline (no target_clones on this platform)";
-#endif
+  if (vector_isa() == VectorIsa::Avx2) return "avx2";
+  return best_vector_isa() == VectorIsa::Avx2 ? "baseline (forced)" : "baseline";
 }
 
 const char* skinning_name(SkinningIsa isa) {
@@ -45,6 +45,42 @@ std::string machine_line() {
   return "cpu: " + cpuinfo("model name") + " (family " + cpuinfo("cpu family") + ", model " + cpuinfo("model") + ", " +
          std::to_string(std::thread::hardware_concurrency()) + " logical cpus); vector clones: " + vector_clone() +
          "; skinning: " + skinning_name(skinning_isa());
+}
+
+bool apply_clone(int& argc, char** argv, std::string* error) {
+  for (int i = 1; i < argc; ++i) {
+    std::string name;
+    int taken = 0;
+    if (std::strcmp(argv[i], "--clone") == 0 && i + 1 < argc) {
+      name = argv[i + 1];
+      taken = 2;
+    } else if (std::strncmp(argv[i], "--clone=", 8) == 0) {
+      name = argv[i] + 8;
+      taken = 1;
+    } else if (std::strcmp(argv[i], "--clone") == 0) {
+      *error = "--clone needs a value: baseline, avx2 or avx512";
+      return false;
+    } else {
+      continue;
+    }
+    bool ok = false;
+    if (name == "baseline") ok = set_vector_isa(VectorIsa::Baseline) && set_skinning_isa(SkinningIsa::Portable);
+    else if (name == "avx2") ok = set_vector_isa(VectorIsa::Avx2) && set_skinning_isa(SkinningIsa::Avx2);
+    else if (name == "avx512") ok = set_vector_isa(VectorIsa::Avx2) && set_skinning_isa(SkinningIsa::Avx512);
+    else {
+      *error = "--clone " + name + ": unknown (baseline, avx2 or avx512)";
+      return false;
+    }
+    if (!ok) {
+      *error = "--clone " + name + ": this CPU or build cannot run it";
+      return false;
+    }
+    for (int j = i; j + taken < argc; ++j) argv[j] = argv[j + taken];
+    argc -= taken;
+    argv[argc] = nullptr;
+    --i;
+  }
+  return true;
 }
 
 }  // namespace ossa::bench

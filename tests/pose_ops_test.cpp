@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <optional>
 #include <random>
@@ -27,6 +28,7 @@
 #include <ossa/loader/asset.h>
 #include <ossa/anim/pose.h>
 #include <ossa/anim/pose_ops.h>
+#include <ossa/anim/vector_isa.h>
 #include "test_files.h"
 
 namespace {
@@ -681,3 +683,53 @@ TEST(LocalToModel, BadParentsAreRootsAndShortSpansAreRespected) {
 }
 
 }  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// The two compiled copies of the per-joint loops (ossa/anim/vector_isa.h)
+
+TEST(VectorIsa, BothCopiesGiveBitIdenticalPoses) {
+  // The AVX2 and baseline copies use IEEE add / sub / mul / div only (no FMA), so every kernel
+  // must agree bit for bit, whichever copy a benchmark or a CPU picks. On a CPU or build without
+  // the AVX2 copy, set_vector_isa must refuse it and leave the baseline selected.
+  if (ossa::best_vector_isa() != ossa::VectorIsa::Avx2) {
+    EXPECT_FALSE(ossa::set_vector_isa(ossa::VectorIsa::Avx2));
+    EXPECT_EQ(ossa::vector_isa(), ossa::VectorIsa::Baseline);
+    GTEST_SKIP() << "no AVX2 copy on this CPU or build";
+  }
+  constexpr uint32_t kMany = 67;
+  const Pose a = random_pose(kMany, 200), b = random_pose(kMany, 201), c = random_pose(kMany, 202);
+  std::vector<int16_t> parents(kMany);
+  for (uint32_t j = 0; j < kMany; ++j) parents[j] = static_cast<int16_t>(j == 0 ? -1 : (j - 1) / 2);
+  std::vector<float> mask(kMany);
+  for (uint32_t j = 0; j < kMany; ++j) mask[j] = static_cast<float>(j % 5) / 4.0f;
+  struct Out {
+    Pose blend{kMany}, blend_n{kMany}, layered{kMany}, additive{kMany}, added{kMany};
+    std::vector<glm::mat4> model = std::vector<glm::mat4>(kMany);
+  };
+  const auto run = [&](ossa::VectorIsa isa, Out& o) {
+    ASSERT_TRUE(ossa::set_vector_isa(isa));
+    EXPECT_EQ(ossa::vector_isa(), isa);
+    ossa::blend(a, b, 0.37f, o.blend);
+    const ConstPoseSpan in[3] = {a, b, c};
+    const float w[3] = {0.2f, 0.5f, 0.3f};
+    ossa::blend_n(in, w, o.blend_n);
+    ossa::blend_layered(a, b, mask, 0.8f, o.layered);
+    ossa::make_additive(b, a, o.additive);
+    ossa::add(c, o.additive, 0.6f, o.added);
+    ossa::local_to_model(parents, o.added, o.model);
+  };
+  Out avx2, baseline;
+  run(ossa::VectorIsa::Avx2, avx2);
+  run(ossa::VectorIsa::Baseline, baseline);
+  ossa::set_vector_isa(ossa::best_vector_isa());
+  const auto same = [](const Pose& x, const Pose& y) {
+    const ConstPoseSpan sx = x, sy = y;
+    return std::memcmp(sx.base, sy.base, sizeof(float) * 10 * sx.stride) == 0;
+  };
+  EXPECT_TRUE(same(avx2.blend, baseline.blend));
+  EXPECT_TRUE(same(avx2.blend_n, baseline.blend_n));
+  EXPECT_TRUE(same(avx2.layered, baseline.layered));
+  EXPECT_TRUE(same(avx2.additive, baseline.additive));
+  EXPECT_TRUE(same(avx2.added, baseline.added));
+  EXPECT_EQ(std::memcmp(avx2.model.data(), baseline.model.data(), sizeof(glm::mat4) * kMany), 0);
+}

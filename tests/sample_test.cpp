@@ -29,6 +29,7 @@
 #include <ossa/loader/asset.h>
 #include <ossa/anim/pose.h>
 #include <ossa/anim/sample.h>
+#include <ossa/anim/vector_isa.h>
 #include "test_files.h"
 
 namespace ossa {
@@ -446,6 +447,30 @@ TEST(Sample, CacheIsInvisibleOnSyntheticClips) {
       expect_cache_invisible(f.clip(), f.skeleton(), random_times(f.clip(), 200, 3), o, "seek");
     }
   }
+}
+
+TEST(Sample, BothVectorCopiesGiveBitIdenticalPoses) {
+  // Sampling's interpolation kernel is compiled for AVX2 and the baseline (vector_isa.h); with no
+  // FMA in either, a pose must not depend on which copy ran.
+  if (ossa::best_vector_isa() != ossa::VectorIsa::Avx2) GTEST_SKIP() << "no AVX2 copy on this CPU or build";
+  int checked = 0;
+  for (const auto& [name, spec] : test::valid_variants()) {
+    if (spec.clips.empty() || !spec.skeleton || spec.clips[0].skeleton_hash) continue;
+    const Loaded f = load(spec);
+    const auto joints = static_cast<uint32_t>(f.skeleton().joint_count());
+    SamplingCache ca = cache_for(f.clip(), f.skeleton()), cb = cache_for(f.clip(), f.skeleton());
+    Pose a(joints), b(joints);
+    for (const float t : playback(f.clip(), 1.0f, 120, true)) {
+      ASSERT_TRUE(ossa::set_vector_isa(ossa::VectorIsa::Avx2));
+      sample(f.clip(), t, {}, ca, a);
+      ASSERT_TRUE(ossa::set_vector_isa(ossa::VectorIsa::Baseline));
+      sample(f.clip(), t, {}, cb, b);
+      ASSERT_TRUE(same_bits(a, b)) << name << " at t=" << t;
+      ++checked;
+    }
+  }
+  ossa::set_vector_isa(ossa::best_vector_isa());
+  EXPECT_GT(checked, 0);
 }
 
 TEST(AdvanceTime, WrapsClampsAndCountsLoops) {

@@ -135,8 +135,7 @@ OSSA_INLINE Columns mul_affine(const Columns& p, const AffineLanes& a, size_t l)
 
 }  // namespace
 
-OSSA_VECTOR_CLONES
-void local_to_model(std::span<const int16_t> parents, ConstPoseSpan local, std::span<glm::mat4> out_model) {
+OSSA_INLINE static void local_to_model_body(std::span<const int16_t> parents, ConstPoseSpan local, std::span<glm::mat4> out_model) {
   const size_t n = std::min({size_t(local.joint_count), parents.size(), out_model.size()});
   AffineLanes a;
   Columns previous{};  // model matrix of joint i - 1
@@ -161,5 +160,7 @@ void local_to_model(std::span<const int16_t> parents, ConstPoseSpan local, std::
     }
   }
 }
+
+OSSA_VECTOR_DISPATCH(local_to_model, (std::span<const int16_t> parents, ConstPoseSpan local, std::span<glm::mat4> out_model), (parents, local, out_model))
 
 }  // namespace ossa

@@ -5,7 +5,7 @@
 // inner loop over the 8 lanes of a block. The inner loop has a fixed trip count that is a
 // multiple of every vector width, so GCC's -O2 vectorizer (cost model "very cheap": no peeling,
 // no epilogue, no run-time alias checks) turns it into 4-wide SSE code, and into 8-wide AVX code
-// in the avx2 clone that OSSA_VECTOR_CLONES asks for; the default clone runs on any x86-64.
+// in the avx2 copy that OSSA_VECTOR_DISPATCH compiles; the baseline copy runs on any x86-64.
 // `#pragma GCC ivdep` states what the API promises: an output is either a different pose or the
 // very same pose as an input (same lane, same component), never a shifted copy of it, so lanes do
 // not depend on each other. Check with -fopt-info-vec: every inner lane loop reports
@@ -234,8 +234,7 @@ OSSA_INLINE void blend_n_pass(ConstPoseSpan ref, const ConstPoseSpan (&in)[3], c
 
 }  // namespace
 
-OSSA_VECTOR_CLONES
-void blend(ConstPoseSpan a, ConstPoseSpan b, float alpha, PoseSpan out) {
+OSSA_INLINE static void blend_body(ConstPoseSpan a, ConstPoseSpan b, float alpha, PoseSpan out) {
   const float t = clamp01(alpha);
   // The ends are copies: exact, and cheaper than blending with a zero weight.
   if (t == 0.0f) return copy_pose(a, out);
@@ -250,8 +249,9 @@ void blend(ConstPoseSpan a, ConstPoseSpan b, float alpha, PoseSpan out) {
   normalize_rotations(out.base + r, stride, stride);
 }
 
-OSSA_VECTOR_CLONES
-void blend_n(std::span<const ConstPoseSpan> poses, std::span<const float> weights, PoseSpan out) {
+OSSA_VECTOR_DISPATCH(blend, (ConstPoseSpan a, ConstPoseSpan b, float alpha, PoseSpan out), (a, b, alpha, out))
+
+OSSA_INLINE static void blend_n_body(std::span<const ConstPoseSpan> poses, std::span<const float> weights, PoseSpan out) {
   const size_t count = std::min(poses.size(), weights.size());
   if (count == 0) return set_identity(out);
   // Normalize the weights; a non-positive (or NaN) total has no meaningful blend, so the first
@@ -307,8 +307,9 @@ void blend_n(std::span<const ConstPoseSpan> poses, std::span<const float> weight
   reset_padding(out);
 }
 
-OSSA_VECTOR_CLONES
-void blend_layered(ConstPoseSpan base, ConstPoseSpan layer, std::span<const float> joint_weights, float weight,
+OSSA_VECTOR_DISPATCH(blend_n, (std::span<const ConstPoseSpan> poses, std::span<const float> weights, PoseSpan out), (poses, weights, out))
+
+OSSA_INLINE static void blend_layered_body(ConstPoseSpan base, ConstPoseSpan layer, std::span<const float> joint_weights, float weight,
                    PoseSpan out) {
   const size_t stride = common_stride(base, layer, out);
   // Joints past joint_weights (and padding lanes) get weight 0: they keep the base pose.
@@ -333,6 +334,8 @@ void blend_layered(ConstPoseSpan base, ConstPoseSpan layer, std::span<const floa
   }
 }
 
+OSSA_VECTOR_DISPATCH(blend_layered, (ConstPoseSpan base, ConstPoseSpan layer, std::span<const float> joint_weights, float weight, PoseSpan out), (base, layer, joint_weights, weight, out))
+
 void build_joint_mask(std::span<const int16_t> parents, int joint, int depth, std::span<float> out) {
   const size_t n = std::min(parents.size(), out.size());
   if (joint < 0 || size_t(joint) >= n) return;
@@ -356,8 +359,7 @@ void build_joint_mask(std::span<const int16_t> parents, int joint, int depth, st
     if (out[i] < 0.0f) out[i] = 1.0f;
 }
 
-OSSA_VECTOR_CLONES
-void make_additive(ConstPoseSpan pose, ConstPoseSpan reference, PoseSpan out_additive) {
+OSSA_INLINE static void make_additive_body(ConstPoseSpan pose, ConstPoseSpan reference, PoseSpan out_additive) {
   const size_t stride = common_stride(pose, reference, out_additive);
   const float *p = pose.base, *r = reference.base;
   float* o = out_additive.base;
@@ -385,8 +387,9 @@ OSSA_IVDEP
   }
 }
 
-OSSA_VECTOR_CLONES
-void add(ConstPoseSpan base, ConstPoseSpan additive, float weight, PoseSpan out) {
+OSSA_VECTOR_DISPATCH(make_additive, (ConstPoseSpan pose, ConstPoseSpan reference, PoseSpan out_additive), (pose, reference, out_additive))
+
+OSSA_INLINE static void add_body(ConstPoseSpan base, ConstPoseSpan additive, float weight, PoseSpan out) {
   const size_t stride = common_stride(base, additive, out);
   const float *b = base.base, *d = additive.base;
   float* o = out.base;
@@ -421,5 +424,7 @@ OSSA_IVDEP
   }
   normalize_rotations(o + r, stride, stride);
 }
+
+OSSA_VECTOR_DISPATCH(add, (ConstPoseSpan base, ConstPoseSpan additive, float weight, PoseSpan out), (base, additive, weight, out))
 
 }  // namespace ossa

@@ -14,8 +14,8 @@
 //      (ossa/format/clip_codec.h);
 //   2. one loop over all joints (SoA, 8-lane blocks): lerp T and S, nlerp R with the shortest-arc
 //      sign fix, write the pose. It is written with vector extensions, and on x86-64 compiled
-//      twice (target_clones: AVX2 and the SSE2 baseline, picked at load time), so the default
-//      build still runs on any x86-64. A block with no animated channel of a kind copies that
+//      twice (AVX2 and the SSE2 baseline, picked per call: internal/vector_clones.h), so the
+//      default build still runs on any x86-64. A block with no animated channel of a kind copies that
 //      kind's fixed values instead of interpolating them.
 // Rotations are stored with one component >= 0 (clip_codec.h drops it), so two neighbouring keys
 // may lie in opposite hemispheres; the sign fix in pass 2 (flip b when dot(a, b) < 0) keeps the
@@ -53,6 +53,7 @@
 
 #include <ossa/format/clip_codec.h>
 #include "internal/memory.h"
+#include "internal/vector_clones.h"
 
 namespace ossa {
 
@@ -301,7 +302,7 @@ void move_run(State& s, Run& r, float frame) {
 // rather than left to the auto-vectorizer: at -O2 GCC will not vectorize a loop that calls sqrt
 // (it must keep errno) or that has selects it cannot if-convert under trapping math, and both are
 // in an nlerp. The same source compiles to one 256-bit op per line in the AVX2 clone and to two
-// SSE2 ops in the baseline clone (target_clones picks at load time), or to scalar code elsewhere.
+// SSE2 ops in the baseline clone (vector_clones.h picks per call), or to scalar code elsewhere.
 
 // The helpers take and return 32-byte vectors by value, which GCC warns changes the ABI between
 // AVX and non-AVX callers; they are always inlined into this file's kernels, so no ABI is involved.
@@ -309,7 +310,6 @@ void move_run(State& s, Run& r, float frame) {
 #if defined(__GNUC__)
 #pragma GCC diagnostic ignored "-Wpsabi"
 #endif
-#define OSSA_INLINE inline __attribute__((always_inline))
 
 using F8 = float __attribute__((vector_size(32)));
 using I8 = int32_t __attribute__((vector_size(32)));
@@ -353,13 +353,8 @@ OSSA_INLINE F8 sqrt8(const F8& x) {
 #endif
 }
 
-// target_clones needs an ifunc, so only ELF targets (Linux) get the clones; Windows (PE) builds
-// compile the kernels once for the baseline, as internal/vector_clones.h does.
-#if defined(__x86_64__) && defined(__ELF__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_ADDRESS__)
-#define OSSA_SAMPLE_CLONES __attribute__((target_clones("avx2", "default")))
-#else
-#define OSSA_SAMPLE_CLONES
-#endif
+// The kernel below is compiled for AVX2 and the baseline and picked per call
+// (internal/vector_clones.h: OSSA_VECTOR_DISPATCH; ossa/anim/vector_isa.h selects).
 
 struct Lanes {
   const float* k0;
@@ -374,8 +369,7 @@ struct Lanes {
 
 constexpr uint8_t kAnimatedT = 1, kAnimatedR = 2, kAnimatedS = 4;
 
-OSSA_SAMPLE_CLONES
-void interpolate_nlerp(const Lanes& l, float frame) {
+OSSA_INLINE static void interpolate_nlerp_body(const Lanes& l, float frame) {
   const size_t n = l.stride;
   const float* k0 = l.k0;
   const float* k1 = l.k1;
@@ -440,6 +434,8 @@ void interpolate_nlerp(const Lanes& l, float frame) {
     store8(out + kRw * n + j, rw * scale);
   }
 }
+
+OSSA_VECTOR_DISPATCH(interpolate_nlerp, (const Lanes& l, float frame), (l, frame))
 
 /// Slerp variant (an option, not the hot path): translations and scales as above, rotations at
 /// constant angular velocity, falling back to nlerp where the keys are nearly equal.

@@ -56,3 +56,51 @@ bool cpu_has_avx2_fma() { return features().avx2_fma; }
 bool cpu_has_avx512() { return features().avx512; }
 
 }  // namespace ossa::detail
+
+// ---------------------------------------------------------------------------------------------
+// The per-joint loops' copy (ossa/anim/vector_isa.h, internal/vector_clones.h). AVX2 alone is
+// what those copies need (they use no FMA), so the test is avx2 with the OS's YMM state, which
+// libgcc's cpu model includes.
+
+#include <atomic>
+
+#include <ossa/anim/vector_isa.h>
+#include "internal/vector_clones.h"
+
+namespace ossa {
+namespace {
+
+bool cpu_has_avx2() {
+#if OSSA_HAVE_VECTOR_CLONES
+  __builtin_cpu_init();
+  return __builtin_cpu_supports("avx2");
+#else
+  return false;
+#endif
+}
+
+std::atomic<bool>& avx2_selected() {
+  static std::atomic<bool> selected{cpu_has_avx2()};
+  return selected;
+}
+
+}  // namespace
+
+VectorIsa best_vector_isa() {
+  static const VectorIsa best = cpu_has_avx2() ? VectorIsa::Avx2 : VectorIsa::Baseline;
+  return best;
+}
+
+VectorIsa vector_isa() { return avx2_selected().load(std::memory_order_relaxed) ? VectorIsa::Avx2 : VectorIsa::Baseline; }
+
+bool set_vector_isa(VectorIsa isa) {
+  if (isa == VectorIsa::Avx2 && best_vector_isa() != VectorIsa::Avx2) return false;
+  avx2_selected().store(isa == VectorIsa::Avx2, std::memory_order_relaxed);
+  return true;
+}
+
+namespace detail {
+bool vector_avx2_selected() { return avx2_selected().load(std::memory_order_relaxed); }
+}  // namespace detail
+
+}  // namespace ossa

@@ -1,0 +1,324 @@
+// bench_guard.cpp — ossa-bench-guard: a performance regression guard that machine speed and noise
+// cannot fool, run by CTest (bench_guard) on every CI machine.
+//
+//   ossa-bench-guard [--trials N]
+//
+// Absolute times on shared CI machines move by 2x between runs and CPUs (the same kernel measured
+// 125 ns on one VM of a kind and 250 ns on another), so no absolute time is checked. Each line
+// times one of ossa's kernels against a reference in the same process, on the same data,
+// interleaved trial by trial, and checks the ratio of the two minimums: machine speed cancels, and
+// the minimum of many short trials discards the trials a neighbour interrupted. The references:
+//   skin.isa     skin_cpu's vectorized path / its portable path (arnaud, positions + normals)
+//   skin.order   arnaud as cooked (class-ordered ranges) / the same vertices dealt across classes
+//                (positions only: where the ordering shows most)
+//   l2m          local_to_model / a per-joint GLM loop (TRS matrices, generic products)
+//   blend3       blend_n of three poses / a per-joint GLM loop (weighted sums, nlerp)
+//   clone.avx2   blend_n + local_to_model in their AVX2 copy / in their baseline copy (AVX2 CPUs)
+//   sample       forward playback at 60 Hz / sampling from a reset cache (every key decoded)
+//   load         Asset::open (map, verify, every semantic check) / open + read + close of the bytes
+// Each limit sits at about 2-3x the ratio measured when it was set (see each row's comment in
+// main), so only a large regression fails — a lost fast path, an accidental O(n^2), a
+// verify pass run twice — never a noisy neighbour. Exit status: 0 all within limits, 1 otherwise;
+// a build without NDEBUG (debug, sanitizers) prints the table and skips (77), since its ratios
+// mean nothing. Output: one tab-separated row per check, after the machine line.
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <functional>
+#include <optional>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/quaternion.hpp>
+
+#include "bench/bench_fixture.h"
+#include "bench/machine.h"
+#include <ossa/anim/pose.h>
+#include <ossa/anim/pose_ops.h>
+#include <ossa/anim/sample.h>
+#include <ossa/anim/vector_isa.h>
+#include <ossa/skinning/skinning.h>
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+volatile uint32_t g_sink = 0;
+
+/// Minimum seconds per call of each side over `trials` interleaved trials of `reps` calls.
+std::pair<double, double> interleaved_min(int trials, int reps, const std::function<void()>& a,
+                                          const std::function<void()>& b) {
+  double best_a = 1e30, best_b = 1e30;
+  for (int i = 0; i < 2; ++i) a(), b();  // warm caches and branch predictors
+  for (int t = 0; t < trials; ++t) {
+    for (int side = 0; side < 2; ++side) {
+      const std::function<void()>& f = side == 0 ? a : b;
+      const auto start = Clock::now();
+      for (int r = 0; r < reps; ++r) f();
+      const double s = std::chrono::duration<double>(Clock::now() - start).count() / reps;
+      (side == 0 ? best_a : best_b) = std::min(side == 0 ? best_a : best_b, s);
+    }
+  }
+  return {best_a, best_b};
+}
+
+struct Row {
+  const char* name;
+  double ossa_ns, reference_ns, limit;
+  double ratio() const { return ossa_ns / reference_ns; }
+};
+
+/// The dealt copy of a class-ordered mesh's file (see bench_anim_skin.cpp's BM_SkinOrder).
+std::vector<uint8_t> dealt_copy(const ossa::Asset& asset) {
+  const std::span<const uint8_t> file = asset.bytes();
+  const ossa::MeshView mesh = asset.mesh(0);
+  std::vector<uint8_t> out(file.begin(), file.end());
+  const size_t at = static_cast<size_t>(mesh.vertex_bytes().data() - file.data());
+  const size_t stride = mesh.vertex_stride();
+  const uint32_t weights = mesh.attribute(ossa::fb::VertexSemantic::Weights)->offset();
+  std::vector<std::vector<uint32_t>> runs;
+  uint32_t last = ~0u;
+  for (uint32_t v = 0; v < mesh.vertex_count(); ++v) {
+    uint32_t w;
+    std::memcpy(&w, mesh.vertex_bytes().data() + v * stride + weights, 4);
+    const uint32_t c = w == 255u ? 0u : 1u + (w >= (1u << 8)) + (w >= (1u << 16)) + (w >= (1u << 24));
+    if (c != last) runs.emplace_back();
+    runs.back().push_back(v);
+    last = c;
+  }
+  size_t n = 0;
+  for (size_t i = 0; n < mesh.vertex_count(); ++i)
+    for (const auto& run : runs)
+      if (i < run.size()) std::memcpy(out.data() + at + n++ * stride, mesh.vertex_bytes().data() + run[i] * stride, stride);
+  return out;
+}
+
+bool read_whole(const fs::path& path, std::vector<char>& buffer) {
+  const int fd = ::open(path.c_str(), O_RDONLY);
+  if (fd < 0) return false;
+  size_t got = 0;
+  while (got < buffer.size()) {
+    const ssize_t n = ::read(fd, buffer.data() + got, buffer.size() - got);
+    if (n <= 0) break;
+    got += static_cast<size_t>(n);
+  }
+  ::close(fd);
+  return got == buffer.size();
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  int trials = 25;
+  for (int i = 1; i < argc; ++i) {
+    if (std::strcmp(argv[i], "--trials") == 0 && i + 1 < argc) {
+      trials = std::max(3, std::atoi(argv[++i]));
+    } else {
+      std::fprintf(stderr, "usage: ossa-bench-guard [--trials N]\n");
+      return 2;
+    }
+  }
+  std::printf("# %s\n", ossa::bench::machine_line().c_str());
+  const ossa::bench::BenchData& data = ossa::bench::bench_data();
+  const ossa::SkeletonView skeleton = data.skeleton.skeleton();
+  const uint32_t joints = static_cast<uint32_t>(skeleton.joint_count());
+  std::vector<Row> rows;
+
+  // Skinning: a posed palette, arnaud's positions and normals.
+  const ossa::MeshView mesh = data.arnaud.mesh(0);
+  ossa::Pose pose(joints);
+  ossa::set_bind_pose(skeleton, pose);
+  std::mt19937 gen(29);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  for (uint32_t j = 0; j < joints; ++j) {
+    ossa::Transform t = ossa::get_transform(pose, j);
+    t.rotation = glm::normalize(t.rotation * glm::angleAxis(0.1f * u(gen), glm::normalize(glm::vec3(u(gen), u(gen), 1.0f))));
+    ossa::set_transform(pose, j, t);
+  }
+  std::vector<glm::mat4> model(joints), palette(std::max<size_t>(1, mesh.joints().size()));
+  ossa::local_to_model(skeleton.parents(), pose, model);
+  ossa::skinning_matrices(mesh, model, palette);
+  std::vector<float> positions(3 * size_t(mesh.vertex_count())), normals(positions.size());
+  const ossa::SkinnedStreams streams{positions, normals, {}};
+  const ossa::SkinnedStreams positions_only{positions, {}, {}};
+  const auto skin = [&](const ossa::MeshView& m, const ossa::SkinnedStreams& out) {
+    return [&, m] {
+      ossa::skin_cpu(m, palette, ossa::SkinningMethod::Linear, out);
+      g_sink = g_sink + static_cast<uint32_t>(positions[0]);
+    };
+  };
+  {
+    const ossa::SkinningIsa best = ossa::skinning_isa();
+    double fast = 1e30, portable = 1e30;
+    for (int t = 0; t < trials; ++t) {  // the ISA switch is process-wide: interleave by hand
+      for (ossa::SkinningIsa isa : {best, ossa::SkinningIsa::Portable}) {
+        ossa::set_skinning_isa(isa);
+        const auto [s, unused] = interleaved_min(1, 4, skin(mesh, streams), [] {});
+        (void)unused;
+        (isa == best ? fast : portable) = std::min(isa == best ? fast : portable, s);
+      }
+    }
+    ossa::set_skinning_isa(best);
+    rows.push_back({"skin.isa", fast * 1e9, portable * 1e9, best == ossa::SkinningIsa::Portable ? 1.5 : 0.35});  // 0.13 measured
+  }
+  const std::vector<uint8_t> dealt_bytes = dealt_copy(data.arnaud);
+  auto dealt = ossa::Asset::from_bytes(dealt_bytes, "arnaud-dealt");
+  if (!dealt) {
+    std::fprintf(stderr, "ossa-bench-guard: %s\n", dealt.error().message.c_str());
+    return 1;
+  }
+  {
+    const auto [ordered, classified] = interleaved_min(trials, 8, skin(mesh, positions_only), skin(dealt->mesh(0), positions_only));
+    rows.push_back({"skin.order", ordered * 1e9, classified * 1e9, 0.95});  // 0.71-0.76 measured
+  }
+
+  // Local to model against GLM.
+  std::vector<glm::mat4> reference(joints);
+  const std::span<const int16_t> parents = skeleton.parents();
+  {
+    const auto [ossa_s, glm_s] = interleaved_min(
+        trials, 64, [&] { ossa::local_to_model(parents, pose, model); g_sink = g_sink + static_cast<uint32_t>(model[1][3][0]); },
+        [&] {
+          for (uint32_t j = 0; j < joints; ++j) {
+            const ossa::Transform t = ossa::get_transform(pose, j);
+            const glm::mat4 local = glm::translate(glm::mat4(1.0f), t.translation) * glm::mat4_cast(t.rotation) *
+                                    glm::scale(glm::mat4(1.0f), t.scale);
+            reference[j] = parents[j] < 0 ? local : reference[size_t(parents[j])] * local;
+          }
+          g_sink = g_sink + static_cast<uint32_t>(reference[1][3][0]);
+        });
+    rows.push_back({"l2m", ossa_s * 1e9, glm_s * 1e9, 0.35});  // 0.12 measured
+  }
+
+  // Three sampled clips, blended, against GLM.
+  const ossa::ClipView clips[3] = {data.walk.clip(0), data.jog.clip(0), data.run.clip(0)};
+  ossa::Pose poses[3] = {ossa::Pose(joints), ossa::Pose(joints), ossa::Pose(joints)};
+  std::optional<ossa::SamplingCache> caches[3];
+  for (int c = 0; c < 3; ++c) {
+    auto cache = ossa::make_sampling_cache(clips[c], skeleton);
+    if (!cache) {
+      std::fprintf(stderr, "ossa-bench-guard: %s\n", cache.error().message.c_str());
+      return 1;
+    }
+    caches[c].emplace(std::move(*cache));
+    ossa::sample(clips[c], 0.3f * float(c + 1) * clips[c].duration() / 4.0f, {}, *caches[c], poses[c]);
+  }
+  {
+    ossa::Pose blended(joints), slow(joints);
+    const ossa::ConstPoseSpan inputs[3] = {poses[0], poses[1], poses[2]};
+    const float weights[3] = {0.2f, 0.5f, 0.3f};
+    const auto [ossa_s, glm_s] = interleaved_min(
+        trials, 64, [&] { ossa::blend_n(inputs, weights, blended); g_sink = g_sink + static_cast<uint32_t>(blended.span().base[0]); },
+        [&] {
+          for (uint32_t j = 0; j < joints; ++j) {
+            ossa::Transform out;
+            out.translation = glm::vec3(0.0f);
+            out.scale = glm::vec3(0.0f);
+            glm::quat q(0.0f, 0.0f, 0.0f, 0.0f);
+            const glm::quat first = ossa::get_transform(inputs[0], j).rotation;
+            for (int k = 0; k < 3; ++k) {
+              const ossa::Transform t = ossa::get_transform(inputs[k], j);
+              out.translation += weights[k] * t.translation;
+              out.scale += weights[k] * t.scale;
+              q = q + (glm::dot(first, t.rotation) < 0.0f ? -weights[k] : weights[k]) * t.rotation;
+            }
+            out.rotation = glm::normalize(q);
+            ossa::set_transform(slow, j, out);
+          }
+          g_sink = g_sink + static_cast<uint32_t>(slow.span().base[0]);
+        });
+    rows.push_back({"blend3", ossa_s * 1e9, glm_s * 1e9, 0.15});  // 0.05 measured
+  }
+
+  // The per-joint loops' AVX2 copy against their baseline copy (vector_isa.h), where there is one.
+  if (ossa::best_vector_isa() == ossa::VectorIsa::Avx2) {
+    ossa::Pose blended(joints);
+    const ossa::ConstPoseSpan inputs[3] = {poses[0], poses[1], poses[2]};
+    const float weights[3] = {0.2f, 0.5f, 0.3f};
+    const auto frame = [&] {
+      ossa::blend_n(inputs, weights, blended);
+      ossa::local_to_model(parents, blended, model);
+      g_sink = g_sink + static_cast<uint32_t>(model[1][3][0]);
+    };
+    double avx2 = 1e30, baseline = 1e30;
+    for (int t = 0; t < trials; ++t) {
+      for (ossa::VectorIsa isa : {ossa::VectorIsa::Avx2, ossa::VectorIsa::Baseline}) {
+        ossa::set_vector_isa(isa);
+        const double s = interleaved_min(1, 64, frame, [] {}).first;
+        (isa == ossa::VectorIsa::Avx2 ? avx2 : baseline) = std::min(isa == ossa::VectorIsa::Avx2 ? avx2 : baseline, s);
+      }
+    }
+    ossa::set_vector_isa(ossa::VectorIsa::Avx2);
+    rows.push_back({"clone.avx2", avx2 * 1e9, baseline * 1e9, 1.0});  // measured below
+  }
+
+  // Sampling: forward playback against a reset cache.
+  {
+    std::vector<float> times(256);
+    float t = 0.0f;
+    for (float& x : times) {
+      x = t;
+      t = ossa::advance_time(t, 1.0f / 60.0f, 1.0f, clips[0].duration(), true);
+    }
+    auto cold = ossa::make_sampling_cache(clips[0], skeleton);
+    if (!cold) return 1;
+    size_t i = 0, k = 0;
+    const auto [forward, reset] = interleaved_min(
+        trials, 64,
+        [&] { ossa::sample(clips[0], times[i++ & 255], {}, *caches[0], poses[0]); g_sink = g_sink + static_cast<uint32_t>(poses[0].span().base[0]); },
+        [&] {
+          ossa::reset(*cold);
+          ossa::sample(clips[0], times[k++ & 255], {}, *cold, poses[1]);
+          g_sink = g_sink + static_cast<uint32_t>(poses[1].span().base[0]);
+        });
+    rows.push_back({"sample", forward * 1e9, reset * 1e9, 1.1});  // 0.54 measured
+  }
+
+  // Load: open + verify against reading the same bytes.
+  {
+    const fs::path dir = fs::temp_directory_path() / ("ossa-bench-guard-" + std::to_string(::getpid()));
+    fs::create_directories(dir);
+    const fs::path file = dir / "skeleton.ossa";
+    {
+      const std::span<const uint8_t> bytes = data.skeleton.bytes();
+      FILE* f = std::fopen(file.c_str(), "wb");
+      if (f == nullptr || std::fwrite(bytes.data(), 1, bytes.size(), f) != bytes.size() || std::fclose(f) != 0) {
+        std::fprintf(stderr, "ossa-bench-guard: cannot write %s\n", file.c_str());
+        return 1;
+      }
+    }
+    std::vector<char> buffer(data.skeleton.bytes().size());
+    const auto [open_s, read_s] = interleaved_min(
+        trials, 32, [&] { g_sink = g_sink + ossa::Asset::open(file.string()).ok(); },
+        [&] { g_sink = g_sink + read_whole(file, buffer); });
+    std::error_code ec;
+    fs::remove_all(dir, ec);
+    rows.push_back({"load", open_s * 1e9, read_s * 1e9, 4.0});  // 2.7 measured (Pab skeleton)
+  }
+
+  std::printf("check\tossa_ns\treference_ns\tratio\tlimit\tstatus\n");
+  bool ok = true;
+  for (const Row& r : rows) {
+    const bool within = r.ratio() <= r.limit;
+    ok = ok && within;
+    std::printf("%s\t%.1f\t%.1f\t%.3f\t%.2f\t%s\n", r.name, r.ossa_ns, r.reference_ns, r.ratio(), r.limit,
+                within ? "ok" : "REGRESSED");
+  }
+#ifndef NDEBUG
+  std::printf("# not an optimized build (NDEBUG unset): ratios not checked\n");
+  return 77;
+#else
+  return ok ? 0 : 1;
+#endif
+}
