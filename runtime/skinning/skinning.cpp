@@ -465,6 +465,7 @@ struct Batch {
   alignas(32) float tangent[kBatch][4];  // x, y, z, bitangent sign
 };
 
+
 template <Slots kSlots>
 inline uint32_t slot_of(uint64_t slot_bits, int k) {
   return kSlots == Slots::Wide ? static_cast<uint32_t>(slot_bits >> (16 * k)) & 0xffffu
@@ -616,8 +617,8 @@ OSSA_TARGET_AVX2 void decode_directions(const FastMesh& m, Batch& b) {
 // ---- the per-class loops ----
 
 /// Blended matrix of the first K influences (K = 0: the first slot's matrix as it is), as
-/// columns 0-1 and 2-3.
-/// `wb` receives the vertex's four weight bytes (loaded for K = 0 only when kNeedWeights).
+/// columns 0-1 and 2-3. `wb` receives the vertex's four weight bytes (loaded for K = 0 only when
+/// kNeedWeights).
 template <int K, Slots kSlots, bool kNeedWeights>
 OSSA_TARGET_AVX2 inline void blend_matrix(const float* palette, const uint8_t* vx, uint32_t off_joints,
                                           uint32_t off_weights, __m256& a01, __m256& a23, uint32_t& wb) {
@@ -677,11 +678,11 @@ OSSA_TARGET_AVX2 inline void store3(float* out, __m128 r) {
 }
 
 /// Stores xyz of r at out. A range loop writes vertices in increasing order, so it may store all
-/// 16 bytes (one store, no shuffle) when another vertex follows: the stray w lands on the next
-/// vertex's x, which that vertex overwrites later. The last vertex of the buffer stores 12.
-template <bool kRange>
+/// 16 bytes (one store, no shuffle; kWide) when another vertex follows: the stray w lands on the
+/// next vertex's x, which that vertex overwrites later. The last vertex of the buffer stores 12.
+template <bool kWide>
 OSSA_TARGET_AVX2 inline void store_xyz(float* out, __m128 r, bool another_follows) {
-  if (kRange && another_follows) _mm_storeu_ps(out, r);
+  if (kWide && another_follows) _mm_storeu_ps(out, r);
   else store3(out, r);
 }
 
@@ -698,45 +699,96 @@ inline uint32_t outside_class(uint32_t wb) {
 /// Class K's loop over n vertices: list[i] (a batch's class list), or first + i when kRange (a
 /// mesh ordered by class). Returns the OR of outside_class<K> over the vertices (kRange only;
 /// non-zero: some vertex did not belong to the range, and its outputs are wrong).
-template <int K, bool kRange, Slots kSlots, bool kPositions, bool kNormals, bool kTangents>
-OSSA_TARGET_AVX2 uint32_t skin_class(const uint32_t* list, uint32_t first, uint32_t n, const float* palette,
-                                     const FastMesh& mesh, const Batch& b, Outputs out) {
-  // Locals, so that the output stores cannot make the compiler reload them.
+/// What one vertex's loop body reads and writes: the vertex's bytes, its decoded directions (in
+/// the batch) and its outputs.
+struct VertexPointers {
+  const uint8_t* vx;
+  const float* normal;   // b.normal row
+  const float* tangent;  // b.tangent row
+  float* position_out;
+  float* normal_out;
+  float* tangent_out;
+};
+
+/// Skins one vertex of class K. kWide: the xyz outputs may be stored as 16 bytes (another vertex
+/// follows in memory order and is written later). Returns outside_class<K> of its weights (only
+/// computed when kCheck).
+template <int K, bool kCheck, bool kWide, Slots kSlots, bool kPositions, bool kNormals, bool kTangents>
+[[gnu::always_inline]] OSSA_TARGET_AVX2 inline uint32_t skin_vertex(const float* palette, const VertexPointers& at,
+                                                                    uint32_t off_position, uint32_t off_joints,
+                                                                    uint32_t off_weights) {
+  __m256 a01, a23;
+  uint32_t wb;
+  blend_matrix<K, kSlots, kCheck>(palette, at.vx, off_joints, off_weights, a01, a23, wb);
+  if constexpr (kPositions) {
+    // The four unorm16 words twice (one duplicating load), widened: (x, y, z, 1) in both lanes.
+    const __m256 scale = _mm256_setr_ps(1.0f / 65535.0f, 1.0f / 65535.0f, 1.0f / 65535.0f, 0.0f, 1.0f / 65535.0f,
+                                        1.0f / 65535.0f, 1.0f / 65535.0f, 0.0f);
+    const __m256 w_one = _mm256_setr_ps(0.0f, 0.0f, 0.0f, 1.0f, 0.0f, 0.0f, 0.0f, 1.0f);
+    const __m128i q2 = _mm_castpd_si128(_mm_loaddup_pd(reinterpret_cast<const double*>(at.vx + off_position)));
+    const __m256 p = _mm256_fmadd_ps(_mm256_cvtepi32_ps(_mm256_cvtepu16_epi32(q2)), scale, w_one);
+    store_xyz<kWide>(at.position_out, transform_dup(a01, a23, p), true);
+  }
+  if constexpr (kNormals)
+    store_xyz<kWide>(at.normal_out, transform_dup(a01, a23, _mm256_broadcast_ps(reinterpret_cast<const __m128*>(at.normal))), true);
+  if constexpr (kTangents) {
+    const __m128 t = _mm_load_ps(at.tangent);
+    // w of t is the sign: transform xyz only, then put the sign back.
+    const __m128 r = transform_dup(a01, a23, _mm256_blend_ps(_mm256_broadcast_ps(reinterpret_cast<const __m128*>(at.tangent)), _mm256_setzero_ps(), 0x88));
+    _mm_storeu_ps(at.tangent_out, _mm_blend_ps(r, t, 0x8));
+  }
+  return kCheck ? outside_class<K>(wb) : 0u;
+}
+
+/// Class K's loop over a batch's list of n vertices (any order).
+template <int K, Slots kSlots, bool kPositions, bool kNormals, bool kTangents>
+OSSA_TARGET_AVX2 void skin_class(const uint32_t* list, uint32_t n, const float* palette, const FastMesh& mesh,
+                                 const Batch& b, Outputs out) {
   const uint8_t* const base = mesh.base;
   const size_t stride = mesh.stride;
   const uint32_t off_position = mesh.off_position, off_joints = mesh.off_joints, off_weights = mesh.off_weights;
-  const uint32_t count = mesh.count;
-  float* const positions = out.positions;
-  float* const normals = out.normals;
-  float* const tangents = out.tangents;
-  const float(*const normal)[4] = b.normal - b.first;
-  const float(*const tangent)[4] = b.tangent - b.first;
-  const __m256 scale = _mm256_setr_ps(1.0f / 65535.0f, 1.0f / 65535.0f, 1.0f / 65535.0f, 0.0f, 1.0f / 65535.0f,
-                                      1.0f / 65535.0f, 1.0f / 65535.0f, 0.0f);
-  const __m256 w_one = _mm256_setr_ps(0.0f, 0.0f, 0.0f, 1.0f, 0.0f, 0.0f, 0.0f, 1.0f);
-  uint32_t outside = 0;
   for (uint32_t i = 0; i < n; ++i) {
-    const uint32_t v = kRange ? first + i : list[i];
-    const uint8_t* vx = base + v * stride;
-    __m256 a01, a23;
-    uint32_t wb;
-    blend_matrix<K, kSlots, kRange>(palette, vx, off_joints, off_weights, a01, a23, wb);
-    if constexpr (kRange) outside |= outside_class<K>(wb);
-    if constexpr (kPositions) {
-      // The four unorm16 words twice (one duplicating load), widened: (x, y, z, 1) in both lanes.
-      const __m128i q2 = _mm_castpd_si128(_mm_loaddup_pd(reinterpret_cast<const double*>(vx + off_position)));
-      const __m256 p = _mm256_fmadd_ps(_mm256_cvtepi32_ps(_mm256_cvtepu16_epi32(q2)), scale, w_one);
-      store_xyz<kRange>(positions + 3 * static_cast<size_t>(v), transform_dup(a01, a23, p), v + 1 < count);
-    }
-    if constexpr (kNormals)
-      store_xyz<kRange>(normals + 3 * static_cast<size_t>(v), transform_dup(a01, a23, _mm256_broadcast_ps(reinterpret_cast<const __m128*>(normal[v]))), v + 1 < count);
-    if constexpr (kTangents) {
-      const __m128 t = _mm_load_ps(tangent[v]);
-      // w of t is the sign: transform xyz only, then put the sign back.
-      const __m128 r = transform_dup(a01, a23, _mm256_blend_ps(_mm256_broadcast_ps(reinterpret_cast<const __m128*>(tangent[v])), _mm256_setzero_ps(), 0x88));
-      _mm_storeu_ps(tangents + 4 * static_cast<size_t>(v), _mm_blend_ps(r, t, 0x8));
-    }
+    const size_t v = list[i];
+    const VertexPointers at{base + v * stride,
+                            b.normal[v - b.first],
+                            b.tangent[v - b.first],
+                            kPositions ? out.positions + 3 * v : nullptr,
+                            kNormals ? out.normals + 3 * v : nullptr,
+                            kTangents ? out.tangents + 4 * v : nullptr};
+    skin_vertex<K, false, false, kSlots, kPositions, kNormals, kTangents>(palette, at, off_position, off_joints, off_weights);
   }
+}
+
+/// Class K's loop over the contiguous vertices [b.first, b.first + b.n) of a class-ordered mesh,
+/// walking every pointer forward (no index arithmetic per vertex). Returns the OR of
+/// outside_class<K> over them: non-zero means some vertex did not belong to the range (and its
+/// outputs are wrong).
+template <int K, Slots kSlots, bool kPositions, bool kNormals, bool kTangents>
+OSSA_TARGET_AVX2 uint32_t skin_range(const float* palette, const FastMesh& mesh, const Batch& b, Outputs out) {
+  const size_t stride = mesh.stride;
+  const uint32_t off_position = mesh.off_position, off_joints = mesh.off_joints, off_weights = mesh.off_weights;
+  const size_t first = b.first;
+  VertexPointers at{mesh.base + first * stride,
+                    b.normal[0],
+                    b.tangent[0],
+                    kPositions ? out.positions + 3 * first : nullptr,
+                    kNormals ? out.normals + 3 * first : nullptr,
+                    kTangents ? out.tangents + 4 * first : nullptr};
+  // The mesh's very last vertex stores 12 bytes per stream; every other one may store 16.
+  const uint32_t wide = b.first + b.n == mesh.count ? b.n - 1 : b.n;
+  uint32_t outside = 0;
+#pragma GCC unroll 2
+  for (uint32_t i = 0; i < wide; ++i) {
+    outside |= skin_vertex<K, true, true, kSlots, kPositions, kNormals, kTangents>(palette, at, off_position, off_joints, off_weights);
+    at.vx += stride;
+    at.normal += 4;
+    at.tangent += 4;
+    if constexpr (kPositions) at.position_out += 3;
+    if constexpr (kNormals) at.normal_out += 3;
+    if constexpr (kTangents) at.tangent_out += 4;
+  }
+  if (wide < b.n)
+    outside |= skin_vertex<K, true, false, kSlots, kPositions, kNormals, kTangents>(palette, at, off_position, off_joints, off_weights);
   return outside;
 }
 
@@ -807,11 +859,11 @@ OSSA_TARGET_AVX2 void normalize_batch(const Batch& b, Outputs out) {
 
 template <Slots kSlots, bool kPositions, bool kNormals, bool kTangents>
 OSSA_TARGET_AVX2 void skin_batch(const float* palette, const FastMesh& m, const Batch& b, Outputs out) {
-  skin_class<0, false, kSlots, kPositions, kNormals, kTangents>(b.lists[0], 0, b.count[0], palette, m, b, out);
-  skin_class<1, false, kSlots, kPositions, kNormals, kTangents>(b.lists[1], 0, b.count[1], palette, m, b, out);
-  skin_class<2, false, kSlots, kPositions, kNormals, kTangents>(b.lists[2], 0, b.count[2], palette, m, b, out);
-  skin_class<3, false, kSlots, kPositions, kNormals, kTangents>(b.lists[3], 0, b.count[3], palette, m, b, out);
-  skin_class<4, false, kSlots, kPositions, kNormals, kTangents>(b.lists[4], 0, b.count[4], palette, m, b, out);
+  skin_class<0, kSlots, kPositions, kNormals, kTangents>(b.lists[0], b.count[0], palette, m, b, out);
+  skin_class<1, kSlots, kPositions, kNormals, kTangents>(b.lists[1], b.count[1], palette, m, b, out);
+  skin_class<2, kSlots, kPositions, kNormals, kTangents>(b.lists[2], b.count[2], palette, m, b, out);
+  skin_class<3, kSlots, kPositions, kNormals, kTangents>(b.lists[3], b.count[3], palette, m, b, out);
+  skin_class<4, kSlots, kPositions, kNormals, kTangents>(b.lists[4], b.count[4], palette, m, b, out);
   normalize_batch<kNormals, kTangents>(b, out);
 }
 
@@ -889,7 +941,7 @@ OSSA_TARGET_AVX2 void skin_fast(const float* palette, const FastMesh& m, Outputs
     for (b.first = begin; b.first < end; b.first += kBatch) {
       b.n = std::min(kBatch, end - b.first);
       if constexpr (kNormals || kTangents) decode_directions<kTangents>(m, b);
-      if (skin_class<K, true, kSlots, kPositions, kNormals, kTangents>(nullptr, b.first, b.n, palette, m, b, out) != 0) {
+      if (skin_range<K, kSlots, kPositions, kNormals, kTangents>(palette, m, b, out) != 0) {
         skin_classified<kSlots, kPositions, kNormals, kTangents>(palette, m, out, avx512, b.first);
         return false;
       }
