@@ -201,4 +201,20 @@ void BM_SkinningMatrices(benchmark::State& state) {
 }
 BENCHMARK(BM_SkinningMatrices);
 
+/// The per-frame palette a game builds: the constant half prepared once (prepare_bind_matrices),
+/// then model * bind per slot, as BM_Frame does.
+void BM_SkinningMatricesPrepared(benchmark::State& state) {
+  SkinBench& b = skin_bench();
+  std::vector<glm::mat4> bind(b.palette.size());
+  ossa::prepare_bind_matrices(b.mesh, bind);
+  for (auto _ : state) {
+    ossa::skinning_matrices(b.mesh.joints(), bind, b.model, b.palette);
+    benchmark::DoNotOptimize(b.palette.data());
+    benchmark::ClobberMemory();
+  }
+  state.counters["ns_per_slot"] = benchmark::Counter(double(b.palette.size()) * 1e-9,
+                                                     benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+}
+BENCHMARK(BM_SkinningMatricesPrepared);
+
 }  // namespace

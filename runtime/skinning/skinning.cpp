@@ -1053,6 +1053,34 @@ inline void palette_product(const glm::mat4& a, const glm::mat4& b, glm::mat4& o
 
 const glm::mat4 kIdentity(1.0f);
 
+#if OSSA_SKIN_X86
+/// palette[s] = model[joints[s]] * bind[s] for n slots, two output columns per 256-bit register:
+/// model's columns duplicated into both lanes (broadcast loads), bind's columns c and c + 1
+/// loaded as one register and each element k spread over its lane with an in-lane permute. Four
+/// multiply-adds per column pair instead of SSE's broadcast, multiply and add per element:
+/// about half the instructions (53 slots: ~60 ns instead of ~110 on Zen 5).
+OSSA_TARGET_AVX2 void palettes_avx2(const uint16_t* joints, const glm::mat4* bind, const glm::mat4* model,
+                                    size_t model_count, glm::mat4* palette, size_t n) {
+  for (size_t s = 0; s < n; ++s) {
+    const float* a = joints[s] < model_count ? &model[joints[s]][0][0] : &kIdentity[0][0];
+    const __m256 a0 = _mm256_broadcast_ps(reinterpret_cast<const __m128*>(a));
+    const __m256 a1 = _mm256_broadcast_ps(reinterpret_cast<const __m128*>(a + 4));
+    const __m256 a2 = _mm256_broadcast_ps(reinterpret_cast<const __m128*>(a + 8));
+    const __m256 a3 = _mm256_broadcast_ps(reinterpret_cast<const __m128*>(a + 12));
+    const float* b = &bind[s][0][0];
+    float* out = &palette[s][0][0];
+    for (int c = 0; c < 4; c += 2) {
+      const __m256 bc = _mm256_loadu_ps(b + 4 * c);  // columns c, c + 1
+      __m256 r = _mm256_mul_ps(a0, _mm256_permute_ps(bc, 0x00));
+      r = _mm256_fmadd_ps(a1, _mm256_permute_ps(bc, 0x55), r);
+      r = _mm256_fmadd_ps(a2, _mm256_permute_ps(bc, 0xaa), r);
+      r = _mm256_fmadd_ps(a3, _mm256_permute_ps(bc, 0xff), r);
+      _mm256_storeu_ps(out + 4 * c, r);
+    }
+  }
+}
+#endif
+
 }  // namespace
 
 void skinning_matrices(const MeshView& mesh, std::span<const glm::mat4> model, std::span<glm::mat4> palette) {
@@ -1088,6 +1116,12 @@ void skinning_matrices(std::span<const uint16_t> joints, std::span<const glm::ma
     return;
   }
   const size_t n = std::min({joints.size(), bind.size(), palette.size()});
+#if OSSA_SKIN_X86
+  if (skinning_isa() != SkinningIsa::Portable) {
+    palettes_avx2(joints.data(), bind.data(), model.data(), model.size(), palette.data(), n);
+    return;
+  }
+#endif
   for (size_t s = 0; s < n; ++s)
     palette_product(joints[s] < model.size() ? model[joints[s]] : kIdentity, bind[s], palette[s]);
 }

@@ -28,7 +28,8 @@ void prepare_bind_matrices(const MeshView& mesh, std::span<glm::mat4> bind);
 
 /// palette[s] = model[joints[s]] * bind[s] (bind from prepare_bind_matrices; for a static mesh,
 /// joints is empty and palette[0] = bind[0]). A joint index past model.size() uses identity.
-/// O(slots), one SSE 4x4 product each; allocation-free.
+/// O(slots), one 4x4 product each (AVX2 + FMA unless skinning_isa() is Portable, SSE then);
+/// allocation-free.
 void skinning_matrices(std::span<const uint16_t> joints, std::span<const glm::mat4> bind,
                        std::span<const glm::mat4> model, std::span<glm::mat4> palette);
 
