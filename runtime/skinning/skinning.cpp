@@ -37,10 +37,10 @@
 //
 // Costs: skinning_matrices O(slots). skin_cpu O(vertices * influences), allocation-free (stack
 // buffers: ~18 KB on the fast path, ~22 KB for dual quaternions), no virtual calls, no
-// per-vertex branches on the fast path. Measured on Pab's arnaud (3748 vertices, ossa-bench-anim's
-// BM_SkinOrder, Zen 5 VM at ~3.2 GHz): ~2.1 ns per vertex for positions, ~4.2 ns with normals, as
-// cooked (class-ordered); ~2.9 / ~5.2 ns classified per batch; portable ~20 / ~31 ns; dual
-// quaternions ~60 ns.
+// per-vertex branches on the fast path. Measured on Pab's arnaud (3748 vertices, ossa-bench-anim,
+// Zen 5 VM at ~3.2 GHz, medians of 5): ~1.7 ns per vertex for positions, ~3.5 ns with normals
+// (~3.2 without renormalizing), as cooked (class-ordered); ~2.8 / ~4.9 ns classified per batch;
+// portable ~19 / ~32 ns; dual quaternions ~69 ns.
 #include <ossa/skinning/skinning.h>
 
 #include <algorithm>
