@@ -136,28 +136,7 @@ const ossa::MeshView& dealt_arnaud() {
   static const auto dealt = [] {
     const ossa::bench::BenchData& data = ossa::bench::bench_data();
     auto d = std::make_unique<DealtArnaud>();
-    const std::span<const uint8_t> file = data.arnaud.bytes();
-    const ossa::MeshView mesh = data.arnaud.mesh(0);
-    d->bytes.assign(file.begin(), file.end());
-    const size_t at = static_cast<size_t>(mesh.vertex_bytes().data() - file.data());
-    const size_t stride = mesh.vertex_stride();
-    const uint32_t weights = mesh.attribute(ossa::fb::VertexSemantic::Weights)->offset();
-    // The class runs of the cooked order, then one vertex of each in turn.
-    std::vector<std::vector<uint32_t>> runs;
-    uint32_t last_word = 0;
-    for (uint32_t v = 0; v < mesh.vertex_count(); ++v) {
-      uint32_t w;
-      std::memcpy(&w, mesh.vertex_bytes().data() + v * stride + weights, 4);
-      const uint32_t word_class = w == 255u ? 0u : 1u + (w >= (1u << 8)) + (w >= (1u << 16)) + (w >= (1u << 24));
-      if (runs.empty() || word_class != last_word) runs.emplace_back();
-      runs.back().push_back(v);
-      last_word = word_class;
-    }
-    size_t out = 0;
-    for (size_t i = 0; out < mesh.vertex_count(); ++i)
-      for (const auto& run : runs)
-        if (i < run.size())
-          std::memcpy(d->bytes.data() + at + out++ * stride, mesh.vertex_bytes().data() + run[i] * stride, stride);
+    d->bytes = ossa::bench::dealt_copy(data.arnaud);
     auto a = ossa::Asset::from_bytes(d->bytes, "arnaud-dealt");
     if (!a) {
       std::fprintf(stderr, "bench: %s\n", a.error().message.c_str());

@@ -5,6 +5,8 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
+#include <span>
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -56,6 +58,32 @@ std::unique_ptr<BenchData> load() {
 }
 
 }  // namespace
+
+std::vector<uint8_t> dealt_copy(const Asset& asset) {
+  const std::span<const uint8_t> file = asset.bytes();
+  const MeshView mesh = asset.mesh(0);
+  std::vector<uint8_t> out(file.begin(), file.end());
+  const size_t at = static_cast<size_t>(mesh.vertex_bytes().data() - file.data());
+  const size_t stride = mesh.vertex_stride();
+  const uint32_t weights = mesh.attribute(fb::VertexSemantic::Weights)->offset();
+  // The class runs of the cooked order (skin_cpu's classes of the weight bytes), then one vertex
+  // of each run in turn.
+  std::vector<std::vector<uint32_t>> runs;
+  uint32_t last = ~0u;
+  for (uint32_t v = 0; v < mesh.vertex_count(); ++v) {
+    uint32_t w;
+    std::memcpy(&w, mesh.vertex_bytes().data() + v * stride + weights, 4);
+    const uint32_t c = w == 255u ? 0u : 1u + (w >= (1u << 8)) + (w >= (1u << 16)) + (w >= (1u << 24));
+    if (c != last) runs.emplace_back();
+    runs.back().push_back(v);
+    last = c;
+  }
+  size_t n = 0;
+  for (size_t i = 0; n < mesh.vertex_count(); ++i)
+    for (const auto& run : runs)
+      if (i < run.size()) std::memcpy(out.data() + at + n++ * stride, mesh.vertex_bytes().data() + run[i] * stride, stride);
+  return out;
+}
 
 const BenchData& bench_data() {
   static const std::unique_ptr<BenchData> data = load();

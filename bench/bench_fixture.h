@@ -4,6 +4,9 @@
 // with default options (the compression a game would ship), and the arnaud skinned mesh. These are
 // the assets the ozz-animation figures were measured on, so results compare directly.
 #pragma once
+#include <cstdint>
+#include <vector>
+
 #include <ossa/loader/asset.h>
 
 namespace ossa::bench {
@@ -16,5 +19,11 @@ struct BenchData {
 
 /// Cooks the assets into a temporary directory on first use; exits with a message on failure.
 const BenchData& bench_data();
+
+/// A copy of `asset`'s file bytes whose first mesh has its influence classes dealt out in turn
+/// (one vertex of each class, each class keeping its order): what a file cooked before the class
+/// ordering, or by another tool, looks like to skin_cpu. Same vertices, same file otherwise (the
+/// index buffer is not renumbered: skinning does not read it). O(file size).
+std::vector<uint8_t> dealt_copy(const Asset& asset);
 
 }  // namespace ossa::bench

@@ -34,6 +34,7 @@
 #include "cooker/import/import_scene.h"
 #include <ossa/loader/asset.h>
 #include "bench/machine.h"
+#include "bench/plain_read.h"
 
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
@@ -58,19 +59,6 @@ double median_ms(double min_seconds, int min_runs, S&& setup, F&& run) {
   return samples[samples.size() / 2];
 }
 
-/// open + read every byte + close, as a loader that copies the file would. False on any error.
-bool read_whole(const fs::path& path, std::vector<char>& buffer) {
-  const int fd = ::open(path.c_str(), O_RDONLY);
-  if (fd < 0) return false;
-  size_t got = 0;
-  while (got < buffer.size()) {
-    const ssize_t n = ::read(fd, buffer.data() + got, buffer.size() - got);
-    if (n <= 0) break;
-    got += static_cast<size_t>(n);
-  }
-  ::close(fd);
-  return got == buffer.size();
-}
 
 }  // namespace
 
@@ -117,7 +105,7 @@ int main(int argc, char** argv) {
     const double ossa_ms =
         median_ms(min_seconds, 200, [] {}, [&] { return ossa::Asset::open(cooked.string()).ok(); });
     std::vector<char> buffer(static_cast<size_t>(rec.cooked_bytes));
-    const double read_ms = median_ms(min_seconds, 200, [] {}, [&] { return read_whole(cooked, buffer); });
+    const double read_ms = median_ms(min_seconds, 200, [] {}, [&] { return ossa::bench::read_whole(cooked, buffer); });
     if (assimp_ms < 0 || ossa_ms < 0 || read_ms < 0) {
       std::fprintf(stderr, "ossa-bench-load: %s: load failed during timing\n", src.string().c_str());
       status = 1;
