@@ -39,6 +39,7 @@
 #include "asset_walk.h"
 #include <ossa/format/hash.h>
 #include <ossa/version.h>
+#include <ossa/anim/vector_isa.h>
 #include <ossa/loader/asset.h>
 #include <ossa/loader/texture.h>
 #include "test_files.h"
@@ -448,6 +449,34 @@ TEST(Mesh, IndexPastVertexCount) {
   spec.meshes[0].index_format = fb::IndexFormat::Uint32;
   spec.meshes[0].indices[4] = 0xFFFFFFFFu;
   EXPECT_TRUE(rejects(spec, with(kMesh, {"index", "indices"})));
+}
+
+TEST(Mesh, IndexPastVertexCountFoundAnywhereInEitherCopy) {
+  // The index scan runs in whole 32-index blocks and a scalar tail, compiled for AVX2 and the
+  // baseline (vector_isa.h): one bad index is found in a block's first or last lane, between
+  // blocks and in the tail, in 16- and 32-bit buffers, by both copies; the same buffer without it
+  // is accepted.
+  std::vector<VectorIsa> isas = {VectorIsa::Baseline};
+  if (best_vector_isa() == VectorIsa::Avx2) isas.push_back(VectorIsa::Avx2);
+  for (const VectorIsa isa : isas) {
+    ASSERT_TRUE(set_vector_isa(isa));
+    for (const fb::IndexFormat format : {fb::IndexFormat::Uint16, fb::IndexFormat::Uint32}) {
+      SyntheticSpec spec;
+      spec.meshes[0].index_format = format;
+      std::vector<uint32_t>& indices = spec.meshes[0].indices;
+      const std::vector<uint32_t> triangle(indices.begin(), indices.begin() + 3);
+      indices.clear();
+      for (int t = 0; t < 100; ++t) indices.insert(indices.end(), triangle.begin(), triangle.end());  // 300
+      EXPECT_TRUE(accepts(make_valid_file(spec)));
+      for (const size_t at : {size_t(0), size_t(31), size_t(32), size_t(150), size_t(287), size_t(299)}) {
+        SyntheticSpec bad = spec;
+        bad.meshes[0].indices[at] = 6;  // 6 vertices: 0..5
+        EXPECT_TRUE(rejects(bad, with(kMesh, {"index " + std::to_string(at) + " is 6"})))
+            << "index " << at << (isa == VectorIsa::Avx2 ? " avx2" : " baseline");
+      }
+    }
+  }
+  set_vector_isa(best_vector_isa());
 }
 
 TEST(Mesh, IndexBytesNotMultipleOfIndexSize) {
