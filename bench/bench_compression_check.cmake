@@ -4,9 +4,10 @@
 # For ASSET (a file that states its unit) and, when it exists, BVH (which states none: read as 1 m),
 # one row per clip is checked at the file's unit and at an overriding --metres-per-unit: the header
 # names the columns in order, unit_m is the unit the row was measured in, raw_bytes does not depend
-# on the unit, and each row held its tolerance (max_error_mm <= tolerance_mm). An unusable unit is
-# a usage error (exit status 2). Scripts and tables are what people paste into notes, so a column
-# moved or dropped here is a change to say in the README's bench section.
+# on the unit, and each row held its tolerance (max_error_mm <= tolerance_mm). With --breakdown,
+# each row's first comment line splits cooked_bytes into parts that must add up to it. An unusable
+# unit is a usage error (exit status 2). Tables are what people paste into notes, so a column moved
+# or dropped here is a change to say in the README's bench section.
 cmake_minimum_required(VERSION 3.25)
 
 set(header "asset\tclip\tjoints\tunit_m\traw_bytes\tcooked_bytes\tratio\tmax_error_mm\tmean_error_mm\ttolerance_mm")
@@ -83,6 +84,52 @@ if(DEFINED BVH AND EXISTS "${BVH}")
 else()
   message(STATUS "no BVH at '${BVH}': the unit-less case is not checked (../shared/assets absent)")
 endif()
+
+# --breakdown: each row is followed by three "# CLIP: " lines, the first of which splits the row's
+# cooked_bytes into the stored vectors; the parts must add up to the column.
+function(check_breakdown file)
+  execute_process(COMMAND "${BENCH}" --breakdown "${file}" RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "ossa-bench-compression --breakdown ${file} failed (${rc}): ${err}")
+  endif()
+  string(REPLACE ";" "," out "${out}")
+  string(REPLACE "\n" ";" lines "${out}")
+  list(FILTER lines EXCLUDE REGEX "^$")
+  list(LENGTH lines n)
+  set(i 2)  # after the machine line and the header
+  set(rows 0)
+  while(i LESS n)
+    list(GET lines ${i} row)
+    field(clip "${row}" 1)
+    field(cooked "${row}" 5)
+    math(EXPR last "${i} + 3")
+    if(last GREATER_EQUAL n AND NOT last EQUAL n)
+      message(FATAL_ERROR "row '${row}' is not followed by three breakdown lines")
+    endif()
+    math(EXPR i "${i} + 1")
+    list(GET lines ${i} parts)
+    if(NOT parts MATCHES "^# ${clip}: constants [0-9]+ x [0-9]+ = ([0-9]+) B \\+ channel records [0-9]+ x [0-9]+ = ([0-9]+) B \\+ key_frames [0-9]+ x 2 = ([0-9]+) B \\+ key_values ([0-9]+) B = ([0-9]+) B$")
+      message(FATAL_ERROR "first breakdown line of '${clip}' is '${parts}'")
+    endif()
+    math(EXPR sum "${CMAKE_MATCH_1} + ${CMAKE_MATCH_2} + ${CMAKE_MATCH_3} + ${CMAKE_MATCH_4}")
+    if(NOT sum EQUAL CMAKE_MATCH_5 OR NOT sum EQUAL cooked)
+      message(FATAL_ERROR "'${clip}': parts add up to ${sum}, the line says ${CMAKE_MATCH_5}, cooked_bytes is ${cooked}")
+    endif()
+    math(EXPR i "${i} + 1")
+    list(GET lines ${i} groups)
+    math(EXPR i "${i} + 1")
+    list(GET lines ${i} bits)
+    if(NOT groups MATCHES "^# ${clip}: keyed at every frame: " OR NOT bits MATCHES "^# ${clip}: bits \\(bits:channels\\): translation ")
+      message(FATAL_ERROR "breakdown of '${clip}' is\n  ${groups}\n  ${bits}")
+    endif()
+    math(EXPR i "${i} + 1")
+    math(EXPR rows "${rows} + 1")
+  endwhile()
+  if(rows EQUAL 0)
+    message(FATAL_ERROR "--breakdown printed no rows for ${file}")
+  endif()
+endfunction()
+check_breakdown("${ASSET}")
 
 foreach(bad 0 -1 abc 1e9)
   execute_process(COMMAND "${BENCH}" --metres-per-unit ${bad} "${ASSET}" RESULT_VARIABLE rc OUTPUT_QUIET ERROR_QUIET)
