@@ -8,19 +8,21 @@
 // when --clip-tolerance is given, again at that one. --metres-per-unit overrides the file's unit as
 // `ossa-cook --metres-per-unit` does (BVH states none and is read as 1 m; CMU's mocap unit is
 // 1/0.45 inch = 0.056444 m): the tolerance is in millimetres, so the unit decides how many source
-// units it spans, and a clip measured in the wrong unit is measured at the wrong tolerance. --skeleton cooks REF_SOURCE first (cook_file,
-// into a temporary directory) and reads the skeleton back from the cooked file
-// (load_reference_skeleton), so clip-only files such as Pab/walk.fbx are measured against the
-// same rig, with the same floats, as `ossa-cook --skeleton REF.ossa` would cook them.
+// units it spans, and a clip measured in the wrong unit is measured at the wrong tolerance.
+// --skeleton cooks REF_SOURCE first (cook_file, into a temporary directory) and reads the skeleton
+// back from the cooked file (load_reference_skeleton), so clip-only files such as Pab/walk.fbx are
+// measured against the same rig, with the same floats, as `ossa-cook --skeleton REF.ossa` would
+// cook them.
 //
 // Output: tab-separated on stdout, header
 //   asset clip joints unit_m raw_bytes cooked_bytes ratio max_error_mm mean_error_mm tolerance_mm
 // unit_m is the metres per source unit the clip was measured in (the file's, or --metres-per-unit),
 // so a row says which unit its ratio holds for. The tolerance_mm column is always there (not only
-// with --clip-tolerance) so the table has one shape whatever the options. raw_bytes is 10 floats per joint per frame; cooked_bytes is the sum
-// of the clip's vectors' bytes (constants, animated, key_frames, key_values with its padding),
-// table overhead excluded (CompressedClip::cooked_bytes). Errors are in millimetres through the
-// file's metres_per_unit. Exit status 1 when any asset fails (its error on stderr), 2 on usage.
+// with --clip-tolerance) so the table has one shape whatever the options. raw_bytes is 10 floats
+// per joint per frame; cooked_bytes is the sum of the clip's vectors' bytes (constants, animated,
+// key_frames, key_values with its padding), table overhead excluded (CompressedClip::cooked_bytes).
+// Errors are in millimetres through the file's metres_per_unit. Exit status 1 when any asset fails
+// (its error on stderr), 2 on usage.
 //
 // --breakdown follows each row with comment lines (starting "# ", so the rows stay one table for
 // whatever reads it) saying where the clip's cooked_bytes go, which is what choosing the next
@@ -51,8 +53,9 @@ using namespace ossa::cook;
 namespace {
 
 int usage() {
-  std::fprintf(stderr, "usage: ossa-bench-compression [--skeleton REF_SOURCE] [--clip-tolerance MM] [--metres-per-unit M] "
-                       "[--breakdown] ASSET...\n");
+  std::fprintf(stderr,
+               "usage: ossa-bench-compression [--skeleton REF_SOURCE] [--clip-tolerance MM] [--metres-per-unit M] "
+               "[--breakdown] ASSET...\n");
   return 2;
 }
 
@@ -170,7 +173,8 @@ int main(int argc, char** argv) {
   }
 
   std::printf("# %s\n", ossa::bench::machine_line().c_str());
-  std::printf("asset\tclip\tjoints\tunit_m\traw_bytes\tcooked_bytes\tratio\tmax_error_mm\tmean_error_mm\ttolerance_mm\n");
+  std::printf("asset\tclip\tjoints\tunit_m\traw_bytes\tcooked_bytes\tratio\tmax_error_mm\tmean_error_mm"
+              "\ttolerance_mm\n");
   int status = 0;
   for (const std::string& asset : assets) {
     auto scene = import_scene(asset, import_options);
@@ -190,7 +194,8 @@ int main(int argc, char** argv) {
         }
         const CompressedClip& c = *compressed;
         std::printf("%s\t%s\t%zu\t%g\t%u\t%u\t%.2f\t%.4f\t%.4f\t%g\n", fs::path(asset).filename().string().c_str(),
-                    c.name.c_str(), scene->skeleton.joints.size(), static_cast<double>(scene->metres_per_unit), c.raw_bytes, c.cooked_bytes,
+                    c.name.c_str(), scene->skeleton.joints.size(), static_cast<double>(scene->metres_per_unit),
+                    c.raw_bytes, c.cooked_bytes,
                     c.cooked_bytes ? static_cast<double>(c.raw_bytes) / c.cooked_bytes : 0.0,
                     c.max_error * mm_per_unit, c.mean_error * mm_per_unit,
                     static_cast<double>(options.tolerance_metres) * 1000.0);
