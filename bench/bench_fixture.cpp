@@ -12,6 +12,7 @@
 #include <string>
 
 #include "cooker/cook.h"
+#include <ossa/format/vertex_codec.h>
 
 namespace ossa::bench {
 namespace fs = std::filesystem;
@@ -73,7 +74,7 @@ std::vector<uint8_t> dealt_copy(const Asset& asset) {
   for (uint32_t v = 0; v < mesh.vertex_count(); ++v) {
     uint32_t w;
     std::memcpy(&w, mesh.vertex_bytes().data() + v * stride + weights, 4);
-    const uint32_t c = w == 255u ? 0u : 1u + (w >= (1u << 8)) + (w >= (1u << 16)) + (w >= (1u << 24));
+    const auto c = static_cast<uint32_t>(influence_class(w));
     if (c != last) runs.emplace_back();
     runs.back().push_back(v);
     last = c;

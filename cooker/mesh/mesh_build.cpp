@@ -378,16 +378,6 @@ std::array<uint8_t, 4> quantize_weights(const glm::vec4& w) {
   return q;
 }
 
-/// The influence class skin_cpu's fast path gives a vertex (runtime/skinning/skinning.cpp): 0 for
-/// one influence of weight 255 (the palette matrix as it is), else 1 + the index of the last
-/// non-zero quantized weight (all-zero: 1).
-int influence_class(const std::array<uint8_t, 4>& q) {
-  if (q[0] == 255 && q[1] == 0 && q[2] == 0 && q[3] == 0) return 0;
-  for (int k = 3; k > 0; --k)
-    if (q[static_cast<size_t>(k)] != 0) return k + 1;
-  return 1;
-}
-
 /// A renumbering (remap[old] = new) that orders vertices by influence class, keeping the fetch
 /// order inside each class (a stable partition): skin_cpu then runs one loop per class over a
 /// contiguous range instead of sorting every batch into classes (ozz-animation splits its skinning
@@ -397,7 +387,9 @@ std::vector<unsigned> influence_class_order(const std::vector<glm::vec4>& weight
   std::array<unsigned, 6> start{};
   std::vector<uint8_t> cls(weights.size());
   for (size_t v = 0; v < weights.size(); ++v) {
-    cls[v] = static_cast<uint8_t>(influence_class(quantize_weights(weights[v])));
+    const std::array<uint8_t, 4> q = quantize_weights(weights[v]);
+    const uint32_t word = q[0] | uint32_t{q[1]} << 8 | uint32_t{q[2]} << 16 | uint32_t{q[3]} << 24;
+    cls[v] = static_cast<uint8_t>(influence_class(word));  // ossa/format/vertex_codec.h
     ++start[cls[v] + 1u];
   }
   for (size_t c = 1; c < start.size(); ++c) start[c] += start[c - 1];

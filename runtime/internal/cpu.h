@@ -24,6 +24,8 @@
 
 namespace ossa::detail {
 
+/// AVX2, with OS support for the YMM state: what the per-joint loops' AVX2 copy uses.
+bool cpu_has_avx2();
 /// AVX2 + FMA + BMI1/2 + POPCNT, with OS support for the YMM state: what the AVX2 kernels use.
 bool cpu_has_avx2_fma();
 /// cpu_has_avx2_fma() and AVX-512 F/VL/BW/DQ, with OS support for the ZMM state.

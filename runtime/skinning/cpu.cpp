@@ -1,5 +1,6 @@
 // cpu.cpp — cpu.h: CPU feature queries through __builtin_cpu_supports (GCC, Clang, MinGW-w64) or
-// CPUID + XGETBV (MSVC). Answers are computed once (function-local statics: thread-safe).
+// CPUID + XGETBV (MSVC). Answers are computed once (function-local statics: thread-safe). Also
+// the process-wide choice of the per-joint loops' copy (ossa/anim/vector_isa.h), made from them.
 #include "internal/cpu.h"
 
 #if OSSA_CPU_X86 && defined(_MSC_VER) && !defined(__clang__)
@@ -11,6 +12,7 @@ namespace ossa::detail {
 namespace {
 
 struct Features {
+  bool avx2 = false;  // AVX2 with the OS's YMM state: all the per-joint loops' copy needs
   bool avx2_fma = false;
   bool avx512 = false;
 };
@@ -19,7 +21,8 @@ Features detect() {
   Features f;
 #if OSSA_CPU_X86 && (defined(__GNUC__) || defined(__clang__))
   __builtin_cpu_init();
-  f.avx2_fma = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") && __builtin_cpu_supports("bmi") &&
+  f.avx2 = __builtin_cpu_supports("avx2");
+  f.avx2_fma = f.avx2 && __builtin_cpu_supports("fma") && __builtin_cpu_supports("bmi") &&
                __builtin_cpu_supports("bmi2") && __builtin_cpu_supports("popcnt");
   f.avx512 = f.avx2_fma && __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
              __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512dq");
@@ -39,7 +42,8 @@ Features detect() {
   const bool avx2 = (r[1] & (1 << 5)) != 0, bmi1 = (r[1] & (1 << 3)) != 0, bmi2 = (r[1] & (1 << 8)) != 0;
   const bool avx512f = (r[1] & (1 << 16)) != 0, avx512dq = (r[1] & (1 << 17)) != 0,
              avx512bw = (r[1] & (1 << 30)) != 0, avx512vl = (r[1] & (1u << 31)) != 0;
-  f.avx2_fma = ymm_state && avx2 && fma && bmi1 && bmi2 && popcnt;
+  f.avx2 = ymm_state && avx2;
+  f.avx2_fma = f.avx2 && fma && bmi1 && bmi2 && popcnt;
   f.avx512 = f.avx2_fma && zmm_state && avx512f && avx512vl && avx512bw && avx512dq;
 #endif
   return f;
@@ -52,15 +56,15 @@ const Features& features() {
 
 }  // namespace
 
+bool cpu_has_avx2() { return features().avx2; }
 bool cpu_has_avx2_fma() { return features().avx2_fma; }
 bool cpu_has_avx512() { return features().avx512; }
 
 }  // namespace ossa::detail
 
 // ---------------------------------------------------------------------------------------------
-// The per-joint loops' copy (ossa/anim/vector_isa.h, internal/vector_clones.h). AVX2 alone is
-// what those copies need (they use no FMA), so the test is avx2 with the OS's YMM state, which
-// libgcc's cpu model includes.
+// The per-joint loops' copy (ossa/anim/vector_isa.h, internal/vector_clones.h): AVX2 alone is
+// what those copies need (they use no FMA), and only builds that have the copy may select it.
 
 #include <atomic>
 
@@ -70,24 +74,17 @@ bool cpu_has_avx512() { return features().avx512; }
 namespace ossa {
 namespace {
 
-bool cpu_has_avx2() {
-#if OSSA_HAVE_VECTOR_CLONES
-  __builtin_cpu_init();
-  return __builtin_cpu_supports("avx2");
-#else
-  return false;
-#endif
-}
+bool avx2_copy_runs() { return OSSA_HAVE_VECTOR_CLONES && detail::cpu_has_avx2(); }
 
 std::atomic<bool>& avx2_selected() {
-  static std::atomic<bool> selected{cpu_has_avx2()};
+  static std::atomic<bool> selected{avx2_copy_runs()};
   return selected;
 }
 
 }  // namespace
 
 VectorIsa best_vector_isa() {
-  static const VectorIsa best = cpu_has_avx2() ? VectorIsa::Avx2 : VectorIsa::Baseline;
+  static const VectorIsa best = avx2_copy_runs() ? VectorIsa::Avx2 : VectorIsa::Baseline;
   return best;
 }
 

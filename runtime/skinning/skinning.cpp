@@ -166,7 +166,6 @@ inline glm::vec3 finish_direction(glm::vec3 v, const Outputs& out) { return out.
 // fetch_vertex_attribute, ossa/skinning/vertex_fetch.h), into plain float arrays; skinning then
 // runs over those arrays with no format switch per vertex.
 
-
 glm::vec3 octahedral(float x, float y) {
   const Float3 n = octahedral_decode({x, y});
   return {n.x, n.y, n.z};
@@ -465,7 +464,6 @@ struct Batch {
   alignas(32) float tangent[kBatch][4];  // x, y, z, bitangent sign
 };
 
-
 template <Slots kSlots>
 inline uint32_t slot_of(uint64_t slot_bits, int k) {
   return kSlots == Slots::Wide ? static_cast<uint32_t>(slot_bits >> (16 * k)) & 0xffffu
@@ -677,12 +675,12 @@ OSSA_TARGET_AVX2 inline void store3(float* out, __m128 r) {
   _mm_store_ss(out + 2, _mm_movehl_ps(r, r));
 }
 
-/// Stores xyz of r at out. A range loop writes vertices in increasing order, so it may store all
-/// 16 bytes (one store, no shuffle; kWide) when another vertex follows: the stray w lands on the
-/// next vertex's x, which that vertex overwrites later. The last vertex of the buffer stores 12.
+/// Stores xyz of r at out. A range loop writes vertices in increasing order, so when another
+/// vertex follows it may store all 16 bytes (kWide: one store, no shuffle): the stray w lands on
+/// the next vertex's x, which that vertex overwrites later. The buffer's last vertex stores 12.
 template <bool kWide>
-OSSA_TARGET_AVX2 inline void store_xyz(float* out, __m128 r, bool another_follows) {
-  if (kWide && another_follows) _mm_storeu_ps(out, r);
+OSSA_TARGET_AVX2 inline void store_xyz(float* out, __m128 r) {
+  if constexpr (kWide) _mm_storeu_ps(out, r);
   else store3(out, r);
 }
 
@@ -696,9 +694,6 @@ inline uint32_t outside_class(uint32_t wb) {
   else return 0;
 }
 
-/// Class K's loop over n vertices: list[i] (a batch's class list), or first + i when kRange (a
-/// mesh ordered by class). Returns the OR of outside_class<K> over the vertices (kRange only;
-/// non-zero: some vertex did not belong to the range, and its outputs are wrong).
 /// What one vertex's loop body reads and writes: the vertex's bytes, its decoded directions (in
 /// the batch) and its outputs.
 struct VertexPointers {
@@ -727,10 +722,10 @@ template <int K, bool kCheck, bool kWide, Slots kSlots, bool kPositions, bool kN
     const __m256 w_one = _mm256_setr_ps(0.0f, 0.0f, 0.0f, 1.0f, 0.0f, 0.0f, 0.0f, 1.0f);
     const __m128i q2 = _mm_castpd_si128(_mm_loaddup_pd(reinterpret_cast<const double*>(at.vx + off_position)));
     const __m256 p = _mm256_fmadd_ps(_mm256_cvtepi32_ps(_mm256_cvtepu16_epi32(q2)), scale, w_one);
-    store_xyz<kWide>(at.position_out, transform_dup(a01, a23, p), true);
+    store_xyz<kWide>(at.position_out, transform_dup(a01, a23, p));
   }
   if constexpr (kNormals)
-    store_xyz<kWide>(at.normal_out, transform_dup(a01, a23, _mm256_broadcast_ps(reinterpret_cast<const __m128*>(at.normal))), true);
+    store_xyz<kWide>(at.normal_out, transform_dup(a01, a23, _mm256_broadcast_ps(reinterpret_cast<const __m128*>(at.normal))));
   if constexpr (kTangents) {
     const __m128 t = _mm_load_ps(at.tangent);
     // w of t is the sign: transform xyz only, then put the sign back.
@@ -898,18 +893,12 @@ inline uint32_t weight_word(const FastMesh& m, uint32_t v) {
   return load_u32(m.base + static_cast<size_t>(v) * m.stride + m.off_weights);
 }
 
-/// The class skin_batch would give these weight bytes (see kClasses).
-inline int class_of(uint32_t w) {
-  if (w == 255u) return 0;
-  return 1 + (w >= (1u << 8)) + (w >= (1u << 16)) + (w >= (1u << 24));
-}
-
 /// Whether the first kOrderProbe vertices' classes never decrease.
 inline bool ordered_start(const FastMesh& m) {
   const uint32_t n = std::min(m.count, kOrderProbe);
   int last = 0;
   for (uint32_t v = 0; v < n; ++v) {
-    const int c = class_of(weight_word(m, v));
+    const int c = influence_class(weight_word(m, v));
     if (c < last) return false;
     last = c;
   }
@@ -921,7 +910,7 @@ inline uint32_t class_end(const FastMesh& m, uint32_t lo, int c) {
   uint32_t hi = m.count;
   while (lo < hi) {
     const uint32_t mid = lo + (hi - lo) / 2;
-    if (class_of(weight_word(m, mid)) > c) hi = mid;
+    if (influence_class(weight_word(m, mid)) > c) hi = mid;
     else lo = mid + 1;
   }
   return lo;
@@ -1058,7 +1047,8 @@ const glm::mat4 kIdentity(1.0f);
 /// model's columns duplicated into both lanes (broadcast loads), bind's columns c and c + 1
 /// loaded as one register and each element k spread over its lane with an in-lane permute. Four
 /// multiply-adds per column pair instead of SSE's broadcast, multiply and add per element:
-/// about half the instructions (53 slots: ~60 ns instead of ~110 on Zen 5).
+/// about half the instructions (53 slots: ~120 ns on Zen 5, BM_SkinningMatricesPrepared; BM_Frame,
+/// which builds this palette, ran ~7% faster with it, back to back).
 OSSA_TARGET_AVX2 void palettes_avx2(const uint16_t* joints, const glm::mat4* bind, const glm::mat4* model,
                                     size_t model_count, glm::mat4* palette, size_t n) {
   for (size_t s = 0; s < n; ++s) {

@@ -65,4 +65,13 @@ uint16_t float_to_half(float f);
 /// IEEE binary16 bits -> float (exact).
 float half_to_float(uint16_t h);
 
+/// The influence class of a vertex's four unorm8 weights read as one little-endian word (influence
+/// 0's weight in the low byte): 0 for a single weight of 255 (the palette matrix as it is), else 1
+/// + the index of the last non-zero weight (all zero: 1). The cooker orders a skinned mesh's
+/// vertices by it and skin_cpu runs one loop per class, so both must agree on it exactly.
+constexpr int influence_class(uint32_t weights) {
+  if (weights == 255u) return 0;
+  return 1 + (weights >= (1u << 8)) + (weights >= (1u << 16)) + (weights >= (1u << 24));
+}
+
 }  // namespace ossa
