@@ -1,9 +1,11 @@
 // format_test.cpp — the shared encoders/decoders and hashes that both cooker and runtime rely on.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <random>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -26,6 +28,50 @@ TEST(Hash, SkeletonHashSeparatesNamesAndParents) {
   EXPECT_NE(ossa::skeleton_hash(ab_c, p1), ossa::skeleton_hash(a_bc, p1));
   EXPECT_NE(ossa::skeleton_hash(ab_c, p1), ossa::skeleton_hash(ab_c, p2));
   EXPECT_EQ(ossa::skeleton_hash(ab_c, p1), ossa::skeleton_hash(ab_c, p1));
+}
+
+TEST(Hash, SkeletonHashIsPinned) {
+  // The value is stored in files (format v8): changing the function needs a format bump, and this
+  // test is where that shows. Computed by this implementation when v8 was introduced.
+  const std::vector<std::string_view> names{"Hips", "Spine", "LeftUpLeg_with_a_longer_name"};
+  const std::vector<int16_t> parents{-1, 0, 0};
+  EXPECT_EQ(ossa::skeleton_hash(names, parents), 0xd4abdc5a51f3b4f5ull);
+  EXPECT_EQ(ossa::skeleton_hash({}, {}), ossa::skeleton_hash_finish(0, 0));
+}
+
+TEST(Hash, SkeletonHashSeesEveryByteLengthOrderAndParent) {
+  // Every name length 1..40 (each tail shape and several whole words): flipping any one bit of
+  // any byte, or growing the name by one byte, changes the hash; so do swapping two joints and
+  // changing a parent. Also the incremental form the loader uses equals the span form.
+  std::vector<uint64_t> seen;
+  for (size_t len = 1; len <= 40; ++len) {
+    std::string base(len, 'a');
+    for (size_t i = 0; i < len; ++i) base[i] = static_cast<char>('a' + (i * 7) % 26);
+    const std::vector<int16_t> parents{-1, 0};
+    const auto h = [&](const std::string& name) {
+      const std::vector<std::string_view> names{"root", name};
+      const uint64_t whole = ossa::skeleton_hash(names, parents);
+      const uint64_t parts = ossa::skeleton_hash_finish(
+          ossa::skeleton_hash_joint(0, "root", -1) + ossa::skeleton_hash_joint(1, name, 0), 2);
+      EXPECT_EQ(whole, parts);
+      return whole;
+    };
+    const uint64_t h0 = h(base);
+    seen.push_back(h0);
+    for (size_t i = 0; i < len; ++i)
+      for (int bit = 0; bit < 8; ++bit) {
+        std::string changed = base;
+        changed[i] = static_cast<char>(changed[i] ^ (1 << bit));
+        ASSERT_NE(h(changed), h0) << "len " << len << " byte " << i << " bit " << bit;
+      }
+    EXPECT_NE(h(base + "a"), h0);
+    const std::vector<std::string_view> ab{base, "root"}, ba{"root", base};
+    const std::vector<int16_t> p{-1, -1}, q{-1, 0};
+    EXPECT_NE(ossa::skeleton_hash(ab, p), ossa::skeleton_hash(ba, p));
+    EXPECT_NE(ossa::skeleton_hash(ba, p), ossa::skeleton_hash(ba, q));
+  }
+  std::sort(seen.begin(), seen.end());
+  EXPECT_EQ(std::adjacent_find(seen.begin(), seen.end()), seen.end()) << "two name lengths collided";
 }
 
 TEST(VertexCodec, OctahedralRoundTripWithinSnorm16Precision) {
