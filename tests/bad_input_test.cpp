@@ -439,6 +439,92 @@ TEST(Skeleton, PerJointArrayLengthMismatch) {
       "inverse");
 }
 
+/// The synthetic rig grown to 11 joints (a chain off the head), so the loader's whole-array scans
+/// of the bind pose (8-float blocks and a scalar tail) see bad values in blocks and tails alike.
+SyntheticSpec eleven_joints() {
+  SyntheticSpec spec;
+  SyntheticSkeleton& s = *spec.skeleton;
+  for (int i = 4; i < 11; ++i) {
+    s.names.push_back("extra" + std::to_string(i));
+    s.parents.push_back(static_cast<int16_t>(i == 4 ? 2 : i - 1));
+    s.translations.push_back(fb::Vec3(0, 0.1f, 0));
+    s.rotations.push_back(fb::Quat(0, 0, 0, 1));
+    s.scales.push_back(fb::Vec3(1, 1, 1));
+  }
+  return spec;
+}
+
+fb::Mat4 identity_mat4() {
+  const float m[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+  return fb::Mat4(flatbuffers::make_span(m));
+}
+fb::Mat4 identity_with(int k, float v) {
+  float m[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+  m[k] = v;
+  return fb::Mat4(flatbuffers::make_span(std::as_const(m)));
+}
+
+TEST(Skeleton, BadBindValueFoundAtEveryJointAndComponent) {
+  // A valid file passes the array scans; a bad value at any joint and component, of each kind,
+  // fails them and the per-joint walk then names that joint (both paths must agree on every value).
+  ASSERT_TRUE(accepts(make_valid_file(eleven_joints())));
+  const auto joint_words = [](size_t j, const char* what) {
+    return Keywords{{"skeleton"}, {"joint " + std::to_string(j) + " "}, {what}};
+  };
+  for (size_t j = 0; j < 11; ++j) {
+    for (int c = 0; c < 3; ++c)
+      for (float bad : {kNaN, kInf, -kInf, 2e7f, -2e7f}) {
+        float v[3] = {0, 0.1f, 0};
+        v[c] = bad;
+        SyntheticSpec t = eleven_joints();
+        t.skeleton->translations[j] = fb::Vec3(v[0], v[1], v[2]);
+        EXPECT_TRUE(rejects(t, joint_words(j, "translation"))) << j << " " << c << " " << bad;
+        float w[3] = {1, 1, 1};
+        w[c] = bad;
+        SyntheticSpec sc = eleven_joints();
+        sc.skeleton->scales[j] = fb::Vec3(w[0], w[1], w[2]);
+        EXPECT_TRUE(rejects(sc, joint_words(j, "scale"))) << j << " " << c << " " << bad;
+      }
+    // Not normalizable: a non-finite component, a zero norm, a squared norm that underflows or
+    // overflows float.
+    for (int c = 0; c < 4; ++c)
+      for (float bad : {kNaN, kInf, 1e20f}) {
+        float q[4] = {0, 0, 0, 1};
+        q[c] = bad;
+        SyntheticSpec r = eleven_joints();
+        r.skeleton->rotations[j] = fb::Quat(q[0], q[1], q[2], q[3]);
+        EXPECT_TRUE(rejects(r, joint_words(j, "rotation"))) << j << " " << c << " " << bad;
+      }
+    for (const fb::Quat& bad : {fb::Quat(0, 0, 0, 0), fb::Quat(1e-25f, 0, 0, 0)}) {
+      SyntheticSpec r = eleven_joints();
+      r.skeleton->rotations[j] = bad;
+      EXPECT_TRUE(rejects(r, joint_words(j, "rotation"))) << j;
+    }
+    for (int k = 0; k < 16; ++k) {
+      SyntheticSpec m = eleven_joints();
+      m.skeleton->inverse_bind = std::vector<fb::Mat4>(11, identity_mat4());
+      (*m.skeleton->inverse_bind)[j] = identity_with(k, k % 2 ? kNaN : -kInf);
+      m.meshes[0].inverse_bind = std::vector<fb::Mat4>(m.meshes[0].joints.size(), identity_mat4());
+      EXPECT_TRUE(rejects(m, joint_words(j, "inverse bind"))) << j << " " << k;
+    }
+  }
+  // The largest finite bind values the loader admits are admitted by both paths.
+  SyntheticSpec edge = eleven_joints();
+  edge.skeleton->translations[10] = fb::Vec3(1e7f, -1e7f, 0);
+  edge.skeleton->rotations[10] = fb::Quat(0, 0, 2e-19f, 0);  // squared norm 4e-38 >= FLT_MIN
+  EXPECT_TRUE(accepts(make_valid_file(edge)));
+}
+
+TEST(Mesh, InverseBindNotFiniteFoundAtEverySlot) {
+  for (size_t slot = 0; slot < 3; ++slot)
+    for (int k = 0; k < 16; ++k) {
+      SyntheticSpec spec;
+      spec.meshes[0].inverse_bind = std::vector<fb::Mat4>(3, identity_mat4());
+      (*spec.meshes[0].inverse_bind)[slot] = identity_with(k, k % 2 ? kInf : kNaN);
+      EXPECT_TRUE(rejects(spec, with(kMesh, {"joint slot " + std::to_string(slot)}, {"inverse bind"}))) << slot << " " << k;
+    }
+}
+
 // ---------------------------------------------------------------------------------------------
 // Mesh invariants
 
