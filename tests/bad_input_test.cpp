@@ -646,6 +646,47 @@ TEST(Mesh, JointSlotPastSlotCount) {
   EXPECT_TRUE(rejects(spec, with(kMesh, {"slot"})));
 }
 
+TEST(Mesh, JointSlotPastSlotCountFoundAtEveryVertexStrideAndCopy) {
+  // The 8-bit slot scan reads whole 64-byte chunks through a mask that repeats every
+  // lcm(stride, 64) bytes, then the vertices of the last partial chunk one by one (a stride past
+  // 256 bytes: one by one throughout); compiled for AVX2 and the baseline. Every valid mesh is
+  // accepted (positions, normals and weights around the slots hold bytes up to 255, so a mask
+  // that let them through would reject it) and slot 3 (of 0..2) is found in the first, a middle
+  // and the last vertex, in each of the four components.
+  std::vector<VectorIsa> isas = {VectorIsa::Baseline};
+  if (best_vector_isa() == VectorIsa::Avx2) isas.push_back(VectorIsa::Avx2);
+  const std::vector<SyntheticVertex> grid = SyntheticMesh::default_vertices();
+  for (const VectorIsa isa : isas) {
+    ASSERT_TRUE(set_vector_isa(isa));
+    for (const uint16_t stride : {24, 28, 32, 40, 60, 64, 100, 260}) {
+      for (const size_t count : {1, 2, 3, 5, 8, 11, 16, 33, 70}) {
+        SyntheticSpec spec;
+        SyntheticMesh& mesh = spec.meshes[0];
+        mesh.vertex_stride = stride;
+        mesh.vertices.clear();
+        for (size_t v = 0; v < count; ++v) {
+          SyntheticVertex x = grid[v % grid.size()];
+          x.position = fb::Vec3(x.position.x() + 0.01f * static_cast<float>(v), x.position.y(), x.position.z());
+          mesh.vertices.push_back(x);
+        }
+        const auto last = static_cast<uint32_t>(count - 1);
+        mesh.indices = {0, std::min(1u, last), std::min(2u, last)};
+        mesh.submeshes = {{0, 3, 0}};
+        mesh.morph_targets.clear();
+        ASSERT_TRUE(accepts(make_valid_file(spec))) << "stride " << stride << " count " << count;
+        for (const size_t v : {size_t{0}, count / 2, count - 1})
+          for (size_t k = 0; k < 4; ++k) {
+            SyntheticSpec bad = spec;
+            bad.meshes[0].vertices[v].slots[k] = 3;
+            EXPECT_TRUE(rejects(bad, with(kMesh, {"vertex " + std::to_string(v) + " uses joint slot 3"})))
+                << "stride " << stride << " count " << count << " vertex " << v << " slot " << k;
+          }
+      }
+    }
+  }
+  ASSERT_TRUE(set_vector_isa(best_vector_isa()));
+}
+
 TEST(Mesh, MeshJointPastSkeletonJointCount) {
   SyntheticSpec spec;
   spec.meshes[0].joints[2] = 4;  // 4 joints: 0..3
