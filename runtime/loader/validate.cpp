@@ -247,7 +247,7 @@ uint32_t max_u8_joint_slot(const uint8_t* vertices, size_t n, size_t stride, siz
   while (period % kChunk != 0) period += stride;  // lcm(stride, 64): stride is a multiple of 4
   const size_t chunks = n * stride / kChunk;
   if (period > kMaxPeriod || chunks == 0) return max_joint_slot<uint8_t>(vertices + offset, n, stride);
-  alignas(64) uint8_t masks[kMaxPeriod];
+  alignas(16) uint8_t masks[kMaxPeriod];
   std::memset(masks, 0, period);
   for (size_t at = offset; at < period; at += stride) std::memset(masks + at, 0xff, 4);
   uint32_t m = 0;
