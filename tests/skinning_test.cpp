@@ -649,6 +649,24 @@ std::vector<std::pair<std::string, std::vector<uint8_t>>> synthetic_files() {
   std::iter_swap(first_of(2) + 40, first_of(4) + 3);
   std::iter_swap(first_of(3) + 10, first_of(0) + 100);
   out.emplace_back("ordered-then-broken", ossa::test::make_valid_file(broken));
+  out.emplace_back("ordered-then-broken-tangents", with_tangents(broken));
+  // The structure-of-arrays kernel (positions with normals, class-ordered) in the layouts it
+  // reads differently from the cooker's: 16-bit slots, weights apart from the slots, and the normal
+  // apart from the position (each read on its own); plus the broken order with it.
+  ossa::test::SyntheticSpec ordered_wide = ordered;
+  ordered_wide.meshes[0].layout = {{S::Position, F::Unorm16x4, 0}, {S::Normal, F::Snorm16x2, 8}, {S::TexCoord0, F::Float16x2, 12},
+                                   {S::Joints, F::Uint16x4, 16},   {S::Weights, F::Unorm8x4, 24}};
+  ordered_wide.meshes[0].vertex_stride = 28;
+  out.emplace_back("ordered-wide-slots", ossa::test::make_valid_file(ordered_wide));
+  ossa::test::SyntheticSpec ordered_apart = ordered;
+  ordered_apart.meshes[0].layout = {{S::Position, F::Unorm16x4, 0}, {S::TexCoord0, F::Float16x2, 8}, {S::Joints, F::Uint8x4, 12},
+                                    {S::Normal, F::Snorm16x2, 16},  {S::Weights, F::Unorm8x4, 20}};
+  out.emplace_back("ordered-attributes-apart", ossa::test::make_valid_file(ordered_apart));
+  ossa::test::SyntheticSpec tight = ordered;  // 12 bytes from the position to the end: no 16-byte load
+  tight.meshes[0].layout = {{S::Joints, F::Uint8x4, 0}, {S::Weights, F::Unorm8x4, 4}, {S::Position, F::Unorm16x4, 8},
+                            {S::Normal, F::Snorm16x2, 16}};
+  tight.meshes[0].vertex_stride = 20;
+  out.emplace_back("ordered-position-last", ossa::test::make_valid_file(tight));
   // Every vertex of one class but the last, which needs all four influences.
   ossa::test::SyntheticSpec last = ordered;
   std::vector<ossa::test::SyntheticVertex>& lv = last.meshes[0].vertices;
@@ -917,6 +935,45 @@ TEST(Skinning, OnlyRequestedStreamsAreWritten) {
       for (size_t i = 0; i < 4 * n; ++i) {
         if (mask & 4) EXPECT_EQ(t[i], all.tangents[i]) << isa_name(isa) << " mask " << mask;
         else EXPECT_TRUE(std::isnan(t[i]));
+      }
+    }
+  }
+}
+
+TEST(Skinning, EveryStreamSelectionGivesBitIdenticalResults) {
+  // skin_cpu's fast paths differ by the streams asked for (positions with normals run eight
+  // vertices at a time, structure-of-arrays; positions alone, or with tangents, one at a time) and
+  // by the vertex order (class ranges or classified batches). They round alike: whatever is asked
+  // for, every value is the same, bit for bit, in every implementation, renormalized or not. The
+  // files cover range tails (class counts not multiples of 8), every class, the layouts the kernels
+  // read differently, a broken class order, and a mesh shorter than one block.
+  for (const auto& [name, bytes] : synthetic_files()) {
+    SyntheticAsset s = load(bytes);
+    ASSERT_NE(s.asset, nullptr) << name;
+    const ossa::MeshView mesh = s.asset->mesh(0);
+    if (mesh.attribute(VertexSemantic::Normal) == nullptr || s.asset->skeleton().empty()) continue;
+    const auto palette = palette_of(mesh, make_pose(s.asset->skeleton(), 0.8f, 9).model);
+    const size_t n = mesh.vertex_count();
+    const bool has_tangents = mesh.attribute(VertexSemantic::Tangent) != nullptr;
+    for (ossa::SkinningIsa isa : available_isas()) {
+      IsaScope scope(isa);
+      for (const bool unit : {true, false}) {
+        const Skinned all = skin(mesh, palette, ossa::SkinningMethod::Linear, unit);
+        std::vector<float> p(3 * n, NAN), nn(3 * n, NAN), p_only(3 * n, NAN), n_only(3 * n, NAN), t(has_tangents ? 4 * n : 0, NAN);
+        ossa::skin_cpu(mesh, palette, ossa::SkinningMethod::Linear, {p, nn, {}, unit});
+        ossa::skin_cpu(mesh, palette, ossa::SkinningMethod::Linear, {p_only, {}, {}, unit});
+        ossa::skin_cpu(mesh, palette, ossa::SkinningMethod::Linear, {{}, n_only, {}, unit});
+        if (has_tangents) ossa::skin_cpu(mesh, palette, ossa::SkinningMethod::Linear, {{}, {}, t, unit});
+        const auto same = [](const std::vector<float>& a, const std::vector<float>& b) {
+          return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0;
+        };
+        EXPECT_TRUE(same(p, all.positions)) << name << " " << isa_name(isa) << " unit " << unit;
+        EXPECT_TRUE(same(p_only, all.positions)) << name << " " << isa_name(isa) << " unit " << unit;
+        EXPECT_TRUE(same(nn, all.normals)) << name << " " << isa_name(isa) << " unit " << unit;
+        EXPECT_TRUE(same(n_only, all.normals)) << name << " " << isa_name(isa) << " unit " << unit;
+        if (has_tangents) {
+          EXPECT_TRUE(same(t, all.tangents)) << name << " " << isa_name(isa) << " unit " << unit;
+        }
       }
     }
   }

@@ -38,9 +38,9 @@
 // Costs: skinning_matrices O(slots). skin_cpu O(vertices * influences), allocation-free (stack
 // buffers: ~18 KB on the fast path, ~22 KB for dual quaternions), no virtual calls, no
 // per-vertex branches on the fast path. Measured on Pab's arnaud (3748 vertices, ossa-bench-anim,
-// Zen 5 VM at ~3.2 GHz, medians of 5): ~1.7 ns per vertex for positions, ~3.5 ns with normals
-// (~3.2 without renormalizing), as cooked (class-ordered); ~2.8 / ~4.9 ns classified per batch;
-// portable ~19 / ~32 ns; dual quaternions ~69 ns.
+// Zen 5 VM at ~3.2 GHz, medians of 5): ~1.6 ns per vertex for positions, ~2.9 ns with normals
+// (~2.5 without renormalizing: soa_kernel.h), as cooked (class-ordered); ~2.8 / ~4.9 ns
+// classified per batch; portable ~19 / ~32 ns; dual quaternions ~69 ns.
 #include <ossa/skinning/skinning.h>
 
 #include <algorithm>
@@ -66,6 +66,7 @@
 #pragma GCC diagnostic pop
 #endif
 #define OSSA_SKIN_X86 1
+#include "skinning/soa_kernel.h"
 #else
 #define OSSA_SKIN_X86 0
 #endif
@@ -418,6 +419,9 @@ void skin_dual_quaternion(const MeshFacts& m, std::span<const glm::mat4> palette
 //      unnormalized);
 //   4. renormalize the batch's output normals (8 at a time, structure-of-arrays) and tangents
 //      (rsqrt + one Newton step).
+// A class-ordered mesh skinned for normals without tangents takes soa_kernel.h instead of steps
+// 2-4: eight vertices at a time, structure-of-arrays after the blend (see "meshes ordered by
+// influence class" below).
 // The per-vertex loops use 256-bit registers on both paths: on Zen 4, which executes a 512-bit
 // operation as two 256-bit halves, a 16-wide per-vertex kernel measured ~25% slower (more
 // cross-lane shuffles for the same arithmetic). The classification is where AVX-512 pays.
@@ -545,16 +549,7 @@ OSSA_TARGET_AVX512 void classify_avx512(const FastMesh& m, Batch& b) {
 
 // ---- direction decoding, 8 vertices at a time ----
 
-/// Octahedral (x, y) in [-1, 1]^2 -> unnormalized direction (ossa/format/vertex_codec.h's unfolding).
-OSSA_TARGET_AVX2 inline void unfold_octahedral(__m256& x, __m256& y, __m256& z) {
-  const __m256 sign_bit = _mm256_set1_ps(-0.0f);
-  const __m256 l1 = _mm256_add_ps(_mm256_andnot_ps(sign_bit, x), _mm256_andnot_ps(sign_bit, y));
-  z = _mm256_sub_ps(_mm256_set1_ps(1.0f), l1);
-  const __m256 fold = _mm256_max_ps(_mm256_sub_ps(l1, _mm256_set1_ps(1.0f)), _mm256_setzero_ps());
-  // x >= 0 ? x - fold : x + fold (snorm decoding never yields -0).
-  x = _mm256_sub_ps(x, _mm256_or_ps(fold, _mm256_and_ps(sign_bit, x)));
-  y = _mm256_sub_ps(y, _mm256_or_ps(fold, _mm256_and_ps(sign_bit, y)));
-}
+using soa::unfold_octahedral;
 
 /// The low (lo) or high 16 bits of each lane as a snorm16, decoded as OpenGL does.
 OSSA_TARGET_AVX2 inline __m256 snorm16_lanes(__m256i g, bool high) {
@@ -787,42 +782,62 @@ OSSA_TARGET_AVX2 uint32_t skin_range(const float* palette, const FastMesh& mesh,
   return outside;
 }
 
-// ---- renormalization of the batch's outputs ----
-
-/// 1 / sqrt(len2) to float precision (rsqrt's 12 bits + one Newton step), 0 for len2 = 0.
-OSSA_TARGET_AVX2 inline __m256 inverse_length(__m256 len2) {
-  len2 = _mm256_max_ps(len2, _mm256_set1_ps(1e-30f));
-  const __m256 y = _mm256_rsqrt_ps(len2);
-  const __m256 half_len2_y = _mm256_mul_ps(_mm256_mul_ps(len2, _mm256_set1_ps(0.5f)), y);
-  return _mm256_mul_ps(y, _mm256_fnmadd_ps(half_len2_y, y, _mm256_set1_ps(1.5f)));
+/// Class K's loop over the contiguous vertices [first, first + n) of a class-ordered mesh, eight at
+/// a time (soa_kernel.h), positions and normals (renormalized as out asks) written directly.
+/// Returns n, or the index (from first) of the block where a vertex did not belong to the class:
+/// outputs from there on are not written, or wrong.
+template <int K, Slots kSlots, bool kPositions, bool kNormals>
+OSSA_TARGET_AVX2 uint32_t skin_range_soa(const float* palette, const FastMesh& m, uint32_t first, uint32_t n, Outputs out,
+                                          bool avx512) {
+  constexpr bool kWide = kSlots == Slots::Wide, kPacked = kSlots == Slots::Packed;
+  const soa::Layout l{palette, kWeight.data(), m.stride, m.off_position, m.off_normal, m.off_joints, m.off_weights,
+                      {m.prescale[0], m.prescale[1], m.prescale[2]}, out.renormalize};
+  const uint8_t* vx = m.base + static_cast<size_t>(first) * m.stride;
+  const soa::Cursor<kPacked> at{vx + m.off_joints, vx + m.off_weights, vx + m.off_position, vx + m.off_normal};
+  float* const p = kPositions ? out.positions + 3 * static_cast<size_t>(first) : nullptr;
+  float* const q = kNormals ? out.normals + 3 * static_cast<size_t>(first) : nullptr;
+  // The cooker's layout: 16 bytes from the position stay inside the vertex, and hold the normal.
+  if (m.off_position + 16 <= m.stride && (!kNormals || m.off_normal == m.off_position + 8))
+    return avx512 ? soa::range_avx512<K, kWide, kPacked, kPositions, kNormals, true>(at, n, l, p, q)
+                  : soa::range_avx2<K, kWide, kPacked, kPositions, kNormals, true>(at, n, l, p, q);
+  return avx512 ? soa::range_avx512<K, kWide, kPacked, kPositions, kNormals, false>(at, n, l, p, q)
+                : soa::range_avx2<K, kWide, kPacked, kPositions, kNormals, false>(at, n, l, p, q);
 }
 
-/// Normalizes n packed xyz vectors in place, 8 at a time; the tail one by one.
+// ---- renormalization of the batch's outputs ----
+
+using soa::inverse_length;
+
+/// Normalizes 8 packed xyz vectors in place (rsqrt + one Newton step, as soa_kernel.h does).
+OSSA_TARGET_AVX2 inline void normalize_xyz8(float* p) {
+  const __m256 a = _mm256_loadu_ps(p), b = _mm256_loadu_ps(p + 8), c = _mm256_loadu_ps(p + 16);
+  const __m256 qa = _mm256_mul_ps(a, a), qb = _mm256_mul_ps(b, b), qc = _mm256_mul_ps(c, c);
+  // a = x0 y0 z0 x1 y1 z1 x2 y2 | b = z2 x3 y3 z3 x4 y4 z4 x5 | c = y5 z5 x6 y6 z6 x7 y7 z7
+  const __m256 xx = _mm256_blend_ps(_mm256_blend_ps(_mm256_permutevar8x32_ps(qa, _mm256_setr_epi32(0, 3, 6, 0, 0, 0, 0, 0)),
+                                                    _mm256_permutevar8x32_ps(qb, _mm256_setr_epi32(0, 0, 0, 1, 4, 7, 0, 0)), 0x38),
+                                    _mm256_permutevar8x32_ps(qc, _mm256_setr_epi32(0, 0, 0, 0, 0, 0, 2, 5)), 0xc0);
+  const __m256 yy = _mm256_blend_ps(_mm256_blend_ps(_mm256_permutevar8x32_ps(qa, _mm256_setr_epi32(1, 4, 7, 0, 0, 0, 0, 0)),
+                                                    _mm256_permutevar8x32_ps(qb, _mm256_setr_epi32(0, 0, 0, 2, 5, 0, 0, 0)), 0x18),
+                                    _mm256_permutevar8x32_ps(qc, _mm256_setr_epi32(0, 0, 0, 0, 0, 0, 3, 6)), 0xe0);
+  const __m256 zz = _mm256_blend_ps(_mm256_blend_ps(_mm256_permutevar8x32_ps(qa, _mm256_setr_epi32(2, 5, 0, 0, 0, 0, 0, 0)),
+                                                    _mm256_permutevar8x32_ps(qb, _mm256_setr_epi32(0, 0, 0, 3, 6, 0, 0, 0)), 0x1c),
+                                    _mm256_permutevar8x32_ps(qc, _mm256_setr_epi32(0, 0, 0, 0, 0, 1, 4, 7)), 0xe0);
+  const __m256 inv = inverse_length(_mm256_add_ps(_mm256_add_ps(xx, yy), zz));
+  _mm256_storeu_ps(p, _mm256_mul_ps(a, _mm256_permutevar8x32_ps(inv, _mm256_setr_epi32(0, 0, 0, 1, 1, 1, 2, 2))));
+  _mm256_storeu_ps(p + 8, _mm256_mul_ps(b, _mm256_permutevar8x32_ps(inv, _mm256_setr_epi32(2, 3, 3, 3, 4, 4, 4, 5))));
+  _mm256_storeu_ps(p + 16, _mm256_mul_ps(c, _mm256_permutevar8x32_ps(inv, _mm256_setr_epi32(5, 5, 6, 6, 6, 7, 7, 7))));
+}
+
+/// Normalizes n packed xyz vectors in place, 8 at a time; the tail through a zero-padded copy, so
+/// that every vector is rounded alike (the structure-of-arrays kernel's results are bit-identical).
 OSSA_TARGET_AVX2 void normalize_xyz(float* p, uint32_t n) {
   uint32_t i = 0;
-  for (; i + 8 <= n; i += 8, p += 24) {
-    const __m256 a = _mm256_loadu_ps(p), b = _mm256_loadu_ps(p + 8), c = _mm256_loadu_ps(p + 16);
-    const __m256 qa = _mm256_mul_ps(a, a), qb = _mm256_mul_ps(b, b), qc = _mm256_mul_ps(c, c);
-    // a = x0 y0 z0 x1 y1 z1 x2 y2 | b = z2 x3 y3 z3 x4 y4 z4 x5 | c = y5 z5 x6 y6 z6 x7 y7 z7
-    const __m256 xx = _mm256_blend_ps(_mm256_blend_ps(_mm256_permutevar8x32_ps(qa, _mm256_setr_epi32(0, 3, 6, 0, 0, 0, 0, 0)),
-                                                      _mm256_permutevar8x32_ps(qb, _mm256_setr_epi32(0, 0, 0, 1, 4, 7, 0, 0)), 0x38),
-                                      _mm256_permutevar8x32_ps(qc, _mm256_setr_epi32(0, 0, 0, 0, 0, 0, 2, 5)), 0xc0);
-    const __m256 yy = _mm256_blend_ps(_mm256_blend_ps(_mm256_permutevar8x32_ps(qa, _mm256_setr_epi32(1, 4, 7, 0, 0, 0, 0, 0)),
-                                                      _mm256_permutevar8x32_ps(qb, _mm256_setr_epi32(0, 0, 0, 2, 5, 0, 0, 0)), 0x18),
-                                      _mm256_permutevar8x32_ps(qc, _mm256_setr_epi32(0, 0, 0, 0, 0, 0, 3, 6)), 0xe0);
-    const __m256 zz = _mm256_blend_ps(_mm256_blend_ps(_mm256_permutevar8x32_ps(qa, _mm256_setr_epi32(2, 5, 0, 0, 0, 0, 0, 0)),
-                                                      _mm256_permutevar8x32_ps(qb, _mm256_setr_epi32(0, 0, 0, 3, 6, 0, 0, 0)), 0x1c),
-                                      _mm256_permutevar8x32_ps(qc, _mm256_setr_epi32(0, 0, 0, 0, 0, 1, 4, 7)), 0xe0);
-    const __m256 inv = inverse_length(_mm256_add_ps(_mm256_add_ps(xx, yy), zz));
-    _mm256_storeu_ps(p, _mm256_mul_ps(a, _mm256_permutevar8x32_ps(inv, _mm256_setr_epi32(0, 0, 0, 1, 1, 1, 2, 2))));
-    _mm256_storeu_ps(p + 8, _mm256_mul_ps(b, _mm256_permutevar8x32_ps(inv, _mm256_setr_epi32(2, 3, 3, 3, 4, 4, 4, 5))));
-    _mm256_storeu_ps(p + 16, _mm256_mul_ps(c, _mm256_permutevar8x32_ps(inv, _mm256_setr_epi32(5, 5, 6, 6, 6, 7, 7, 7))));
-  }
-  for (; i < n; ++i, p += 3) {
-    glm::vec3 v;
-    std::memcpy(&v[0], p, 12);
-    v = normalize_or_zero(v);
-    std::memcpy(p, &v[0], 12);
+  for (; i + 8 <= n; i += 8, p += 24) normalize_xyz8(p);
+  if (i < n) {
+    float tail[24] = {};
+    std::memcpy(tail, p, 12 * (n - i));
+    normalize_xyz8(tail);
+    std::memcpy(p, tail, 12 * (n - i));
   }
 }
 
@@ -885,7 +900,9 @@ OSSA_TARGET_AVX2 void skin_classified(const float* palette, const FastMesh& m, O
 // vertex it skins against its class (outside_class, one shift and OR on bytes it loads anyway).
 // A range that fails is redone, with everything after it, by the classified path; a mesh whose
 // first kOrderProbe vertices are out of order (an older cook, another tool's file) goes there
-// from the start, so it pays a 64-vertex probe and nothing else.
+// from the start, so it pays a 64-vertex probe and nothing else. With normals and no tangents a
+// range runs soa_kernel.h's eight-vertex blocks (skin_range_soa), which check their vertices the
+// same way and report the first failing block; positions alone, or with tangents, run skin_range.
 
 constexpr uint32_t kOrderProbe = 64;
 
@@ -927,6 +944,15 @@ OSSA_TARGET_AVX2 void skin_fast(const float* palette, const FastMesh& m, Outputs
   const auto run = [&](auto k) -> bool {
     constexpr int K = decltype(k)::value;
     const uint32_t end = K == kClasses - 1 ? m.count : class_end(m, begin, K);
+    if constexpr (kNormals && !kTangents) {
+      const uint32_t done = skin_range_soa<K, kSlots, kPositions, kNormals>(palette, m, begin, end - begin, out, avx512);
+      if (done != end - begin) {
+        skin_classified<kSlots, kPositions, kNormals, kTangents>(palette, m, out, avx512, begin + done);
+        return false;
+      }
+      begin = end;
+      return true;
+    }
     for (b.first = begin; b.first < end; b.first += kBatch) {
       b.n = std::min(kBatch, end - b.first);
       if constexpr (kNormals || kTangents) decode_directions<kTangents>(m, b);
