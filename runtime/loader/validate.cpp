@@ -130,7 +130,7 @@ bool all_normalizable(const float* q, size_t n) {
   bool bad = false;
   for (size_t i = 0; i < n; ++i, q += 4) {
     const float n2 = q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3];
-    bad |= !(n2 >= std::numeric_limits<float>::min()) | !(n2 <= std::numeric_limits<float>::max());
+    bad |= !(n2 >= std::numeric_limits<float>::min() && n2 <= std::numeric_limits<float>::max());
   }
   return !bad;
 }

@@ -40,7 +40,7 @@ namespace ossa::soa {
 
 #define OSSA_SOA_TARGET OSSA_TARGET("avx2,fma,bmi,bmi2,popcnt")
 #if defined(__GNUC__) || defined(__clang__)
-#define OSSA_SOA_INLINE [[gnu::always_inline]] inline
+#define OSSA_SOA_INLINE __attribute__((always_inline)) inline  // GNU form: it follows OSSA_TARGET, and Clang takes no [[...]] after __attribute__
 #else
 #define OSSA_SOA_INLINE __forceinline
 #endif
@@ -223,8 +223,11 @@ OSSA_SOA_TARGET OSSA_SOA_INLINE uint32_t block(Cursor<kPacked> at, uint32_t last
     }
     blend<K, kWideSlots>(at.joints, at.weights(), l, a[v], c[v]);
     blend<K, kWideSlots>(at.joints + d4, at.weights() + d4, l, a[v + 4], c[v + 4]);
-    A[v] = _mm256_inserti128_si256(_mm256_castsi128_si256(words_of<kNormals, kFused>(at.position, at.normal)),
-                                   words_of<kNormals, kFused>(at.position + d4, at.normal + d4), 1);
+    // Named first: Clang's _mm256_inserti128_si256 is a macro, and the template's comma would split
+    // its arguments.
+    const __m128i lo = words_of<kNormals, kFused>(at.position, at.normal);
+    const __m128i hi = words_of<kNormals, kFused>(at.position + d4, at.normal + d4);
+    A[v] = _mm256_inserti128_si256(_mm256_castsi128_si256(lo), hi, 1);
     uint32_t w0, w4;
     std::memcpy(&w0, at.weights(), 4);
     std::memcpy(&w4, at.weights() + d4, 4);
