@@ -12,10 +12,12 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "test_files.h"
@@ -146,29 +148,130 @@ TEST_F(ViewerWindow, UiScaleTwoMakesThePanelWider) {
   EXPECT_GT(differing, a.height / 2);
 }
 
+// A gate between the viewer and its cooker: OSSA_COOK names a script that marks that it started,
+// waits until the test opens the gate, then runs the real ossa-cook. With it the cook tests wait
+// for events (the cook started, the viewer reported frames drawn meanwhile, the viewer opened the
+// output, it exited), never for a frame count within a time; each wait is bounded only so that a
+// hang fails instead of stalling the suite.
+class GatedCook {
+ public:
+  explicit GatedCook(const fs::path& dir) : dir_(dir / "gate") {
+    fs::create_directories(dir_);
+    const fs::path script = dir_ / "ossa-cook";
+    write_file(script, "#!/bin/sh\n: > " + quote((dir_ / "started").string()) + "\nwhile [ ! -e " +
+                           quote((dir_ / "open").string()) + " ]; do sleep 0.02; done\nexec " +
+                           quote((bin_dir() / "ossa-cook").string()) + " \"$@\"\n");
+    fs::permissions(script, fs::perms::owner_all);
+  }
+  std::string env() const { return "OSSA_COOK=" + quote((dir_ / "ossa-cook").string()); }
+  bool started() const { return fs::exists(dir_ / "started"); }
+  void open() const { write_file(dir_ / "open", std::string_view("")); }
+
+ private:
+  fs::path dir_;
+};
+
+/// ossa-view run in the background: its stderr and exit status land in files the test polls.
+class BackgroundViewer {
+ public:
+  BackgroundViewer(const fs::path& dir, const std::string& env, const std::string& args) : dir_(dir / "bg") {
+    fs::create_directories(dir_);
+    std::string why;
+    const auto display = test_display(&why);
+    if (!display) return;
+    run_command("( " + env + " DISPLAY=" + quote(*display) + " " + quote((bin_dir() / "ossa-view").string()) + " " + args +
+                " -v >/dev/null 2>" + quote(err_path().string()) + " & echo $! > " + quote((dir_ / "pid").string()) +
+                "; wait $!; echo $? > " + quote((dir_ / "rc.tmp").string()) + "; mv " + quote((dir_ / "rc.tmp").string()) +
+                " " + quote((dir_ / "rc").string()) + " ) >/dev/null 2>&1 &");
+  }
+  ~BackgroundViewer() { stop(); }
+  std::string err() const { return read_text(err_path()).value_or(""); }
+  bool exited() const { return fs::exists(dir_ / "rc"); }
+  int exit_code() const { return std::atoi(read_text(dir_ / "rc").value_or("-1").c_str()); }
+  void stop() const {
+    if (exited()) return;
+    if (const auto pid = read_text(dir_ / "pid")) run_command("kill " + std::to_string(std::atoi(pid->c_str())));
+    wait_for([&] { return exited(); }, 60.0);
+  }
+  /// Polls `done` every 20 ms until it holds or `seconds` pass; whether it held.
+  template <class F>
+  static bool wait_for(F&& done, double seconds) {
+    for (int i = 0; i < static_cast<int>(seconds * 50.0); ++i) {
+      if (done()) return true;
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    return done();
+  }
+
+ private:
+  fs::path err_path() const { return dir_ / "err.txt"; }
+  fs::path dir_;
+};
+
+/// The largest frame count in the viewer's "cooking SOURCE: N s, F frames drawn" progress lines.
+int frames_reported_while_cooking(const std::string& err) {
+  int most = 0;
+  for (size_t at = err.find(" frames drawn\n"); at != std::string::npos; at = err.find(" frames drawn\n", at + 1)) {
+    const size_t comma = err.rfind(", ", at);
+    if (comma != std::string::npos) most = std::max(most, std::atoi(err.c_str() + comma + 2));
+  }
+  return most;
+}
+
 // A source given to --cook-and-open (as a dropped one) is cooked by ossa-cook into the cache
-// folder while frames keep being drawn, then opened and shown.
+// folder while frames keep being drawn, then opened and shown; --window-frames counts only the
+// frames after that, so the capture shows the cooked character.
 TEST_F(ViewerWindow, CookAndOpenShowsTheCookedCharacter) {
   const fs::path source = source_dir() / "assets" / "Fox" / "Fox.glb";
-  const CommandResult r =
-      window("--cook-and-open " + quote(source.string()) + " --no-grid --size 800x500", "cooked", cache_env());
-  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const GatedCook gate(dir_);
+  const fs::path png = dir_ / "cooked.png";
+  BackgroundViewer viewer(dir_, cache_env() + " " + gate.env(),
+                          "--cook-and-open " + quote(source.string()) +
+                              " --no-grid --size 800x500 --window-frames 3 --screenshot " + quote(png.string()));
+  ASSERT_TRUE(BackgroundViewer::wait_for([&] { return gate.started() || viewer.exited(); }, 120.0)) << viewer.err();
+  ASSERT_FALSE(viewer.exited()) << "the viewer ended before its cook:\n" << viewer.err();
+  // The cook is held at the gate: the window must go on drawing meanwhile.
+  ASSERT_TRUE(BackgroundViewer::wait_for([&] { return frames_reported_while_cooking(viewer.err()) >= 2 || viewer.exited(); },
+                                         120.0))
+      << "the window stopped drawing while the cooker ran:\n" << viewer.err();
+  ASSERT_FALSE(viewer.exited()) << viewer.err();
+  gate.open();
+  ASSERT_TRUE(BackgroundViewer::wait_for([&] { return viewer.exited(); }, 600.0)) << viewer.err();
+  const std::string err = viewer.err();
+  ASSERT_EQ(viewer.exit_code(), 0) << err;
   std::vector<fs::path> outputs;
   for (const auto& e : fs::recursive_directory_iterator(dir_ / "cache" / "ossa-view"))
     if (e.path().extension() == ".ossa") outputs.push_back(e.path());
   ASSERT_EQ(outputs.size(), 1u) << "expected one cooked file under the cache";
   EXPECT_EQ(outputs.front().filename(), "Fox.ossa");
-  EXPECT_NE(r.err.find("opened " + outputs.front().string()), std::string::npos) << r.err;
-  int frames = -1;
-  const size_t at = r.err.find("frames drawn meanwhile");
-  ASSERT_NE(at, std::string::npos) << r.err;
-  const size_t open_paren = r.err.rfind('(', at);
-  std::sscanf(r.err.c_str() + open_paren, "(%d", &frames);
-  EXPECT_GE(frames, 2) << "the window stopped drawing while the cooker ran";
-  const Layout l = parse_layout(r.err);
+  EXPECT_NE(err.find("opened " + outputs.front().string()), std::string::npos) << err;
+  EXPECT_NE(err.find("frames drawn meanwhile"), std::string::npos) << err;
+  const Layout l = parse_layout(err);
   const Box b = scene_foreground(shot("cooked"), l);
   ASSERT_FALSE(b.empty()) << "the cooked fox is not shown";
   EXPECT_GT((b.x1 - b.x0) * (b.y1 - b.y0), static_cast<int>(0.05 * l.width * l.height));
+}
+
+// Without --window-frames the window stays: through the cook, after the character is opened,
+// until it is closed (here: terminated by the test). It once closed itself at once, exit 0, with
+// nothing cooked (issue 26 item 6).
+TEST_F(ViewerWindow, CookAndOpenWithoutAFrameLimitKeepsTheWindow) {
+  const fs::path source = source_dir() / "assets" / "Fox" / "Fox.glb";
+  const GatedCook gate(dir_);
+  BackgroundViewer viewer(dir_, cache_env() + " " + gate.env(), "--cook-and-open " + quote(source.string()) + " --size 640x400");
+  ASSERT_TRUE(BackgroundViewer::wait_for([&] { return gate.started() || viewer.exited(); }, 120.0)) << viewer.err();
+  ASSERT_FALSE(viewer.exited()) << "the window closed before its cook (exit " << viewer.exit_code() << "):\n"
+                                << viewer.err();
+  gate.open();
+  ASSERT_TRUE(BackgroundViewer::wait_for([&] { return viewer.err().find("opened ") != std::string::npos || viewer.exited(); },
+                                         600.0))
+      << viewer.err();
+  EXPECT_NE(viewer.err().find("cooked " + source.string()), std::string::npos) << viewer.err();
+  // A window that closes by itself does so within a frame or two; a second is ample to see it.
+  EXPECT_FALSE(BackgroundViewer::wait_for([&] { return viewer.exited(); }, 1.0))
+      << "the window closed by itself after opening the character (exit " << viewer.exit_code() << "):\n"
+      << viewer.err();
+  viewer.stop();
 }
 
 // A source the cooker refuses: the cooker's message in the panel, in red, and on stderr; exit 1

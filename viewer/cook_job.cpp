@@ -168,7 +168,7 @@ void CookJob::run(fs::path cooker, fs::path output) {
   // files beside the source (a .gltf's buffers and textures) and nothing else.
   const std::vector<std::string> args = {cooker.string(), "--quiet", source_.string(), "--root",
                                          fs::absolute(source_).parent_path().string(), "-o",
-                                         output.parent_path().string(), "--timeout", "300"};
+                                         output.parent_path().string()};
   std::vector<char*> argv;
   for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
   argv.push_back(nullptr);
@@ -239,7 +239,16 @@ bool busy(const PendingWork& work) { return !work.open.empty() || !work.cook_que
 
 void note_indicator_drawn(PendingWork& work) {
   if (!work.open.empty()) work.open_announced = true;
-  if (work.cook.running()) ++work.frames_while_cooking;
+  if (!work.cook.running()) return;
+  ++work.frames_while_cooking;
+  // Once a second of cooking, a progress line for -v: what a script (and the tests) read to know
+  // the window keeps drawing while the cooker runs, without assuming how fast either is.
+  const int seconds = static_cast<int>(work.cook.elapsed_seconds());
+  if (seconds > work.progress_logged) {
+    work.progress_logged = seconds;
+    work.log.push_back("cooking " + work.cook.source().string() + ": " + std::to_string(seconds) + " s, " +
+                       std::to_string(work.frames_while_cooking) + " frames drawn");
+  }
 }
 
 void step_pending_work(PendingWork& work, App& app, float aspect, std::string& status) {
@@ -267,17 +276,20 @@ void step_pending_work(PendingWork& work, App& app, float aspect, std::string& s
     const fs::path source = work.cook_queue.front();
     work.cook_queue.pop_front();
     if (work.cooker.empty()) {
+      const char* chosen = std::getenv("OSSA_COOK");
       const char* path = std::getenv("PATH");
-      if (const auto found = find_cooker(executable_dir(), path ? path : "")) work.cooker = *found;
+      if (chosen != nullptr && *chosen != '\0') work.cooker = chosen;
+      else if (const auto found = find_cooker(executable_dir(), path ? path : "")) work.cooker = *found;
     }
     if (work.cache_root.empty()) work.cache_root = cook_cache_root(std::getenv("XDG_CACHE_HOME"), std::getenv("HOME"));
     std::string error;
     if (work.cooker.empty()) {
-      status = source.string() + ": cannot cook it: ossa-cook was found neither beside ossa-view nor on PATH";
+      status = source.string() + ": cannot cook it: ossa-cook was found neither beside ossa-view nor on PATH (OSSA_COOK names one)";
     } else if (!work.cook.start(work.cooker, source, cook_output_for(work.cache_root, source), error)) {
       status = source.string() + ": " + error;
     } else {
       work.frames_while_cooking = 0;
+      work.progress_logged = 0;
     }
   }
 }

@@ -8,8 +8,9 @@
 // of its own, so the window keeps drawing (a spinner, the elapsed time) while it runs; the main
 // loop polls CookJob::finished() once a frame and takes the result.
 //
-// Where things go: the cooker is looked for next to the running ossa-view (/proc/self/exe's
-// folder: the build's bin/ and an install's bin/ hold both), then on PATH. Outputs go to a cache
+// Where things go: the cooker is $OSSA_COOK when set, else looked for next to the running
+// ossa-view (/proc/self/exe's folder: the build's bin/ and an install's bin/ hold both), then on
+// PATH. The cook runs with the cooker's own limits (its --timeout default, settings files). Outputs go to a cache
 // folder, $XDG_CACHE_HOME/ossa-view (else ~/.cache/ossa-view), one sub-folder per source path
 // (a hash of it), so two sources of one name never share an output and a second cook of an
 // unchanged source is answered by the cooker's own cook-key check without cooking again.
@@ -108,6 +109,7 @@ struct PendingWork {
   std::filesystem::path cooker;        // empty: not found yet (looked for on the first cook)
   std::filesystem::path cache_root;    // cook_cache_root from the environment
   int frames_while_cooking = 0;        // frames drawn while the current cook ran (-v reports it)
+  int progress_logged = 0;             // whole seconds of the current cook already reported in `log`
   std::vector<std::string> log;        // lines for -v: what was cooked / opened, and how long it took
 };
 

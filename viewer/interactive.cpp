@@ -317,8 +317,10 @@ int run_interactive(const ViewerOptions& o) {
     }
     ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
     if (Status s = check_gl("drawing a frame"); !s) ui.status = s.message();
+    // --window-frames N counts frames once nothing is pending, so a capture waits for every cook
+    // and open; without it (0) the window stays until it is closed.
     counted += busy(ui.work) ? 0 : 1;
-    if (counted == o.window_frames) {  // automation: capture the window, panel included, and stop
+    if (o.window_frames > 0 && counted == o.window_frames) {  // automation: capture the window, panel included, and stop
       if (o.verbose)
         std::fprintf(stderr, "ossa-view: layout: panel %.0f, scene %.0f %.0f %.0f %.0f, timeline %.0f (window %dx%d, framebuffer %dx%d)\n",
                      panel_width(ui), l.scene.x, l.scene.y, l.scene.width, l.scene.height, l.timeline.height, win_width,
