@@ -47,6 +47,13 @@ std::string machine_line() {
          "; skinning: " + skinning_name(skinning_isa());
 }
 
+CpuVendor cpu_vendor() {
+  const std::string id = cpuinfo("vendor_id");
+  if (id == "AuthenticAMD") return CpuVendor::Amd;
+  if (id == "GenuineIntel") return CpuVendor::Intel;
+  return CpuVendor::Other;
+}
+
 bool apply_clone(int& argc, char** argv, std::string* error) {
   for (int i = 1; i < argc; ++i) {
     std::string name;

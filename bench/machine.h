@@ -15,6 +15,11 @@ namespace ossa::bench {
 /// — one line, no newline. Fields that cannot be known read "unknown".
 std::string machine_line();
 
+enum class CpuVendor { Amd, Intel, Other };
+
+/// The CPU's vendor from /proc/cpuinfo's vendor_id (AuthenticAMD, GenuineIntel), else Other.
+CpuVendor cpu_vendor();
+
 /// Takes `--clone baseline|avx2|avx512` (or `--clone=...`) out of argv, if present, and forces
 /// that copy: baseline = the per-joint loops' baseline copy and portable skinning; avx2 = their
 /// AVX2 copies; avx512 = the AVX2 per-joint loops (they have no AVX-512 copy) and AVX-512 skinning.
