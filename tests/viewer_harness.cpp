@@ -117,7 +117,10 @@ CommandResult run_viewer(const std::string& args) {
   std::string why;
   const auto display = test_display(&why);
   if (!display) return {-1, "", "no display: " + why};
-  return run_command("DISPLAY=" + quote(*display) + " " + quote((bin_dir() / "ossa-view").string()) + " " + args);
+  // Bounded, so a viewer that hangs (waiting on a FIFO, say) fails its test with exit 124 instead
+  // of stalling the suite until CTest's own timeout.
+  return run_command("DISPLAY=" + quote(*display) + " timeout --kill-after=10 600 " +
+                     quote((bin_dir() / "ossa-view").string()) + " " + args);
 }
 
 Image load_png(const std::filesystem::path& path) {

@@ -26,7 +26,8 @@ std::filesystem::path viewer_cooked_dir();
 /// The display tests render on (":N"), starting Xvfb on first use; nullopt + why when none.
 std::optional<std::string> test_display(std::string* why = nullptr);
 
-/// Runs `ossa-view ARGS` on the test display (ARGS already shell-quoted as needed).
+/// Runs `ossa-view ARGS` on the test display (ARGS already shell-quoted as needed), for at most
+/// 600 s (exit 124 after that).
 CommandResult run_viewer(const std::string& args);
 
 /// Shell-quotes a path or argument.

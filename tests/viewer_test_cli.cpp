@@ -285,11 +285,10 @@ TEST_F(Viewer, HostileTexturesAreLeftOutByName) {
   spec.materials.push_back(second);
   const fs::path file = dir_ / "hostile.ossa";
   ASSERT_TRUE(write_file(file, make_valid_file(spec)));
-  const auto start = std::chrono::steady_clock::now();
-  const CommandResult r = run_viewer(quote(file.string()) + " --size 64x64 --frames 1");
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  // A FIFO opened for reading would wait for a writer forever, and /dev/zero never ends: the run
+  // is bounded (a hang fails as exit 124, not as a stalled suite) and each is named as left out.
+  const CommandResult r = run_viewer("--size 64x64 --frames 1 " + quote(file.string()));
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  EXPECT_LT(seconds, 20.0);
   EXPECT_NE(r.err.find("over the viewer's limit of 16384 per side and 67108864 pixels"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("passwd left out: it lies outside the file's folder"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("pipe.png left out: it is not a regular file"), std::string::npos) << r.err;
