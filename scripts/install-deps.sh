@@ -4,7 +4,7 @@
 set -euo pipefail
 
 PACKAGES=(
-  cmake ninja-build g++ pkg-config git
+  cmake ninja-build g++ pkg-config git ccache
   libassimp-dev libglm-dev libglfw3-dev flatbuffers-compiler libflatbuffers-dev libstb-dev
   libopenmesh-dev libmeshoptimizer-dev libcli11-dev nlohmann-json3-dev libxxhash-dev
   libgtest-dev libgmock-dev libbenchmark-dev libimgui-dev libepoxy-dev
@@ -13,6 +13,7 @@ PACKAGES=(
   python3 python3-jsonschema
   g++-mingw-w64-x86-64-posix wine64
 )
+# ccache: scripts/test.sh compiles its five builds through it, so they share what they compile alike.
 # g++-mingw-w64-x86-64-posix + wine64: the Windows stage of scripts/test.sh cross-builds the runtime
 # and its suites with MinGW-w64 (cmake/toolchains/mingw-w64-x86_64.cmake) and runs them under Wine;
 # GoogleTest's sources for that build come with libgtest-dev (/usr/src/googletest).
