@@ -18,7 +18,7 @@
 
 #include "cooker/clip/clip_events.h"
 #include "cooker/cook_internal.h"
-#include "cooker/cook_settings.h"
+#include "cooker/model/cook_settings.h"
 #include "cooker/import/import_scene.h"
 #include "cooker/mesh/mesh_build.h"
 #include "cooker/clip/root_motion.h"

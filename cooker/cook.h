@@ -13,8 +13,8 @@
 #include <vector>
 
 #include "cooker/clip/clip_compress.h"
-#include "cooker/import/input_log.h"
-#include "cooker/import/source_scene.h"
+#include "cooker/model/input_log.h"
+#include "cooker/model/source_scene.h"
 #include <ossa/format/result.h>
 
 namespace ossa::cook {

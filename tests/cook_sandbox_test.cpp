@@ -1,4 +1,4 @@
-// cook_sandbox_test.cpp — the cook's read sandbox (cooker/import/input_log.h) against the attacks a
+// cook_sandbox_test.cpp — the cook's read sandbox (cooker/model/input_log.h) against the attacks a
 // source from an untrusted hand can make: a glTF buffer or image URI climbing out of the tree, a
 // graph source given by absolute path, a symlink pointing out, a FIFO or device as an input or a
 // texture. Each is refused by name (never opened, so nothing hangs or leaks into an output), the

@@ -27,7 +27,7 @@
 #include <glm/gtc/quaternion.hpp>
 #include <nlohmann/json.hpp>
 
-#include "cooker/clip/clip_grid.h"
+#include "cooker/model/clip_grid.h"
 #include "cooker/import/gltf_samplers.h"
 #include "cooker/import/import_scene.h"
 #include "test_files.h"

@@ -1,4 +1,4 @@
-// graph_fixture.h — graph files for runtime tests and benchmarks, built in C++ (cooker/graph/graph_def.h)
+// graph_fixture.h — graph files for runtime tests and benchmarks, built in C++ (cooker/model/graph_def.h)
 // around Pab's real clips, so the tests pin the evaluator without depending on the JSON compiler.
 //
 // pab_rig() imports assets/Pab once per process: the 67-joint skeleton and the walk, jog, run and
@@ -12,8 +12,8 @@
 #include <vector>
 
 #include "cooker/clip/clip_compress.h"
-#include "cooker/graph/graph_def.h"
-#include "cooker/import/source_scene.h"
+#include "cooker/model/graph_def.h"
+#include "cooker/model/source_scene.h"
 #include <glm/glm.hpp>
 #include <ossa/graph/graph.h>
 #include <ossa/loader/asset.h>

@@ -22,7 +22,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/quaternion.hpp>
 
-#include "cooker/clip/clip_grid.h"
+#include "cooker/model/clip_grid.h"
 #include "cooker/cook.h"
 #include "cooker/clip/root_motion.h"
 #include <ossa/loader/asset.h>

@@ -13,9 +13,9 @@
 #include <string>
 #include <vector>
 
-#include "cooker/clip/clip_grid.h"
+#include "cooker/model/clip_grid.h"
 #include "cooker/clip/morph_weights.h"
-#include "cooker/import/source_scene.h"
+#include "cooker/model/source_scene.h"
 #include <ossa/format/result.h>
 
 namespace ossa::cook {

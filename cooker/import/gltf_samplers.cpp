@@ -9,7 +9,7 @@
 // a hostile file must give an error message, never a read out of bounds or a huge allocation.
 // All arithmetic on offsets is in uint64_t after checking each term, so nothing overflows.
 #include "cooker/import/gltf_samplers.h"
-#include "cooker/import/input_log.h"
+#include "cooker/model/input_log.h"
 
 #include <algorithm>
 #include <cmath>

@@ -35,8 +35,8 @@
 
 #include <assimp/scene.h>
 
-#include "cooker/clip/clip_grid.h"
-#include "cooker/clip/clip_split.h"
+#include "cooker/model/clip_grid.h"
+#include "cooker/import/clip_split.h"
 #include "cooker/import/gltf_samplers.h"
 #include "cooker/import/import_internal.h"
 
@@ -353,7 +353,7 @@ float resampling_rate(const std::vector<NodeKeys>& keys, double tps, float estim
 }
 
 /// The clip's frame rate: the slowest rate whose grid holds every source key, so that cooking on
-/// that grid (cooker/clip/clip_grid.h) loses no key. The most common key spacing is only a first guess:
+/// that grid (cooker/model/clip_grid.h) loses no key. The most common key spacing is only a first guess:
 /// Pab's jog keys most channels every 1/15 s but some every 1/30 s, and a BVH's "Frame Time:
 /// 0.0083333" is not exactly 120 Hz. Candidates, slowest first among: the estimate rounded to a
 /// whole rate, the estimate as measured, their multiples up to 8x, and the common exporter rates

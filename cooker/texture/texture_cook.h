@@ -25,7 +25,7 @@
 #include <vector>
 
 #include "cooker/cook.h"
-#include "cooker/import/source_scene.h"
+#include "cooker/model/source_scene.h"
 #include <ossa/format/result.h>
 
 namespace ossa::cook {

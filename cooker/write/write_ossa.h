@@ -11,10 +11,10 @@
 #include <vector>
 
 #include "cooker/clip/clip_compress.h"
-#include "cooker/graph/graph_def.h"
-#include "cooker/import/input_log.h"
+#include "cooker/model/graph_def.h"
+#include "cooker/model/input_log.h"
 #include "cooker/mesh/mesh_build.h"
-#include "cooker/import/source_scene.h"
+#include "cooker/model/source_scene.h"
 
 namespace ossa::cook {
 

@@ -77,7 +77,7 @@ struct SourceTrack {
 };
 
 /// Root motion taken out of a clip at cook time (cooker/clip/root_motion.h), one sample per frame of
-/// the clip's frame grid (cooker/clip/clip_grid.h), relative to frame 0.
+/// the clip's frame grid (cooker/model/clip_grid.h), relative to frame 0.
 struct SourceRootMotion {
   std::vector<glm::vec3> translations;
   std::vector<float> yaws;               // radians about up_axis

@@ -1,5 +1,5 @@
 // input_log.cpp — the per-cook record of files read, and the cook key (see input_log.h).
-#include "cooker/import/input_log.h"
+#include "cooker/model/input_log.h"
 
 #include <fcntl.h>
 #include <sys/stat.h>

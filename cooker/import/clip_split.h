@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "cooker/import/source_scene.h"
+#include "cooker/model/source_scene.h"
 
 namespace ossa::cook {
 

@@ -7,7 +7,7 @@
 #include <cmath>
 #include <cstdint>
 
-#include "cooker/import/source_scene.h"
+#include "cooker/model/source_scene.h"
 
 namespace ossa::cook {
 

@@ -1,5 +1,5 @@
 // clip_split.cpp — see clip_split.h.
-#include "cooker/clip/clip_split.h"
+#include "cooker/import/clip_split.h"
 
 #include <algorithm>
 #include <cmath>
@@ -7,7 +7,7 @@
 
 #include <glm/gtc/quaternion.hpp>
 
-#include "cooker/clip/clip_grid.h"
+#include "cooker/model/clip_grid.h"
 
 namespace ossa::cook {
 namespace {

@@ -1,5 +1,5 @@
 // cook_settings.cpp — reading and layering ossa.cook.json / <stem>.cook.json (see cook_settings.h).
-#include "cooker/cook_settings.h"
+#include "cooker/model/cook_settings.h"
 #include "cooker/texture/texture_cook.h"
 
 #include <fnmatch.h>
