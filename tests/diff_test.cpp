@@ -1,4 +1,4 @@
-// diff_test.cpp — ossa-diff's comparison (runtime/tools/diff/diff.h) and the probe-point measure
+// diff_test.cpp — ossa-diff's comparison (tools/diff/diff.h) and the probe-point measure
 // behind it (<ossa/anim/pose_error.h>), on synthetic files where the one change is known exactly.
 //
 // Each test builds a pair of files from SyntheticSpec (tests/test_files.h) that differ in one

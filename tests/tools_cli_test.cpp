@@ -1,4 +1,4 @@
-// tools_cli_test.cpp — the command-line conventions every tool shares (runtime/tools/cli/cli.h),
+// tools_cli_test.cpp — the command-line conventions every tool shares (tools/cli/cli.h),
 // checked on the real binaries: --version's line, --help, exit status 2 with a "did you mean" for
 // a mistyped option and for a missing argument, -q and -v. Nothing here needs a display: ossa-view
 // answers these before it opens a window (its -q / -v on a rendered scene are in viewer_test).
@@ -12,7 +12,7 @@
 
 #include <ossa/version.h>
 
-#include "runtime/tools/cli/cli.h"
+#include "tools/cli/cli.h"
 #include "test_files.h"
 
 namespace fs = std::filesystem;

@@ -235,7 +235,7 @@ TEST_F(Viewer, BadSizeIsAUsageError) {
   EXPECT_NE(r.err.find("run 'ossa-view --help'"), std::string::npos) << r.err;
 }
 
-// -q / -v (runtime/tools/cli/cli.h) on a rendered scene. The synthetic file's normal map is a path
+// -q / -v (tools/cli/cli.h) on a rendered scene. The synthetic file's normal map is a path
 // that does not exist, so a plain run warns that it was left out.
 TEST_F(Viewer, QuietHidesWarningsVerboseNamesTheContext) {
   const fs::path file = dir_ / "synthetic.ossa";

@@ -12,7 +12,7 @@
 #include <set>
 
 #include "cooker/cli/worker.h"
-#include "runtime/internal/message.h"
+#include "common/message.h"
 
 #include <ossa/version.h>
 

@@ -12,7 +12,7 @@
 #include <cstring>
 #include <fstream>
 
-#include "runtime/internal/message.h"
+#include "common/message.h"
 #include <ossa/version.h>
 
 namespace ossa::cook {

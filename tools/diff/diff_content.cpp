@@ -16,7 +16,7 @@
 #include <nlohmann/json.hpp>
 
 #include <ossa/format/hash.h>
-#include "internal/message.h"
+#include "common/message.h"
 #include "tools/diff/diff_internal.h"
 #include "tools/inspect/describe.h"
 

@@ -11,7 +11,7 @@
 #include <string_view>
 #include <unordered_map>
 
-#include "internal/message.h"
+#include "common/message.h"
 #include "tools/diff/diff_internal.h"
 
 namespace ossa::diff {

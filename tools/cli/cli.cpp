@@ -1,5 +1,5 @@
 // cli.cpp — see cli.h. CLI11's exceptions are caught here and never leave parse().
-#include "runtime/tools/cli/cli.h"
+#include "tools/cli/cli.h"
 
 #include <algorithm>
 #include <cstdio>

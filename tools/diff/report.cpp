@@ -10,7 +10,7 @@
 #include <string>
 
 #include "tools/inspect/describe.h"
-#include "internal/message.h"
+#include "common/message.h"
 
 namespace ossa::diff {
 namespace {

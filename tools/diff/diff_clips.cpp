@@ -20,7 +20,7 @@
 #include <ossa/anim/pose_error.h>
 #include <ossa/anim/root_motion.h>
 #include <ossa/anim/sample.h>
-#include "internal/message.h"
+#include "common/message.h"
 #include "tools/diff/diff_internal.h"
 
 namespace ossa::diff::internal {

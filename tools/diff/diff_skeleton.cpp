@@ -14,7 +14,7 @@
 #include <glm/gtc/quaternion.hpp>
 
 #include <ossa/anim/pose_error.h>
-#include "internal/message.h"
+#include "common/message.h"
 #include "tools/diff/diff_internal.h"
 
 namespace ossa::diff::internal {

@@ -13,7 +13,7 @@
 #include <vector>
 
 #include <ossa/format/hash.h>
-#include "internal/message.h"
+#include "common/message.h"
 
 namespace ossa::inspect {
 namespace {

@@ -18,7 +18,7 @@
 
 #include <ossa/format/vertex_codec.h>
 #include <ossa/format/vertex_format.h>
-#include "internal/message.h"
+#include "common/message.h"
 #include "tools/diff/diff_internal.h"
 
 namespace ossa::diff::internal {

@@ -9,7 +9,7 @@
 // regression tests compare and is described in docs/schemas/ossa-inspect.schema.json; it names the
 // file without its directory so goldens do not depend on where a tree is checked out.
 //
-// Exit status (runtime/tools/cli/cli.h): 0 the file loads; 1 it is not a valid .ossa file (the
+// Exit status (tools/cli/cli.h): 0 the file loads; 1 it is not a valid .ossa file (the
 // loader's message, naming the file, on stderr); 2 usage error, or the file cannot be read at all.
 #include <cstdio>
 #include <filesystem>
@@ -17,7 +17,7 @@
 #include <string>
 
 #include <ossa/loader/asset.h>
-#include "runtime/tools/cli/cli.h"
+#include "tools/cli/cli.h"
 #include "tools/inspect/describe.h"
 
 int main(int argc, char** argv) {

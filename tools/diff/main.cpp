@@ -5,7 +5,7 @@
 // Exit status is the interface a CI job uses, so it is kept to three values whatever happens:
 // 0 the cooks are the same within the tolerance, 1 they differ (every difference named on stdout),
 // 2 they cannot be compared (a file the loader refuses, with its message naming the file, on
-// stderr) or the command line is wrong. The shared command line (runtime/tools/cli/cli.h) gives
+// stderr) or the command line is wrong. The shared command line (tools/cli/cli.h) gives
 // --help, --version, -q / -v, the mapping of every CLI11 parse error to 2 and "did you mean".
 // -q prints nothing on stdout (an error that makes comparing impossible still goes to stderr, as
 // cmp -s does).
@@ -13,7 +13,7 @@
 #include <iostream>
 #include <string>
 
-#include "runtime/tools/cli/cli.h"
+#include "tools/cli/cli.h"
 #include "tools/diff/diff.h"
 #include "tools/diff/report.h"
 
