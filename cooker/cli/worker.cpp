@@ -43,16 +43,16 @@ using Clock = std::chrono::steady_clock;
 #if defined(__GLIBCXX__) && defined(__LP64__)
 static_assert(sizeof(CookRecord) == 336,
               "CookRecord changed: extend record_to_json / record_from_json (cooker/cli/worker.cpp) and "
-              "the round trip in tests/cook_isolation_test.cpp, then update this size");
+              "the round trip in tests/cooker/cook_isolation_test.cpp, then update this size");
 static_assert(sizeof(MorphRecord) == 88,
               "MorphRecord changed: extend record_to_json / record_from_json (cooker/cli/worker.cpp) and "
-              "the round trip in tests/cook_isolation_test.cpp, then update this size");
+              "the round trip in tests/cooker/cook_isolation_test.cpp, then update this size");
 static_assert(sizeof(TextureRecord) == 152,
               "TextureRecord changed: extend record_to_json / record_from_json (cooker/cli/worker.cpp) and "
-              "the round trip in tests/cook_isolation_test.cpp, then update this size");
+              "the round trip in tests/cooker/cook_isolation_test.cpp, then update this size");
 static_assert(sizeof(ClipRecord) == 88,
               "ClipRecord changed: extend record_to_json / record_from_json (cooker/cli/worker.cpp) and "
-              "the round trip in tests/cook_isolation_test.cpp, then update this size");
+              "the round trip in tests/cooker/cook_isolation_test.cpp, then update this size");
 #endif
 
 // ---------------------------------------------------------------------------------------------

@@ -1,10 +1,10 @@
 // json_schema_test.cpp — the JSON the tools write matches its documentation (docs/JSON.md,
-// docs/schemas/), checked on real output with tests/json_schema_check.py (Debian's
+// docs/schemas/), checked on real output with tests/support/json_schema_check.py (Debian's
 // python3-jsonschema):
 //  - the --report of a batch with successes and failures of every stage (unreadable, unparsable,
 //    failing after import), and that a failed record names no output and keeps what it counted;
 //  - ossa-inspect --json (and -v --json) of every kind of cooked sample and of every synthetic
-//    variant of tests/test_files.h;
+//    variant of tests/support/test_files.h;
 //  - that the schemas constrain: mutated documents (an unknown field, a wrong type, a failed
 //    record naming an output, ...) are rejected, so the checks above cannot pass vacuously;
 //  - that every object in the schemas is closed and every property described (--lint).
@@ -38,7 +38,7 @@ CommandResult tool(const char* name, const std::string& args) {
 
 /// json_schema_check.py SCHEMA DOCS...: 0 all valid, 1 some invalid, 2 unreadable.
 CommandResult check(const fs::path& schema_file, const std::vector<fs::path>& docs) {
-  std::string cmd = "/usr/bin/python3 " + q(ossa::test::source_dir() / "tests" / "json_schema_check.py") + " " +
+  std::string cmd = "/usr/bin/python3 " + q(ossa::test::source_dir() / "tests/support/json_schema_check.py") + " " +
                     q(schema_file);
   for (const fs::path& d : docs) cmd += " " + q(d);
   return run_command(cmd);
@@ -313,7 +313,7 @@ TEST(SchemasConstrain, MutatedInspectDocumentsAreRejected) {
 }
 
 TEST(SchemasConstrain, EveryObjectIsClosedAndEveryPropertyDescribed) {
-  const std::string checker = q(ossa::test::source_dir() / "tests" / "json_schema_check.py");
+  const std::string checker = q(ossa::test::source_dir() / "tests" / "support" / "json_schema_check.py");
   const CommandResult lint = run_command("/usr/bin/python3 " + checker + " --lint " + q(schema("ossa-cook-report")) +
                                          " " + q(schema("ossa-inspect")) + " " + q(schema("ossa-diff")));
   EXPECT_EQ(lint.exit_code, 0) << lint.out << lint.err;

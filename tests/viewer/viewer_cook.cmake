@@ -18,6 +18,6 @@ cook("${ASSETS}/Pab/arnaud.fbx" "${ASSETS}/Pab/walk.fbx" "${ASSETS}/Pab/jog.fbx"
 cook("${ASSETS}/Pab/pab.graph.json" --root "${ASSETS}" -o "${OUT}/quantized")
 cook("${ASSETS}/CesiumMan" "${ASSETS}/Fox" "${ASSETS}/RiggedSimple" --float-vertices --root "${ASSETS}" -o "${OUT}/float")
 # The textured characters with their textures kept as the source's PNG / JPEG bytes, and as
-# uncompressed RGBA8 chains, for tests/viewer_texture_test.cpp to compare with the BC cooks above.
+# uncompressed RGBA8 chains, for tests/viewer/viewer_texture_test.cpp to compare with the BC cooks above.
 cook("${ASSETS}/CesiumMan" "${ASSETS}/Fox" --texture-format source --root "${ASSETS}" -o "${OUT}/source-textures")
 cook("${ASSETS}/CesiumMan" "${ASSETS}/Fox" --texture-format rgba8 --root "${ASSETS}" -o "${OUT}/rgba8-textures")

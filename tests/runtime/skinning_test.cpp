@@ -11,7 +11,7 @@
 //
 // Every implementation the CPU has (portable, AVX2, AVX-512: set_skinning_isa) is run against
 // the reference. Assets: CesiumMan, RiggedSimple, and Pab's arnaud cooked against Pab's skeleton
-// (the benchmark mesh); synthetic files (tests/test_files.h) cover the layouts and cases the
+// (the benchmark mesh); synthetic files (tests/support/test_files.h) cover the layouts and cases the
 // cooker does not write (tangents, 16-bit slots in a quantized layout, static meshes) and the
 // dual quaternion cases built to order (identical rigid palettes, a twisted two-bone cylinder).
 //

@@ -24,7 +24,7 @@ using namespace ossa::test;
 namespace {
 
 // ---------------------------------------------------------------------------------------------
-// Morph targets, on synthetic files (tests/test_files.h): the 2 x 3 grid (x in +-0.5, rows at
+// Morph targets, on synthetic files (tests/support/test_files.h): the 2 x 3 grid (x in +-0.5, rows at
 // y = 0, 1, 2, skinned to spine / head) with target "smile" moving the head row (vertices 4, 5)
 // +0.4 in x and tilting its normals, and "frown" moving the middle row (2, 3) -0.1 in x (default
 // weight 0.25). The clip drives smile from 0 to 1 over its one second.
@@ -226,7 +226,7 @@ TEST_F(ViewerMorph, RobotExpressiveSurprisedChangesTheFaceOnly) {
   EXPECT_LT(paths.mean_abs, kMaxMeanSame);
 }
 
-// A blend-shape face without joints (tests/blend_shape_fbx.h): its weights-only clip plays on the
+// A blend-shape face without joints (tests/support/blend_shape_fbx.h): its weights-only clip plays on the
 // targets. At 1 s "smile" is at 1 (corners 1 and 3 moved), at 0 s at 0; GPU and CPU paths agree.
 TEST_F(ViewerMorph, AWeightsOnlyClipPlaysOnAFaceWithoutJoints) {
   ASSERT_TRUE(write_file(dir_ / "face.fbx", std::string(kBlendShapeFbx)));

@@ -338,7 +338,7 @@ TEST(CookMorph, InspectReportsEveryTargetAndTrack) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// FBX blend shapes (tests/blend_shape_fbx.h): targets, and per-channel keys out of merged ones.
+// FBX blend shapes (tests/support/blend_shape_fbx.h): targets, and per-channel keys out of merged ones.
 
 TEST(CookMorph, FbxBlendShapesAndTheirPerChannelKeysAreCarried) {
   const fs::path dir = ossa::test::make_temp_dir("morph-fbx");

@@ -1,7 +1,7 @@
 // diff_test.cpp — ossa-diff's comparison (tools/diff/diff.h) and the probe-point measure
 // behind it (<ossa/anim/pose_error.h>), on synthetic files where the one change is known exactly.
 //
-// Each test builds a pair of files from SyntheticSpec (tests/test_files.h) that differ in one
+// Each test builds a pair of files from SyntheticSpec (tests/support/test_files.h) that differ in one
 // field and checks that the report names exactly that item with the expected figure: the point of
 // ossa-diff is that a regression is named precisely, and a test that only checked "differs" would
 // pass for a tool that reports the wrong joint.
