@@ -1,6 +1,6 @@
 // cook_settings.cpp — reading and layering ossa.cook.json / <stem>.cook.json (see cook_settings.h).
 #include "cooker/model/cook_settings.h"
-#include "cooker/texture/texture_cook.h"
+#include "cooker/model/reference_skeleton.h"
 
 #include <fnmatch.h>
 

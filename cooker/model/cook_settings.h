@@ -21,7 +21,8 @@
 #include <memory>
 #include <string>
 
-#include "cooker/cook.h"
+#include "cooker/model/cook_options.h"
+#include "cooker/model/source_scene.h"
 #include <ossa/format/result.h>
 
 namespace ossa::cook {

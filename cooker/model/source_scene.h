@@ -158,4 +158,8 @@ struct SourceScene {
   uint32_t vertices_over_4_influences = 0;  // vertices that lost weight to the 4-influence cap
 };
 
+/// The skeleton hash of a SourceSkeleton (ossa/format/hash.h's skeleton_hash over its names and
+/// parents): what clip-only files and graphs are bound by, the same value the loader recomputes.
+uint64_t skeleton_hash_of(const SourceSkeleton& skeleton);
+
 }  // namespace ossa::cook

@@ -31,9 +31,6 @@ struct WriteOptions {
   std::span<const GraphDef> graphs;  // animation graphs (a character cooked from a graph file)
 };
 
-/// The skeleton hash of a SourceSkeleton (ossa/format/hash.h's skeleton_hash over its names/parents).
-uint64_t skeleton_hash_of(const SourceSkeleton& skeleton);
-
 /// Serializes. `clips` are the compressed forms of scene.clips (same order); they are tagged with
 /// the hash of scene.skeleton. O(output size).
 std::vector<uint8_t> write_ossa(const SourceScene& scene, std::span<const CookedMesh> meshes,
