@@ -14,22 +14,6 @@ std::string version_line(std::string_view tool) {
   return std::string(tool) + " " + OSSA_VERSION_STRING + " (format " + std::to_string(kFormatVersion) + ")";
 }
 
-size_t edit_distance(std::string_view a, std::string_view b) {
-  // One row of the dynamic-programming table at a time.
-  std::vector<size_t> row(b.size() + 1);
-  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
-  for (size_t i = 1; i <= a.size(); ++i) {
-    size_t diagonal = row[0];
-    row[0] = i;
-    for (size_t j = 1; j <= b.size(); ++j) {
-      const size_t above = row[j];
-      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
-      diagonal = above;
-    }
-  }
-  return row[b.size()];
-}
-
 std::string closest_name(std::string_view unknown, const std::vector<std::string>& known) {
   unknown = unknown.substr(0, unknown.find('='));
   std::string best;

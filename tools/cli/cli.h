@@ -8,7 +8,7 @@
 // its own words; each tool wrapping that by hand drifted. Here CLI11's ParseError is caught once
 // and every usage error becomes status 2.
 //
-// Exit statuses (documented in each tool's --help footer and in README.md):
+// Exit statuses (documented in each tool's --help footer and in docs/CLI.md):
 //   0  success
 //   1  the tool ran and its job failed, in the tool's own sense (an input did not cook, the file
 //      is not a valid .ossa, the scene could not be shown, the files differ)
@@ -25,6 +25,8 @@
 
 #include <CLI/CLI.hpp>
 
+#include "common/edit_distance.h"
+
 namespace ossa::cli {
 
 inline constexpr int kExitOk = 0;
@@ -36,8 +38,8 @@ enum class Verbosity { quiet, normal, verbose };
 /// "<tool> 0.6.0 (format 7)": what --version prints.
 std::string version_line(std::string_view tool);
 
-/// Levenshtein distance (insertions, deletions, substitutions each cost 1). O(|a| * |b|).
-size_t edit_distance(std::string_view a, std::string_view b);
+/// Levenshtein distance (insertions, deletions, substitutions each cost 1; common/edit_distance.h).
+using ossa::edit_distance;
 
 /// The name in `known` closest to `unknown` by edit distance, or "" when even the closest needs
 /// more than max(2, |unknown| / 3) edits (a guess that far off would mislead). Ties go to the
