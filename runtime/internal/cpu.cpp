@@ -1,6 +1,6 @@
 // cpu.cpp — cpu.h: CPU feature queries through __builtin_cpu_supports (GCC, Clang, MinGW-w64) or
-// CPUID + XGETBV (MSVC). Answers are computed once (function-local statics: thread-safe). Also
-// the process-wide choice of the per-joint loops' copy (ossa/anim/vector_isa.h), made from them.
+// CPUID + XGETBV (MSVC). Answers are computed once (function-local statics: thread-safe). The
+// skinning kernels' choice (skinning/) and the per-joint loops' copy (anim/vector_isa.cpp) read them.
 #include "internal/cpu.h"
 
 #if OSSA_CPU_X86 && defined(_MSC_VER) && !defined(__clang__)
@@ -61,43 +61,3 @@ bool cpu_has_avx2_fma() { return features().avx2_fma; }
 bool cpu_has_avx512() { return features().avx512; }
 
 }  // namespace ossa::detail
-
-// ---------------------------------------------------------------------------------------------
-// The per-joint loops' copy (ossa/anim/vector_isa.h, internal/vector_clones.h): AVX2 alone is
-// what those copies need (they use no FMA), and only builds that have the copy may select it.
-
-#include <atomic>
-
-#include <ossa/anim/vector_isa.h>
-#include "internal/vector_clones.h"
-
-namespace ossa {
-namespace {
-
-bool avx2_copy_runs() { return OSSA_HAVE_VECTOR_CLONES && detail::cpu_has_avx2(); }
-
-std::atomic<bool>& avx2_selected() {
-  static std::atomic<bool> selected{avx2_copy_runs()};
-  return selected;
-}
-
-}  // namespace
-
-VectorIsa best_vector_isa() {
-  static const VectorIsa best = avx2_copy_runs() ? VectorIsa::Avx2 : VectorIsa::Baseline;
-  return best;
-}
-
-VectorIsa vector_isa() { return avx2_selected().load(std::memory_order_relaxed) ? VectorIsa::Avx2 : VectorIsa::Baseline; }
-
-bool set_vector_isa(VectorIsa isa) {
-  if (isa == VectorIsa::Avx2 && best_vector_isa() != VectorIsa::Avx2) return false;
-  avx2_selected().store(isa == VectorIsa::Avx2, std::memory_order_relaxed);
-  return true;
-}
-
-namespace detail {
-bool vector_avx2_selected() { return avx2_selected().load(std::memory_order_relaxed); }
-}  // namespace detail
-
-}  // namespace ossa
