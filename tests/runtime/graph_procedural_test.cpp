@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "allocation_counter.h"
-#include "cooker/graph/graph_compile.h"
+#include "cooker/model/graph_def.h"
 #include "graph_fixture.h"
 #include <glm/gtc/matrix_transform.hpp>
 #include <ossa/anim/pose_ops.h>

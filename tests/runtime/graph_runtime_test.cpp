@@ -14,7 +14,6 @@
 #include <random>
 
 #include "allocation_counter.h"
-#include "cooker/cook.h"
 #include "test_files.h"
 #include "graph_fixture.h"
 #include <ossa/graph/graph.h>
@@ -495,15 +494,11 @@ void drive(GraphInstance& inst, const GraphDefinition& def, int frames, uint32_t
   }
 }
 
-/// The Pab sample graph (assets/Pab/pab.graph.json) cooked by the real cooker, once per process.
+/// The Pab sample graph (assets/Pab/pab.graph.json) cooked by ossa-cook into the committed
+/// fixtures (tests/fixtures/Pab/pab.ossa), opened once per process.
 const Asset* pab_sample() {
   static const std::unique_ptr<Asset> asset = []() -> std::unique_ptr<Asset> {
-    const std::filesystem::path source = test::source_dir() / "assets" / "Pab" / "pab.graph.json";
-    if (!std::filesystem::exists(source)) return nullptr;
-    const std::filesystem::path out = test::make_temp_dir("graph_runtime") / "pab.ossa";
-    const cook::CookRecord r = cook::cook_file(source, out, cook::CookOptions{});
-    EXPECT_TRUE(r.ok) << r.error;
-    auto a = Asset::open(out.string());
+    auto a = Asset::open((test::fixtures_dir() / "Pab" / "pab.ossa").string());
     EXPECT_TRUE(a.ok()) << (a.ok() ? "" : a.error().message);
     return a.ok() ? std::make_unique<Asset>(std::move(*a)) : nullptr;
   }();
@@ -512,7 +507,7 @@ const Asset* pab_sample() {
 
 TEST(GraphInstance, SampleGraphIsDeterministicAndAllocationFree) {
   const Asset* sample = pab_sample();
-  if (!sample) GTEST_SKIP() << "assets/Pab/pab.graph.json not found or did not cook";
+  ASSERT_NE(sample, nullptr) << "tests/fixtures/Pab/pab.ossa could not be opened";
   Played a;
   auto def = GraphDefinition::create(*sample, "pab");
   ASSERT_TRUE(def.ok()) << def.error().message;

@@ -5,8 +5,8 @@
 // Poses are built directly (seeded random joints) so the arithmetic is tested independently of
 // the sampler; joint counts are deliberately not multiples of kPoseLanes so every test also
 // covers a partial last lane block and its padding. Skeletons come from the synthetic file
-// (test_files.h) and, where the cooker has been built, from the cooked Pab rig (67 joints): a real
-// parents array and a real bind pose. Those tests skip with a notice when ossa-cook is absent.
+// (test_files.h) and from the cooked Pab rig (67 joints, tests/fixtures/Pab/skeleton.ossa): a real
+// parents array and a real bind pose.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -159,19 +159,11 @@ struct SyntheticRig {
   }
 };
 
-/// The cooked Pab skeleton (67 joints), cooked once per test run; nullopt without ossa-cook.
+/// The cooked Pab skeleton (67 joints): the committed fixture ossa-cook made (tests/fixtures/Pab),
+/// opened once per test run; nullopt (after a failure naming the file) when it cannot be opened.
 const std::optional<ossa::Asset>& pab() {
   static const std::optional<ossa::Asset> asset = []() -> std::optional<ossa::Asset> {
-    const fs::path cook = ossa::test::bin_dir() / "ossa-cook";
-    if (!fs::exists(cook)) return std::nullopt;
-    const fs::path dir = ossa::test::make_temp_dir("pose-ops-pab");
-    const fs::path src = ossa::test::source_dir() / "assets" / "Pab" / "skeleton.fbx";
-    const auto r = ossa::test::run_command("'" + cook.string() + "' '" + src.string() + "' -o '" + dir.string() + "'");
-    if (r.exit_code != 0) {
-      ADD_FAILURE() << "ossa-cook failed on Pab/skeleton.fbx: " << r.err;
-      return std::nullopt;
-    }
-    auto a = ossa::Asset::open((dir / "skeleton.ossa").string());
+    auto a = ossa::Asset::open((ossa::test::fixtures_dir() / "Pab" / "skeleton.ossa").string());
     if (!a) {
       ADD_FAILURE() << a.error().message;
       return std::nullopt;
@@ -181,9 +173,7 @@ const std::optional<ossa::Asset>& pab() {
   return asset;
 }
 
-#define REQUIRE_PAB()                                                                       \
-  if (!pab()) GTEST_SKIP() << "ossa-cook not built (" << ossa::test::bin_dir().string()   \
-                           << "): Pab skeleton unavailable"
+#define REQUIRE_PAB() ASSERT_TRUE(pab()) << "tests/fixtures/Pab/skeleton.ossa could not be opened"
 
 // ---------------------------------------------------------------------------------------------
 // Pose storage

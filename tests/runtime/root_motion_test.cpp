@@ -15,6 +15,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <new>
 #include <string>
 #include <vector>
@@ -23,7 +24,6 @@
 #include <glm/gtc/quaternion.hpp>
 
 #include "cooker/model/clip_grid.h"
-#include "cooker/cook.h"
 #include "cooker/clip/root_motion.h"
 #include <ossa/loader/asset.h>
 #include <ossa/anim/pose.h>
@@ -518,28 +518,12 @@ TEST(RootMotionDelta, DoesNotAllocate) {
 // A real clip: Pab's walk cooked with --root-motion against the Pab skeleton.
 
 TEST(RootMotionCooked, PabWalkMovesForwardWithTheRootInPlace) {
-  namespace fs = std::filesystem;
-  const fs::path pab = test::source_dir() / "assets" / "Pab";
-  if (!fs::exists(pab / "walk.fbx")) GTEST_SKIP() << "no " << (pab / "walk.fbx").string();
-  const fs::path dir = test::make_temp_dir("root-motion");
-
-  cook::CookOptions rig_options;
-  const cook::CookRecord rig = cook::cook_file(pab / "skeleton.fbx", dir / "skeleton.ossa", rig_options);
-  ASSERT_TRUE(rig.ok) << rig.error;
-  auto reference = cook::load_reference_skeleton(dir / "skeleton.ossa");
-  ASSERT_TRUE(reference) << reference.error().message;
-
-  cook::CookOptions options;
-  options.root_motion = true;
-  options.up_axis = 1;
-  options.reference = &*reference;
-  options.reference_name = "skeleton.ossa";
-  const cook::CookRecord walk = cook::cook_file(pab / "walk.fbx", dir / "walk.ossa", options);
-  ASSERT_TRUE(walk.ok) << walk.error;
-
-  auto rig_asset = Asset::open((dir / "skeleton.ossa").string());
+  // Cooked by ossa-cook into the committed fixtures (tests/fixtures/cook_fixtures.cmake): the walk
+  // against Pab's skeleton with --root-motion --up-axis y.
+  const std::filesystem::path dir = test::fixtures_dir();
+  auto rig_asset = Asset::open((dir / "Pab" / "skeleton.ossa").string());
   ASSERT_TRUE(rig_asset) << rig_asset.error().message;
-  auto asset = Asset::open((dir / "walk.ossa").string());
+  auto asset = Asset::open((dir / "root-motion" / "Pab" / "walk.ossa").string());
   ASSERT_TRUE(asset) << asset.error().message;
   ASSERT_EQ(asset->clip_count(), 1u);
   const ClipView clip = asset->clip(0);

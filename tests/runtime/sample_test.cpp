@@ -8,8 +8,8 @@
 //     (negative rate through advance_time) and random-seek sequences;
 //   - loop and clamp modes, loop-boundary continuity, rotations across hemispheres, slerp;
 //   - a clip is refused by a skeleton it was not cooked for.
-// Synthetic v2 clips (test_files.h) pin the exact cases; Pab's cooked walk (assets/Pab, cooked
-// with the real cooker against its skeleton, as bench/bench_fixture.cpp does) checks real data.
+// Synthetic v2 clips (test_files.h) pin the exact cases; Pab's cooked walk (tests/fixtures/Pab,
+// cooked by ossa-cook against its skeleton, as bench/bench_fixture.cpp does) checks real data.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -24,7 +24,6 @@
 #include <glm/glm.hpp>
 #include <glm/gtc/quaternion.hpp>
 
-#include "cooker/cook.h"
 #include <ossa/format/clip_codec.h>
 #include <ossa/loader/asset.h>
 #include <ossa/anim/pose.h>
@@ -169,8 +168,8 @@ SamplingCache cache_for(const ClipView& clip, const SkeletonView& skeleton) {
   return std::move(*cache);
 }
 
-/// Pab's skeleton and its walk, cooked once per process with default options; null (and the test
-/// skips) when assets/Pab is not in the tree.
+/// Pab's skeleton and its walk, cooked by ossa-cook (the walk against the skeleton, default options)
+/// into the committed fixtures (tests/fixtures/Pab); opened once per process.
 struct Pab {
   Asset skeleton;
   Asset walk;
@@ -178,23 +177,11 @@ struct Pab {
 
 const Pab* pab() {
   static const std::unique_ptr<Pab> data = []() -> std::unique_ptr<Pab> {
-    const fs::path dir = test::source_dir() / "assets" / "Pab";
-    if (!fs::exists(dir / "walk.fbx")) return nullptr;
-    const fs::path out = test::make_temp_dir("sample_test");
-    const cook::CookRecord rig = cook::cook_file(dir / "skeleton.fbx", out / "skeleton.ossa", {});
-    EXPECT_TRUE(rig.ok) << rig.error;
-    auto reference = cook::load_reference_skeleton(out / "skeleton.ossa");
-    EXPECT_TRUE(reference.ok()) << (reference.ok() ? "" : reference.error().message);
-    if (!rig.ok || !reference.ok()) return nullptr;
-    cook::CookOptions bound;
-    bound.reference = &*reference;
-    bound.reference_name = "skeleton.ossa";
-    const cook::CookRecord walk = cook::cook_file(dir / "walk.fbx", out / "walk.ossa", bound);
-    EXPECT_TRUE(walk.ok) << walk.error;
-    if (!walk.ok) return nullptr;
-    auto s = Asset::open((out / "skeleton.ossa").string());
-    auto w = Asset::open((out / "walk.ossa").string());
-    EXPECT_TRUE(s.ok() && w.ok());
+    const fs::path dir = test::fixtures_dir() / "Pab";
+    auto s = Asset::open((dir / "skeleton.ossa").string());
+    auto w = Asset::open((dir / "walk.ossa").string());
+    EXPECT_TRUE(s.ok()) << (s.ok() ? "" : s.error().message);
+    EXPECT_TRUE(w.ok()) << (w.ok() ? "" : w.error().message);
     if (!s.ok() || !w.ok()) return nullptr;
     return std::unique_ptr<Pab>(new Pab{std::move(*s), std::move(*w)});
   }();
@@ -203,7 +190,7 @@ const Pab* pab() {
 
 #define REQUIRE_PAB()                                                             \
   const Pab* p = pab();                                                           \
-  if (!p) GTEST_SKIP() << "assets/Pab not found, or it did not cook (see above)"; \
+  ASSERT_NE(p, nullptr) << "tests/fixtures/Pab could not be opened (see above)"; \
   const ClipView clip = p->walk.clip(0);                                          \
   const SkeletonView skeleton = p->skeleton.skeleton()
 

@@ -1,10 +1,13 @@
 // graph_fixture.h — graph files for runtime tests and benchmarks, built in C++ (cooker/model/graph_def.h)
 // around Pab's real clips, so the tests pin the evaluator without depending on the JSON compiler.
 //
-// pab_rig() imports assets/Pab once per process: the 67-joint skeleton and the walk, jog, run and
-// crossarms clips bound to it, compressed with the default tolerance. make_graph_file() writes one
-// .ossa holding that skeleton, the clips (with any events given) and the graphs, through the same
-// writer ossa-cook uses, and opens it with the runtime's verified loader.
+// pab_rig() reads Pab's 67-joint skeleton and its walk, jog, run and crossarms clips (cooked against
+// it with the default tolerance) from the committed fixtures (tests/fixtures/Pab, cooked by
+// ossa-cook; tests/cooker/fixtures_test.cpp re-cooks them and checks they are current and that
+// reading them back gives what importing and compressing gives). make_graph_file() writes one .ossa
+// holding that skeleton, the clips (with any events given) and the graphs, through the writer
+// ossa-cook uses (ossa_cook_base), and opens it with the runtime's verified loader. Neither needs
+// Assimp: the runtime-only and Windows builds run these suites too.
 #pragma once
 #include <map>
 #include <memory>
@@ -18,10 +21,10 @@
 #include <ossa/graph/graph.h>
 #include <ossa/loader/asset.h>
 
-/// In a test: `rig` is Pab's rig, or the test is skipped when assets/Pab is missing.
+/// In a test: `rig` is Pab's rig (a missing or unreadable fixture is a failure, named).
 #define NEED_RIG()                                            \
   const ::ossa::test::PabRig* rig = ::ossa::test::pab_rig(); \
-  if (!rig) GTEST_SKIP() << "assets/Pab not found or did not import"
+  ASSERT_NE(rig, nullptr) << "tests/fixtures/Pab could not be read"
 
 namespace ossa::test {
 
@@ -32,7 +35,7 @@ struct PabRig {
   int joint(std::string_view name) const;   // -1 when absent
 };
 
-/// Null when assets/Pab is missing or fails to import (the message is printed).
+/// Null (after a test failure naming the file) when a fixture is missing or unreadable.
 const PabRig* pab_rig();
 
 /// Clip index in PabRig::clips / GraphDef::clips order.

@@ -630,6 +630,7 @@ std::string env_or(const char* name, const char* fallback) {
 std::filesystem::path source_dir() { return env_or("OSSA_SOURCE_DIR", OSSA_TEST_SOURCE_DIR); }
 std::filesystem::path bin_dir() { return env_or("OSSA_BIN_DIR", OSSA_TEST_BIN_DIR); }
 std::filesystem::path shared_assets() { return env_or("OSSA_SHARED_ASSETS", OSSA_TEST_SHARED_ASSETS); }
+std::filesystem::path fixtures_dir() { return source_dir() / "tests" / "fixtures"; }
 
 std::filesystem::path make_temp_dir(std::string_view prefix) {
   const std::filesystem::path root = env_or("OSSA_TEST_TMP", OSSA_TEST_TMP_DIR);

@@ -244,6 +244,10 @@ std::string env_or(const char* name, const char* fallback);
 std::filesystem::path source_dir();     // OSSA_SOURCE_DIR (the repo root)
 std::filesystem::path bin_dir();        // OSSA_BIN_DIR (where the tools are built)
 std::filesystem::path shared_assets();  // OSSA_SHARED_ASSETS (may not exist)
+/// tests/fixtures: files ossa-cook made, committed so suites that must not link the cooker (the
+/// runtime's, in runtime-only and Windows builds too) read real cooked data. fixtures_test re-cooks
+/// them (tests/fixtures/cook_fixtures.cmake) and fails when they are stale.
+std::filesystem::path fixtures_dir();
 
 /// A new, empty directory under OSSA_TEST_TMP (created as needed) named <prefix>-XXXXXX.
 std::filesystem::path make_temp_dir(std::string_view prefix = "test");
