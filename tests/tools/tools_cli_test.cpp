@@ -222,4 +222,46 @@ TEST(ToolsCli, InspectPrintsADeepChainInBoundedLines) {
   EXPECT_LT(r.out.size(), size_t{4} << 20) << "bounded output";
 }
 
+// The exit statuses docs/CLI.md states per tool, case by case: 0 success, 1 the tool's job
+// failed, 2 a usage error or the tool cannot run. Real files: the committed fixtures (cooked Pab)
+// and a file of garbage; ossa-view's "no display" is run with DISPLAY unset.
+TEST(ToolsCli, ExitStatusesAreTheDocumentedOnes) {
+  const fs::path dir = ossa::test::make_temp_dir("exit-status");
+  const fs::path fixtures = ossa::test::fixtures_dir() / "Pab";
+  const fs::path garbage = dir / "garbage.ossa";
+  ASSERT_TRUE(ossa::test::write_file(garbage, std::vector<uint8_t>(1000, 0x5a)));
+  fs::create_directories(dir / "empty");
+  const std::string skeleton = q(fixtures / "skeleton.ossa"), walk = q(fixtures / "walk.ossa");
+  const std::string walk_rm = q(ossa::test::fixtures_dir() / "root-motion" / "Pab" / "walk.ossa");
+  const std::string out = " -o " + q(dir / "out") + " -q";
+  struct Case {
+    const char* tool;
+    std::string args;
+    int status;
+  };
+  const Case cases[] = {
+      {"ossa-cook", q(asset("RiggedSimple/RiggedSimple.glb")) + out, 0},
+      {"ossa-cook", q(dir / "no-such-source.fbx") + out, 1},  // a failed input, named
+      {"ossa-cook", q(dir / "empty") + out, 2},                // no source found
+      {"ossa-cook", q(asset("Pab/walk.fbx")) + " " + q(asset("Pab/walk.fbx")) + out, 2},  // outputs collide
+      {"ossa-cook", q(asset("Pab/walk.fbx")) + " --skeleton " + q(dir / "no-rig.ossa") + out, 2},
+      {"ossa-inspect", "-q " + skeleton, 0},
+      {"ossa-inspect", "-q " + q(garbage), 1},
+      {"ossa-inspect", "-q " + q(dir / "no-such.ossa"), 2},
+      {"ossa-diff", "-q " + skeleton + " " + skeleton, 0},
+      {"ossa-diff", "-q " + walk + " " + walk_rm + " --skeleton " + skeleton, 1},
+      {"ossa-diff", "-q " + skeleton + " " + q(garbage), 2},
+      {"ossa-diff", "-q " + skeleton + " " + q(dir / "no-such.ossa"), 2},
+  };
+  for (const Case& c : cases) {
+    const CommandResult r = run_tool(c.tool, c.args);
+    EXPECT_EQ(r.exit_code, c.status) << c.tool << " " << c.args << "\n" << r.err;
+  }
+  // ossa-view: a file it cannot show is 1 (checked before any window), no display is 2.
+  const std::string view = "env -u DISPLAY -u WAYLAND_DISPLAY " + q(ossa::test::bin_dir() / "ossa-view") + " ";
+  EXPECT_EQ(run_command(view + q(dir / "no-such.ossa")).exit_code, 1);
+  EXPECT_EQ(run_command(view + q(garbage)).exit_code, 1);
+  EXPECT_EQ(run_command(view + skeleton).exit_code, 2);
+}
+
 }  // namespace
