@@ -178,7 +178,7 @@ constexpr void record_fields(F&& f, Record& r, More&... more) {
   }
 }
 
-namespace detail {
+namespace record_check {
 
 /// Converts to any member type: T{AnyField{}, ...} compiles for up to as many initializers as the
 /// aggregate T has members, which counts them without naming them.
@@ -205,19 +205,19 @@ constexpr size_t listed_count() {
   return n;
 }
 
-}  // namespace detail
+}  // namespace record_check
 
 // A member added to a record and not to its list would silently stay out of the wire, the report
 // and the round-trip test: refuse to compile instead.
-static_assert(detail::member_count<ClipRecord>() == detail::listed_count<ClipRecord>(),
+static_assert(record_check::member_count<ClipRecord>() == record_check::listed_count<ClipRecord>(),
               "ClipRecord: add the new member to clip_record_fields");
-static_assert(detail::member_count<TextureRecord>() == detail::listed_count<TextureRecord>(),
+static_assert(record_check::member_count<TextureRecord>() == record_check::listed_count<TextureRecord>(),
               "TextureRecord: add the new member to texture_record_fields");
-static_assert(detail::member_count<MorphRecord>() == detail::listed_count<MorphRecord>(),
+static_assert(record_check::member_count<MorphRecord>() == record_check::listed_count<MorphRecord>(),
               "MorphRecord: add the new member to morph_record_fields");
-static_assert(detail::member_count<InputFile>() == detail::listed_count<InputFile>(),
+static_assert(record_check::member_count<InputFile>() == record_check::listed_count<InputFile>(),
               "InputFile: add the new member to input_file_fields");
-static_assert(detail::member_count<CookRecord>() == detail::listed_count<CookRecord>(),
+static_assert(record_check::member_count<CookRecord>() == record_check::listed_count<CookRecord>(),
               "CookRecord: add the new member to cook_record_fields");
 
 }  // namespace ossa::cook
