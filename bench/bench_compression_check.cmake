@@ -7,7 +7,7 @@
 # on the unit, and each row held its tolerance (max_error_mm <= tolerance_mm). With --breakdown,
 # each row's first comment line splits cooked_bytes into parts that must add up to it. An unusable
 # unit is a usage error (exit status 2). Tables are what people paste into notes, so a column moved
-# or dropped here is a change to say in the README's bench section.
+# or dropped here is a change to say in docs/MEASURING.md.
 cmake_minimum_required(VERSION 3.25)
 
 set(header "asset\tclip\tjoints\tunit_m\traw_bytes\tcooked_bytes\tratio\tmax_error_mm\tmean_error_mm\ttolerance_mm")

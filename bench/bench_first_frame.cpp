@@ -20,7 +20,7 @@
 // loads every character there at once: one process per side shows each in turn, one frame each
 // (first_frame_ossa.cpp, first_frame_assimp.h). Needs an X display
 // (run under `xvfb-run -a` on a machine without one). Not a test: the numbers depend on the
-// machine; the README quotes one run.
+// machine; docs/MEASURING.md quotes one run.
 #include <fcntl.h>
 #include <poll.h>
 #include <spawn.h>

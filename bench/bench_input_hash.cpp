@@ -1,5 +1,5 @@
 // bench_input_hash.cpp — ossa-bench-input-hash (Google Benchmark): the cook key's input hash,
-// XXH3-64 (cooker/import/input_log.h), against the FNV-1a 64 it replaced, on buffers the size of a
+// XXH3-64 (cooker/model/input_log.h), against the FNV-1a 64 it replaced, on buffers the size of a
 // sidecar, a texture and a large source. Why it matters: an all-up-to-date run re-hashes every
 // input of the tree, so the hash must run at memory speed to keep that run a few percent of a
 // full cook (docs/SCALE.md).
@@ -8,7 +8,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "cooker/import/input_log.h"
+#include "cooker/model/input_log.h"
 #include <ossa/format/hash.h>
 
 namespace {

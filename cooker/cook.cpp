@@ -18,7 +18,7 @@
 
 #include "cooker/clip/clip_events.h"
 #include "cooker/cook_internal.h"
-#include "cooker/cook_settings.h"
+#include "cooker/model/cook_settings.h"
 #include "cooker/import/import_scene.h"
 #include "cooker/mesh/mesh_build.h"
 #include "cooker/clip/root_motion.h"
@@ -29,39 +29,6 @@
 
 namespace ossa::cook {
 namespace fs = std::filesystem;
-
-bool is_graph_file(const fs::path& path) {
-  std::string name = path.filename().string();
-  std::transform(name.begin(), name.end(), name.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  constexpr std::string_view kSuffix = ".graph.json";
-  return name.size() > kSuffix.size() && name.compare(name.size() - kSuffix.size(), kSuffix.size(), kSuffix) == 0;
-}
-
-std::string CookOptions::canonical() const {
-  std::string s = float_vertices ? "vertices=float32" : "vertices=quantized";
-  if (!clips.enabled) {
-    s += ";clips=lossless";
-  } else {
-    char buf[96];
-    std::snprintf(buf, sizeof buf, ";clips=%gm@%gm", static_cast<double>(clips.tolerance_metres),
-                  static_cast<double>(clips.probe_metres));
-    s += buf;
-  }
-  if (root_motion) s += std::string(";root_motion=") + "xyz"[up_axis % 3];
-  if (textures != TextureOutput::Compressed) s += std::string(";textures=") + texture_output_name(textures);
-  if (metres_per_unit > 0.0f) {
-    char unit[64];
-    std::snprintf(unit, sizeof unit, ";unit=%gm", static_cast<double>(metres_per_unit));
-    s += unit;
-  }
-  // The rig by name and content: the reference usually lives in the output tree, outside the
-  // input's directory, so it enters the key through its hash here rather than as a relative path.
-  if (reference != nullptr) {
-    s += ";skeleton=" + reference_name;
-    if (reference_input.present) s += "@" + hex64(reference_input.hash);
-  }
-  return s;
-}
 
 namespace detail {
 
@@ -375,38 +342,6 @@ CookRecord cook_file(const fs::path& input, const fs::path& output, const CookOp
 std::optional<CookRecord> up_to_date_record(const fs::path& input, const fs::path& output,
                                             const CookOptions& batch_options) {
   return cook_or_check(input, output, batch_options, true);
-}
-
-Result<SourceSkeleton> load_reference_skeleton(const fs::path& ossa_file, InputFile* as_read) {
-  if (as_read != nullptr) {
-    InputLog log;
-    InputLogScope scope(&log);
-    auto bytes = read_input(ossa_file);
-    if (!bytes) return bytes.error();
-    *as_read = log.files().front();
-  }
-  auto asset = Asset::open(ossa_file.string());
-  if (!asset) return asset.error();
-  const SkeletonView sk = asset->skeleton();
-  if (sk.empty() || sk.joint_count() == 0) return Error{ossa_file.string() + ": holds no skeleton to cook against"};
-  SourceSkeleton out;
-  out.metres_per_unit = asset->file().metres_per_unit();
-  out.joints.resize(sk.joint_count());
-  for (size_t i = 0; i < sk.joint_count(); ++i) {
-    SourceJoint& j = out.joints[i];
-    j.name = std::string(sk.joint_name(i));
-    j.parent = sk.parents()[i];
-    const fb::Vec3& t = sk.bind_translations()[i];
-    const fb::Quat& r = sk.bind_rotations()[i];
-    const fb::Vec3& s = sk.bind_scales()[i];
-    j.translation = {t.x(), t.y(), t.z()};
-    j.rotation = glm::quat(r.w(), r.x(), r.y(), r.z());
-    j.scale = {s.x(), s.y(), s.z()};
-    const auto* m = sk.inverse_bind()[i].m();
-    for (int c = 0; c < 4; ++c)
-      for (int r4 = 0; r4 < 4; ++r4) j.inverse_bind[c][r4] = m->Get(static_cast<flatbuffers::uoffset_t>(c * 4 + r4));
-  }
-  return out;
 }
 
 namespace {

@@ -8,7 +8,7 @@
 
 #include "cooker/clip/clip_compress.h"
 #include "cooker/cook.h"
-#include "cooker/import/source_scene.h"
+#include "cooker/model/source_scene.h"
 #include "cooker/mesh/mesh_build.h"
 #include "cooker/write/write_ossa.h"
 #include <ossa/format/result.h>

@@ -2,7 +2,7 @@
 // cooker accepts, so a first-time user can find something to look at without a command line.
 //
 // Split in two: list_folder (and the sorting and filtering it uses) is plain std::filesystem, so
-// tests/viewer_unit_test.cpp checks what is listed and in which order; browser_panel draws the
+// tests/viewer/viewer_unit_test.cpp checks what is listed and in which order; browser_panel draws the
 // listing with ImGui and reports a click. The listing is read when the folder changes (or on
 // Refresh), never once a frame: a network folder must not stall drawing.
 //

@@ -5,7 +5,7 @@
 #include <cstdio>
 #include <string>
 
-#include "runtime/tools/cli/cli.h"
+#include "tools/cli/cli.h"
 #include "viewer/app.h"
 #include "viewer/gl_util.h"
 #include "viewer/offscreen.h"

@@ -30,7 +30,7 @@
 #include <backends/imgui_impl_glfw.h>
 #include <backends/imgui_impl_opengl3.h>
 
-#include "runtime/tools/cli/cli.h"
+#include "tools/cli/cli.h"
 #include "viewer/app.h"
 #include "viewer/gl_util.h"
 #include "viewer/graph_keys.h"

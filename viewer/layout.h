@@ -21,7 +21,7 @@
 // which playback wraps when loop is on (animation.h advance). It is drawn with ImGui draw lists in
 // an undecorated window pinned to SceneLayout::timeline. The geometry (regions, time <-> x, which
 // handle a press grabs) and the key list are plain functions, checked by
-// tests/viewer_unit_test_window.cpp; the keys are computed once per clip, not per frame.
+// tests/viewer/viewer_unit_test_window.cpp; the keys are computed once per clip, not per frame.
 #pragma once
 #include <cstdint>
 #include <string>

@@ -16,7 +16,7 @@
 #include <stb_image.h>
 
 #include <ossa/loader/texture.h>
-#include "runtime/internal/message.h"
+#include "common/message.h"
 
 namespace ossa::view {
 namespace {

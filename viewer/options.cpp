@@ -1,11 +1,11 @@
-// options.cpp — see options.h. CLI11 does the parsing through runtime/tools/cli (the conventions
+// options.cpp — see options.h. CLI11 does the parsing through tools/cli (the conventions
 // every ossa tool shares); its exceptions stay inside that library.
 #include "viewer/options.h"
 
 #include <charconv>
 #include <cmath>
 
-#include "runtime/tools/cli/cli.h"
+#include "tools/cli/cli.h"
 
 namespace ossa::view {
 namespace {

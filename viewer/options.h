@@ -38,7 +38,7 @@
 // renderer and what was loaded. Parsing is separate from running so tests and the bench can build
 // command lines with the same names.
 //
-// Exit status (runtime/tools/cli/cli.h): 0 success; 1 the files could not be shown (a file refused,
+// Exit status (tools/cli/cli.h): 0 success; 1 the files could not be shown (a file refused,
 // a clip / graph / parameter not found, a GL error, the screenshot not written); 2 usage error, or
 // no OpenGL 3.3 window can be made (no display).
 #pragma once

@@ -9,10 +9,13 @@
 #include <cmath>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <set>
+#include <string_view>
+#include <type_traits>
 
 #include "cooker/cli/worker.h"
-#include "runtime/internal/message.h"
+#include "common/message.h"
 
 #include <ossa/version.h>
 
@@ -191,6 +194,111 @@ void make_utf8(nlohmann::ordered_json& j) {
   }
 }
 
+template <class T>
+struct is_optional : std::false_type {};
+template <class T>
+struct is_optional<std::optional<T>> : std::true_type {};
+
+double ratio(uint64_t raw, uint64_t stored) { return stored > 0 ? static_cast<double>(raw) / static_cast<double>(stored) : 0.0; }
+
+/// A clip's compression: its fields, with raw / cooked as "ratio" after the sizes.
+nlohmann::ordered_json clip_json(const ClipRecord& c) {
+  nlohmann::ordered_json j;
+  clip_record_fields(
+      [&](const char* key, const auto& value) {
+        j[key] = value;
+        if (std::string_view(key) == "cooked_bytes") j["ratio"] = ratio(c.raw_bytes, c.cooked_bytes);
+      },
+      c);
+  return j;
+}
+
+/// A cooked texture: its fields; the angles to the source's normals only for a normal map.
+nlohmann::ordered_json texture_json(const TextureRecord& t) {
+  nlohmann::ordered_json j;
+  texture_record_fields(
+      [&](const char* key, const auto& value) {
+        const std::string_view k(key);
+        if ((k == "normal_mean_deg" || k == "normal_max_deg") && t.role != "normal") return;
+        j[key] = value;
+      },
+      t);
+  return j;
+}
+
+/// A cooked morph target: its fields, with raw / stored as "ratio" after the sizes.
+nlohmann::ordered_json morph_json(const MorphRecord& m) {
+  nlohmann::ordered_json j;
+  morph_record_fields(
+      [&](const char* key, const auto& value) {
+        j[key] = value;
+        if (std::string_view(key) == "stored_bytes") j["ratio"] = ratio(m.raw_bytes, m.stored_bytes);
+      },
+      m);
+  return j;
+}
+
+/// A file the cook read (path relative to the input's directory, like provenance): its hash in hex
+/// and its size as "bytes" when present, "absent": true otherwise.
+nlohmann::ordered_json input_json(const InputFile& f) {
+  nlohmann::ordered_json j;
+  input_file_fields(
+      [&](const char* key, const auto& value) {
+        const std::string_view k(key);
+        if (k == "path") j[key] = value;
+        else if (k == "hash" && f.present) j[key] = hex64(f.hash);
+        else if (k == "size" && f.present) j["bytes"] = value;
+        else if (k == "present" && !f.present) j["absent"] = true;
+      },
+      f);
+  return j;
+}
+
+template <class Record>
+nlohmann::ordered_json json_list(const std::vector<Record>& records,
+                                 nlohmann::ordered_json (*one)(const Record&)) {
+  nlohmann::ordered_json list = nlohmann::ordered_json::array();
+  for (const Record& r : records) list.push_back(one(r));
+  return list;
+}
+
+/// One record of the report: CookRecord's field list in its order, under the report's names and
+/// rules (docs/JSON.md). "ok" is "status"; only a file that was written is named (cook.h), with its
+/// size, whether it was up to date and its cook key; an error only for a failed input; counts as far
+/// as the cook got (all of them when ok, those counted before the failure otherwise); per-clip
+/// records always, texture and morph records when there are any.
+nlohmann::ordered_json report_record(const CookRecord& r) {
+  nlohmann::ordered_json j;
+  cook_record_fields(
+      [&](const char* key, const auto& value) {
+        using T = std::decay_t<decltype(value)>;
+        const std::string_view k(key);
+        if constexpr (is_optional<T>::value) {
+          if (value) j[key] = *value;
+        } else if constexpr (std::is_same_v<T, std::vector<ClipRecord>>) {
+          j["clip_compression"] = json_list(value, clip_json);
+        } else if constexpr (std::is_same_v<T, std::vector<TextureRecord>>) {
+          if (!value.empty()) j["textures_cooked"] = json_list(value, texture_json);
+        } else if constexpr (std::is_same_v<T, std::vector<MorphRecord>>) {
+          if (!value.empty()) j["morph_targets"] = json_list(value, morph_json);
+        } else if constexpr (std::is_same_v<T, std::vector<InputFile>>) {
+          j[key] = json_list(relative_inputs(value, fs::path(r.input).parent_path()), input_json);
+        } else if (k == "ok") {
+          j["status"] = r.ok ? "ok" : "failed";
+        } else if (k == "error") {
+          if (!r.ok) j[key] = value;
+        } else if (k == "cook_key") {
+          if (r.ok) j[key] = hex64(r.cook_key);
+        } else if (k == "output" || k == "cooked_bytes" || k == "up_to_date") {
+          if (r.ok) j[key] = value;
+        } else {
+          j[key] = value;
+        }
+      },
+      r);
+  return j;
+}
+
 }  // namespace
 
 nlohmann::ordered_json report_json(const std::vector<CookRecord>& records, const CookOptions& options,
@@ -205,103 +313,8 @@ nlohmann::ordered_json report_json(const std::vector<CookRecord>& records, const
   size_t failed = 0;
   nlohmann::ordered_json list = nlohmann::ordered_json::array();
   for (const CookRecord& r : records) {
-    nlohmann::ordered_json j;
-    j["input"] = r.input;
-    j["status"] = r.ok ? "ok" : "failed";
-    // Only a file that was written is named: a failed input leaves none (cook.h).
-    if (r.ok) j["output"] = r.output;
-    if (!r.ok) {
-      ++failed;
-      j["error"] = r.error;
-    }
-    // Counts as far as the cook got: all of them when ok, those counted before the failure otherwise.
-    const auto count = [&j](const char* key, const std::optional<uint32_t>& value) {
-      if (value) j[key] = *value;
-    };
-    count("joints", r.joints);
-    count("meshes", r.meshes);
-    count("submeshes", r.submeshes);
-    count("vertices", r.vertices);
-    count("triangles", r.triangles);
-    count("clips", r.clips);
-    count("materials", r.materials);
-    count("textures", r.textures);
-    count("vertices_over_4_influences", r.vertices_over_4_influences);
-    nlohmann::ordered_json clips = nlohmann::ordered_json::array();
-    for (const ClipRecord& c : r.clip_records) {
-      nlohmann::ordered_json cj;
-      cj["name"] = c.name;
-      cj["joints"] = c.joints;
-      cj["frames"] = c.frames;
-      cj["raw_bytes"] = c.raw_bytes;
-      cj["cooked_bytes"] = c.cooked_bytes;
-      cj["ratio"] = c.cooked_bytes > 0 ? static_cast<double>(c.raw_bytes) / c.cooked_bytes : 0.0;
-      cj["max_error_mm"] = c.max_error_mm;
-      cj["mean_error_mm"] = c.mean_error_mm;
-      cj["worst_joint"] = c.worst_joint;
-      clips.push_back(std::move(cj));
-    }
-    j["clip_compression"] = std::move(clips);
-    if (!r.texture_records.empty()) {
-      nlohmann::ordered_json textures = nlohmann::ordered_json::array();
-      for (const TextureRecord& t : r.texture_records) {
-        nlohmann::ordered_json tj;
-        tj["name"] = t.name;
-        tj["role"] = t.role;
-        tj["encoding"] = t.encoding;
-        tj["srgb"] = t.srgb;
-        tj["width"] = t.width;
-        tj["height"] = t.height;
-        tj["mips"] = t.mips;
-        tj["source_bytes"] = t.source_bytes;
-        tj["cooked_bytes"] = t.cooked_bytes;
-        tj["gpu_rgba8_bytes"] = t.gpu_rgba8_bytes;
-        tj["psnr_db"] = t.psnr_db;
-        if (t.role == "normal") {
-          tj["normal_mean_deg"] = t.normal_mean_deg;
-          tj["normal_max_deg"] = t.normal_max_deg;
-        }
-        textures.push_back(std::move(tj));
-      }
-      j["textures_cooked"] = std::move(textures);
-    }
-    if (!r.morph_records.empty()) {
-      nlohmann::ordered_json morphs = nlohmann::ordered_json::array();
-      for (const MorphRecord& m : r.morph_records) {
-        nlohmann::ordered_json mj;
-        mj["mesh"] = m.mesh;
-        mj["name"] = m.name;
-        mj["vertices"] = m.vertices;
-        mj["raw_bytes"] = m.raw_bytes;
-        mj["stored_bytes"] = m.stored_bytes;
-        mj["ratio"] = m.stored_bytes > 0 ? static_cast<double>(m.raw_bytes) / m.stored_bytes : 0.0;
-        mj["position_error_mm"] = m.position_error_mm;
-        mj["normal_error_deg"] = m.normal_error_deg;
-        morphs.push_back(std::move(mj));
-      }
-      j["morph_targets"] = std::move(morphs);
-    }
-    j["source_bytes"] = r.source_bytes;
-    if (r.ok) j["cooked_bytes"] = r.cooked_bytes;
-    if (r.ok) j["up_to_date"] = r.up_to_date;
-    if (r.ok) j["cook_key"] = hex64(r.cook_key);
-    // What the cook read (as far as it got), relative to the input's directory like provenance.
-    nlohmann::ordered_json inputs = nlohmann::ordered_json::array();
-    for (const InputFile& f : relative_inputs(r.inputs_read, fs::path(r.input).parent_path())) {
-      nlohmann::ordered_json fj;
-      fj["path"] = f.path;
-      if (f.present) {
-        fj["hash"] = hex64(f.hash);
-        fj["bytes"] = f.size;
-      } else {
-        fj["absent"] = true;
-      }
-      inputs.push_back(std::move(fj));
-    }
-    j["inputs_read"] = std::move(inputs);
-    j["seconds"] = r.seconds;
-    j["warnings"] = r.warnings;
-    list.push_back(std::move(j));
+    if (!r.ok) ++failed;
+    list.push_back(report_record(r));
   }
   doc["inputs"] = records.size();
   doc["failed"] = failed;

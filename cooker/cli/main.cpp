@@ -15,7 +15,7 @@
 // --max-memory (default 0.8 x memory / workers, at least 1 GiB) fails alone, named with the cause.
 // This process must stay single-threaded: it forks the workers.
 //
-// Exit status (runtime/tools/cli/cli.h): 0 when every input cooked; 1 when any failed (the rest
+// Exit status (tools/cli/cli.h): 0 when every input cooked; 1 when any failed (the rest
 // are still cooked) or the report could not be written; 2 for a usage error or a plan that cannot
 // be carried out (nothing is written then).
 //
@@ -42,8 +42,8 @@
 #include "cooker/cli/worker.h"
 #include "cooker/cook.h"
 #include "cooker/texture/texture_cook.h"
-#include "runtime/internal/message.h"
-#include "runtime/tools/cli/cli.h"
+#include "common/message.h"
+#include "tools/cli/cli.h"
 
 namespace fs = std::filesystem;
 using namespace ossa::cook;

@@ -21,7 +21,9 @@
 #include <cstdlib>
 #include <cstring>
 #include <new>
+#include <stdexcept>
 #include <string_view>
+#include <type_traits>
 
 // Sanitizers whose shadow memory is reserved address space (terabytes): RLIMIT_AS would starve them.
 #if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
@@ -37,187 +39,84 @@ namespace fs = std::filesystem;
 using json = nlohmann::json;
 using Clock = std::chrono::steady_clock;
 
-// A field added to CookRecord or ClipRecord must cross the pipe too, or a cooked record would come
-// back without it. Sizes are checked on the one platform the cooker is built for (64-bit
-// libstdc++); a field that fits in padding slips through, so the round-trip test is the other half.
-#if defined(__GLIBCXX__) && defined(__LP64__)
-static_assert(sizeof(CookRecord) == 336,
-              "CookRecord changed: extend record_to_json / record_from_json (cooker/cli/worker.cpp) and "
-              "the round trip in tests/cook_isolation_test.cpp, then update this size");
-static_assert(sizeof(MorphRecord) == 88,
-              "MorphRecord changed: extend record_to_json / record_from_json (cooker/cli/worker.cpp) and "
-              "the round trip in tests/cook_isolation_test.cpp, then update this size");
-static_assert(sizeof(TextureRecord) == 152,
-              "TextureRecord changed: extend record_to_json / record_from_json (cooker/cli/worker.cpp) and "
-              "the round trip in tests/cook_isolation_test.cpp, then update this size");
-static_assert(sizeof(ClipRecord) == 88,
-              "ClipRecord changed: extend record_to_json / record_from_json (cooker/cli/worker.cpp) and "
-              "the round trip in tests/cook_isolation_test.cpp, then update this size");
-#endif
-
 // ---------------------------------------------------------------------------------------------
-// The record on the wire
+// The record on the wire: every field of the records' field lists (cooker/model/cook_record.h),
+// under its own key, optionals as null. A field added to a record and to its list crosses the pipe
+// with no edit here; tests/cooker/cook_isolation_test.cpp checks that every listed field survives.
 
 namespace {
 
-json optional_count(const std::optional<uint32_t>& value) { return value ? json(*value) : json(nullptr); }
+template <class T>
+struct is_optional : std::false_type {};
+template <class T>
+struct is_optional<std::optional<T>> : std::true_type {};
 
-void read_count(const json& j, const char* key, std::optional<uint32_t>& out) {
-  const json& v = j.at(key);
-  if (v.is_null()) out.reset();
-  else if (v.is_number_unsigned()) out = v.get<uint32_t>();
-  else throw std::invalid_argument(key);
-}
+/// Records that have a field list (and are sent as objects), as opposed to plain values.
+template <class T>
+constexpr bool kIsRecord = std::is_same_v<T, ClipRecord> || std::is_same_v<T, TextureRecord> ||
+                           std::is_same_v<T, MorphRecord> || std::is_same_v<T, InputFile>;
 
 template <class T>
-void read_field(const json& j, const char* key, T& out) {
-  out = j.at(key).get<T>();
+struct record_vector : std::false_type {};
+template <class T>
+struct record_vector<std::vector<T>> : std::bool_constant<kIsRecord<T>> {};
+
+template <class Record>
+json to_wire(const Record& r);
+
+template <class T>
+json value_to_wire(const T& value) {
+  if constexpr (is_optional<T>::value) {
+    return value ? json(*value) : json(nullptr);
+  } else if constexpr (record_vector<T>::value) {
+    json list = json::array();
+    for (const auto& r : value) list.push_back(to_wire(r));
+    return list;
+  } else {
+    return json(value);
+  }
+}
+
+template <class Record>
+json to_wire(const Record& r) {
+  json j = json::object();
+  record_fields([&j](const char* key, const auto& value) { j[key] = value_to_wire(value); }, r);
+  return j;
+}
+
+template <class Record>
+void from_wire(const json& j, Record& r);
+
+/// Throws (std::invalid_argument, or nlohmann's type_error / out_of_range) when `j` is not a `T`.
+template <class T>
+void value_from_wire(const json& j, T& out) {
+  if constexpr (is_optional<T>::value) {
+    if (j.is_null()) out.reset();
+    else if (j.is_number_unsigned()) out = j.get<typename T::value_type>();
+    else throw std::invalid_argument("not a count");
+  } else if constexpr (record_vector<T>::value) {
+    if (!j.is_array()) throw std::invalid_argument("not a list");
+    out.clear();
+    for (const json& item : j) from_wire(item, out.emplace_back());
+  } else {
+    out = j.get<T>();
+  }
+}
+
+template <class Record>
+void from_wire(const json& j, Record& r) {
+  if (!j.is_object()) throw std::invalid_argument("not an object");
+  record_fields([&j](const char* key, auto& value) { value_from_wire(j.at(key), value); }, r);
 }
 
 }  // namespace
 
-json record_to_json(const CookRecord& r) {
-  json morphs = json::array();
-  for (const MorphRecord& m : r.morph_records)
-    morphs.push_back({{"mesh", m.mesh},
-                      {"name", m.name},
-                      {"vertices", m.vertices},
-                      {"raw_bytes", m.raw_bytes},
-                      {"stored_bytes", m.stored_bytes},
-                      {"position_error_mm", m.position_error_mm},
-                      {"normal_error_deg", m.normal_error_deg}});
-  json textures = json::array();
-  for (const TextureRecord& t : r.texture_records)
-    textures.push_back({{"name", t.name},
-                        {"role", t.role},
-                        {"encoding", t.encoding},
-                        {"srgb", t.srgb},
-                        {"width", t.width},
-                        {"height", t.height},
-                        {"mips", t.mips},
-                        {"source_bytes", t.source_bytes},
-                        {"cooked_bytes", t.cooked_bytes},
-                        {"gpu_rgba8_bytes", t.gpu_rgba8_bytes},
-                        {"psnr_db", t.psnr_db},
-                        {"normal_mean_deg", t.normal_mean_deg},
-                        {"normal_max_deg", t.normal_max_deg}});
-  json clips = json::array();
-  for (const ClipRecord& c : r.clip_records)
-    clips.push_back({{"name", c.name},
-                     {"joints", c.joints},
-                     {"frames", c.frames},
-                     {"raw_bytes", c.raw_bytes},
-                     {"cooked_bytes", c.cooked_bytes},
-                     {"max_error_mm", c.max_error_mm},
-                     {"mean_error_mm", c.mean_error_mm},
-                     {"worst_joint", c.worst_joint}});
-  json inputs = json::array();
-  for (const InputFile& f : r.inputs_read)
-    inputs.push_back({{"path", f.path}, {"hash", f.hash}, {"size", f.size}, {"present", f.present}});
-  return {{"input", r.input},
-          {"output", r.output},
-          {"ok", r.ok},
-          {"error", r.error},
-          {"warnings", r.warnings},
-          {"joints", optional_count(r.joints)},
-          {"clips", optional_count(r.clips)},
-          {"materials", optional_count(r.materials)},
-          {"textures", optional_count(r.textures)},
-          {"vertices_over_4_influences", optional_count(r.vertices_over_4_influences)},
-          {"meshes", optional_count(r.meshes)},
-          {"submeshes", optional_count(r.submeshes)},
-          {"vertices", optional_count(r.vertices)},
-          {"triangles", optional_count(r.triangles)},
-          {"source_bytes", r.source_bytes},
-          {"cooked_bytes", r.cooked_bytes},
-          {"seconds", r.seconds},
-          {"clip_records", std::move(clips)},
-          {"morph_records", std::move(morphs)},
-          {"texture_records", std::move(textures)},
-          {"inputs_read", std::move(inputs)},
-          {"cook_key", r.cook_key},
-          {"up_to_date", r.up_to_date}};
-}
+json record_to_json(const CookRecord& r) { return to_wire(r); }
 
 std::optional<CookRecord> record_from_json(const json& j) {
   try {
-    if (!j.is_object()) return std::nullopt;
     CookRecord r;
-    read_field(j, "input", r.input);
-    read_field(j, "output", r.output);
-    read_field(j, "ok", r.ok);
-    read_field(j, "error", r.error);
-    read_field(j, "warnings", r.warnings);
-    read_count(j, "joints", r.joints);
-    read_count(j, "clips", r.clips);
-    read_count(j, "materials", r.materials);
-    read_count(j, "textures", r.textures);
-    read_count(j, "vertices_over_4_influences", r.vertices_over_4_influences);
-    read_count(j, "meshes", r.meshes);
-    read_count(j, "submeshes", r.submeshes);
-    read_count(j, "vertices", r.vertices);
-    read_count(j, "triangles", r.triangles);
-    read_field(j, "source_bytes", r.source_bytes);
-    read_field(j, "cooked_bytes", r.cooked_bytes);
-    read_field(j, "seconds", r.seconds);
-    const json& clips = j.at("clip_records");
-    if (!clips.is_array()) return std::nullopt;
-    for (const json& cj : clips) {
-      ClipRecord c;
-      read_field(cj, "name", c.name);
-      read_field(cj, "joints", c.joints);
-      read_field(cj, "frames", c.frames);
-      read_field(cj, "raw_bytes", c.raw_bytes);
-      read_field(cj, "cooked_bytes", c.cooked_bytes);
-      read_field(cj, "max_error_mm", c.max_error_mm);
-      read_field(cj, "mean_error_mm", c.mean_error_mm);
-      read_field(cj, "worst_joint", c.worst_joint);
-      r.clip_records.push_back(std::move(c));
-    }
-    if (const auto it = j.find("texture_records"); it != j.end() && it->is_array()) {
-      for (const json& tj : *it) {
-        TextureRecord t;
-        read_field(tj, "name", t.name);
-        read_field(tj, "role", t.role);
-        read_field(tj, "encoding", t.encoding);
-        read_field(tj, "srgb", t.srgb);
-        read_field(tj, "width", t.width);
-        read_field(tj, "height", t.height);
-        read_field(tj, "mips", t.mips);
-        read_field(tj, "source_bytes", t.source_bytes);
-        read_field(tj, "cooked_bytes", t.cooked_bytes);
-        read_field(tj, "gpu_rgba8_bytes", t.gpu_rgba8_bytes);
-        read_field(tj, "psnr_db", t.psnr_db);
-        read_field(tj, "normal_mean_deg", t.normal_mean_deg);
-        read_field(tj, "normal_max_deg", t.normal_max_deg);
-        r.texture_records.push_back(std::move(t));
-      }
-    }
-    if (const auto it = j.find("morph_records"); it != j.end() && it->is_array()) {
-      for (const json& mj : *it) {
-        MorphRecord m;
-        read_field(mj, "mesh", m.mesh);
-        read_field(mj, "name", m.name);
-        read_field(mj, "vertices", m.vertices);
-        read_field(mj, "raw_bytes", m.raw_bytes);
-        read_field(mj, "stored_bytes", m.stored_bytes);
-        read_field(mj, "position_error_mm", m.position_error_mm);
-        read_field(mj, "normal_error_deg", m.normal_error_deg);
-        r.morph_records.push_back(std::move(m));
-      }
-    }
-    const json& inputs = j.at("inputs_read");
-    if (!inputs.is_array()) return std::nullopt;
-    for (const json& fj : inputs) {
-      InputFile f;
-      read_field(fj, "path", f.path);
-      read_field(fj, "hash", f.hash);
-      read_field(fj, "size", f.size);
-      read_field(fj, "present", f.present);
-      r.inputs_read.push_back(std::move(f));
-    }
-    read_field(j, "cook_key", r.cook_key);
-    read_field(j, "up_to_date", r.up_to_date);
+    from_wire(j, r);
     return r;
   } catch (const std::exception&) {  // a missing key or a value of another type
     return std::nullopt;

@@ -13,20 +13,13 @@
 #include <string>
 #include <vector>
 
-#include "cooker/clip/clip_grid.h"
+#include "cooker/model/clip_grid.h"
+#include "cooker/model/cook_options.h"
 #include "cooker/clip/morph_weights.h"
-#include "cooker/import/source_scene.h"
+#include "cooker/model/source_scene.h"
 #include <ossa/format/result.h>
 
 namespace ossa::cook {
-
-struct ClipCompressionOptions {
-  bool enabled = true;              // false: lossless (bind/constant only when bit-equal, every
-                                    // other channel raw floats at every frame)
-  float tolerance_metres = 0.0001f; // 0.1 mm ...
-  float probe_metres = 0.1f;        // ... at 10 cm
-  float morph_weight_tolerance = 0.001f;  // largest error of a morph weight at any frame
-};
 
 struct CompressedConstant {
   uint16_t joint = 0;

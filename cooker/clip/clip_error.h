@@ -27,7 +27,7 @@
 #include <glm/glm.hpp>
 
 #include "cooker/clip/clip_compress.h"
-#include "cooker/import/source_scene.h"
+#include "cooker/model/source_scene.h"
 #include <ossa/anim/pose_error.h>
 
 namespace ossa::cook {

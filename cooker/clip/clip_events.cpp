@@ -9,8 +9,8 @@
 #include <fstream>
 #include <iterator>
 
-#include "cooker/clip/clip_grid.h"
-#include "cooker/import/input_log.h"
+#include "cooker/model/clip_grid.h"
+#include "cooker/model/input_log.h"
 
 namespace ossa::cook {
 namespace fs = std::filesystem;

@@ -18,7 +18,7 @@
 #include <vector>
 
 #include "cooker/json/json_check.h"
-#include "cooker/import/source_scene.h"
+#include "cooker/model/source_scene.h"
 #include <ossa/format/result.h>
 
 namespace ossa::cook {

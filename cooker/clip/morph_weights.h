@@ -13,8 +13,8 @@
 #include <string>
 #include <vector>
 
-#include "cooker/clip/clip_grid.h"
-#include "cooker/import/source_scene.h"
+#include "cooker/model/clip_grid.h"
+#include "cooker/model/source_scene.h"
 
 namespace ossa::cook {
 

@@ -1,7 +1,7 @@
 // root_motion.cpp — extracting root motion at cook time (cooker/clip/root_motion.h).
 //
 // The convention, one definition that the runtime (runtime/anim/root_motion.cpp) and the tests rely on.
-// Let u be the up axis, and for frame f of the clip's grid (cooker/clip/clip_grid.h) let the root
+// Let u be the up axis, and for frame f of the clip's grid (cooker/model/clip_grid.h) let the root
 // joint's local (= model-space) transform be T(p_f) R(q_f) S(s_f). Then
 //   ground  g_f = p_f - (p_f . u) u          height h_f = (p_f . u) u
 //   yaw     psi_f = angle of the twist of q_f about u (swing-twist decomposition), unwrapped
@@ -35,7 +35,7 @@
 
 #include <glm/gtc/quaternion.hpp>
 
-#include "cooker/clip/clip_grid.h"
+#include "cooker/model/clip_grid.h"
 
 namespace ossa::cook {
 namespace {

@@ -7,7 +7,7 @@
 #pragma once
 #include <cstdint>
 
-#include "cooker/import/source_scene.h"
+#include "cooker/model/source_scene.h"
 #include <ossa/format/result.h>
 
 namespace ossa::cook {

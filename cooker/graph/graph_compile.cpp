@@ -13,7 +13,6 @@
 #include "cooker/clip/clip_events.h"
 #include "cooker/graph/graph_condition.h"
 #include "cooker/json/json_check.h"
-#include "cooker/write/write_ossa.h"
 #include <ossa/anim/blend_space.h>
 #include <ossa/loader/validate.h>
 

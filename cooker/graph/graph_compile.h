@@ -20,9 +20,9 @@
 #include <string_view>
 #include <vector>
 
-#include "cooker/graph/graph_def.h"
+#include "cooker/model/graph_def.h"
 #include "cooker/json/json_source.h"
-#include "cooker/import/source_scene.h"
+#include "cooker/model/source_scene.h"
 #include <ossa/format/result.h>
 
 namespace ossa::cook {

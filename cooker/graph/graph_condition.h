@@ -20,7 +20,7 @@
 #include <string_view>
 #include <vector>
 
-#include "cooker/graph/graph_def.h"
+#include "cooker/model/graph_def.h"
 
 namespace ossa::cook {
 

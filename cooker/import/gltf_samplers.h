@@ -91,7 +91,7 @@ Result<Animations> parse_gltf_animations(const std::vector<uint8_t>& bytes,
                                          const std::string& directory, const std::string& label);
 
 /// The name Assimp 5.2.5 gives the aiNode of glTF node `index`: the node's name, or "nodes[i]"
-/// for an unnamed one (checked against Assimp by tests/gltf_sampler_test.cpp).
+/// for an unnamed one (checked against Assimp by tests/cooker/gltf_sampler_test.cpp).
 std::string assimp_node_name(const Animations& file, int index);
 
 /// The sampler's value at `time` seconds, as the specification defines it: the first / last

@@ -20,7 +20,7 @@
 #include <glm/gtc/quaternion.hpp>
 
 #include "cooker/import/import_scene.h"
-#include "cooker/import/source_scene.h"
+#include "cooker/model/source_scene.h"
 #include <ossa/format/result.h>
 
 struct aiScene;

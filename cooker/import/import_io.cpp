@@ -9,7 +9,7 @@
 
 #include <assimp/IOStream.hpp>
 
-#include "cooker/import/input_log.h"
+#include "cooker/model/input_log.h"
 #include "cooker/import/source_precheck.h"
 
 namespace ossa::cook {

@@ -17,7 +17,7 @@
 
 #include "cooker/import/image_check.h"
 #include "cooker/import/import_internal.h"
-#include "cooker/import/input_log.h"
+#include "cooker/model/input_log.h"
 
 namespace ossa::cook::detail {
 namespace {

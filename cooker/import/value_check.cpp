@@ -5,7 +5,7 @@
 #include <cstdio>
 #include <string>
 
-#include "runtime/internal/message.h"
+#include "common/message.h"
 
 namespace ossa::cook {
 namespace {

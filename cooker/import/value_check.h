@@ -8,7 +8,7 @@
 // would object, as "internal error, cooked bytes fail verification". Here the same bounds are
 // checked on the SourceScene with the joint, clip and key named. O(joints + keys + vertices).
 #pragma once
-#include "cooker/import/source_scene.h"
+#include "cooker/model/source_scene.h"
 #include <ossa/format/result.h>
 
 namespace ossa::cook {

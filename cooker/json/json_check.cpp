@@ -5,6 +5,8 @@
 #include <cctype>
 #include <cmath>
 
+#include "common/edit_distance.h"
+
 namespace ossa::cook::json {
 
 std::string Checker::message() const {
@@ -41,21 +43,6 @@ bool Checker::expect(const Value& v, Type t, std::string_view what) {
 }
 
 namespace {
-
-size_t edit_distance(std::string_view a, std::string_view b) {
-  std::vector<size_t> row(b.size() + 1);
-  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
-  for (size_t i = 1; i <= a.size(); ++i) {
-    size_t diagonal = row[0];
-    row[0] = i;
-    for (size_t j = 1; j <= b.size(); ++j) {
-      const size_t up = row[j];
-      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
-      diagonal = up;
-    }
-  }
-  return row[b.size()];
-}
 
 std::string folded(std::string_view s) {
   std::string out;

@@ -18,7 +18,7 @@
 
 #include <glm/glm.hpp>
 
-#include "cooker/import/source_scene.h"
+#include "cooker/model/source_scene.h"
 #include "cooker/mesh/morph_build.h"
 #include <ossa/format/ossa_generated.h>
 #include <ossa/format/result.h>

@@ -139,21 +139,6 @@ Result<TextureRecord> cook_one(SourceTexture& t, TextureOutput output) {
 
 }  // namespace
 
-std::optional<TextureOutput> parse_texture_output(std::string_view name) {
-  if (name == "bc") return TextureOutput::Compressed;
-  if (name == "rgba8") return TextureOutput::Rgba8;
-  if (name == "source") return TextureOutput::Source;
-  return std::nullopt;
-}
-
-const char* texture_output_name(TextureOutput output) {
-  switch (output) {
-    case TextureOutput::Rgba8: return "rgba8";
-    case TextureOutput::Source: return "source";
-    default: return "bc";
-  }
-}
-
 Status cook_textures(SourceScene& scene, TextureOutput output, const std::string& label,
                      std::vector<TextureRecord>& records) {
   // First every repeat is found while all bytes are still as read: (role, size, hash) -> the

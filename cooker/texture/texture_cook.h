@@ -24,15 +24,12 @@
 #include <string_view>
 #include <vector>
 
-#include "cooker/cook.h"
-#include "cooker/import/source_scene.h"
+#include "cooker/model/cook_options.h"
+#include "cooker/model/cook_record.h"
+#include "cooker/model/source_scene.h"
 #include <ossa/format/result.h>
 
 namespace ossa::cook {
-
-/// "bc" | "rgba8" | "source" -> the output; nullopt for anything else.
-std::optional<TextureOutput> parse_texture_output(std::string_view name);
-const char* texture_output_name(TextureOutput output);
 
 /// Cooks the embedded textures of every material of `scene` in place (SourceTexture's encoding
 /// fields, same_as for repeats) and appends one record per distinct texture. An image that does

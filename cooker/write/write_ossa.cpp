@@ -342,18 +342,6 @@ Offset<fb::Material> write_material(FlatBufferBuilder& fbb, const SourceMaterial
 
 }  // namespace
 
-uint64_t skeleton_hash_of(const SourceSkeleton& skeleton) {
-  std::vector<std::string_view> names;
-  std::vector<int16_t> parents;
-  names.reserve(skeleton.joints.size());
-  parents.reserve(skeleton.joints.size());
-  for (const SourceJoint& j : skeleton.joints) {
-    names.push_back(j.name);
-    parents.push_back(static_cast<int16_t>(j.parent));
-  }
-  return skeleton_hash(names, parents);
-}
-
 std::vector<uint8_t> write_ossa(const SourceScene& scene, std::span<const CookedMesh> meshes,
                                 std::span<const CompressedClip> clips, const WriteProvenance& provenance,
                                 const WriteOptions& options) {

@@ -11,10 +11,10 @@
 #include <vector>
 
 #include "cooker/clip/clip_compress.h"
-#include "cooker/graph/graph_def.h"
-#include "cooker/import/input_log.h"
+#include "cooker/model/graph_def.h"
+#include "cooker/model/input_log.h"
 #include "cooker/mesh/mesh_build.h"
-#include "cooker/import/source_scene.h"
+#include "cooker/model/source_scene.h"
 
 namespace ossa::cook {
 
@@ -30,9 +30,6 @@ struct WriteOptions {
   bool include_skeleton = true;  // false for clip-only files cooked against --skeleton
   std::span<const GraphDef> graphs;  // animation graphs (a character cooked from a graph file)
 };
-
-/// The skeleton hash of a SourceSkeleton (ossa/format/hash.h's skeleton_hash over its names/parents).
-uint64_t skeleton_hash_of(const SourceSkeleton& skeleton);
 
 /// Serializes. `clips` are the compressed forms of scene.clips (same order); they are tagged with
 /// the hash of scene.skeleton. O(output size).

@@ -36,7 +36,7 @@
 
 namespace ossa::detail {
 
-/// Whether the AVX2 copies run (ossa/anim/vector_isa.h sets it; runtime/skinning/cpu.cpp).
+/// Whether the AVX2 copies run (ossa/anim/vector_isa.h sets it; runtime/internal/cpu.cpp).
 bool vector_avx2_selected();
 
 }  // namespace ossa::detail

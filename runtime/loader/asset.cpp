@@ -24,7 +24,7 @@
 
 #include <ossa/version.h>
 #include "internal/memory.h"
-#include "internal/message.h"
+#include "common/message.h"
 #include "internal/platform_file.h"
 #include <ossa/loader/validate.h>
 

@@ -31,7 +31,7 @@
 #include <ossa/format/hash.h>
 #include <ossa/format/vertex_format.h>
 #include <ossa/loader/texture.h>
-#include "internal/message.h"
+#include "common/message.h"
 #include "internal/vector_clones.h"
 
 namespace ossa {

@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "internal/message.h"
+#include "common/message.h"
 #include <ossa/loader/validate.h>
 
 namespace ossa {

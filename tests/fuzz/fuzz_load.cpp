@@ -2,7 +2,7 @@
 //
 // Each input goes through both entry points (verify_buffer over a 16-byte aligned copy, which is
 // what its contract asks for, and Asset::from_bytes); they must agree. An accepted input is then
-// walked by tests/asset_walk.h, which reads every byte the views expose and re-checks the
+// walked by tests/support/asset_walk.h, which reads every byte the views expose and re-checks the
 // invariants of ossa/loader/validate.h, so the fuzzer finds not only out-of-bounds reads (ASan) and
 // UB (UBSan) but also files the validator wrongly lets through (abort with the broken promise).
 //
@@ -16,7 +16,7 @@
 #include <string>
 
 #include <ossa/loader/asset.h>
-#include "tests/asset_walk.h"
+#include "tests/support/asset_walk.h"
 
 namespace {
 

@@ -1,5 +1,5 @@
 // make_corpus.cpp — writes the seed corpus for fuzz_load: one file per valid synthetic variant
-// (tests/test_files.h: valid_variants), named <variant>.ossa, into the directory given.
+// (tests/support/test_files.h: valid_variants), named <variant>.ossa, into the directory given.
 //
 // A C++ generator rather than a script because the seeds are built with the same FlatBufferBuilder
 // code as the tests' synthetic file; a checked-in binary corpus would silently go stale when the
@@ -11,7 +11,7 @@
 #include <filesystem>
 #include <system_error>
 
-#include "tests/test_files.h"
+#include "tests/support/test_files.h"
 
 int main(int argc, char** argv) {
   if (argc != 2) {

@@ -1,0 +1,68 @@
+// cook_options.h — what a cook makes of its input (--float-vertices, --clip-tolerance, --texture-format,
+// --root-motion, --skeleton, ...) and how it runs (the read sandbox, --force, --list-inputs).
+//
+// Part of the cooker's model: the command line and the batch (cli/) fill it, per-asset settings
+// (cook_settings.h) layer over it, every stage reads the part it needs. canonical() is the text of
+// the options that change output bytes: it is recorded in each output's provenance and enters the
+// cook key, so two cooks with equal canonical text and inputs make equal bytes.
+#pragma once
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "cooker/model/input_log.h"
+#include "cooker/model/source_scene.h"
+
+namespace ossa::cook {
+
+/// What the cooker makes of a texture (--texture-format; cooker/texture/texture_cook.h).
+enum class TextureOutput : uint8_t {
+  Compressed,  // "bc": mip chains in BC1 / BC3 / BC4 / BC5 by role (the default)
+  Rgba8,       // "rgba8": mip chains of uncompressed RGBA8
+  Source,      // "source": the source's PNG / JPEG bytes, decoded by the loader
+};
+
+/// How clips are compressed (--clip-tolerance, --no-clip-compression; cooker/clip/clip_compress.h).
+struct ClipCompressionOptions {
+  bool enabled = true;              // false: lossless (bind/constant only when bit-equal, every
+                                    // other channel raw floats at every frame)
+  float tolerance_metres = 0.0001f; // 0.1 mm ...
+  float probe_metres = 0.1f;        // ... at 10 cm
+  float morph_weight_tolerance = 0.001f;  // largest error of a morph weight at any frame
+};
+
+/// "bc" | "rgba8" | "source" -> the output; nullopt for anything else.
+std::optional<TextureOutput> parse_texture_output(std::string_view name);
+const char* texture_output_name(TextureOutput output);
+
+/// True for `*.graph.json` (case-insensitive): an animation graph file rather than a source.
+bool is_graph_file(const std::filesystem::path& path);
+
+struct CookOptions {
+  bool float_vertices = false;
+  TextureOutput textures = TextureOutput::Compressed;  // --texture-format
+  ClipCompressionOptions clips;       // --clip-tolerance, --no-clip-compression
+  bool root_motion = false;           // --root-motion: extract root motion from every clip
+  uint8_t up_axis = 1;                // --up-axis: 0 x, 1 y, 2 z
+  /// --metres-per-unit: the sources' length unit, overriding the file (BVH states none); 0: the file's.
+  float metres_per_unit = 0.0f;
+  /// Clip-only cooking against this rig (loaded from --skeleton REF.ossa); null otherwise.
+  const SourceSkeleton* reference = nullptr;
+  std::string reference_name;  // REF.ossa's file name, recorded in the options string
+  InputFile reference_input;   // REF.ossa as read (absolute path, hash): its hash is in canonical()
+  /// Canonical text of the options that change output bytes, recorded in provenance.
+  std::string canonical() const;
+
+  // How to run, not what to make (not in canonical(), not in the key):
+  /// The read sandbox (input_log.h): a cook reads only inside `root` (--root) or, without one, the
+  /// input's own folder tree, and inside each of `allow_dirs` (--allow-dir).
+  std::filesystem::path root;
+  std::vector<std::filesystem::path> allow_dirs;
+  bool force = false;  // --force: cook even when the output is up to date
+  bool write = true;   // false (--list-inputs): cook in memory, write nothing
+};
+
+}  // namespace ossa::cook

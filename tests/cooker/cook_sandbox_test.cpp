@@ -1,0 +1,298 @@
+// cook_sandbox_test.cpp — the cook's read sandbox (cooker/model/input_log.h) against the attacks a
+// source from an untrusted hand can make: a glTF buffer or image URI climbing out of the tree, a
+// graph source given by absolute path, a symlink pointing out, a FIFO or device as an input or a
+// texture. Each is refused by name (never opened, so nothing hangs or leaks into an output), the
+// cook fails alone, and --root / --allow-dir widen the sandbox when the user means it.
+#include <sys/stat.h>
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <filesystem>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include <ossa/loader/asset.h>
+#include "test_files.h"
+
+namespace fs = std::filesystem;
+using ossa::test::run_command;
+
+namespace {
+
+std::string cook_cmd() { return (ossa::test::bin_dir() / "ossa-cook").string(); }
+fs::path asset(const char* rel) { return ossa::test::source_dir() / "assets" / rel; }
+std::string q(const fs::path& p) { return "'" + p.string() + "'"; }
+
+/// A minimal glTF: one triangle whose positions come from buffer `uri` (36 bytes of floats), with
+/// a material whose base-colour image is `image_uri` (none when empty).
+std::string triangle_gltf(const std::string& uri, const std::string& image_uri = "") {
+  nlohmann::json j = {
+      {"asset", {{"version", "2.0"}}},
+      {"scene", 0},
+      {"scenes", {{{"nodes", {0}}}}},
+      {"nodes", {{{"mesh", 0}}}},
+      {"meshes", {{{"primitives", {{{"attributes", {{"POSITION", 0}}}, {"material", 0}}}}}}},
+      {"materials", {nlohmann::json::object()}},
+      {"buffers", {{{"uri", uri}, {"byteLength", 36}}}},
+      {"bufferViews", {{{"buffer", 0}, {"byteLength", 36}}}},
+      {"accessors", {{{"bufferView", 0}, {"componentType", 5126}, {"count", 3}, {"type", "VEC3"},
+                      {"min", {0, 0, 0}}, {"max", {1, 1, 0}}}}}};
+  if (!image_uri.empty()) {
+    j["images"] = {{{"uri", image_uri}}};
+    j["textures"] = {{{"source", 0}}};
+    j["materials"][0]["pbrMetallicRoughness"] = {{"baseColorTexture", {{"index", 0}}}};
+  }
+  return j.dump();
+}
+
+std::string triangle_bytes() {
+  const float v[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+  return std::string(reinterpret_cast<const char*>(v), sizeof v);
+}
+
+class CookSandbox : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir = ossa::test::make_temp_dir("sandbox");
+    tree = dir / "tree";
+    secret = dir / "secret";
+    fs::create_directories(tree / "chars");
+    fs::create_directories(secret);
+    ASSERT_TRUE(ossa::test::write_file(secret / "creds.bin", triangle_bytes()));
+    ASSERT_TRUE(ossa::test::write_file(secret / "creds.png", std::string_view("\x89PNG\r\n\x1a\n secret")));
+    ASSERT_TRUE(ossa::test::write_file(tree / "chars" / "tri.bin", triangle_bytes()));
+  }
+  ossa::test::CommandResult cook(const fs::path& input, const std::string& extra = "") {
+    return run_command(cook_cmd() + " " + q(input) + " -o " + q(dir / "out") + " " + extra);
+  }
+  fs::path dir, tree, secret;
+};
+
+TEST_F(CookSandbox, AGltfInsideItsTreeCooks) {
+  ASSERT_TRUE(ossa::test::write_file(tree / "chars" / "ok.gltf", triangle_gltf("tri.bin")));
+  const auto r = cook(tree / "chars" / "ok.gltf");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(fs::exists(dir / "out" / "ok.ossa"));
+}
+
+TEST_F(CookSandbox, BufferUriClimbingOutIsRefusedByName) {
+  ASSERT_TRUE(ossa::test::write_file(tree / "chars" / "evil.gltf", triangle_gltf("../../secret/creds.bin")));
+  const auto r = cook(tree / "chars" / "evil.gltf", "--report " + q(dir / "report.json"));
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find((secret / "creds.bin").string() + ": refused: outside the folders this cook may read"),
+            std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("evil.gltf"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "out" / "evil.ossa"));
+  // With the secret's folder allowed, the same file cooks: the refusal was the sandbox's doing.
+  const auto allowed = cook(tree / "chars" / "evil.gltf", "--allow-dir " + q(secret));
+  EXPECT_EQ(allowed.exit_code, 0) << allowed.err;
+}
+
+TEST_F(CookSandbox, ImageUriClimbingOutIsRefusedAndNothingIsEmbedded) {
+  ASSERT_TRUE(ossa::test::write_file(tree / "chars" / "img.gltf", triangle_gltf("tri.bin", "../../secret/creds.png")));
+  const auto r = cook(tree / "chars" / "img.gltf");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("creds.png: refused: outside the folders this cook may read"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("texture"), std::string::npos) << "names the reference: " << r.err;
+  EXPECT_FALSE(fs::exists(dir / "out" / "img.ossa"));
+}
+
+TEST_F(CookSandbox, SymlinksOutOfTheTreeAreResolvedAndRefused) {
+  fs::create_symlink(secret / "creds.bin", tree / "chars" / "link.bin");
+  ASSERT_TRUE(ossa::test::write_file(tree / "chars" / "sym.gltf", triangle_gltf("link.bin")));
+  const auto r = cook(tree / "chars" / "sym.gltf");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find((secret / "creds.bin").string() + ": refused: outside the folders this cook may read"),
+            std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("link.bin'"), std::string::npos) << "names the link as written: " << r.err;
+}
+
+TEST_F(CookSandbox, GraphSourcesOutsideTheTreeAreRefused) {
+  const std::string graph = R"({"ossa_graph": 1, "name": "g", "skeleton": ")" + asset("Pab/skeleton.fbx").string() +
+                            R"(", "clips": {"walk": ")" + asset("Pab/walk.fbx").string() +
+                            R"("}, "parameters": {}, "root": {"clip": "walk"}})";
+  ASSERT_TRUE(ossa::test::write_file(tree / "g.graph.json", graph));
+  const auto r = cook(tree / "g.graph.json");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("skeleton.fbx: refused: outside the folders this cook may read"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("g.graph.json:1:"), std::string::npos) << "names the graph entry: " << r.err;
+}
+
+TEST_F(CookSandbox, RootWidensTheSandboxAndADirectoryArgumentIsItsOwnTree) {
+  fs::create_directories(tree / "textures");
+  ASSERT_TRUE(ossa::test::write_file(tree / "textures" / "tri.bin", triangle_bytes()));
+  ASSERT_TRUE(ossa::test::write_file(tree / "chars" / "up.gltf", triangle_gltf("../textures/tri.bin")));
+  EXPECT_EQ(cook(tree / "chars" / "up.gltf").exit_code, 1) << "a file input: its own folder only";
+  EXPECT_EQ(cook(tree / "chars" / "up.gltf", "--root " + q(tree)).exit_code, 0);
+  fs::remove_all(dir / "out");
+  const auto r = run_command(cook_cmd() + " " + q(tree) + " -o " + q(dir / "out") + " --root " + q(tree));
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+}
+
+TEST_F(CookSandbox, FifosAndDevicesAreRefusedWithoutBeingOpened) {
+  ASSERT_EQ(::mkfifo((tree / "chars" / "pipe.gltf").c_str(), 0644), 0);
+  ASSERT_EQ(::mkfifo((tree / "chars" / "pipe.bin").c_str(), 0644), 0);
+  ASSERT_TRUE(ossa::test::write_file(tree / "chars" / "fifo.gltf", triangle_gltf("pipe.bin")));
+  // A FIFO as the input itself, and a FIFO as a buffer; /dev/zero as an allowed folder's file.
+  // Opening a FIFO would wait for a writer and reading /dev/zero never ends: either would end in
+  // the time limit (or the memory limit) instead of the refusals below.
+  const auto r = run_command(cook_cmd() + " " + q(tree / "chars" / "pipe.gltf") + " " + q(tree / "chars" / "fifo.gltf") +
+                             " /dev/zero -o " + q(dir / "out") + " --timeout 120");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_EQ(r.err.find("exceeded the"), std::string::npos) << "something waited for a writer or read an endless device:\n"
+                                                             << r.err;
+  EXPECT_NE(r.err.find("pipe.gltf: refused: is a FIFO, not a regular file"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("pipe.bin: refused: is a FIFO, not a regular file"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("/dev/zero: refused: is a device, not a regular file"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "out"));
+}
+
+// Textures are identified by their bytes and must decode (cooker/import/image_check.h).
+TEST_F(CookSandbox, TexturesMustBeTheImagesTheyClaimToBe) {
+  const auto png = ossa::test::tiny_png();
+  std::string bomb(png.begin(), png.end());
+  // The IHDR's width and height (bytes 16..23) rewritten to 20000 x 20000: a decompression bomb.
+  for (int k = 0; k < 2; ++k) {
+    bomb[16 + 4 * k] = 0;
+    bomb[17 + 4 * k] = 0;
+    bomb[18 + 4 * k] = char(20000 >> 8);
+    bomb[19 + 4 * k] = char(20000 & 0xff);
+  }
+  const std::string cases[][2] = {
+      {"text.png", "just some text, named like a picture\n"},
+      {"truncated.png", std::string(png.begin(), png.begin() + 40)},
+      {"bomb.png", bomb},
+  };
+  const char* expected[] = {"is not a PNG or JPEG image", "does not decode as png", "claims 20000 x 20000 pixels"};
+  for (size_t i = 0; i < std::size(cases); ++i) {
+    ASSERT_TRUE(ossa::test::write_file(tree / "chars" / cases[i][0], cases[i][1]));
+    ASSERT_TRUE(ossa::test::write_file(tree / "chars" / "t.gltf", triangle_gltf("tri.bin", cases[i][0])));
+    const auto r = cook(tree / "chars" / "t.gltf");
+    EXPECT_EQ(r.exit_code, 1) << cases[i][0];
+    EXPECT_NE(r.err.find("texture '" + cases[i][0] + "' " + expected[i]), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(dir / "out" / "t.ossa")) << cases[i][0];
+  }
+  // A real PNG under a .jpg name is embedded as what it is (kept as source bytes: image/png), and
+  // cooked by default into a BC1 chain of its 2 x 2 texels.
+  ASSERT_TRUE(ossa::test::write_file(tree / "chars" / "real.jpg", png));
+  ASSERT_TRUE(ossa::test::write_file(tree / "chars" / "t.gltf", triangle_gltf("tri.bin", "real.jpg")));
+  for (const char* format : {"source", "bc"}) {
+    const auto r = cook(tree / "chars" / "t.gltf", std::string("--force --texture-format ") + format);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    auto a = ossa::Asset::open((dir / "out" / "t.ossa").string());
+    ASSERT_TRUE(a.ok());
+    size_t embedded = 0;
+    for (const auto* m : *a->file().materials())
+      if (m->textures())
+        for (const auto* t : *m->textures()) {
+          if (std::string(format) == "source") {
+            EXPECT_EQ(flatbuffers::GetStringView(t->mime()), "image/png");
+            EXPECT_EQ(t->encoding(), ossa::fb::TextureEncoding::Source);
+          } else {
+            EXPECT_EQ(t->encoding(), ossa::fb::TextureEncoding::Bc1);
+            EXPECT_EQ(t->width(), 2u);
+            EXPECT_EQ(t->mip_count(), 2u);
+          }
+          embedded += t->data() ? 1 : 0;
+        }
+    EXPECT_EQ(embedded, 1u) << format;
+  }
+}
+
+// A huge but finite value in a source is named at import (it used to surface as "internal error,
+// cooked bytes fail verification").
+TEST_F(CookSandbox, HugeSourceValuesAreNamedAtImport) {
+  // An animated node: keys at 0 s and 1 s, the first translation 1e20.
+  const float data[8] = {0.0f, 1.0f, 1e20f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f};
+  ASSERT_TRUE(ossa::test::write_file(tree / "chars" / "anim.bin",
+                                     std::string(reinterpret_cast<const char*>(data), sizeof data)));
+  nlohmann::json j = {
+      {"asset", {{"version", "2.0"}}},
+      {"scene", 0},
+      {"scenes", {{{"nodes", {0}}}}},
+      {"nodes", {{{"name", "hips"}}}},
+      {"buffers", {{{"uri", "anim.bin"}, {"byteLength", 32}}}},
+      {"bufferViews", {{{"buffer", 0}, {"byteLength", 8}}, {{"buffer", 0}, {"byteOffset", 8}, {"byteLength", 24}}}},
+      {"accessors", {{{"bufferView", 0}, {"componentType", 5126}, {"count", 2}, {"type", "SCALAR"}, {"min", {0}}, {"max", {1}}},
+                     {{"bufferView", 1}, {"componentType", 5126}, {"count", 2}, {"type", "VEC3"}}}},
+      {"animations", {{{"name", "move"},
+                       {"samplers", {{{"input", 0}, {"output", 1}}}},
+                       {"channels", {{{"sampler", 0}, {"target", {{"node", 0}, {"path", "translation"}}}}}}}}}};
+  ASSERT_TRUE(ossa::test::write_file(tree / "chars" / "huge.gltf", j.dump()));
+  const auto r = cook(tree / "chars" / "huge.gltf");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_EQ(r.err.find("internal error"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("clip 'move', joint 'hips': translation key 0 (at 0 s) (1e+20, 0, 0) is unusable"),
+            std::string::npos) << r.err;
+}
+
+// What Assimp cannot take is handled before it reads the bytes (cooker/import/source_precheck.h).
+TEST_F(CookSandbox, DeepHierarchiesAreRefusedBeforeTheImporterRecurses) {
+  // A glTF chain of 20,000 nodes, and a BVH 20,000 joints deep.
+  nlohmann::json nodes = nlohmann::json::array();
+  for (int i = 0; i < 20000; ++i) {
+    nlohmann::json node = {{"name", "n" + std::to_string(i)}};
+    if (i + 1 < 20000) node["children"] = {i + 1};
+    nodes.push_back(node);
+  }
+  const nlohmann::json gltf = {{"asset", {{"version", "2.0"}}}, {"scene", 0}, {"scenes", {{{"nodes", {0}}}}}, {"nodes", nodes}};
+  ASSERT_TRUE(ossa::test::write_file(tree / "chars" / "chain.gltf", gltf.dump()));
+  std::string bvh = "HIERARCHY\nROOT j0\n{\n OFFSET 0 0 0\n CHANNELS 3 Zrotation Xrotation Yrotation\n";
+  for (int i = 1; i < 20000; ++i) bvh += " JOINT j" + std::to_string(i) + "\n {\n OFFSET 0 1 0\n CHANNELS 3 Zrotation Xrotation Yrotation\n";
+  bvh += " End Site\n {\n OFFSET 0 1 0\n }\n";
+  for (int i = 0; i < 20000; ++i) bvh += "}\n";
+  bvh += "MOTION\nFrames: 1\nFrame Time: 0.033\n";
+  for (int i = 0; i < 20000; ++i) bvh += "0 0 0 ";
+  ASSERT_TRUE(ossa::test::write_file(tree / "chars" / "chainb.bvh", bvh));
+  const auto r = run_command(cook_cmd() + " " + q(tree / "chars") + " -o " + q(dir / "out") + " --report " +
+                             q(dir / "report.json"));
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("chain.gltf: its node tree is nested over 1000+ levels deep"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("chainb.bvh: its joint hierarchy is nested over 1000+ levels deep"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("signal"), std::string::npos) << "refused, not crashed: " << r.err;
+}
+
+TEST_F(CookSandbox, AGltfSkinWithoutInverseBindMatricesMeansIdentity) {
+  // glTF 2.0: "When undefined, each matrix is a 4x4 identity matrix." Assimp 5.2 crashes on it;
+  // the cooker supplies the identity matrices before Assimp reads the file.
+  const fs::path shared = ossa::test::shared_assets() / "Khronos_embedded" / "rigged_simple.gltf";
+  if (!fs::exists(shared)) GTEST_SKIP() << "../shared/assets not present";
+  auto doc = nlohmann::json::parse(*ossa::test::read_text(shared));
+  ASSERT_TRUE(doc.contains("skins"));
+  for (auto& skin : doc["skins"]) skin.erase("inverseBindMatrices");
+  ASSERT_TRUE(ossa::test::write_file(tree / "chars" / "noibm.gltf", doc.dump()));
+  const auto r = run_command(cook_cmd() + " " + q(tree / "chars" / "noibm.gltf") + " -o " + q(dir / "out"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  auto a = ossa::Asset::open((dir / "out" / "noibm.ossa").string());
+  ASSERT_TRUE(a.ok());
+  ASSERT_GT(a->mesh_count(), 0u);
+  ASSERT_GT(a->skeleton().joint_count(), 0u);
+  // Every joint slot of the mesh binds with the identity.
+  const auto* mesh = a->file().meshes()->Get(0);
+  ASSERT_NE(mesh->inverse_bind(), nullptr);
+  for (const auto* m : *mesh->inverse_bind())
+    for (int k = 0; k < 16; ++k) EXPECT_FLOAT_EQ(m->m()->Get(k), k % 5 == 0 ? 1.0f : 0.0f) << k;
+}
+
+// Broken containers are described as what they are, not by Assimp's consequences ("No suitable
+// reader found", "aiScene::mNumMeshes is 0", "4252017601 frames").
+TEST_F(CookSandbox, BrokenContainersAreDescribedAsSuch) {
+  const std::string gltf = triangle_gltf("tri.bin");
+  ASSERT_TRUE(ossa::test::write_file(tree / "chars" / "cut.gltf", gltf.substr(0, gltf.size() / 2)));
+  const auto glb = ossa::test::read_file(asset("RiggedSimple/RiggedSimple.glb"));
+  ASSERT_TRUE(glb.has_value());
+  ASSERT_TRUE(ossa::test::write_file(tree / "chars" / "cutb.glb", std::span<const uint8_t>(glb->data(), 5000)));
+  ASSERT_TRUE(ossa::test::write_file(tree / "chars" / "zero.bvh", std::string_view(
+      "HIERARCHY\nROOT Hips\n{\n OFFSET 0 0 0\n CHANNELS 3 Zrotation Xrotation Yrotation\n End Site\n {\n"
+      "  OFFSET 0 1 0\n }\n}\nMOTION\nFrames: 0\nFrame Time: 0.033\n")));
+  const auto r = run_command(cook_cmd() + " " + q(tree / "chars") + " -o " + q(dir / "out") + " --root " + q(tree));
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("cut.gltf: is not valid glTF JSON (truncated? parse error"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("cutb.glb: is a GLB file that declares " + std::to_string(glb->size()) + " bytes but has 5000"),
+            std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("zero.bvh: declares \"Frames: 0\": a BVH motion needs at least one frame"), std::string::npos) << r.err;
+}
+
+}  // namespace

@@ -1,0 +1,546 @@
+// sample_test.cpp — the clip sampler (ossa/anim/sample.h) against an independent reference.
+//
+// The reference here decodes keys with ossa/format/clip_codec.h and interpolates them the slow, obvious
+// way (linear search for the key pair, double precision, lerp / nlerp with the shortest-arc sign
+// fix / slerp), so the tests hold the cached SoA sampler to what the format says a clip means:
+//   - at frame times sampling reproduces the decoded keys; between keys it is their interpolation;
+//   - the cache is invisible: cached sampling equals a fresh cache for forward (60 Hz), reverse
+//     (negative rate through advance_time) and random-seek sequences;
+//   - loop and clamp modes, loop-boundary continuity, rotations across hemispheres, slerp;
+//   - a clip is refused by a skeleton it was not cooked for.
+// Synthetic v2 clips (test_files.h) pin the exact cases; Pab's cooked walk (tests/fixtures/Pab,
+// cooked by ossa-cook against its skeleton, as bench/bench_fixture.cpp does) checks real data.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+#include <glm/gtc/quaternion.hpp>
+
+#include <ossa/format/clip_codec.h>
+#include <ossa/loader/asset.h>
+#include <ossa/anim/pose.h>
+#include <ossa/anim/sample.h>
+#include <ossa/anim/vector_isa.h>
+#include "test_files.h"
+
+namespace ossa {
+namespace {
+
+namespace fs = std::filesystem;
+using test::SyntheticSpec;
+
+// ---- the reference sampler -----------------------------------------------------------------
+
+/// One joint's channel values as doubles: T xyz, R xyzw, S xyz (pose component order).
+struct RefJoint {
+  double v[kPoseComponents];
+};
+
+/// Decoded key k of an animated channel, rotation w restored.
+std::array<double, 4> decoded_key(const ClipView& clip, const fb::AnimatedChannel& a, uint32_t k) {
+  const float lo[3] = {a.range_min().x(), a.range_min().y(), a.range_min().z()};
+  const float ex[3] = {a.range_extent().x(), a.range_extent().y(), a.range_extent().z()};
+  float v[3];
+  decode_key(clip.key_values().data(), a.bit_offset(), a.bits(), lo, ex, k, v);
+  if (a.channel() != fb::Channel::Rotation) return {v[0], v[1], v[2], 0.0};
+  // The dropped component, rebuilt by the format's own float expression (the cooker tunes the
+  // stored values to it, so a double-precision rebuild would disagree near half turns).
+  const double rebuilt = rotation_w(v);
+  std::array<double, 4> q{};
+  for (uint32_t c = 0, i = 0; c < 4; ++c) q[c] = c == a.dropped() ? rebuilt : v[i++];
+  return q;
+}
+
+uint32_t first_component(fb::Channel c) { return c == fb::Channel::Translation ? kTx : c == fb::Channel::Rotation ? kRx : kSx; }
+
+enum class RefRotation { Nlerp, Slerp };
+
+/// The pose at frame position `frame` (already wrapped or clamped), computed the obvious way.
+std::vector<RefJoint> reference_pose(const ClipView& clip, const SkeletonView& skeleton, double frame,
+                                     RefRotation rotation = RefRotation::Nlerp) {
+  std::vector<RefJoint> out(skeleton.joint_count());
+  for (size_t j = 0; j < out.size(); ++j) {
+    const auto& t = skeleton.bind_translations()[j];
+    const auto& r = skeleton.bind_rotations()[j];
+    const auto& s = skeleton.bind_scales()[j];
+    out[j] = RefJoint{{t.x(), t.y(), t.z(), r.x(), r.y(), r.z(), r.w(), s.x(), s.y(), s.z()}};
+  }
+  for (const fb::ConstantChannel& c : clip.constants()) {
+    const uint32_t base = first_component(c.channel());
+    const double q[4] = {c.value().x(), c.value().y(), c.value().z(), c.value().w()};
+    for (uint32_t i = 0; i < (c.channel() == fb::Channel::Rotation ? 4u : 3u); ++i) out[c.joint()].v[base + i] = q[i];
+  }
+  for (const fb::AnimatedChannel& a : clip.animated()) {
+    const uint16_t* frames = clip.key_frames().data() + a.first_key();
+    uint32_t k = 0;
+    while (k + 2 < a.key_count() && frames[k + 1] <= frame) ++k;
+    const double f0 = frames[k], f1 = frames[k + 1];
+    const double w = std::clamp((frame - f0) / (f1 - f0), 0.0, 1.0);
+    const auto ka = decoded_key(clip, a, k), kb0 = decoded_key(clip, a, k + 1);
+    auto kb = kb0;
+    const uint32_t base = first_component(a.channel());
+    if (a.channel() != fb::Channel::Rotation) {
+      for (int i = 0; i < 3; ++i) out[a.joint()].v[base + i] = ka[i] * (1 - w) + kb[i] * w;
+      continue;
+    }
+    const double dot = ka[0] * kb[0] + ka[1] * kb[1] + ka[2] * kb[2] + ka[3] * kb[3];
+    if (dot < 0)
+      for (double& x : kb) x = -x;
+    double r[4];
+    if (rotation == RefRotation::Slerp && std::fabs(dot) < 0.9995) {
+      const double theta = std::acos(std::fabs(dot));
+      const double wa = std::sin((1 - w) * theta) / std::sin(theta), wb = std::sin(w * theta) / std::sin(theta);
+      for (int i = 0; i < 4; ++i) r[i] = ka[i] * wa + kb[i] * wb;
+    } else {
+      for (int i = 0; i < 4; ++i) r[i] = ka[i] * (1 - w) + kb[i] * w;
+    }
+    const double n = std::sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2] + r[3] * r[3]);
+    for (int i = 0; i < 4; ++i) out[a.joint()].v[base + i] = r[i] / n;
+  }
+  // Normalize fixed rotations too (the sampler does, at cache creation).
+  for (RefJoint& j : out) {
+    const double n = std::sqrt(j.v[kRx] * j.v[kRx] + j.v[kRy] * j.v[kRy] + j.v[kRz] * j.v[kRz] + j.v[kRw] * j.v[kRw]);
+    for (uint32_t i = kRx; i <= kRw; ++i) j.v[i] /= n;
+  }
+  return out;
+}
+
+/// Largest difference between a sampled pose and the reference; rotations compared up to sign.
+double max_difference(ConstPoseSpan pose, const std::vector<RefJoint>& ref) {
+  double worst = 0.0;
+  for (uint32_t j = 0; j < ref.size(); ++j) {
+    for (PoseComponent c : {kTx, kTy, kTz, kSx, kSy, kSz}) worst = std::max(worst, std::fabs(pose[c][j] - ref[j].v[c]));
+    double same = 0.0, flipped = 0.0;
+    for (uint32_t c = kRx; c <= kRw; ++c) {
+      const double p = pose[static_cast<PoseComponent>(c)][j];
+      same = std::max(same, std::fabs(p - ref[j].v[c]));
+      flipped = std::max(flipped, std::fabs(p + ref[j].v[c]));
+    }
+    worst = std::max(worst, std::min(same, flipped));
+  }
+  return worst;
+}
+
+/// Bitwise equality of the joints' lanes of two poses.
+bool same_bits(ConstPoseSpan a, ConstPoseSpan b) {
+  for (uint32_t c = 0; c < kPoseComponents; ++c)
+    if (std::memcmp(a[static_cast<PoseComponent>(c)], b[static_cast<PoseComponent>(c)], a.joint_count * sizeof(float)) != 0)
+      return false;
+  return true;
+}
+
+double wrapped_frame(const ClipView& clip, double t, bool loop) {
+  const double d = clip.duration();
+  if (loop) {
+    t = d > 0 ? t - std::floor(t / d) * d : 0.0;
+    if (t >= d) t = 0.0;
+  } else {
+    t = std::clamp(t, 0.0, d);
+  }
+  return std::min(t * clip.sample_rate(), static_cast<double>(clip.frame_count() - 1));
+}
+
+// ---- fixtures ------------------------------------------------------------------------------
+
+struct Loaded {
+  Asset asset;
+  ClipView clip() const { return asset.clip(0); }
+  SkeletonView skeleton() const { return asset.skeleton(); }
+};
+
+Loaded load(const SyntheticSpec& spec) {
+  auto asset = Asset::from_bytes(make_valid_file(spec), "synthetic.ossa");
+  EXPECT_TRUE(asset.ok()) << asset.error().message;
+  return Loaded{std::move(*asset)};
+}
+
+SamplingCache cache_for(const ClipView& clip, const SkeletonView& skeleton) {
+  auto cache = make_sampling_cache(clip, skeleton);
+  EXPECT_TRUE(cache.ok()) << cache.error().message;
+  return std::move(*cache);
+}
+
+/// Pab's skeleton and its walk, cooked by ossa-cook (the walk against the skeleton, default options)
+/// into the committed fixtures (tests/fixtures/Pab); opened once per process.
+struct Pab {
+  Asset skeleton;
+  Asset walk;
+};
+
+const Pab* pab() {
+  static const std::unique_ptr<Pab> data = []() -> std::unique_ptr<Pab> {
+    const fs::path dir = test::fixtures_dir() / "Pab";
+    auto s = Asset::open((dir / "skeleton.ossa").string());
+    auto w = Asset::open((dir / "walk.ossa").string());
+    EXPECT_TRUE(s.ok()) << (s.ok() ? "" : s.error().message);
+    EXPECT_TRUE(w.ok()) << (w.ok() ? "" : w.error().message);
+    if (!s.ok() || !w.ok()) return nullptr;
+    return std::unique_ptr<Pab>(new Pab{std::move(*s), std::move(*w)});
+  }();
+  return data.get();
+}
+
+#define REQUIRE_PAB()                                                             \
+  const Pab* p = pab();                                                           \
+  ASSERT_NE(p, nullptr) << "tests/fixtures/Pab could not be opened (see above)"; \
+  const ClipView clip = p->walk.clip(0);                                          \
+  const SkeletonView skeleton = p->skeleton.skeleton()
+
+// ---- synthetic clips -----------------------------------------------------------------------
+
+TEST(Sample, FrameTimesReproduceDecodedKeys) {
+  const Loaded f = load({});
+  const ClipView clip = f.clip();
+  SamplingCache cache = cache_for(clip, f.skeleton());
+  Pose pose(static_cast<uint32_t>(f.skeleton().joint_count()));
+  for (const fb::AnimatedChannel& a : clip.animated()) {
+    for (uint32_t k = 0; k < a.key_count(); ++k) {
+      const uint16_t frame = clip.key_frames()[a.first_key() + k];
+      sample(clip, static_cast<float>(frame) / clip.sample_rate(), SampleOptions{.loop = false}, cache, pose);
+      const auto key = decoded_key(clip, a, k);
+      const uint32_t base = first_component(a.channel());
+      const uint32_t n = a.channel() == fb::Channel::Rotation ? 4 : 3;
+      double norm = 0.0;
+      for (uint32_t i = 0; i < n; ++i) norm += key[i] * key[i];
+      norm = a.channel() == fb::Channel::Rotation ? std::sqrt(norm) : 1.0;
+      for (uint32_t i = 0; i < n; ++i)
+        EXPECT_NEAR(pose.span()[static_cast<PoseComponent>(base + i)][a.joint()], key[i] / norm, 1e-6)
+            << "joint " << a.joint() << " channel " << int(a.channel()) << " key " << k << " component " << i;
+    }
+  }
+}
+
+TEST(Sample, AbsentAndConstantChannelsHoldTheirValues) {
+  const Loaded f = load({});
+  SamplingCache cache = cache_for(f.clip(), f.skeleton());
+  Pose pose(4);
+  sample(f.clip(), 0.4f, {}, cache, pose);
+  // root: nothing in the clip: bind pose (identity at the origin).
+  const Transform root = get_transform(pose, 0);
+  EXPECT_EQ(root.translation, glm::vec3(0.0f));
+  EXPECT_EQ(root.scale, glm::vec3(1.0f));
+  // spine translation: constant (0, 1, 0); head rotation: constant 30 degrees about z.
+  EXPECT_EQ(get_transform(pose, 1).translation, glm::vec3(0, 1, 0));
+  const glm::quat head = get_transform(pose, 2).rotation;
+  EXPECT_NEAR(head.z, 0.25881905f, 1e-6f);
+  EXPECT_NEAR(head.w, 0.96592583f, 1e-6f);
+  // arm rotation: absent: the bind rotation (90 degrees about z).
+  EXPECT_NEAR(get_transform(pose, 3).rotation.z, 0.70710678f, 1e-6f);
+}
+
+TEST(Sample, BetweenKeysMatchesInterpolationOfDecodedKeys) {
+  for (const auto& [name, spec] : test::valid_variants()) {
+    if (spec.clips.empty() || !spec.skeleton || spec.clips[0].skeleton_hash) continue;
+    const Loaded f = load(spec);
+    const ClipView clip = f.clip();
+    SamplingCache cache = cache_for(clip, f.skeleton());
+    Pose pose(static_cast<uint32_t>(f.skeleton().joint_count()));
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<float> time(-0.5f, 2.5f);
+    for (int i = 0; i < 200; ++i) {
+      const float t = time(rng);
+      for (bool loop : {true, false}) {
+        sample(clip, t, SampleOptions{.loop = loop}, cache, pose);
+        const auto ref = reference_pose(clip, f.skeleton(), wrapped_frame(clip, t, loop));
+        ASSERT_LT(max_difference(pose, ref), 2e-6) << name << " t=" << t << " loop=" << loop;
+      }
+    }
+  }
+}
+
+/// A clip of one joint rotating about x from 170 to 190 degrees: stored with w >= 0 (w dropped),
+/// its second key lies in the opposite hemisphere of the first, and only the sign fix keeps the
+/// blend on the 20-degree arc through 180 degrees.
+SyntheticSpec hemisphere_spec(uint8_t bits) {
+  SyntheticSpec spec;
+  test::SyntheticClip& c = spec.clips[0];
+  c.constants.clear();
+  c.animated.clear();
+  const double a0 = glm::radians(170.0) / 2, a1 = glm::radians(190.0) / 2;
+  // 190 degrees has w = cos(95) < 0: stored negated.
+  test::SyntheticAnimated r;
+  r.joint = 1;
+  r.channel = fb::Channel::Rotation;
+  r.bits = bits;
+  r.frames = {0, 30};
+  r.values = {{static_cast<float>(std::sin(a0)), 0, 0}, {static_cast<float>(-std::sin(a1)), 0, 0}};
+  c.animated.push_back(r);
+  return spec;
+}
+
+TEST(Sample, RotationKeysInOppositeHemispheresTakeTheShortArc) {
+  for (uint8_t bits : {uint8_t{16}, uint8_t{32}}) {
+    for (RotationInterpolation mode : {RotationInterpolation::Nlerp, RotationInterpolation::Slerp}) {
+      const Loaded f = load(hemisphere_spec(bits));
+      SamplingCache cache = cache_for(f.clip(), f.skeleton());
+      Pose pose(4);
+      sample(f.clip(), 0.5f, SampleOptions{.loop = false, .rotation = mode}, cache, pose);
+      const glm::quat q = get_transform(pose, 1).rotation;
+      // Half way is 180 degrees about x: (x, y, z, w) = (+-1, 0, 0, 0).
+      EXPECT_NEAR(std::fabs(q.x), 1.0f, 1e-4f) << int(bits);
+      EXPECT_NEAR(q.w, 0.0f, 1e-3f) << int(bits);
+      // A quarter of the way: 175 degrees.
+      sample(f.clip(), 0.25f, SampleOptions{.loop = false, .rotation = mode}, cache, pose);
+      const glm::quat r = get_transform(pose, 1).rotation;
+      EXPECT_NEAR(std::fabs(r.w), std::cos(glm::radians(175.0f) / 2), 2e-3f) << int(bits);
+    }
+  }
+}
+
+TEST(Sample, SlerpHasConstantAngularVelocity) {
+  // 0 -> 160 degrees about y in 30 frames: nlerp and slerp differ visibly at a quarter.
+  SyntheticSpec spec;
+  test::SyntheticClip& c = spec.clips[0];
+  c.animated[0].frames = {0, 30};
+  c.animated[0].values = {{0, 0, 0}, {0, static_cast<float>(std::sin(glm::radians(80.0))), 0}};
+  const Loaded f = load(spec);
+  SamplingCache cache = cache_for(f.clip(), f.skeleton());
+  Pose pose(4);
+  for (float t : {0.0f, 0.25f, 0.5f, 0.8f, 1.0f}) {
+    sample(f.clip(), t, SampleOptions{.loop = false, .rotation = RotationInterpolation::Slerp}, cache, pose);
+    const glm::quat q = get_transform(pose, 1).rotation;
+    const float angle = glm::degrees(2.0f * std::atan2(std::fabs(q.y), std::fabs(q.w)));
+    EXPECT_NEAR(angle, 160.0f * t, 0.05f) << t;
+    const auto ref = reference_pose(f.clip(), f.skeleton(), t * 30.0, RefRotation::Slerp);
+    EXPECT_LT(max_difference(pose, ref), 2e-6) << t;
+  }
+  sample(f.clip(), 0.25f, SampleOptions{.loop = false, .rotation = RotationInterpolation::Nlerp}, cache, pose);
+  const glm::quat n = get_transform(pose, 1).rotation;
+  EXPECT_GT(std::fabs(glm::degrees(2.0f * std::atan2(std::fabs(n.y), std::fabs(n.w))) - 40.0f), 1.0f)
+      << "nlerp and slerp should differ on a 160-degree key pair";
+}
+
+TEST(Sample, ClampAndLoopModes) {
+  const Loaded f = load({});
+  const ClipView clip = f.clip();
+  SamplingCache cache = cache_for(clip, f.skeleton());
+  Pose a(4), b(4);
+  const SampleOptions clamp{.loop = false};
+  // Clamped: before the start is frame 0, past the end is the last frame.
+  sample(clip, -3.0f, clamp, cache, a);
+  sample(clip, 0.0f, clamp, cache, b);
+  EXPECT_TRUE(same_bits(a, b));
+  sample(clip, 7.5f, clamp, cache, a);
+  sample(clip, clip.duration(), clamp, cache, b);
+  EXPECT_TRUE(same_bits(a, b));
+  EXPECT_LT(max_difference(a, reference_pose(clip, f.skeleton(), 30.0)), 1e-6);
+  // Looping: t and t + k * duration are the same pose; duration itself wraps to 0.
+  sample(clip, 0.3f, {}, cache, a);
+  sample(clip, 2.3f, {}, cache, b);
+  EXPECT_LT(max_difference(b, reference_pose(clip, f.skeleton(), wrapped_frame(clip, 2.3, true))), 2e-6);
+  EXPECT_LT(max_difference(a, reference_pose(clip, f.skeleton(), 9.0)), 2e-6);
+  sample(clip, -0.7f, {}, cache, a);
+  EXPECT_LT(max_difference(a, reference_pose(clip, f.skeleton(), 9.0)), 2e-5);
+  sample(clip, clip.duration(), {}, cache, a);
+  sample(clip, 0.0f, {}, cache, b);
+  EXPECT_TRUE(same_bits(a, b));
+  // Not-a-number time plays frame 0 rather than poisoning the pose.
+  sample(clip, std::numeric_limits<float>::quiet_NaN(), {}, cache, a);
+  EXPECT_TRUE(same_bits(a, b));
+}
+
+TEST(Sample, SingleFrameClip) {
+  SyntheticSpec spec;
+  spec.clips[0].frame_count = 1;
+  spec.clips[0].animated.clear();
+  const Loaded f = load(spec);
+  SamplingCache cache = cache_for(f.clip(), f.skeleton());
+  Pose a(4), b(4);
+  sample(f.clip(), 0.0f, {}, cache, a);
+  for (float t : {-1.0f, 0.5f, 100.0f}) {
+    for (bool loop : {true, false}) {
+      sample(f.clip(), t, SampleOptions{.loop = loop}, cache, b);
+      EXPECT_TRUE(same_bits(a, b)) << t;
+    }
+  }
+}
+
+TEST(Sample, RefusesAnotherSkeleton) {
+  SyntheticSpec spec;
+  spec.clips[0].skeleton_hash = 0xBADBADBADull;
+  const Loaded f = load(spec);
+  const auto cache = make_sampling_cache(f.clip(), f.skeleton());
+  ASSERT_FALSE(cache.ok());
+  EXPECT_NE(cache.error().message.find("walk"), std::string::npos) << cache.error().message;
+  EXPECT_NE(cache.error().message.find("skeleton"), std::string::npos) << cache.error().message;
+  // No skeleton at all.
+  EXPECT_FALSE(make_sampling_cache(f.clip(), SkeletonView{}).ok());
+  // The right hash on a clip claiming another joint count is refused too (a clip-only file).
+  SyntheticSpec clip_only;
+  clip_only.skeleton.reset();
+  clip_only.meshes.clear();
+  clip_only.clips[0].skeleton_hash = load({}).skeleton().hash();
+  clip_only.clips[0].joint_count = 5;
+  clip_only.clips[0].animated[1].joint = 4;
+  clip_only.clips[0].animated[2].joint = 4;
+  const Loaded other = load(clip_only);
+  const Loaded rig = load({});
+  EXPECT_FALSE(make_sampling_cache(other.clip(), rig.skeleton()).ok());
+}
+
+/// Plays `times` twice, through one persistent cache and through a fresh one per sample, and
+/// requires bit-identical poses.
+void expect_cache_invisible(const ClipView& clip, const SkeletonView& skeleton, const std::vector<float>& times,
+                            const SampleOptions& options, const char* what) {
+  SamplingCache cached = cache_for(clip, skeleton);
+  const auto joints = static_cast<uint32_t>(skeleton.joint_count());
+  Pose a(joints), b(joints);
+  for (size_t i = 0; i < times.size(); ++i) {
+    sample(clip, times[i], options, cached, a);
+    SamplingCache fresh = cache_for(clip, skeleton);
+    sample(clip, times[i], options, fresh, b);
+    ASSERT_TRUE(same_bits(a, b)) << what << ": sample " << i << " at t=" << times[i];
+  }
+  // reset() forgets cursors without changing results.
+  reset(cached);
+  sample(clip, times.back(), options, cached, a);
+  ASSERT_TRUE(same_bits(a, b)) << what << " after reset";
+}
+
+std::vector<float> playback(const ClipView& clip, float rate, int frames, bool loop, float start = 0.0f) {
+  std::vector<float> times;
+  float t = start;
+  for (int i = 0; i < frames; ++i) {
+    times.push_back(t);
+    t = advance_time(t, 1.0f / 60.0f, rate, clip.duration(), loop);
+  }
+  return times;
+}
+
+std::vector<float> random_times(const ClipView& clip, int n, uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> u(-clip.duration(), 2.0f * clip.duration());
+  std::vector<float> times;
+  for (int i = 0; i < n; ++i) times.push_back(u(rng));
+  return times;
+}
+
+TEST(Sample, CacheIsInvisibleOnSyntheticClips) {
+  for (const auto& [name, spec] : test::valid_variants()) {
+    if (spec.clips.empty() || !spec.skeleton || spec.clips[0].skeleton_hash) continue;
+    const Loaded f = load(spec);
+    for (bool loop : {true, false}) {
+      const SampleOptions o{.loop = loop};
+      expect_cache_invisible(f.clip(), f.skeleton(), playback(f.clip(), 1.0f, 200, loop), o, "forward");
+      expect_cache_invisible(f.clip(), f.skeleton(), playback(f.clip(), -1.3f, 200, loop, 0.9f), o, "reverse");
+      expect_cache_invisible(f.clip(), f.skeleton(), random_times(f.clip(), 200, 3), o, "seek");
+    }
+  }
+}
+
+TEST(Sample, BothVectorCopiesGiveBitIdenticalPoses) {
+  // Sampling's interpolation kernel is compiled for AVX2 and the baseline (vector_isa.h); with no
+  // FMA in either, a pose must not depend on which copy ran.
+  if (ossa::best_vector_isa() != ossa::VectorIsa::Avx2) GTEST_SKIP() << "no AVX2 copy on this CPU or build";
+  int checked = 0;
+  for (const auto& [name, spec] : test::valid_variants()) {
+    if (spec.clips.empty() || !spec.skeleton || spec.clips[0].skeleton_hash) continue;
+    const Loaded f = load(spec);
+    const auto joints = static_cast<uint32_t>(f.skeleton().joint_count());
+    SamplingCache ca = cache_for(f.clip(), f.skeleton()), cb = cache_for(f.clip(), f.skeleton());
+    Pose a(joints), b(joints);
+    for (const float t : playback(f.clip(), 1.0f, 120, true)) {
+      ASSERT_TRUE(ossa::set_vector_isa(ossa::VectorIsa::Avx2));
+      sample(f.clip(), t, {}, ca, a);
+      ASSERT_TRUE(ossa::set_vector_isa(ossa::VectorIsa::Baseline));
+      sample(f.clip(), t, {}, cb, b);
+      ASSERT_TRUE(same_bits(a, b)) << name << " at t=" << t;
+      ++checked;
+    }
+  }
+  ossa::set_vector_isa(ossa::best_vector_isa());
+  EXPECT_GT(checked, 0);
+}
+
+TEST(AdvanceTime, WrapsClampsAndCountsLoops) {
+  int loops = 7;
+  EXPECT_FLOAT_EQ(advance_time(0.5f, 0.25f, 1.0f, 1.0f, true, &loops), 0.75f);
+  EXPECT_EQ(loops, 0);
+  EXPECT_FLOAT_EQ(advance_time(0.9f, 0.2f, 1.0f, 1.0f, true, &loops), 0.1f);
+  EXPECT_EQ(loops, 1);
+  EXPECT_FLOAT_EQ(advance_time(0.1f, 0.2f, -1.0f, 1.0f, true, &loops), 0.9f);
+  EXPECT_EQ(loops, -1);
+  EXPECT_FLOAT_EQ(advance_time(0.5f, 1.0f, 2.5f, 1.0f, true, &loops), 0.0f);
+  EXPECT_EQ(loops, 3);
+  EXPECT_FLOAT_EQ(advance_time(0.9f, 0.2f, 1.0f, 1.0f, false, &loops), 1.0f);
+  EXPECT_EQ(loops, 0);
+  EXPECT_FLOAT_EQ(advance_time(0.1f, 0.2f, -1.0f, 1.0f, false, &loops), 0.0f);
+  EXPECT_FLOAT_EQ(advance_time(0.3f, 0.1f, 1.0f, 0.0f, true, &loops), 0.0f);  // a one-frame clip
+  EXPECT_FLOAT_EQ(advance_time(0.3f, std::numeric_limits<float>::infinity(), 1.0f, 1.0f, true), 0.0f);
+  // A looping time never reaches the duration.
+  for (float t = 0.0f; t < 1.0f; t += 0.01f) EXPECT_LT(advance_time(t, 1.0f / 60.0f, 1.0f, 1.0f, true), 1.0f);
+}
+
+// ---- Pab's cooked walk -------------------------------------------------------------------------
+
+TEST(SamplePab, FrameTimesReproduceDecodedKeys) {
+  REQUIRE_PAB();
+  SamplingCache cache = cache_for(clip, skeleton);
+  Pose pose(static_cast<uint32_t>(skeleton.joint_count()));
+  for (uint32_t frame = 0; frame < clip.frame_count(); ++frame) {
+    sample(clip, static_cast<float>(frame) / clip.sample_rate(), SampleOptions{.loop = false}, cache, pose);
+    ASSERT_LT(max_difference(pose, reference_pose(clip, skeleton, frame)), 2e-6) << "frame " << frame;
+  }
+}
+
+TEST(SamplePab, BetweenKeysMatchesInterpolationOfDecodedKeys) {
+  REQUIRE_PAB();
+  SamplingCache cache = cache_for(clip, skeleton);
+  Pose pose(static_cast<uint32_t>(skeleton.joint_count()));
+  for (float t : random_times(clip, 300, 11)) {
+    sample(clip, t, {}, cache, pose);
+    // Positions in centimetres: 2e-6 relative to values of order 100.
+    ASSERT_LT(max_difference(pose, reference_pose(clip, skeleton, wrapped_frame(clip, t, true))), 2e-4) << t;
+  }
+}
+
+TEST(SamplePab, LoopBoundaryIsContinuous) {
+  REQUIRE_PAB();
+  SamplingCache cache = cache_for(clip, skeleton);
+  const auto joints = static_cast<uint32_t>(skeleton.joint_count());
+  Pose end(joints), start(joints), step(joints);
+  sample(clip, clip.duration() - 1e-4f, {}, cache, end);
+  sample(clip, 0.0f, {}, cache, start);
+  sample(clip, 1.0f / 60.0f, {}, cache, step);
+  // The walk's last frame repeats its first, except where the character travels: the root's
+  // translation (this cook keeps root motion in the root). Every other channel crosses the loop
+  // moving a joint no more than a 60 Hz step inside the clip does.
+  double across = 0.0, inside = 0.0;
+  for (uint32_t j = 0; j < joints; ++j) {
+    const Transform a = get_transform(end, j), b = get_transform(start, j), c = get_transform(step, j);
+    EXPECT_GT(std::fabs(glm::dot(a.rotation, b.rotation)), 0.9995f) << "joint " << j;
+    if (skeleton.parents()[j] < 0) continue;
+    across = std::max<double>(across, glm::length(a.translation - b.translation));
+    inside = std::max<double>(inside, glm::length(c.translation - b.translation));
+  }
+  EXPECT_LE(across, inside + 1e-3) << "translation jump across the loop: " << across << " vs a step: " << inside;
+}
+
+TEST(SamplePab, CacheIsInvisible) {
+  REQUIRE_PAB();
+  const SampleOptions loop{};
+  expect_cache_invisible(clip, skeleton, playback(clip, 1.0f, 400, true), loop, "forward 60 Hz");
+  expect_cache_invisible(clip, skeleton, playback(clip, -1.0f, 400, true, 0.3f), loop, "reverse");
+  expect_cache_invisible(clip, skeleton, playback(clip, 0.37f, 400, false), SampleOptions{.loop = false}, "slow, clamped");
+  expect_cache_invisible(clip, skeleton, random_times(clip, 400, 5), loop, "random seeks");
+  expect_cache_invisible(clip, skeleton, random_times(clip, 100, 6),
+                         SampleOptions{.loop = true, .rotation = RotationInterpolation::Slerp}, "slerp seeks");
+}
+
+TEST(SamplePab, RefusedByAnotherRig) {
+  REQUIRE_PAB();
+  const Loaded other = load({});
+  EXPECT_FALSE(make_sampling_cache(clip, other.skeleton()).ok());
+  EXPECT_TRUE(make_sampling_cache(clip, skeleton).ok());
+}
+
+}  // namespace
+}  // namespace ossa

@@ -1,0 +1,63 @@
+// main.cpp — ossa-inspect: print what a cooked .ossa file holds, as text or as JSON.
+//
+//   ossa-inspect FILE.ossa [--json] [-q | -v] [--version] [--help]
+//
+// The tool is the runtime's loader plus describe.h: it opens the file exactly as a game would
+// (mmap, verify, validate), so "ossa-inspect says it is fine" means "the runtime will load it";
+// -q prints nothing and answers that question with the exit status alone. -v adds every clip
+// channel (joint, kind, constant or animated, keys, bits). The JSON form is what the golden
+// regression tests compare and is described in docs/schemas/ossa-inspect.schema.json; it names the
+// file without its directory so goldens do not depend on where a tree is checked out.
+//
+// Exit status (tools/cli/cli.h): 0 the file loads; 1 it is not a valid .ossa file (the
+// loader's message, naming the file, on stderr); 2 usage error, or the file cannot be read at all.
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <string>
+
+#include <ossa/loader/asset.h>
+#include "tools/cli/cli.h"
+#include "tools/inspect/describe.h"
+
+int main(int argc, char** argv) {
+  ossa::cli::Command command("ossa-inspect",
+                             "ossa-inspect: print what a cooked .ossa file holds (skeleton, meshes, clips, materials, graphs)",
+                             "when the file is not a valid .ossa file");
+  std::string path;
+  bool json = false;
+  command.app().add_option("file", path, "the .ossa file to inspect")->required();
+  command.app().add_flag("--json", json, "print JSON with a stable key order (docs/JSON.md; what the golden tests compare)");
+  if (const auto exit_now = command.parse(argc, argv)) return *exit_now;
+
+  // A file that is not there or not a regular file is a usage problem, not an invalid .ossa.
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) {
+    std::fprintf(stderr, "ossa-inspect: %s: %s\n", path.c_str(),
+                 std::filesystem::exists(path, ec) ? "not a regular file" : "no such file");
+    return ossa::cli::kExitUsage;
+  }
+  auto asset = ossa::Asset::open(path);
+  if (!asset) {
+    std::fprintf(stderr, "ossa-inspect: %s\n", asset.error().message.c_str());
+    return ossa::cli::kExitFailed;
+  }
+  if (command.quiet()) return ossa::cli::kExitOk;
+
+  const std::string file_name = std::filesystem::path(path).filename().string();
+  ossa::inspect::DescribeOptions options;
+  options.channels = command.verbose();
+  const auto description = ossa::inspect::describe(*asset, file_name, options);
+  if (json) {
+    // File text is not guaranteed to be UTF-8: replace bad bytes rather than throw.
+    std::cout << description.dump(2, ' ', false, nlohmann::ordered_json::error_handler_t::replace) << '\n';
+  } else {
+    std::cout << ossa::inspect::describe_text(description);
+  }
+  std::cout.flush();
+  if (!std::cout.good()) {
+    std::fprintf(stderr, "ossa-inspect: %s: cannot write the description to stdout\n", path.c_str());
+    return ossa::cli::kExitUsage;
+  }
+  return ossa::cli::kExitOk;
+}
