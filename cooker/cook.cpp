@@ -334,7 +334,7 @@ std::optional<CookRecord> cook_or_check(const fs::path& input, const fs::path& o
   std::vector<fs::path> allowed = options.allow_dirs;
   allowed.push_back(options.root.empty() ? input.parent_path() : options.root);
   if (allowed.back().empty()) allowed.back() = ".";
-  ReadSandboxScope sandbox(allowed);
+  ReadSandboxScope sandbox(allowed, options.allow_hard_links);
   try {
     if (Status st = apply_cook_settings(input, options, settings); !st) {
       if (only_if_up_to_date) return std::nullopt;

@@ -173,6 +173,10 @@ int main(int argc, char** argv) {
   app.add_option("--allow-dir", allow_dirs,
                  "also let cooks read files inside this directory (repeatable), e.g. a shared texture library")
       ->allow_extra_args(false);  // one directory per --allow-dir: the inputs that follow stay inputs
+  bool allow_hard_links = false;
+  app.add_flag("--allow-hard-links", allow_hard_links,
+               "read files that have more than one hard link (refused by default: another name for the same "
+               "bytes may lie outside the folders a cook may read)");
   app.add_option("-j,--jobs", jobs, "cook this many files in parallel, each in a worker process of its own")
       ->check(CLI::Range(1u, 256u));
   CLI::Option* max_memory_option = app.add_option("--max-memory", max_memory_text,
@@ -236,6 +240,7 @@ int main(int argc, char** argv) {
     options.allow_dirs.emplace_back(d);
   }
   options.write = !list_inputs;
+  options.allow_hard_links = allow_hard_links;
   SourceSkeleton reference;
   if (!skeleton_path.empty()) {
     auto loaded = load_reference_skeleton(skeleton_path, &options.reference_input);
