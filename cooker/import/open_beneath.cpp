@@ -11,6 +11,7 @@
 #include <atomic>
 #include <cerrno>
 #include <cstdint>
+#include <cstdio>
 #include <cstdlib>
 #include <deque>
 #include <string>
@@ -257,6 +258,22 @@ OpenedFile via_system(const fs::path& path, bool for_reading) {
   return finish(opath, for_reading, [&] { return ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC); });
 }
 
+/// For the hard-link rule: true when the name `fd` was opened by has been unlinked since (the
+/// kernel marks the descriptor's path " (deleted)"). A file seen with one link whose name is still
+/// linked after that look had no other name at the look; without this, a link made into the tree,
+/// opened, then removed again would show one link: the outside name's. Unknown (no /proc) counts
+/// as not unlinked: the link count is then the only check.
+bool name_unlinked(int fd) {
+  char proc[32];
+  std::snprintf(proc, sizeof proc, "/proc/self/fd/%d", fd);
+  char target[4096];
+  const ssize_t n = ::readlink(proc, target, sizeof target);
+  constexpr std::string_view kDeleted = " (deleted)";
+  if (n <= 0 || static_cast<size_t>(n) >= sizeof target) return false;
+  const std::string_view link(target, static_cast<size_t>(n));
+  return link.size() >= kDeleted.size() && link.substr(link.size() - kDeleted.size()) == kDeleted;
+}
+
 }  // namespace
 
 ReadRoots::ReadRoots(const std::vector<fs::path>& dirs) {
@@ -294,6 +311,8 @@ bool have_openat2() {
   return known == 1;
 }
 
+void force_walk_for_testing(bool walk) { g_openat2.store(walk ? 0 : -1); }
+
 OpenedFile open_beneath(const ReadRoots* roots, const fs::path& path, bool for_reading, bool allow_hard_links) {
   OpenedFile f;
   if (path.native().find('\0') != std::string::npos) return failed(OpenOutcome::kError, EINVAL);  // another file for the OS
@@ -306,14 +325,24 @@ OpenedFile open_beneath(const ReadRoots* roots, const fs::path& path, bool for_r
       if (!fallback) f = via_openat2(*roots, abs, for_reading, fallback);
       if (fallback) f = via_walk(*roots, abs, for_reading);
     }
-    if (!(f.outcome == OpenOutcome::kError && f.error == kRetry)) break;
+    if (f.outcome == OpenOutcome::kError && f.error == kRetry) continue;
+    if (f.outcome == OpenOutcome::kOpened && roots != nullptr && !allow_hard_links) {
+      if (f.st.st_nlink > 1) {
+        if (f.fd >= 0) ::close(f.fd);
+        f.fd = -1;
+        f.outcome = OpenOutcome::kHardLinked;
+        break;
+      }
+      // One link at the fstat above; the name must still be linked now (see name_unlinked).
+      if (f.fd >= 0 && name_unlinked(f.fd)) {
+        ::close(f.fd);
+        f = failed(OpenOutcome::kError, kRetry);
+        continue;
+      }
+    }
+    break;
   }
   if (f.outcome == OpenOutcome::kError && f.error == kRetry) f.error = EAGAIN;  // kept changing: give up
-  if (f.outcome == OpenOutcome::kOpened && roots != nullptr && !allow_hard_links && f.st.st_nlink > 1) {
-    if (f.fd >= 0) ::close(f.fd);
-    f.fd = -1;
-    f.outcome = OpenOutcome::kHardLinked;
-  }
   return f;
 }
 

@@ -83,4 +83,8 @@ const char* file_kind(const struct stat& st);
 /// Whether this process resolves with openat2 (false: the walk). Probed once; for tests and -v.
 bool have_openat2();
 
+/// Tests: `walk` true makes later resolutions use the walk, as on a kernel without openat2; false
+/// probes again.
+void force_walk_for_testing(bool walk);
+
 }  // namespace ossa::cook
