@@ -175,34 +175,13 @@ TEST(SandboxWalk, FollowsLinksThatStayInsideAndRefusesTheRest) {
   fs::remove_all(dir);
 }
 
-/// tiny_png with a tEXt chunk carrying `marker` after IHDR: still a PNG that decodes, and with
-/// --texture-format source its bytes are embedded as they are, so the marker shows a leak.
-std::string marked_png(const std::string& marker) {
-  const auto png = ossa::test::tiny_png();
-  std::string bytes(png.begin(), png.end());
-  std::string chunk = "tEXt" + std::string("Comment") + '\0' + marker;
-  uint32_t crc = 0xFFFFFFFFu;
-  for (unsigned char ch : chunk) {
-    crc ^= ch;
-    for (int k = 0; k < 8; ++k) crc = (crc >> 1) ^ (0xEDB88320u & (0u - (crc & 1u)));
-  }
-  crc ^= 0xFFFFFFFFu;
-  const uint32_t length = static_cast<uint32_t>(chunk.size() - 4);
-  std::string framed;
-  for (int k = 3; k >= 0; --k) framed += static_cast<char>((length >> (8 * k)) & 0xFF);
-  framed += chunk;
-  for (int k = 3; k >= 0; --k) framed += static_cast<char>((crc >> (8 * k)) & 0xFF);
-  bytes.insert(8 + 25, framed);  // signature (8) + IHDR chunk (25)
-  return bytes;
-}
-
 // End to end: one batch of ossa-cook cooks many sources naming the swapped texture.
 TEST(SandboxRaceCook, NoCookedOutputEmbedsTheSecret) {
   const fs::path dir = ossa::test::make_temp_dir("race-cook");
   const fs::path tree = dir / "tree", secret = dir / "secret";
   fs::create_directories(tree);
   fs::create_directories(secret);
-  const std::string secret_png = marked_png("SECRET-MARKER-7d1c");
+  const std::string secret_png = ossa::test::tiny_png_with_text("SECRET-MARKER-7d1c");
   ASSERT_TRUE(ossa::test::write_file(secret / "t.png", secret_png));
   const float v[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
   ASSERT_TRUE(ossa::test::write_file(tree / "tri.bin", std::string(reinterpret_cast<const char*>(v), sizeof v)));

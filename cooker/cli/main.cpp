@@ -16,7 +16,7 @@
 // This process must stay single-threaded: it forks the workers.
 //
 // Exit status (runtime/tools/cli/cli.h): 0 when every input cooked; 1 when any failed (the rest
-// are still cooked) or the report could not be written; 2 for a usage error or a plan that cannot
+// are still cooked) or the report or the depfile could not be written; 2 for a usage error or a plan that cannot
 // be carried out (nothing is written then).
 //
 // Output: failures always (stderr). Without -q, a progress line per input and the number of
@@ -306,11 +306,14 @@ int main(int argc, char** argv) {
 
   size_t failed = 0;
   for (const CookRecord& r : records) failed += r.ok ? 0 : 1;
+  // The report and the depfile are written whatever happens to the other: a build tool relies on
+  // the depfile even when the report's folder is read-only, and each failure is said.
+  bool written = true;
   if (!report_path.empty()) {
     const std::string text = report_json(records, options, limits).dump(2) + "\n";
     if (ossa::Status st = write_file_atomic(report_path, std::vector<uint8_t>(text.begin(), text.end())); !st) {
-      std::fprintf(stderr, "ossa-cook: report: %s\n", st.message().c_str());
-      return ossa::cli::kExitFailed;
+      std::fprintf(stderr, "ossa-cook: report: %s\n", shown(st.message()).c_str());
+      written = false;
     }
   }
   if (list_inputs) {
@@ -323,8 +326,8 @@ int main(int argc, char** argv) {
   }
   if (!depfile_path.empty()) {
     if (ossa::Status st = write_depfile(depfile_path, records); !st) {
-      std::fprintf(stderr, "ossa-cook: depfile: %s\n", st.message().c_str());
-      return ossa::cli::kExitFailed;
+      std::fprintf(stderr, "ossa-cook: depfile %s\n", shown(st.message()).c_str());
+      written = false;
     }
   }
   if (!quiet && !list_inputs) print_summary(records);
@@ -345,5 +348,5 @@ int main(int argc, char** argv) {
     }
     return ossa::cli::kExitFailed;
   }
-  return ossa::cli::kExitOk;
+  return written ? ossa::cli::kExitOk : ossa::cli::kExitFailed;
 }
