@@ -15,6 +15,7 @@
 #include "cooker/clip/clip_compress.h"
 #include "cooker/import/input_log.h"
 #include "cooker/import/source_scene.h"
+#include "cooker/write/atomic_file.h"
 #include <ossa/format/result.h>
 
 namespace ossa::cook {
@@ -146,10 +147,5 @@ bool is_graph_file(const std::filesystem::path& path);
 /// Loads the skeleton of a cooked file (for --skeleton). Errors name the file. `as_read`, when
 /// given, receives the file's input record (absolute path, hash, size) for the cooks' input logs.
 Result<SourceSkeleton> load_reference_skeleton(const std::filesystem::path& ossa_file, InputFile* as_read = nullptr);
-
-/// Writes bytes to a temporary file in path's directory, flushes, then renames it onto path.
-/// On any failure the temporary is removed and path is untouched. A read-only file at path is
-/// refused, not replaced; temporaries of path left by processes that no longer exist are removed.
-Status write_file_atomic(const std::filesystem::path& path, const std::vector<uint8_t>& bytes);
 
 }  // namespace ossa::cook

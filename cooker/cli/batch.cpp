@@ -113,6 +113,14 @@ std::optional<uint64_t> parse_size(const std::string& text) {
 std::vector<CookRecord> run_batch(const std::vector<BatchItem>& items, const CookOptions& options,
                                   const BatchLimits& limits, unsigned jobs, const BatchProgress& progress) {
   std::vector<CookRecord> records(items.size());
+  // Temporaries of writers that died (a batch killed mid-write) go now, before anything is found
+  // up to date: an up-to-date output is never rewritten, so no later write would remove them.
+  if (options.write) {
+    std::vector<fs::path> outputs;
+    outputs.reserve(items.size());
+    for (const BatchItem& item : items) outputs.push_back(item.output);
+    remove_stale_temporaries(outputs);
+  }
   size_t done = 0;
   cook_in_workers(items, options, limits, jobs, [&](size_t index, CookRecord record) {
     records[index] = std::move(record);

@@ -24,6 +24,7 @@
 // input's warnings, time and sizes, one line per clip (frames, error, ratio) and the total time.
 // Warnings are not printed one by one by default: importing the samples alone gives dozens of
 // lines (dropped cameras, matched joint names) that would bury the failures. The --report document is docs/schemas/ossa-cook-report.schema.json (docs/JSON.md).
+#include <signal.h>
 #include <sys/ioctl.h>
 #include <unistd.h>
 
@@ -148,6 +149,9 @@ void print_details(const CookRecord& r) {
 
 int main(int argc, char** argv) {
   const auto start = std::chrono::steady_clock::now();
+  // A file-size limit (ulimit -f) reached while writing is a write error to report with the input
+  // it concerns, like a full disk, not a signal that ends the process (workers inherit this).
+  ::signal(SIGXFSZ, SIG_IGN);
   ossa::cli::Command command("ossa-cook",
                              "ossa-cook: cook FBX / glTF / GLB / Collada / BVH sources and animation graph files "
                              "(*.graph.json) into .ossa files",
@@ -303,6 +307,12 @@ int main(int argc, char** argv) {
     std::fflush(stderr);
   };
   const std::vector<CookRecord> records = run_batch(*plan, options, limits, jobs, progress);
+  {
+    std::vector<fs::path> own;
+    for (const std::string& p : {report_path, depfile_path})
+      if (!p.empty()) own.emplace_back(p);
+    remove_stale_temporaries(own);
+  }
 
   size_t failed = 0;
   for (const CookRecord& r : records) failed += r.ok ? 0 : 1;

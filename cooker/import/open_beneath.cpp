@@ -54,6 +54,9 @@ int sys_openat2(int dirfd, const char* path, uint64_t flags) {
 
 std::atomic<int> g_openat2{-1};  // -1 not probed, 0 absent, 1 present
 
+/// Errors that mean "there is no such file": a name too long for the file system cannot exist.
+bool absent_errno(int e) { return e == ENOENT || e == ENOTDIR || e == ENAMETOOLONG; }
+
 bool same_file(const struct stat& a, const struct stat& b) { return a.st_dev == b.st_dev && a.st_ino == b.st_ino; }
 
 OpenedFile failed(OpenOutcome outcome, int error = 0) {
@@ -133,7 +136,7 @@ OpenedFile via_openat2(const ReadRoots& roots, const fs::path& abs, bool for_rea
   const int opath = sys_openat2(dirfd, rel.c_str(), O_PATH | O_CLOEXEC);
   if (opath < 0) {
     const int e = errno;
-    if (e == ENOENT || e == ENOTDIR) return failed(OpenOutcome::kAbsent, e);
+    if (absent_errno(e)) return failed(OpenOutcome::kAbsent, e);
     if (e == ENOSYS || e == EPERM) g_openat2.store(0);
     if (e == EXDEV || e == ELOOP || e == EAGAIN || e == ENOSYS || e == EPERM) fallback = true;
     return failed(OpenOutcome::kError, e);
@@ -193,7 +196,7 @@ OpenedFile via_walk(const ReadRoots& roots, fs::path abs, bool for_reading) {
       if (fd < 0) {
         const int e = errno;
         close_all();
-        return failed(e == ENOENT || e == ENOTDIR ? OpenOutcome::kAbsent : OpenOutcome::kError, e);
+        return failed(absent_errno(e) ? OpenOutcome::kAbsent : OpenOutcome::kError, e);
       }
       struct stat st {};
       if (::fstat(fd, &st) != 0) {
@@ -254,7 +257,7 @@ OpenedFile via_walk(const ReadRoots& roots, fs::path abs, bool for_reading) {
 OpenedFile via_system(const fs::path& path, bool for_reading) {
   const int opath = ::open(path.c_str(), O_PATH | O_CLOEXEC);
   if (opath < 0)
-    return failed(errno == ENOENT || errno == ENOTDIR ? OpenOutcome::kAbsent : OpenOutcome::kError, errno);
+    return failed(absent_errno(errno) ? OpenOutcome::kAbsent : OpenOutcome::kError, errno);
   return finish(opath, for_reading, [&] { return ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC); });
 }
 

@@ -55,7 +55,7 @@ class ReadRoots {
 
 enum class OpenOutcome {
   kOpened,      // fd is the file (regular), st its fstat
-  kAbsent,      // no such file (error: ENOENT or ENOTDIR)
+  kAbsent,      // no such file (error: ENOENT, ENOTDIR, or ENAMETOOLONG: no such name can exist)
   kOutside,     // the path, or a link on the way, leads outside every root
   kNotRegular,  // a directory, FIFO, device or socket (st says which); never opened for reading
   kHardLinked,  // a regular file with st.st_nlink > 1, and hard links are not allowed
