@@ -12,10 +12,12 @@
 // The counts (tried / wrong re-runs / commands run) are printed for the closing notes.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -179,6 +181,9 @@ int build_with(const std::string& tool, const NameClass& c, Where where, const f
   const auto again = run_command(run);
   wrong += count_of(again.out, "COOKING") != 0;
   EXPECT_EQ(count_of(again.out, "COOKING"), 0) << what << ": nothing changed: " << again.out;
+  // File times come from the kernel's coarse clock (a tick of 1-4 ms): a change made within the
+  // tick of the output's write would look no newer to either tool.
+  std::this_thread::sleep_for(std::chrono::milliseconds(20));
   if (where == Where::kTexture) EXPECT_TRUE(ossa::test::write_file(named, ossa::test::tiny_png_with_text("changed")));
   else EXPECT_TRUE(ossa::test::write_file(src, kObj + "v 0 0 1\n"));
   const auto changed = run_command(run);
@@ -186,6 +191,7 @@ int build_with(const std::string& tool, const NameClass& c, Where where, const f
   EXPECT_EQ(count_of(changed.out, "COOKING"), 1) << what << ": the named file changed: " << changed.out;
   if (where == Where::kTexture) {
     // The source changes too (a rule's recipe smuggled in by a name would run now).
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
     EXPECT_TRUE(ossa::test::write_file(src, textured_gltf(c.stem + ".png") + "\n"));
     const auto source_changed = run_command(run);
     wrong += count_of(source_changed.out, "COOKING") != 1;

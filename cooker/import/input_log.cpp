@@ -213,7 +213,15 @@ bool probe_input(const fs::path& path, std::string_view reference) {
       if (InputLog* log = current_input_log()) log->add_absent(path);
       return false;
     case OpenOutcome::kOutside: refuse(path, outside_message(), reference); return false;
-    case OpenOutcome::kNotRegular: refuse(path, std::string("is ") + file_kind(f.st) + ", not a regular file", reference); return false;
+    case OpenOutcome::kNotRegular:
+      // A folder is no file of that name (an importer probes folders, e.g. an empty "mtllib"); a
+      // FIFO, device or socket is a file the cook cannot read, and must not pass for absent.
+      if (S_ISDIR(f.st.st_mode)) {
+        if (InputLog* log = current_input_log()) log->add_absent(path);
+        return false;
+      }
+      refuse(path, std::string("is ") + file_kind(f.st) + ", not a regular file", reference);
+      return false;
     case OpenOutcome::kHardLinked: refuse(path, hard_link_message(f.st), reference); return false;
     case OpenOutcome::kError: refuse(path, std::string("cannot be opened: ") + std::strerror(f.error), reference); return false;
   }

@@ -114,8 +114,8 @@ Result<std::vector<uint8_t>> read_input(const std::filesystem::path& path, uint6
 /// of the file's size.
 Status hash_input(const std::filesystem::path& path, std::string_view reference = {});
 
-/// True when `path` is a regular file inside the sandbox; a missing file is recorded absent; one
-/// outside the sandbox, one that exists but is not a regular file (a FIFO named like a sidecar),
+/// True when `path` is a regular file inside the sandbox; a missing file (or a folder) is recorded
+/// absent; one outside the sandbox, a FIFO, device or socket (one named like a sidecar),
 /// has other hard links or cannot be opened is recorded as a refusal (the cook must fail, not
 /// carry on as if it were absent). Opens nothing for reading.
 bool probe_input(const std::filesystem::path& path, std::string_view reference = {});
