@@ -32,8 +32,8 @@ namespace {
 
 struct NameClass {
   const char* label;
-  std::string stem;  // the source is <stem>.obj, the output <stem>.ossa
-  bool spellable;    // a depfile can name it for both Make and Ninja
+  std::string stem;              // the source is <stem>.obj, the output <stem>.ossa
+  bool spellable;                // a depfile can name it for both Make and Ninja
   bool as_prerequisite = false;  // ... though not as a target (where Make reads '%' as a pattern)
 };
 
@@ -88,14 +88,23 @@ const std::string kObj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
 
 /// A glTF triangle whose material's texture is `image` (beside it) and whose buffer is tri.bin.
 std::string textured_gltf(const std::string& image) {
-  const nlohmann::json j = {
-      {"asset", {{"version", "2.0"}}}, {"scene", 0}, {"scenes", {{{"nodes", {0}}}}}, {"nodes", {{{"mesh", 0}}}},
-      {"meshes", {{{"primitives", {{{"attributes", {{"POSITION", 0}}}, {"material", 0}}}}}}},
-      {"materials", {{{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}}}},
-      {"images", {{{"uri", image}}}}, {"textures", {{{"source", 0}}}},
-      {"buffers", {{{"uri", "tri.bin"}, {"byteLength", 36}}}}, {"bufferViews", {{{"buffer", 0}, {"byteLength", 36}}}},
-      {"accessors", {{{"bufferView", 0}, {"componentType", 5126}, {"count", 3}, {"type", "VEC3"},
-                      {"min", {0, 0, 0}}, {"max", {1, 1, 0}}}}}};
+  const nlohmann::json j = {{"asset", {{"version", "2.0"}}},
+                            {"scene", 0},
+                            {"scenes", {{{"nodes", {0}}}}},
+                            {"nodes", {{{"mesh", 0}}}},
+                            {"meshes", {{{"primitives", {{{"attributes", {{"POSITION", 0}}}, {"material", 0}}}}}}},
+                            {"materials", {{{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}}}},
+                            {"images", {{{"uri", image}}}},
+                            {"textures", {{{"source", 0}}}},
+                            {"buffers", {{{"uri", "tri.bin"}, {"byteLength", 36}}}},
+                            {"bufferViews", {{{"buffer", 0}, {"byteLength", 36}}}},
+                            {"accessors",
+                             {{{"bufferView", 0},
+                               {"componentType", 5126},
+                               {"count", 3},
+                               {"type", "VEC3"},
+                               {"min", {0, 0, 0}},
+                               {"max", {1, 1, 0}}}}}};
   return j.dump();
 }
 
@@ -163,7 +172,8 @@ int build_with(const std::string& tool, const NameClass& c, Where where, const f
   const bool spellable = c.spellable || (c.as_prerequisite && where == Where::kTexture);
   if (!spellable) {
     EXPECT_NE(first.exit_code, 0) << what << ": the cook must fail: " << first.out;
-    EXPECT_NE(first.out.find("a name no depfile spells alike for Make and Ninja"), std::string::npos) << what << ": " << first.out;
+    EXPECT_NE(first.out.find("a name no depfile spells alike for Make and Ninja"), std::string::npos)
+        << what << ": " << first.out;
     EXPECT_NE(first.out.find(src.filename().string()), std::string::npos) << what << ": names the input: " << first.out;
     EXPECT_FALSE(fs::exists(work / "cook.d")) << what;
     if (first.exit_code != 0) return 0;
@@ -184,8 +194,10 @@ int build_with(const std::string& tool, const NameClass& c, Where where, const f
   // File times come from the kernel's coarse clock (a tick of 1-4 ms): a change made within the
   // tick of the output's write would look no newer to either tool.
   std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  if (where == Where::kTexture) EXPECT_TRUE(ossa::test::write_file(named, ossa::test::tiny_png_with_text("changed")));
-  else EXPECT_TRUE(ossa::test::write_file(src, kObj + "v 0 0 1\n"));
+  if (where == Where::kTexture)
+    EXPECT_TRUE(ossa::test::write_file(named, ossa::test::tiny_png_with_text("changed")));
+  else
+    EXPECT_TRUE(ossa::test::write_file(src, kObj + "v 0 0 1\n"));
   const auto changed = run_command(run);
   wrong += count_of(changed.out, "COOKING") != 1;
   EXPECT_EQ(count_of(changed.out, "COOKING"), 1) << what << ": the named file changed: " << changed.out;
@@ -219,9 +231,11 @@ TEST(CookDepfile, EveryHostileNameIsReadBackOrRefusedByMakeAndNinja) {
   int commands = 0;
   for (const auto& e : fs::recursive_directory_iterator(base))
     commands += e.path().filename().string().rfind("MAKEPWNED", 0) == 0 ? 1 : 0;
-  std::printf("depfile: %d builds (%zu name classes, as a texture and as the source, with make and ninja), "
-              "%d with a name refused by the cook, %d wrong outcomes (re-runs or dependencies), %d commands run "
-              "from a name\n", tried, hostile_names().size(), refused, wrong, commands);
+  std::printf(
+      "depfile: %d builds (%zu name classes, as a texture and as the source, with make and ninja), "
+      "%d with a name refused by the cook, %d wrong outcomes (re-runs or dependencies), %d commands run "
+      "from a name\n",
+      tried, hostile_names().size(), refused, wrong, commands);
   EXPECT_EQ(wrong, 0);
   EXPECT_EQ(commands, 0);
   fs::remove_all(base);

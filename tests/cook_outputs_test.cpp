@@ -34,12 +34,20 @@ std::string q(const fs::path& p) { return "'" + p.string() + "'"; }
 const std::string kObj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
 
 std::string triangle_gltf() {
-  return nlohmann::json{{"asset", {{"version", "2.0"}}}, {"scene", 0}, {"scenes", {{{"nodes", {0}}}}},
-                        {"nodes", {{{"mesh", 0}}}}, {"meshes", {{{"primitives", {{{"attributes", {{"POSITION", 0}}}}}}}}},
+  return nlohmann::json{{"asset", {{"version", "2.0"}}},
+                        {"scene", 0},
+                        {"scenes", {{{"nodes", {0}}}}},
+                        {"nodes", {{{"mesh", 0}}}},
+                        {"meshes", {{{"primitives", {{{"attributes", {{"POSITION", 0}}}}}}}}},
                         {"buffers", {{{"uri", "tri.bin"}, {"byteLength", 36}}}},
                         {"bufferViews", {{{"buffer", 0}, {"byteLength", 36}}}},
-                        {"accessors", {{{"bufferView", 0}, {"componentType", 5126}, {"count", 3}, {"type", "VEC3"},
-                                        {"min", {0, 0, 0}}, {"max", {1, 1, 0}}}}}}
+                        {"accessors",
+                         {{{"bufferView", 0},
+                           {"componentType", 5126},
+                           {"count", 3},
+                           {"type", "VEC3"},
+                           {"min", {0, 0, 0}},
+                           {"max", {1, 1, 0}}}}}}
       .dump();
 }
 
@@ -110,10 +118,10 @@ TEST_F(CookOutputs, StaleTemporariesGoAtTheNextRunAndLiveOnesStay) {
     bool stale;
   };
   const Temp temps[] = {
-      {out / ossa::cook::temporary_name(name, dead_pid(), 0), true},  // its writer is gone
-      {out / ossa::cook::temporary_name(name, self, 7), false},       // a live writer, locked below
-      {out / ossa::cook::temporary_name(name, self, 8), false},       // a live pid, not locked, fresh
-      {out / ossa::cook::temporary_name(name, self, 9), true},        // not locked and two hours old
+      {out / ossa::cook::temporary_name(name, dead_pid(), 0), true},           // its writer is gone
+      {out / ossa::cook::temporary_name(name, self, 7), false},                // a live writer, locked below
+      {out / ossa::cook::temporary_name(name, self, 8), false},                // a live pid, not locked, fresh
+      {out / ossa::cook::temporary_name(name, self, 9), true},                 // not locked and two hours old
       {out / ossa::cook::temporary_name("other.ossa", dead_pid(), 0), false},  // not this batch's output
   };
   for (const Temp& t : temps) ASSERT_TRUE(ossa::test::write_file(t.path, std::string(3 << 20, 'x')));
@@ -122,7 +130,8 @@ TEST_F(CookOutputs, StaleTemporariesGoAtTheNextRunAndLiveOnesStay) {
   const auto two_hours_ago = fs::file_time_type::clock::now() - std::chrono::hours(2);
   fs::last_write_time(temps[3].path, two_hours_ago);
   fs::last_write_time(temps[1].path, two_hours_ago);  // old, but its lock says a writer holds it
-  const auto r = run_command(cook_cmd() + " " + q(src / "scene.obj") + " -o " + q(out) + " --report " + q(dir / "r.json"));
+  const auto r =
+      run_command(cook_cmd() + " " + q(src / "scene.obj") + " -o " + q(out) + " --report " + q(dir / "r.json"));
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_TRUE(only_record(dir / "r.json")["up_to_date"].get<bool>());
   int wrong = 0;
@@ -131,7 +140,8 @@ TEST_F(CookOutputs, StaleTemporariesGoAtTheNextRunAndLiveOnesStay) {
     EXPECT_EQ(gone, t.stale) << t.path;
     wrong += gone != t.stale;
   }
-  std::printf("stale temporaries: %zu left in the output folder, %d wrongly kept or removed\n", std::size(temps), wrong);
+  std::printf("stale temporaries: %zu left in the output folder, %d wrongly kept or removed\n", std::size(temps),
+              wrong);
   ::close(lock_fd);
   EXPECT_TRUE(fs::exists(out / name));
 }
@@ -150,7 +160,8 @@ TEST_F(CookOutputs, OutputNamesUpToNameMaxCookAndTheirTemporariesFit) {
   EXPECT_EQ(outputs, 14u);
   for (size_t length : {228, 229, 255, 400}) {
     EXPECT_LE(ossa::cook::temporary_name(std::string(length, 'n'), 4194304, 4294967295u).size(), 255u) << length;
-    EXPECT_NE(ossa::cook::temporary_prefix(std::string(length, 'n')), ossa::cook::temporary_prefix(std::string(length, 'm')));
+    EXPECT_NE(ossa::cook::temporary_prefix(std::string(length, 'n')),
+              ossa::cook::temporary_prefix(std::string(length, 'm')));
   }
 }
 
@@ -165,13 +176,17 @@ TEST_F(CookOutputs, WriteErrorsNameTheInputTheyConcern) {
 
   // A full disk: the file-size limit makes the same write(2) fail (EFBIG instead of ENOSPC).
   std::string big;
-  for (int i = 0; i < 3000; ++i) big += "v " + std::to_string(i) + " 0 0\nv " + std::to_string(i) + " 1 0\nv " + std::to_string(i) + " 0 1\n";
-  for (int i = 0; i < 3000; ++i) big += "f " + std::to_string(3 * i + 1) + " " + std::to_string(3 * i + 2) + " " + std::to_string(3 * i + 3) + "\n";
+  for (int i = 0; i < 3000; ++i)
+    big += "v " + std::to_string(i) + " 0 0\nv " + std::to_string(i) + " 1 0\nv " + std::to_string(i) + " 0 1\n";
+  for (int i = 0; i < 3000; ++i)
+    big += "f " + std::to_string(3 * i + 1) + " " + std::to_string(3 * i + 2) + " " + std::to_string(3 * i + 3) + "\n";
   ASSERT_TRUE(ossa::test::write_file(src / "big.obj", big));
   r = run_command("prlimit --fsize=65536 -- " + cook_cmd() + " " + q(src / "big.obj") + " -o " + q(out) + " -q");
   EXPECT_EQ(r.exit_code, 1);
-  EXPECT_NE(r.err.find((src / "big.obj").string() + ": " + (out / "big.ossa").string() + ": write failed: File too large"),
-            std::string::npos) << r.err;
+  EXPECT_NE(
+      r.err.find((src / "big.obj").string() + ": " + (out / "big.ossa").string() + ": write failed: File too large"),
+      std::string::npos)
+      << r.err;
   EXPECT_EQ(r.err.find("signal"), std::string::npos) << "an error, not a signal: " << r.err;
   for (const auto& e : fs::directory_iterator(out)) ADD_FAILURE() << "left behind: " << e.path();
 
@@ -181,7 +196,8 @@ TEST_F(CookOutputs, WriteErrorsNameTheInputTheyConcern) {
   fs::permissions(out / "ro.ossa", fs::perms::owner_read | fs::perms::group_read | fs::perms::others_read);
   r = run_command(cook_cmd() + " " + q(src / "ro.obj") + " -o " + q(out) + " -q --force");
   EXPECT_EQ(r.exit_code, 1);
-  EXPECT_NE(r.err.find((src / "ro.obj").string() + ": " + (out / "ro.ossa").string() + ": is read-only"), std::string::npos)
+  EXPECT_NE(r.err.find((src / "ro.obj").string() + ": " + (out / "ro.ossa").string() + ": is read-only"),
+            std::string::npos)
       << r.err;
 }
 

@@ -35,7 +35,9 @@ namespace {
 enum class Swap { kFileSymlink, kFolderSymlink, kHardLink };
 
 const char* swap_name(Swap s) {
-  return s == Swap::kFileSymlink ? "file <-> symlink" : s == Swap::kFolderSymlink ? "folder <-> symlink" : "file <-> hard link";
+  return s == Swap::kFileSymlink     ? "file <-> symlink"
+         : s == Swap::kFolderSymlink ? "folder <-> symlink"
+                                     : "file <-> hard link";
 }
 
 struct RaceCounts {
@@ -54,8 +56,10 @@ void swapper(const fs::path& tree, const fs::path& secret_dir, Swap kind, const 
     } else {
       ossa::test::write_file(tmp_file, std::string_view("INSIDE-BYTES"));
       std::rename(tmp_file.c_str(), (tree / "t.bin").c_str());
-      if (kind == Swap::kFileSymlink) ::symlink((secret_dir / "t.bin").c_str(), tmp_link.c_str());
-      else ::link((secret_dir / "t.bin").c_str(), tmp_link.c_str());
+      if (kind == Swap::kFileSymlink)
+        ::symlink((secret_dir / "t.bin").c_str(), tmp_link.c_str());
+      else
+        ::link((secret_dir / "t.bin").c_str(), tmp_link.c_str());
       std::rename(tmp_link.c_str(), (tree / "t.bin").c_str());
     }
     swaps.fetch_add(1, std::memory_order_relaxed);
@@ -78,8 +82,8 @@ RaceCounts race(const fs::path& dir, Swap kind, size_t min_tries) {
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(20);
   {
     ReadSandboxScope sandbox({tree});
-    while (counts.tried < min_tries || ((counts.inside == 0 || counts.refused == 0) &&
-                                        std::chrono::steady_clock::now() < deadline)) {
+    while (counts.tried < min_tries ||
+           ((counts.inside == 0 || counts.refused == 0) && std::chrono::steady_clock::now() < deadline)) {
       InputLog log;
       InputLogScope scope(&log);
       auto bytes = read_input(target);
@@ -89,8 +93,10 @@ RaceCounts race(const fs::path& dir, Swap kind, size_t min_tries) {
         continue;
       }
       const std::string text(bytes->begin(), bytes->end());
-      if (text == "INSIDE-BYTES") ++counts.inside;
-      else ++counts.leaked;
+      if (text == "INSIDE-BYTES")
+        ++counts.inside;
+      else
+        ++counts.leaked;
     }
   }
   stop = true;
@@ -119,14 +125,16 @@ TEST_P(SandboxRace, TheSecretIsNeverRead) {
   fs::remove_all(dir);
 }
 
-INSTANTIATE_TEST_SUITE_P(Swaps, SandboxRace,
-                         ::testing::Combine(::testing::Values(Swap::kFileSymlink, Swap::kFolderSymlink, Swap::kHardLink),
-                                            ::testing::Bool()),
-                         [](const ::testing::TestParamInfo<std::tuple<Swap, bool>>& p) {
-                           const Swap s = std::get<0>(p.param);
-                           return std::string(s == Swap::kFileSymlink ? "FileSymlink" : s == Swap::kFolderSymlink ? "FolderSymlink" : "HardLink") +
-                                  (std::get<1>(p.param) ? "Walk" : "Openat2");
-                         });
+INSTANTIATE_TEST_SUITE_P(
+    Swaps, SandboxRace,
+    ::testing::Combine(::testing::Values(Swap::kFileSymlink, Swap::kFolderSymlink, Swap::kHardLink), ::testing::Bool()),
+    [](const ::testing::TestParamInfo<std::tuple<Swap, bool>>& p) {
+      const Swap s = std::get<0>(p.param);
+      return std::string(s == Swap::kFileSymlink     ? "FileSymlink"
+                         : s == Swap::kFolderSymlink ? "FolderSymlink"
+                                                     : "HardLink") +
+             (std::get<1>(p.param) ? "Walk" : "Openat2");
+    });
 
 // What the walk must still allow: links that stay inside the allowed folders, absolute or
 // relative, and a link from the tree into an --allow-dir folder; and what it refuses.
@@ -185,14 +193,23 @@ TEST(SandboxRaceCook, NoCookedOutputEmbedsTheSecret) {
   ASSERT_TRUE(ossa::test::write_file(secret / "t.png", secret_png));
   const float v[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
   ASSERT_TRUE(ossa::test::write_file(tree / "tri.bin", std::string(reinterpret_cast<const char*>(v), sizeof v)));
-  const nlohmann::json gltf = {
-      {"asset", {{"version", "2.0"}}}, {"scene", 0}, {"scenes", {{{"nodes", {0}}}}}, {"nodes", {{{"mesh", 0}}}},
-      {"meshes", {{{"primitives", {{{"attributes", {{"POSITION", 0}}}, {"material", 0}}}}}}},
-      {"materials", {{{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}}}},
-      {"images", {{{"uri", "t.png"}}}}, {"textures", {{{"source", 0}}}},
-      {"buffers", {{{"uri", "tri.bin"}, {"byteLength", 36}}}}, {"bufferViews", {{{"buffer", 0}, {"byteLength", 36}}}},
-      {"accessors", {{{"bufferView", 0}, {"componentType", 5126}, {"count", 3}, {"type", "VEC3"},
-                      {"min", {0, 0, 0}}, {"max", {1, 1, 0}}}}}};
+  const nlohmann::json gltf = {{"asset", {{"version", "2.0"}}},
+                               {"scene", 0},
+                               {"scenes", {{{"nodes", {0}}}}},
+                               {"nodes", {{{"mesh", 0}}}},
+                               {"meshes", {{{"primitives", {{{"attributes", {{"POSITION", 0}}}, {"material", 0}}}}}}},
+                               {"materials", {{{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}}}},
+                               {"images", {{{"uri", "t.png"}}}},
+                               {"textures", {{{"source", 0}}}},
+                               {"buffers", {{{"uri", "tri.bin"}, {"byteLength", 36}}}},
+                               {"bufferViews", {{{"buffer", 0}, {"byteLength", 36}}}},
+                               {"accessors",
+                                {{{"bufferView", 0},
+                                  {"componentType", 5126},
+                                  {"count", 3},
+                                  {"type", "VEC3"},
+                                  {"min", {0, 0, 0}},
+                                  {"max", {1, 1, 0}}}}}};
   constexpr int kSources = 80;
   for (int k = 0; k < kSources; ++k)
     ASSERT_TRUE(ossa::test::write_file(tree / ("c" + std::to_string(k) + ".gltf"), gltf.dump()));
@@ -210,8 +227,8 @@ TEST(SandboxRaceCook, NoCookedOutputEmbedsTheSecret) {
       swaps.fetch_add(1);
     }
   });
-  const auto r = ossa::test::run_command((ossa::test::bin_dir() / "ossa-cook").string() + " '" + tree.string() + "' -o '" +
-                                         (dir / "out").string() + "' --texture-format source --jobs 2 -q");
+  const auto r = ossa::test::run_command((ossa::test::bin_dir() / "ossa-cook").string() + " '" + tree.string() +
+                                         "' -o '" + (dir / "out").string() + "' --texture-format source --jobs 2 -q");
   stop = true;
   other.join();
   size_t cooked = 0, leaked = 0;

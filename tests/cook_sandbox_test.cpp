@@ -159,8 +159,8 @@ TEST_F(CookSandbox, HardLinkedFilesAreRefusedUnlessAllowed) {
   ASSERT_TRUE(ossa::test::write_file(secret / "s.obj", obj));
   ASSERT_TRUE(ossa::test::write_file(secret / "m.mtl", std::string_view("newmtl skin\nKd 1 0 0\n")));
   struct Case {
-    const char* name;      // the input, in tree/chars
-    const char* linked;    // the name in tree/chars that is a hard link to a file in secret/
+    const char* name;    // the input, in tree/chars
+    const char* linked;  // the name in tree/chars that is a hard link to a file in secret/
     const char* target;
   };
   const Case cases[] = {{"img.gltf", "hl.png", "real.png"},
@@ -176,7 +176,8 @@ TEST_F(CookSandbox, HardLinkedFilesAreRefusedUnlessAllowed) {
     fs::create_hard_link(secret / c.target, link);
     const auto r = cook(tree / "chars" / c.name, "--force");
     EXPECT_EQ(r.exit_code, 1) << c.name << ": " << r.err;
-    EXPECT_NE(r.err.find(std::string(c.linked) + ": refused: has 2 hard links"), std::string::npos) << c.name << ": " << r.err;
+    EXPECT_NE(r.err.find(std::string(c.linked) + ": refused: has 2 hard links"), std::string::npos)
+        << c.name << ": " << r.err;
     EXPECT_NE(r.err.find("--allow-hard-links"), std::string::npos) << r.err;
     EXPECT_FALSE(fs::exists(dir / "out" / (fs::path(c.name).stem().string() + ".ossa"))) << c.name;
     const auto allowed = cook(tree / "chars" / c.name, "--force --allow-hard-links");
@@ -310,23 +311,28 @@ TEST_F(CookSandbox, DeepHierarchiesAreRefusedBeforeTheImporterRecurses) {
   // (as deep once Assimp expands it, with no nesting in the XML).
   const auto collada = [](const std::string& library, const std::string& scene) {
     return "<?xml version=\"1.0\"?>\n<COLLADA xmlns=\"http://www.collada.org/2005/11/COLLADASchema\" version=\"1.4.1\">"
-           "<asset><unit meter=\"1\"/><up_axis>Y_UP</up_axis></asset><library_nodes>" + library +
-           "</library_nodes><library_visual_scenes><visual_scene id=\"s\">" + scene +
+           "<asset><unit meter=\"1\"/><up_axis>Y_UP</up_axis></asset><library_nodes>" +
+           library + "</library_nodes><library_visual_scenes><visual_scene id=\"s\">" + scene +
            "</visual_scene></library_visual_scenes><scene><instance_visual_scene url=\"#s\"/></scene></COLLADA>\n";
   };
   for (int n : {2000, 20000}) {
     std::string nested;
-    for (int i = 0; i < n; ++i) nested += "<node id=\"n" + std::to_string(i) + "\" type=\"JOINT\"><translate>0 1 0</translate>";
+    for (int i = 0; i < n; ++i)
+      nested += "<node id=\"n" + std::to_string(i) + "\" type=\"JOINT\"><translate>0 1 0</translate>";
     for (int i = 0; i < n; ++i) nested += "</node>";
     ASSERT_TRUE(ossa::test::write_file(tree / "chars" / ("chain" + std::to_string(n) + ".dae"), collada("", nested)));
   }
   std::string instanced;
   for (int i = 0; i < 20000; ++i)
-    instanced += "<node id=\"n" + std::to_string(i) + "\">" + (i + 1 < 20000 ? "<instance_node url=\"#n" + std::to_string(i + 1) + "\"/>" : "") + "</node>";
-  ASSERT_TRUE(ossa::test::write_file(tree / "chars" / "chaini.dae", collada(instanced, "<node id=\"root\"><instance_node url=\"#n0\"/></node>")));
+    instanced += "<node id=\"n" + std::to_string(i) + "\">" +
+                 (i + 1 < 20000 ? "<instance_node url=\"#n" + std::to_string(i + 1) + "\"/>" : "") + "</node>";
+  ASSERT_TRUE(ossa::test::write_file(tree / "chars" / "chaini.dae",
+                                     collada(instanced, "<node id=\"root\"><instance_node url=\"#n0\"/></node>")));
   // Within the limit: 999 nested nodes (a skeleton of 999 joints) cook.
   std::string ok;
-  for (int i = 0; i < 999; ++i) ok += "<node id=\"j" + std::to_string(i) + "\" sid=\"j" + std::to_string(i) + "\" type=\"JOINT\"><translate>0 1 0</translate>";
+  for (int i = 0; i < 999; ++i)
+    ok += "<node id=\"j" + std::to_string(i) + "\" sid=\"j" + std::to_string(i) +
+          "\" type=\"JOINT\"><translate>0 1 0</translate>";
   for (int i = 0; i < 999; ++i) ok += "</node>";
   ASSERT_TRUE(ossa::test::write_file(tree / "chars" / "deep999.dae", collada("", ok)));
   const auto r = run_command(cook_cmd() + " " + q(tree / "chars") + " -o " + q(dir / "out") + " --report " +
@@ -335,8 +341,11 @@ TEST_F(CookSandbox, DeepHierarchiesAreRefusedBeforeTheImporterRecurses) {
   EXPECT_NE(r.err.find("chain.gltf: its node tree is nested over 1000+ levels deep"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("chainb.bvh: its joint hierarchy is nested over 1000+ levels deep"), std::string::npos) << r.err;
   for (const char* dae : {"chain2000.dae", "chain20000.dae", "chaini.dae"})
-    EXPECT_NE(r.err.find(std::string(dae) + ": its node tree (nested <node>s and the <instance_node>s they expand) is nested "
-                         "over 1000+ levels deep"), std::string::npos) << r.err;
+    EXPECT_NE(
+        r.err.find(std::string(dae) + ": its node tree (nested <node>s and the <instance_node>s they expand) is nested "
+                                      "over 1000+ levels deep"),
+        std::string::npos)
+        << r.err;
   EXPECT_EQ(r.err.find("signal"), std::string::npos) << "refused, not crashed: " << r.err;
   EXPECT_EQ(r.err.find("deep999.dae: "), std::string::npos) << "within the limit: " << r.err;
   EXPECT_TRUE(fs::exists(dir / "out" / "deep999.ossa"));

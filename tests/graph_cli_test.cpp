@@ -280,16 +280,18 @@ TEST(GraphCli, WhatTheLoaderWouldRefuseIsRefusedWithAPosition) {
     return "{\n  \"ossa_graph\": 1,\n  \"name\": \"b\",\n  \"skeleton\": \"" + pab("skeleton.fbx").string() +
            "\",\n  \"clips\": {\"walk\": \"" + pab("walk.fbx").string() + "\", \"run\": \"" + pab("run.fbx").string() +
            "\"},\n  \"parameters\": {\"speed\": {\"type\": \"float\"}, \"lean\": {\"type\": \"float\"}, "
-           "\"stop\": {\"type\": \"trigger\"}},\n  \"root\": " + root + "\n}\n";
+           "\"stop\": {\"type\": \"trigger\"}},\n  \"root\": " +
+           root + "\n}\n";
   };
   const auto machine = [](const std::string& transition) {
     return R"({"state_machine": {"name": "m", "entry": "a", "states": {"a": {"node": {"clip": "walk"}}, "b": {"node": {"clip": "run"}}},
-      "transitions": [{"from": "a", "to": "b"}, )" + transition + "]}}";
+      "transitions": [{"from": "a", "to": "b"}, )" +
+           transition + "]}}";
   };
   std::string grid;
   for (int i = 0; i < 2000; ++i)
-    grid += std::string(i ? ", " : "") + R"({"clip": ")" + (i % 2 ? "walk" : "run") + R"(", "x": )" + std::to_string(i % 50) +
-            R"(, "y": )" + std::to_string(i / 50) + "}";
+    grid += std::string(i ? ", " : "") + R"({"clip": ")" + (i % 2 ? "walk" : "run") + R"(", "x": )" +
+            std::to_string(i % 50) + R"(, "y": )" + std::to_string(i / 50) + "}";
   std::string deep = R"({"clip": "walk"})";
   for (int i = 0; i < 70; ++i) deep = R"({"blend": [)" + deep + R"(, {"clip": "run"}], "alpha": "lean"})";
   const std::vector<std::pair<std::string, std::string>> cases = {
@@ -304,7 +306,8 @@ TEST(GraphCli, WhatTheLoaderWouldRefuseIsRefusedWithAPosition) {
       {"deep", deep},
   };
   for (const auto& [name, root] : cases) ASSERT_TRUE(ossa::test::write_file(dir / (name + ".graph.json"), graph(root)));
-  ASSERT_TRUE(ossa::test::write_file(dir / "fine.graph.json", graph(machine(R"({"from": "b", "to": "a", "when": "stop", "duration": 1e6})"))));
+  ASSERT_TRUE(ossa::test::write_file(dir / "fine.graph.json",
+                                     graph(machine(R"({"from": "b", "to": "a", "when": "stop", "duration": 1e6})"))));
   const auto r = run_command(cook_cmd() + " " + q(dir) + " -o " + q(dir / "out") + " --jobs 2");
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_EQ(r.err.find("internal error"), std::string::npos) << r.err.substr(0, 3000);

@@ -646,14 +646,15 @@ TEST_F(GraphCompile, WhatTheLoaderRefusesIsRefusedWhereTheFileSaysIt) {
     "transitions": [{"from": "a", "to": "b"}, {"from": "b", "to": "b", "when": "stop"}]}})");
   EXPECT_HAS(errors(self), at(self, "\"b\", \"when\"") + "a transition from state 'b' to itself");
   const std::string far = graph(R"({"blend_space": "speed", "y": "lean", "samples": [
-      {"clip": "walk", "x": 0, "y": 0}, {"clip": "run", "x": 3.4e38, "y": 0}, {"clip": "wave", "x": 0, "y": -3.4e38}]})");
+      {"clip": "walk", "x": 0, "y": 0}, {"clip": "run", "x": 3.4e38, "y": 0},
+      {"clip": "wave", "x": 0, "y": -3.4e38}]})");
   const std::string fm = errors(far);
   EXPECT_HAS(fm, at(far, "3.4e38") + "a sample's \"x\" must be within [-1e+06, 1e+06], not 3.4e+38");
   EXPECT_HAS(fm, at(far, "-3.4e38") + "a sample's \"y\" must be within [-1e+06, 1e+06], not -3.4e+38");
   std::string many = R"({"blend_space": "speed", "y": "lean", "samples": [)";
   for (int i = 0; i < 2000; ++i)
-    many += std::string(i ? ", " : "") + "{\"clip\": \"walk\", \"x\": " + std::to_string(i % 50) + ", \"y\": " +
-            std::to_string(i / 50) + "}";
+    many += std::string(i ? ", " : "") + "{\"clip\": \"walk\", \"x\": " + std::to_string(i % 50) +
+            ", \"y\": " + std::to_string(i / 50) + "}";
   const std::string mg = graph(many + "]}");
   EXPECT_HAS(errors(mg), at(mg, "[{") + "a blend space has 2000 samples; at most 1024");
   // The other bounds of the loader: rates, weights, times, nesting, conditions.
@@ -683,7 +684,8 @@ TEST_F(GraphCompile, WhatTheLoaderRefusesIsRefusedWhereTheFileSaysIt) {
   for (int i = 1; i < 17; ++i) cond = "speed > " + std::to_string(i) + " || (" + cond + ")";
   const std::string cg = graph(R"({"state_machine": {"name": "m", "entry": "a", "states": {
       "a": {"node": {"clip": "walk"}}, "b": {"node": {"clip": "run"}}},
-    "transitions": [{"from": "a", "to": "b", "when": ")" + cond + R"("}]}})");
+    "transitions": [{"from": "a", "to": "b", "when": ")" +
+                               cond + R"("}]}})");
   EXPECT_HAS(errors(cg), "the condition holds more than 16 values at once here");
 }
 

@@ -55,8 +55,8 @@ std::string machine(size_t states, size_t clips, size_t params) {
          "\", \"rate_parameter\": \"p" + std::to_string(i % params) + "\"}}";
   s += "},\n\"transitions\": [";
   for (size_t i = 0; i + 1 < states; ++i)
-    s += (i ? ",\n" : "") + std::string("{\"from\": \"s") + std::to_string(i) + "\", \"to\": \"s" + std::to_string(i + 1) +
-         "\", \"when\": \"p" + std::to_string(i % params) + " > 0.5\"}";
+    s += (i ? ",\n" : "") + std::string("{\"from\": \"s") + std::to_string(i) + "\", \"to\": \"s" +
+         std::to_string(i + 1) + "\", \"when\": \"p" + std::to_string(i % params) + " > 0.5\"}";
   return s + "]}}";
 }
 

@@ -152,11 +152,14 @@ bool read_texture_file(const std::string& asset_path, const std::string& named, 
   }
   const fs::path folder = fs::path(asset_path).parent_path();
   const cook::ReadRoots roots({folder.empty() ? fs::path(".") : folder});
-  const cook::OpenedFile f = cook::open_beneath(&roots, (folder.empty() ? fs::path(".") : folder) / as_named, true, false);
+  const cook::OpenedFile f =
+      cook::open_beneath(&roots, (folder.empty() ? fs::path(".") : folder) / as_named, true, false);
   switch (f.outcome) {
     case cook::OpenOutcome::kOpened: break;
     case cook::OpenOutcome::kOutside: why = "it lies outside the file's folder"; return false;
-    case cook::OpenOutcome::kNotRegular: why = std::string("it is ") + cook::file_kind(f.st) + ", not a regular file"; return false;
+    case cook::OpenOutcome::kNotRegular:
+      why = std::string("it is ") + cook::file_kind(f.st) + ", not a regular file";
+      return false;
     case cook::OpenOutcome::kHardLinked:
       why = "it has " + std::to_string(f.st.st_nlink) + " hard links (another name for it may lie outside the folder)";
       return false;

@@ -40,7 +40,6 @@ constexpr double kDegrees = 3.14159265358979323846 / 180.0;
 constexpr double kMaxRate = 1000.0, kMaxWeight = 100.0, kMaxSeconds = 1e6, kMaxCoordinate = 1e6;
 constexpr size_t kMaxBlendSamples = 1024;
 
-
 std::string a_type(ParamType t) {
   return (t == ParamType::Int || t == ParamType::Enum ? "an " : "a ") + std::string(type_word(t));
 }
@@ -184,8 +183,8 @@ class GraphCompiler {
   size_t visits_ = 0;
   bool too_many_ = false;
   bool checking_unused_ = false;  // the node limit then only bounds the work, it is no error
-  uint32_t depth_ = 0;         // node() frames on the path, uses included (bounds the recursion)
-  uint32_t output_depth_ = 0;  // nodes on the path that are written (uses excluded)
+  uint32_t depth_ = 0;            // node() frames on the path, uses included (bounds the recursion)
+  uint32_t output_depth_ = 0;     // nodes on the path that are written (uses excluded)
 
   void warn(Pos pos, const std::string& what) { warnings_.push_back(json::where(check_.doc().file, pos) + what); }
 
@@ -530,8 +529,9 @@ class GraphCompiler {
     // than kMaxGraphDepth + 1 of them.
     const bool output = kind->key != "use";
     if (output && output_depth_ > kMaxGraphDepth) {
-      check_.error(v.pos, "nodes nested deeper than " + std::to_string(kMaxGraphDepth) +
-                              " levels below the root (the runtime's limit; each {\"use\"} counts as the node it copies)");
+      check_.error(v.pos,
+                   "nodes nested deeper than " + std::to_string(kMaxGraphDepth) +
+                       " levels below the root (the runtime's limit; each {\"use\"} counts as the node it copies)");
       return -1;
     }
     std::string name = default_name;
@@ -724,7 +724,8 @@ class GraphCompiler {
     if (!ctx_.skeleton) return -1;
     const auto& joints = ctx_.skeleton->joints;
     if (joint_index_.empty())
-      for (size_t j = joints.size(); j-- > 0;) joint_index_[joints[j].name] = static_cast<int>(j);  // the first of a name
+      for (size_t j = joints.size(); j-- > 0;)
+        joint_index_[joints[j].name] = static_cast<int>(j);  // the first of a name
     if (const auto found = joint_index_.find(v.string); found != joint_index_.end()) return found->second;
     if (check_.full()) return check_.error(v.pos, "unknown joint '" + v.string + "' in " + role), -1;
     std::vector<std::string> names;
@@ -831,8 +832,9 @@ class GraphCompiler {
     const Value* samples = required(v, "samples", "a blend space");
     if (!samples || !check_.expect(*samples, Type::Array, "\"samples\"")) return -1;
     if (samples->items.size() > kMaxBlendSamples)
-      return check_.error(samples->pos, "a blend space has " + std::to_string(samples->items.size()) + " samples; at most " +
-                                            std::to_string(kMaxBlendSamples)), -1;
+      return check_.error(samples->pos, "a blend space has " + std::to_string(samples->items.size()) +
+                                            " samples; at most " + std::to_string(kMaxBlendSamples)),
+             -1;
     const bool two_d = yv != nullptr;
     std::vector<Pos> where;  // each sample's position, for the checks across samples
     for (const Value& s : samples->items) {
@@ -942,7 +944,8 @@ class GraphCompiler {
       const int param = p ? parameter(*p, {ParamType::Float, ParamType::Bool}, "a drive's \"parameter\"") : -1;
       ok &= param >= 0;
       drive.parameter = static_cast<uint16_t>(std::max(param, 0));
-      if (const Value* sc = d.find("scale")) ok &= read_float(*sc, "a drive's \"scale\"", &drive.scale, -kMaxWeight, kMaxWeight);
+      if (const Value* sc = d.find("scale"))
+        ok &= read_float(*sc, "a drive's \"scale\"", &drive.scale, -kMaxWeight, kMaxWeight);
       m.drives.push_back(std::move(drive));
     }
     if (!ok) return -1;
@@ -1478,7 +1481,8 @@ class GraphCompiler {
       ok &= read_float(*e, "\"exit_time\" (normalized time of the source state; leave it out for none)", &out.exit_time,
                        0.0, kMaxSeconds);
     }
-    if (const Value* d = t.find("duration")) ok &= read_float(*d, "\"duration\" (seconds)", &out.duration, 0.0, kMaxSeconds);
+    if (const Value* d = t.find("duration"))
+      ok &= read_float(*d, "\"duration\" (seconds)", &out.duration, 0.0, kMaxSeconds);
     if (const Value* mode = t.find("mode")) {
       static const std::vector<std::string_view> kModes = {"crossfade", "sync_crossfade", "inertialize"};
       if (!check_.expect(*mode, Type::String, "\"mode\"")) {

@@ -39,7 +39,8 @@ const char* op_text(CondOp op) {
 
 class ConditionParser {
  public:
-  ConditionParser(std::string_view text, std::span<const GraphParameter> parameters, const ParameterIndex* index, bool hints)
+  ConditionParser(std::string_view text, std::span<const GraphParameter> parameters, const ParameterIndex* index,
+                  bool hints)
       : s_(text), params_(parameters), index_(index), hints_(hints) {}
 
   ConditionResult run() {
@@ -73,8 +74,8 @@ class ConditionParser {
   std::string error_;
   size_t error_offset_ = 0;
   int depth_ = 0;
-  int stack_ = 0;             // values on the evaluation stack after the code so far
-  size_t too_deep_at_ = 0;    // 1 + the offset where the stack first passed the limit; 0: never
+  int stack_ = 0;           // values on the evaluation stack after the code so far
+  size_t too_deep_at_ = 0;  // 1 + the offset where the stack first passed the limit; 0: never
 
   bool fail(size_t offset, std::string what) {
     if (error_.empty()) {
@@ -155,8 +156,10 @@ class ConditionParser {
   /// evaluation order): a loader runs conditions on a fixed stack of kMaxConditionStack values.
   void emit(CondOp op, uint16_t parameter = 0, float value = 0.0f) {
     code_.push_back({op, parameter, value});
-    if (op == CondOp::And || op == CondOp::Or) --stack_;
-    else if (op != CondOp::Not) ++stack_;
+    if (op == CondOp::And || op == CondOp::Or)
+      --stack_;
+    else if (op != CondOp::Not)
+      ++stack_;
     if (stack_ > kMaxConditionStack && !too_deep_at_) too_deep_at_ = tok_.offset + 1;  // +1: 0 means "not yet"
   }
 
@@ -301,7 +304,8 @@ class ConditionParser {
         }
         // A value past float's range would be stored as infinity, which no comparison can use.
         if (!(std::fabs(lit.number) <= 3.4028234663852886e38))
-          return fail(lit.offset, "the number " + std::string(lit.text) + " is outside the range of a float (+-3.4e38)");
+          return fail(lit.offset,
+                      "the number " + std::string(lit.text) + " is outside the range of a float (+-3.4e38)");
         emit(op.op, p16, static_cast<float>(lit.number));
         next();
         return true;

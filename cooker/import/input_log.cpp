@@ -126,7 +126,8 @@ Result<OpenedInput> open_input(const fs::path& path, uint64_t max_bytes, std::st
   if (path.native().find('\0') != std::string::npos)
     return Error{refuse(path, "contains a NUL byte", reference)};
   const ReadSandbox* sandbox = t_sandbox;
-  const OpenedFile f = open_beneath(sandbox ? &sandbox->roots : nullptr, path, true, !sandbox || sandbox->allow_hard_links);
+  const OpenedFile f =
+      open_beneath(sandbox ? &sandbox->roots : nullptr, path, true, !sandbox || sandbox->allow_hard_links);
   switch (f.outcome) {
     case OpenOutcome::kOpened: break;
     case OpenOutcome::kAbsent:
@@ -206,7 +207,8 @@ bool probe_input(const fs::path& path, std::string_view reference) {
   // Resolved as a read would resolve it, nothing opened for reading: a name that exists but is no
   // regular file (a FIFO called walk.events.json) is refused, not taken for absent.
   const ReadSandbox* sandbox = t_sandbox;
-  const OpenedFile f = open_beneath(sandbox ? &sandbox->roots : nullptr, path, false, !sandbox || sandbox->allow_hard_links);
+  const OpenedFile f =
+      open_beneath(sandbox ? &sandbox->roots : nullptr, path, false, !sandbox || sandbox->allow_hard_links);
   switch (f.outcome) {
     case OpenOutcome::kOpened: return true;
     case OpenOutcome::kAbsent:
@@ -223,7 +225,9 @@ bool probe_input(const fs::path& path, std::string_view reference) {
       refuse(path, std::string("is ") + file_kind(f.st) + ", not a regular file", reference);
       return false;
     case OpenOutcome::kHardLinked: refuse(path, hard_link_message(f.st), reference); return false;
-    case OpenOutcome::kError: refuse(path, std::string("cannot be opened: ") + std::strerror(f.error), reference); return false;
+    case OpenOutcome::kError:
+      refuse(path, std::string("cannot be opened: ") + std::strerror(f.error), reference);
+      return false;
   }
   return false;
 }

@@ -104,8 +104,9 @@ class ReadSandboxScope {
 
 /// Reads the whole of `path` and records it in the current log (a missing file is recorded absent).
 /// Refused without reading: a path outside the sandbox, anything not a regular file, a file with
-/// other hard links, a file over `max_bytes`; a refusal is also kept in the log. `reference` says what named the file (e.g.
-/// "a texture of material 'skin'") for the messages. Errors name the file. O(file size).
+/// other hard links, a file over `max_bytes`; a refusal is also kept in the log. `reference` says
+/// what named the file (e.g. "a texture of material 'skin'") for the messages. Errors name the
+/// file. O(file size).
 Result<std::vector<uint8_t>> read_input(const std::filesystem::path& path, uint64_t max_bytes = UINT64_MAX,
                                         std::string_view reference = {});
 

@@ -33,7 +33,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr int kMaxLinks = 40;  // what the kernel allows (MAXSYMLINKS) for one resolution
+constexpr int kMaxLinks = 40;   // what the kernel allows (MAXSYMLINKS) for one resolution
 constexpr int kMaxRetries = 8;  // a file swapped between the two opens of one resolution: try again
 constexpr uint64_t kResolve = RESOLVE_BENEATH | RESOLVE_NO_MAGICLINKS;
 
@@ -141,7 +141,8 @@ OpenedFile via_openat2(const ReadRoots& roots, const fs::path& abs, bool for_rea
     if (e == EXDEV || e == ELOOP || e == EAGAIN || e == ENOSYS || e == EPERM) fallback = true;
     return failed(OpenOutcome::kError, e);
   }
-  return finish(opath, for_reading, [&] { return sys_openat2(dirfd, rel.c_str(), O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC); });
+  return finish(opath, for_reading,
+                [&] { return sys_openat2(dirfd, rel.c_str(), O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC); });
 }
 
 std::string read_link(int link_fd) {
@@ -256,8 +257,7 @@ OpenedFile via_walk(const ReadRoots& roots, fs::path abs, bool for_reading) {
 
 OpenedFile via_system(const fs::path& path, bool for_reading) {
   const int opath = ::open(path.c_str(), O_PATH | O_CLOEXEC);
-  if (opath < 0)
-    return failed(absent_errno(errno) ? OpenOutcome::kAbsent : OpenOutcome::kError, errno);
+  if (opath < 0) return failed(absent_errno(errno) ? OpenOutcome::kAbsent : OpenOutcome::kError, errno);
   return finish(opath, for_reading, [&] { return ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC); });
 }
 
@@ -318,7 +318,8 @@ void force_walk_for_testing(bool walk) { g_openat2.store(walk ? 0 : -1); }
 
 OpenedFile open_beneath(const ReadRoots* roots, const fs::path& path, bool for_reading, bool allow_hard_links) {
   OpenedFile f;
-  if (path.native().find('\0') != std::string::npos) return failed(OpenOutcome::kError, EINVAL);  // another file for the OS
+  if (path.native().find('\0') != std::string::npos)
+    return failed(OpenOutcome::kError, EINVAL);  // another file for the OS
   for (int attempt = 0; attempt < kMaxRetries; ++attempt) {
     if (roots == nullptr) {
       f = via_system(path, for_reading);

@@ -64,9 +64,9 @@ enum class OpenOutcome {
 
 struct OpenedFile {
   OpenOutcome outcome = OpenOutcome::kError;
-  int fd = -1;         // kOpened only: O_RDONLY | O_NONBLOCK | O_CLOEXEC; the caller closes it
-  struct stat st {};   // kOpened, kNotRegular, kHardLinked
-  int error = 0;       // kAbsent, kError
+  int fd = -1;        // kOpened only: O_RDONLY | O_NONBLOCK | O_CLOEXEC; the caller closes it
+  struct stat st {};  // kOpened, kNotRegular, kHardLinked
+  int error = 0;      // kAbsent, kError
 };
 
 /// Opens `path` for reading if it resolves, from one of `roots`, to a regular file beneath one of

@@ -116,8 +116,8 @@ std::string_view attribute(std::string_view attrs, std::string_view name) {
 uint64_t collada_node_depth(std::span<const uint8_t> bytes) {
   const std::string_view text(reinterpret_cast<const char*>(bytes.data()), bytes.size());
   struct Node {
-    std::vector<uint32_t> children;         // nested <node>s
-    std::vector<std::string_view> instances; // ids named by <instance_node> directly inside
+    std::vector<uint32_t> children;           // nested <node>s
+    std::vector<std::string_view> instances;  // ids named by <instance_node> directly inside
   };
   std::vector<Node> nodes;
   std::unordered_map<std::string_view, uint32_t> by_id;
@@ -138,10 +138,22 @@ uint64_t collada_node_depth(std::span<const uint8_t> bytes) {
   size_t i = 0;
   while ((i = text.find('<', i)) != std::string_view::npos) {
     const std::string_view rest = text.substr(i);
-    if (rest.substr(0, 4) == "<!--") { i = skip_to(i + 4, "-->"); continue; }
-    if (rest.substr(0, 9) == "<![CDATA[") { i = skip_to(i + 9, "]]>"); continue; }
-    if (rest.substr(0, 2) == "<?") { i = skip_to(i + 2, "?>"); continue; }
-    if (rest.substr(0, 2) == "<!") { i = skip_to(i + 2, ">"); continue; }
+    if (rest.substr(0, 4) == "<!--") {
+      i = skip_to(i + 4, "-->");
+      continue;
+    }
+    if (rest.substr(0, 9) == "<![CDATA[") {
+      i = skip_to(i + 9, "]]>");
+      continue;
+    }
+    if (rest.substr(0, 2) == "<?") {
+      i = skip_to(i + 2, "?>");
+      continue;
+    }
+    if (rest.substr(0, 2) == "<!") {
+      i = skip_to(i + 2, ">");
+      continue;
+    }
     const bool closing = rest.substr(0, 2) == "</";
     const size_t name_at = i + (closing ? 2 : 1);
     size_t name_end = name_at;
@@ -173,7 +185,8 @@ uint64_t collada_node_depth(std::span<const uint8_t> bytes) {
         if (const int64_t parent = enclosing_node(); parent >= 0)
           nodes[static_cast<size_t>(parent)].children.push_back(static_cast<uint32_t>(index));
         nodes.emplace_back();
-        if (const std::string_view id = attribute(attrs, "id"); !id.empty()) by_id.emplace(id, static_cast<uint32_t>(index));
+        if (const std::string_view id = attribute(attrs, "id"); !id.empty())
+          by_id.emplace(id, static_cast<uint32_t>(index));
       }
       open.push_back(index);
     }
@@ -198,8 +211,10 @@ uint64_t collada_node_depth(std::span<const uint8_t> bytes) {
         state[n] = 1;
         bool cycle = false;
         edges(n, [&](uint32_t c) {
-          if (state[c] == 0) stack.push_back(c);
-          else if (state[c] == 1) cycle = true;
+          if (state[c] == 0)
+            stack.push_back(c);
+          else if (state[c] == 1)
+            cycle = true;
         });
         if (cycle) return uint64_t{kMaxHierarchyDepth} + 1;
         continue;

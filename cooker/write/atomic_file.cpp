@@ -23,7 +23,7 @@ namespace {
 
 // '.' + name + ".tmp-" + pid (<= 10 digits) + '-' + counter (<= 10 digits) <= 255.
 constexpr size_t kLongestKeptName = 255 - 1 - 5 - 10 - 1 - 10;  // 228
-constexpr size_t kCutName = kLongestKeptName - 9;                // 219, then '~' and 8 hex digits
+constexpr size_t kCutName = kLongestKeptName - 9;               // 219, then '~' and 8 hex digits
 constexpr time_t kOldSeconds = 3600;
 
 }  // namespace
@@ -52,7 +52,8 @@ Status write_file_atomic(const fs::path& path, std::span<const uint8_t> bytes) {
     return Error{path.string() + ": is read-only, not replaced (make it writable or remove it)"};
   fs::create_directories(dir, ec);
   if (ec) return Error{path.string() + ": cannot create its folder " + dir.string() + ": " + ec.message()};
-  const fs::path tmp = dir / temporary_name(path.filename().string(), static_cast<long>(::getpid()), counter.fetch_add(1));
+  const fs::path tmp =
+      dir / temporary_name(path.filename().string(), static_cast<long>(::getpid()), counter.fetch_add(1));
   const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
   if (fd < 0) return Error{path.string() + ": cannot create its temporary file: " + std::strerror(errno)};
   ::flock(fd, LOCK_EX);  // held until this process closes it or dies (see the header)
@@ -90,7 +91,8 @@ Status write_file_atomic(const fs::path& path, std::span<const uint8_t> bytes) {
 size_t remove_stale_temporaries(const std::vector<fs::path>& outputs) {
   std::map<fs::path, std::set<std::string>> prefixes;  // folder -> temporary prefixes of its outputs
   for (const fs::path& out : outputs)
-    prefixes[out.parent_path().empty() ? fs::path(".") : out.parent_path()].insert(temporary_prefix(out.filename().string()));
+    prefixes[out.parent_path().empty() ? fs::path(".") : out.parent_path()].insert(
+        temporary_prefix(out.filename().string()));
   size_t removed = 0;
   const time_t now = std::time(nullptr);
   for (const auto& [dir, wanted] : prefixes) {
@@ -98,7 +100,8 @@ size_t remove_stale_temporaries(const std::vector<fs::path>& outputs) {
     for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
       const std::string entry = it->path().filename().string();
       const size_t tmp = entry.rfind(".tmp-");
-      if (entry.empty() || entry[0] != '.' || tmp == std::string::npos || !wanted.count(entry.substr(0, tmp + 5))) continue;
+      if (entry.empty() || entry[0] != '.' || tmp == std::string::npos || !wanted.count(entry.substr(0, tmp + 5)))
+        continue;
       char* end_of_pid = nullptr;
       const long pid = std::strtol(entry.c_str() + tmp + 5, &end_of_pid, 10);
       if (pid <= 0 || end_of_pid == nullptr || *end_of_pid != '-') continue;
@@ -107,9 +110,10 @@ size_t remove_stale_temporaries(const std::vector<fs::path>& outputs) {
       struct stat st {};
       // A lock held means a writer is alive, wherever it runs; an unlocked file is stale when its
       // pid is gone here or it is old.
-      const bool stale = ::fstat(fd, &st) == 0 && S_ISREG(st.st_mode) && ::flock(fd, LOCK_EX | LOCK_NB) == 0 &&
-                         pid != static_cast<long>(::getpid()) &&
-                         ((::kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH) || now - st.st_mtime > kOldSeconds);
+      const bool stale =
+          ::fstat(fd, &st) == 0 && S_ISREG(st.st_mode) && ::flock(fd, LOCK_EX | LOCK_NB) == 0 &&
+          pid != static_cast<long>(::getpid()) &&
+          ((::kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH) || now - st.st_mtime > kOldSeconds);
       struct stat named {};
       if (stale && ::lstat(it->path().c_str(), &named) == 0 && named.st_dev == st.st_dev && named.st_ino == st.st_ino &&
           ::unlink(it->path().c_str()) == 0)
