@@ -158,7 +158,7 @@ bool read_texture_file(const std::string& asset_path, const std::string& named, 
     case cook::OpenOutcome::kOpened: break;
     case cook::OpenOutcome::kOutside: why = "it lies outside the file's folder"; return false;
     case cook::OpenOutcome::kNotRegular:
-      why = std::string("it is ") + cook::file_kind(f.st) + ", not a regular file";
+      why = std::string("it is not a regular file (") + cook::file_kind(f.st) + ")";
       return false;
     case cook::OpenOutcome::kHardLinked:
       why = "it has " + std::to_string(f.st.st_nlink) + " hard links (another name for it may lie outside the folder)";
