@@ -140,7 +140,7 @@ bool write_verified(CookRecord& record, const std::vector<uint8_t>& bytes, const
   }
   if (!write) return true;  // --list-inputs: the cook ran to the end, nothing is written
   if (Status st = write_file_atomic(output, bytes); !st) {
-    record.error = st.message();
+    record.error = input.string() + ": " + st.message();  // the input it concerns, then the file and the cause
     return false;
   }
   record.cooked_bytes = bytes.size();
@@ -168,6 +168,16 @@ bool up_to_date(CookRecord& record, const fs::path& input, const fs::path& outpu
   if (prov == nullptr || prov->inputs() == nullptr || prov->inputs()->size() == 0) return false;
   const std::string canonical = options.canonical();
   if (flatbuffers::GetStringView(prov->options()) != canonical) return false;
+  // The output must be this input's: `x.obj` then `x.gltf` cooked into one folder share an output
+  // name, and the OBJ's inputs being unchanged says nothing about the glTF. The recorded source
+  // (its name, which carries its kind: importer by extension, or graph) must be this input, and
+  // be among the inputs re-hashed below.
+  const std::string source_name = input.filename().string();
+  if (flatbuffers::GetStringView(prov->source_name()) != source_name) return false;
+  bool source_listed = false;
+  for (const fb::InputFile* f : *prov->inputs())
+    source_listed |= f->path() != nullptr && f->path()->string_view() == source_name && !f->absent();
+  if (!source_listed) return false;
   const fs::path base = input.parent_path();
   InputLog log;
   InputLogScope scope(&log);
@@ -301,7 +311,7 @@ std::optional<CookRecord> cook_or_check(const fs::path& input, const fs::path& o
   std::vector<fs::path> allowed = options.allow_dirs;
   allowed.push_back(options.root.empty() ? input.parent_path() : options.root);
   if (allowed.back().empty()) allowed.back() = ".";
-  ReadSandboxScope sandbox(allowed);
+  ReadSandboxScope sandbox(allowed, options.allow_hard_links);
   try {
     if (Status st = apply_cook_settings(input, options, settings); !st) {
       if (only_if_up_to_date) return std::nullopt;
@@ -342,73 +352,6 @@ CookRecord cook_file(const fs::path& input, const fs::path& output, const CookOp
 std::optional<CookRecord> up_to_date_record(const fs::path& input, const fs::path& output,
                                             const CookOptions& batch_options) {
   return cook_or_check(input, output, batch_options, true);
-}
-
-namespace {
-
-/// Removes `.<name>.tmp-<pid>-<n>` files in `dir` left by a cook whose process no longer exists
-/// (a worker or a whole ossa-cook killed mid-write). A live process's temporaries are kept.
-void remove_stale_temporaries(const fs::path& dir, const std::string& name) {
-  const std::string prefix = "." + name + ".tmp-";
-  std::error_code ec;
-  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
-    const std::string entry = it->path().filename().string();
-    if (entry.rfind(prefix, 0) != 0) continue;
-    const long pid = std::strtol(entry.c_str() + prefix.size(), nullptr, 10);
-    if (pid <= 0 || pid == static_cast<long>(::getpid())) continue;
-    if (::kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH) ::unlink(it->path().c_str());
-  }
-}
-
-}  // namespace
-
-Status write_file_atomic(const fs::path& path, const std::vector<uint8_t>& bytes) {
-  static std::atomic<unsigned> counter{0};
-  std::error_code ec;
-  const fs::path dir = path.parent_path().empty() ? fs::path(".") : path.parent_path();
-  // A read-only file is the user's way of saying "do not replace": rename(2) would, so it is
-  // refused here (by its mode bits, which also hold for root, whom access(2) lets write anything).
-  struct stat existing{};
-  if (::stat(path.c_str(), &existing) == 0 && S_ISREG(existing.st_mode) &&
-      (existing.st_mode & (S_IWUSR | S_IWGRP | S_IWOTH)) == 0)
-    return Error{path.string() + ": is read-only, not replaced (make it writable or remove it)"};
-  fs::create_directories(dir, ec);
-  if (ec) return Error{path.string() + ": cannot create directory " + dir.string() + ": " + ec.message()};
-  remove_stale_temporaries(dir, path.filename().string());
-  const fs::path tmp = dir / ("." + path.filename().string() + ".tmp-" + std::to_string(::getpid()) + "-" +
-                              std::to_string(counter.fetch_add(1)));
-  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
-  if (fd < 0) return Error{path.string() + ": cannot create " + tmp.string() + ": " + std::strerror(errno)};
-  size_t done = 0;
-  bool ok = true;
-  std::string why;
-  while (done < bytes.size()) {
-    const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
-    if (n < 0) {
-      if (errno == EINTR) continue;
-      ok = false;
-      why = std::strerror(errno);
-      break;
-    }
-    done += static_cast<size_t>(n);
-  }
-  if (ok && ::fsync(fd) != 0) {
-    ok = false;
-    why = std::strerror(errno);
-  }
-  if (::close(fd) != 0 && ok) {
-    ok = false;
-    why = std::strerror(errno);
-  }
-  if (ok && std::rename(tmp.c_str(), path.c_str()) != 0) {
-    ok = false;
-    why = std::strerror(errno);
-  }
-  if (!ok) {
-    ::unlink(tmp.c_str());
-    return Error{path.string() + ": write failed: " + why};
-  }
-  return {};
 }
 
 }  // namespace ossa::cook

@@ -19,6 +19,7 @@
 #include "cooker/model/cook_options.h"
 #include "cooker/model/cook_record.h"
 #include "cooker/model/reference_skeleton.h"
+#include "cooker/write/atomic_file.h"
 #include <ossa/format/result.h>
 
 namespace ossa::cook {
@@ -46,10 +47,5 @@ CookRecord cook_file(const std::filesystem::path& input, const std::filesystem::
 /// and an all-up-to-date run costs no process per input. O(bytes of the listed inputs).
 std::optional<CookRecord> up_to_date_record(const std::filesystem::path& input, const std::filesystem::path& output,
                                             const CookOptions& options);
-
-/// Writes bytes to a temporary file in path's directory, flushes, then renames it onto path.
-/// On any failure the temporary is removed and path is untouched. A read-only file at path is
-/// refused, not replaced; temporaries of path left by processes that no longer exist are removed.
-Status write_file_atomic(const std::filesystem::path& path, const std::vector<uint8_t>& bytes);
 
 }  // namespace ossa::cook

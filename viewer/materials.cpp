@@ -7,6 +7,7 @@
 
 #include <cerrno>
 #include <climits>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -17,6 +18,7 @@
 
 #include <ossa/loader/texture.h>
 #include "common/message.h"
+#include "common/open_beneath.h"
 
 namespace ossa::view {
 namespace {
@@ -134,51 +136,50 @@ GLuint upload_cooked(const TextureView& view, uint64_t& gpu_bytes, std::string& 
   return t;
 }
 
-/// Reads a texture a file names by path: relative, inside the file's folder once `..` and symlinks
-/// are resolved, a regular file (never a directory, FIFO or device: opened non-blocking and checked
-/// again after opening), at most kMaxTextureFileBytes. A file from elsewhere cannot make the viewer
-/// read outside its folder, hang on a FIFO or read /dev/zero until memory runs out.
+/// Reads a texture a file names by path: relative, beneath the file's folder, a regular file with
+/// no other hard links (never a directory, FIFO or device), at most kMaxTextureFileBytes. Resolved
+/// and opened in one step from the folder's descriptor and checked on the opened file, through the
+/// cooker's door (common/open_beneath.h): a file from elsewhere cannot make the viewer read
+/// outside its folder, even by swapping a symlink in while it loads, hang on a FIFO or read
+/// /dev/zero until memory runs out.
 bool read_texture_file(const std::string& asset_path, const std::string& named, std::vector<uint8_t>& bytes,
                        std::string& why) {
   namespace fs = std::filesystem;
-  std::error_code ec;
   const fs::path as_named(named);
   if (named.find('\0') != std::string::npos || as_named.is_absolute() || as_named.has_root_name()) {
     why = "a texture path must be relative to the file";
     return false;
   }
-  const fs::path folder = fs::weakly_canonical(fs::absolute(fs::path(asset_path).parent_path(), ec), ec);
-  const fs::path file = fs::weakly_canonical(fs::absolute(fs::path(asset_path).parent_path() / as_named, ec), ec);
-  const fs::path rel = file.lexically_relative(folder);
-  if (ec || rel.empty() || *rel.begin() == "..") {
-    why = "it lies outside the file's folder";
-    return false;
+  const fs::path folder = fs::path(asset_path).parent_path();
+  const cook::ReadRoots roots({folder.empty() ? fs::path(".") : folder});
+  const cook::OpenedFile f =
+      cook::open_beneath(&roots, (folder.empty() ? fs::path(".") : folder) / as_named, true, false);
+  switch (f.outcome) {
+    case cook::OpenOutcome::kOpened: break;
+    case cook::OpenOutcome::kOutside: why = "it lies outside the file's folder"; return false;
+    case cook::OpenOutcome::kNotRegular:
+      why = std::string("it is not a regular file (") + cook::file_kind(f.st) + ")";
+      return false;
+    case cook::OpenOutcome::kHardLinked:
+      why = "it has " + std::to_string(f.st.st_nlink) + " hard links (another name for it may lie outside the folder)";
+      return false;
+    case cook::OpenOutcome::kAbsent:
+    case cook::OpenOutcome::kError: why = std::string("cannot open it: ") + std::strerror(f.error); return false;
   }
-  const int fd = ::open(file.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
-  if (fd < 0) {
-    why = "cannot open it";
-    return false;
-  }
-  struct stat st{};
-  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
-    ::close(fd);
-    why = "it is not a regular file";
-    return false;
-  }
-  if (static_cast<uint64_t>(st.st_size) > kMaxTextureFileBytes) {
-    ::close(fd);
+  if (static_cast<uint64_t>(f.st.st_size) > kMaxTextureFileBytes) {
+    ::close(f.fd);
     why = "it is over " + std::to_string(kMaxTextureFileBytes >> 20) + " MiB";
     return false;
   }
-  bytes.resize(static_cast<size_t>(st.st_size));
+  bytes.resize(static_cast<size_t>(f.st.st_size));
   size_t done = 0;
   while (done < bytes.size()) {
-    const ssize_t n = ::read(fd, bytes.data() + done, bytes.size() - done);
+    const ssize_t n = ::read(f.fd, bytes.data() + done, bytes.size() - done);
     if (n < 0 && errno == EINTR) continue;
     if (n <= 0) break;
     done += static_cast<size_t>(n);
   }
-  ::close(fd);
+  ::close(f.fd);
   bytes.resize(done);
   return true;
 }

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <map>
 #include <optional>
@@ -115,6 +116,14 @@ std::optional<uint64_t> parse_size(const std::string& text) {
 std::vector<CookRecord> run_batch(const std::vector<BatchItem>& items, const CookOptions& options,
                                   const BatchLimits& limits, unsigned jobs, const BatchProgress& progress) {
   std::vector<CookRecord> records(items.size());
+  // Temporaries of writers that died (a batch killed mid-write) go now, before anything is found
+  // up to date: an up-to-date output is never rewritten, so no later write would remove them.
+  if (options.write) {
+    std::vector<fs::path> outputs;
+    outputs.reserve(items.size());
+    for (const BatchItem& item : items) outputs.push_back(item.output);
+    remove_stale_temporaries(outputs);
+  }
   size_t done = 0;
   cook_in_workers(items, options, limits, jobs, [&](size_t index, CookRecord record) {
     records[index] = std::move(record);
@@ -124,25 +133,72 @@ std::vector<CookRecord> run_batch(const std::vector<BatchItem>& items, const Coo
   return records;
 }
 
-namespace {
-
-std::string make_escaped(const std::string& path) {
+std::optional<std::string> depfile_spelling(const std::string& path, bool target, std::string& why) {
+  // The rules both readers apply (GNU Make 4.3's read.c, Ninja 1.11's depfile_parser.in.cc), checked
+  // by building with each over every class of hostile name (tests/cook_depfile_test.cpp):
+  // - both: "\ " is a space, "\#" a '#', "\:" a ':', "$$" a '$'; letters, digits, bytes >= 0x80
+  //   and "+,-./_~()[]{}%=@!" stand for themselves in Ninja, which ends a name at anything else
+  //   (';' '&' '|' quotes '*' '?' '<' '>' '^' '`', TAB, ESC, ...) and has no escape for them;
+  // - Make runs what follows a ';' as a recipe, reads '=' as a variable assignment, globs "[...]",
+  //   takes "x(y)" for an archive member and a '%' in a target for a pattern rule;
+  // - a backslash stands for itself in both only before an ordinary character.
+  const auto refuse = [&why](std::string reason) -> std::optional<std::string> {
+    why = std::move(reason);
+    return std::nullopt;
+  };
   std::string out;
-  for (char c : path) {
-    if (c == ' ' || c == '#') out += '\\';
-    if (c == '$') out += '$';
-    out += c;
+  out.reserve(path.size() + 8);
+  for (size_t i = 0; i < path.size(); ++i) {
+    const auto c = static_cast<unsigned char>(path[i]);
+    if (c == '\n' || c == '\r') return refuse("a line break ends a rule for Make and Ninja");
+    if (c == '\t') return refuse("Ninja ends a name at a TAB and has no escape for it");
+    if (c < 0x20 || c == 0x7f) {
+      char hex[8];
+      std::snprintf(hex, sizeof hex, "0x%02x", c);
+      return refuse(std::string("Ninja ends a name at the control byte ") + hex + " and has no escape for it");
+    }
+    if (std::string_view(";&|`'\"*?<>^").find(static_cast<char>(c)) != std::string_view::npos)
+      return refuse(std::string("Ninja ends a name at '") + static_cast<char>(c) + "' and has no escape for it" +
+                    (c == ';' ? " (and Make would run what follows it as a command)" : ""));
+    if (c == '=') return refuse("Make reads a rule with '=' as a variable assignment");
+    if (c == '[' && path.find(']', i) != std::string::npos) return refuse("Make would read \"[...]\" as a wildcard");
+    if (c == '%' && target) return refuse("Make would read a target with '%' as a pattern rule");
+    if (c == '\\') {
+      const char next = i + 1 < path.size() ? path[i + 1] : '\0';
+      if (next == '\0' || std::string_view(" #:$%").find(next) != std::string_view::npos)
+        return refuse("a backslash at the end of a name or before one of ' #:$%' reads differently in Make and Ninja");
+      out += '\\';
+    } else if (c == ' ' || c == '#' || c == ':') {
+      if (c == ':' && i + 1 == path.size()) return refuse("Ninja cannot read a name that ends with ':'");
+      out += '\\';
+      out += static_cast<char>(c);
+    } else if (c == '$') {
+      out += "$$";
+    } else {
+      out += static_cast<char>(c);
+    }
   }
+  if (!path.empty() && path.back() == ')' && path.find('(') != std::string::npos)
+    return refuse("Make would read \"name(member)\" as a member of an archive");
   return out;
 }
 
-}  // namespace
-
 Status write_depfile(const fs::path& path, const std::vector<CookRecord>& records) {
   std::string text;
+  std::string problem;
+  size_t problems = 0;
+  const auto spell = [&](const std::string& name, bool target, const CookRecord& r) {
+    std::string why;
+    std::optional<std::string> spelled = depfile_spelling(name, target, why);
+    if (spelled) return std::move(*spelled);
+    if (problems++ == 0)
+      problem = r.input + ": " + (target ? "its output " : "it reads ") + "'" + detail::printable(name, 400) +
+                "', a name no depfile spells alike for Make and Ninja: " + why;
+    return std::string();
+  };
   for (const CookRecord& r : records) {
     if (!r.ok) continue;
-    text += make_escaped(fs::absolute(r.output).lexically_normal().string()) + ":";
+    text += spell(fs::absolute(r.output).lexically_normal().string(), true, r) + ":";
     std::set<std::string> deps;
     for (const InputFile& f : r.inputs_read) {
       if (f.present) {
@@ -155,8 +211,17 @@ Status write_depfile(const fs::path& path, const std::vector<CookRecord>& record
         if (fs::is_directory(dir, ec)) deps.insert(dir.string());
       }
     }
-    for (const std::string& d : deps) text += " \\\n  " + make_escaped(d);
+    for (const std::string& d : deps) text += " \\\n  " + spell(d, false, r);
     text += "\n";
+  }
+  if (problems > 0) {
+    // No depfile rather than one that means something else to the build tool (an older one would
+    // still name the previous inputs).
+    std::error_code ec;
+    fs::remove(path, ec);
+    return Error{path.string() + ": not written: " + problem +
+                 (problems > 1 ? " (and " + std::to_string(problems - 1) + " more such names)" : "") +
+                 "; rename it, or cook without --depfile"};
   }
   return write_file_atomic(path, std::vector<uint8_t>(text.begin(), text.end()));
 }

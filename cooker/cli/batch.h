@@ -69,13 +69,21 @@ using BatchProgress = std::function<void(size_t done, size_t total, const CookRe
 std::vector<CookRecord> run_batch(const std::vector<BatchItem>& items, const CookOptions& options,
                                   const BatchLimits& limits, unsigned jobs, const BatchProgress& progress);
 
-/// Writes a Make-syntax depfile (atomically): one rule per output written or up to date,
-/// `OUTPUT: INPUT...`, naming every file its cook read. A file looked for and absent cannot be a
-/// prerequisite (Make would fail, Ninja would re-cook every time), so its folder is named instead:
-/// creating the file changes the folder's mtime, the build tool re-runs the cook, and a cook that
-/// finds nothing changed leaves its output alone. Absolute paths; spaces, '#' and '$' escaped as
-/// Make and Ninja read them. Failed inputs have no rule.
+/// Writes a depfile (atomically) that GNU Make and Ninja read alike: one rule per output written or
+/// up to date, `OUTPUT: INPUT...`, naming every file its cook read. A file looked for and absent
+/// cannot be a prerequisite (Make would fail, Ninja would re-cook every time), so its folder is
+/// named instead: creating the file changes the folder's mtime, the build tool re-runs the cook,
+/// and a cook that finds nothing changed leaves its output alone. Absolute paths, spelled by
+/// depfile_spelling. Failed inputs have no rule. A name no spelling gives to both tools fails the
+/// whole depfile (the error names the input and the name) and removes an older one: a depfile that
+/// means something else makes the build tool miss a change, or run a command.
 Status write_depfile(const std::filesystem::path& path, const std::vector<CookRecord>& records);
+
+/// `path` as a depfile must spell it for GNU Make and Ninja to read it back as `path` (a space as
+/// "\ ", '#' as "\#", ':' as "\:", '$' as "$$"), or nullopt with `why` set when no spelling means
+/// the same to both (';', quotes, '*', '?', '=', control bytes, a line break; the full list is in
+/// docs/COOKING-SECURITY.md). `target`: the name is a rule's target (where '%' makes a pattern).
+std::optional<std::string> depfile_spelling(const std::string& path, bool target, std::string& why);
 
 /// The --report document's "schema" and "schema_version": docs/schemas/ossa-cook-report.schema.json
 /// describes it (docs/JSON.md). The version moves only on an incompatible change (a field removed,

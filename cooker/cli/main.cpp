@@ -16,7 +16,7 @@
 // This process must stay single-threaded: it forks the workers.
 //
 // Exit status (tools/cli/cli.h): 0 when every input cooked; 1 when any failed (the rest
-// are still cooked) or the report could not be written; 2 for a usage error or a plan that cannot
+// are still cooked) or the report or the depfile could not be written; 2 for a usage error or a plan that cannot
 // be carried out (nothing is written then).
 //
 // Output: failures always (stderr). Without -q, a progress line per input and the number of
@@ -24,6 +24,7 @@
 // input's warnings, time and sizes, one line per clip (frames, error, ratio) and the total time.
 // Warnings are not printed one by one by default: importing the samples alone gives dozens of
 // lines (dropped cameras, matched joint names) that would bury the failures. The --report document is docs/schemas/ossa-cook-report.schema.json (docs/JSON.md).
+#include <signal.h>
 #include <sys/ioctl.h>
 #include <unistd.h>
 
@@ -148,6 +149,9 @@ void print_details(const CookRecord& r) {
 
 int main(int argc, char** argv) {
   const auto start = std::chrono::steady_clock::now();
+  // A file-size limit (ulimit -f) reached while writing is a write error to report with the input
+  // it concerns, like a full disk, not a signal that ends the process (workers inherit this).
+  ::signal(SIGXFSZ, SIG_IGN);
   ossa::cli::Command command("ossa-cook",
                              "ossa-cook: cook FBX / glTF / GLB / Collada / BVH sources and animation graph files "
                              "(*.graph.json) into .ossa files",
@@ -173,6 +177,10 @@ int main(int argc, char** argv) {
   app.add_option("--allow-dir", allow_dirs,
                  "also let cooks read files inside this directory (repeatable), e.g. a shared texture library")
       ->allow_extra_args(false);  // one directory per --allow-dir: the inputs that follow stay inputs
+  bool allow_hard_links = false;
+  app.add_flag("--allow-hard-links", allow_hard_links,
+               "read files that have more than one hard link (refused by default: another name for the same "
+               "bytes may lie outside the folders a cook may read)");
   app.add_option("-j,--jobs", jobs, "cook this many files in parallel, each in a worker process of its own")
       ->check(CLI::Range(1u, 256u));
   CLI::Option* max_memory_option = app.add_option("--max-memory", max_memory_text,
@@ -236,6 +244,7 @@ int main(int argc, char** argv) {
     options.allow_dirs.emplace_back(d);
   }
   options.write = !list_inputs;
+  options.allow_hard_links = allow_hard_links;
   SourceSkeleton reference;
   if (!skeleton_path.empty()) {
     auto loaded = load_reference_skeleton(skeleton_path, &options.reference_input);
@@ -298,14 +307,23 @@ int main(int argc, char** argv) {
     std::fflush(stderr);
   };
   const std::vector<CookRecord> records = run_batch(*plan, options, limits, jobs, progress);
+  {
+    std::vector<fs::path> own;
+    for (const std::string& p : {report_path, depfile_path})
+      if (!p.empty()) own.emplace_back(p);
+    remove_stale_temporaries(own);
+  }
 
   size_t failed = 0;
   for (const CookRecord& r : records) failed += r.ok ? 0 : 1;
+  // The report and the depfile are written whatever happens to the other: a build tool relies on
+  // the depfile even when the report's folder is read-only, and each failure is said.
+  bool written = true;
   if (!report_path.empty()) {
     const std::string text = report_json(records, options, limits).dump(2) + "\n";
     if (ossa::Status st = write_file_atomic(report_path, std::vector<uint8_t>(text.begin(), text.end())); !st) {
-      std::fprintf(stderr, "ossa-cook: report: %s\n", st.message().c_str());
-      return ossa::cli::kExitFailed;
+      std::fprintf(stderr, "ossa-cook: report: %s\n", shown(st.message()).c_str());
+      written = false;
     }
   }
   if (list_inputs) {
@@ -318,8 +336,8 @@ int main(int argc, char** argv) {
   }
   if (!depfile_path.empty()) {
     if (ossa::Status st = write_depfile(depfile_path, records); !st) {
-      std::fprintf(stderr, "ossa-cook: depfile: %s\n", st.message().c_str());
-      return ossa::cli::kExitFailed;
+      std::fprintf(stderr, "ossa-cook: depfile %s\n", shown(st.message()).c_str());
+      written = false;
     }
   }
   if (!quiet && !list_inputs) print_summary(records);
@@ -340,5 +358,5 @@ int main(int argc, char** argv) {
     }
     return ossa::cli::kExitFailed;
   }
-  return ossa::cli::kExitOk;
+  return written ? ossa::cli::kExitOk : ossa::cli::kExitFailed;
 }

@@ -208,8 +208,7 @@ void inject_fault_before(std::string_view fault, const BatchItem& item, int reco
   if (fault == "abort-writing") {  // die as if in the middle of write_file_atomic (cook.cpp)
     std::error_code ignored;
     fs::create_directories(item.output.parent_path(), ignored);
-    const fs::path tmp = item.output.parent_path() /
-                         ("." + item.output.filename().string() + ".tmp-" + std::to_string(::getpid()) + "-0");
+    const fs::path tmp = item.output.parent_path() / temporary_name(item.output.filename().string(), ::getpid(), 0);
     if (FILE* f = std::fopen(tmp.c_str(), "wb")) {
       std::fputs("half a file", f);
       std::fclose(f);
@@ -300,7 +299,7 @@ std::string signal_name(int sig) {
 void remove_leftovers(const fs::path& output, const Worker& w) {
   std::error_code ec;
   const fs::path dir = output.parent_path().empty() ? fs::path(".") : output.parent_path();
-  const std::string prefix = "." + output.filename().string() + ".tmp-" + std::to_string(w.pid) + "-";
+  const std::string prefix = temporary_prefix(output.filename().string()) + std::to_string(w.pid) + "-";
   for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
     if (it->path().filename().string().rfind(prefix, 0) != 0) continue;
     std::error_code ignored;

@@ -29,7 +29,7 @@
 //   the parent's process group so that Ctrl-C in a terminal reaches them too; and on Linux each
 //   asks for SIGKILL when the parent dies (PR_SET_PDEATHSIG), so none outlives a killed batch.
 // - After an abnormal end the parent removes what the child may have left: its temporary file
-//   (cook.cpp's write_file_atomic names them `.<output name>.tmp-<pid>-<n>` beside the output) and
+//   (write/atomic_file.h's temporary_name: `.<output name>.tmp-<pid>-<n>` beside the output) and
 //   an output it renamed into place before dying (told apart from a previous output, which a failed
 //   input must leave untouched, by its inode).
 //

@@ -9,6 +9,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <unordered_map>
+#include <unordered_set>
 
 #include "cooker/clip/clip_events.h"
 #include "cooker/graph/graph_condition.h"
@@ -31,15 +33,23 @@ const std::vector<std::string_view> kNodeKinds = {
     "clip",  "blend",      "select",         "layered",   "blend_space", "additive", "state_machine", "morph",
     "use",   "two_bone_ik", "aim",           "foot_placement", "foot_lock", "spring"};
 constexpr double kDegrees = 3.14159265358979323846 / 180.0;
-
+// The loader's bounds (runtime/loader/validate_graph.cpp). A value past one compiled into a file
+// that failed verification ("internal error, cooked bytes fail verification"): each is refused
+// here instead, where the file writes it.
+constexpr double kMaxRate = 1000.0, kMaxWeight = 100.0, kMaxSeconds = 1e6, kMaxCoordinate = 1e6;
+constexpr size_t kMaxBlendSamples = 1024;
 
 std::string a_type(ParamType t) {
   return (t == ParamType::Int || t == ParamType::Enum ? "an " : "a ") + std::string(type_word(t));
 }
 
+/// "'a', 'b', 'c'": the names a message lists, at most 20 (then "... (N in all)"): a file can
+/// declare tens of thousands, and a message per mistake must not list them all.
 std::string quoted(const std::vector<std::string>& names) {
+  constexpr size_t kListed = 20;
   std::string out;
-  for (const std::string& n : names) out += (out.empty() ? "'" : ", '") + n + "'";
+  for (size_t i = 0; i < names.size() && i < kListed; ++i) out += (out.empty() ? "'" : ", '") + names[i] + "'";
+  if (names.size() > kListed) out += ", ... (" + std::to_string(names.size()) + " in all)";
   return out;
 }
 
@@ -161,13 +171,19 @@ class GraphCompiler {
   struct Named {
     const Member* member = nullptr;
     size_t uses = 0;
+    bool checked = false;  // its node has been compiled once (the unused pass needs it no more)
   };
   std::vector<Named> named_;
+  // Name lookups by hash: a file can declare tens of thousands of each, and every reference
+  // looked up by a scan made the checks quadratic in the file's size.
+  std::unordered_map<std::string_view, size_t> named_index_;
+  std::unordered_map<std::string_view, int> param_index_, clip_index_, joint_index_;
   std::vector<std::string> use_stack_;
   size_t visits_ = 0;
   bool too_many_ = false;
   bool checking_unused_ = false;  // the node limit then only bounds the work, it is no error
-  uint32_t depth_ = 0;
+  uint32_t depth_ = 0;            // node() frames on the path, uses included (bounds the recursion)
+  uint32_t output_depth_ = 0;     // nodes on the path that are written (uses excluded)
 
   void warn(Pos pos, const std::string& what) { warnings_.push_back(json::where(check_.doc().file, pos) + what); }
 
@@ -177,7 +193,8 @@ class GraphCompiler {
     double d = 0.0;
     if (!check_.expect_number(v, what, &d)) return false;
     if (d < lo || d > hi) {
-      if (hi >= kFloatMax && lo > -kFloatMax)
+      // Below 0 where the upper bound is none, or 1e6 s (no real time nears it): name the lower only.
+      if (d < lo && lo > -kFloatMax && (hi >= kFloatMax || (lo == 0.0 && hi == kMaxSeconds)))
         return check_.error(v.pos, what + " must be >= " + number_text(lo) + ", not " + number_text(d));
       return check_.error(
           v.pos, what + " must be within [" + number_text(lo) + ", " + number_text(hi) + "], not " + number_text(d));
@@ -195,10 +212,10 @@ class GraphCompiler {
   /// A parameter named by the string v, of one of the allowed types; -1 (reported) otherwise.
   int parameter(const Value& v, std::initializer_list<ParamType> allowed, const std::string& role) {
     if (!check_.expect(v, Type::String, role + " (a parameter name)")) return -1;
-    int index = -1;
-    for (size_t p = 0; p < g_.parameters.size(); ++p)
-      if (g_.parameters[p].name == v.string) index = static_cast<int>(p);
+    const auto found = param_index_.find(v.string);
+    const int index = found == param_index_.end() ? -1 : found->second;
     if (index < 0) {
+      if (check_.full()) return check_.error(v.pos, "unknown parameter '" + v.string + "' in " + role), -1;
       std::vector<std::string> names;
       for (const GraphParameter& p : g_.parameters) names.push_back(p.name);
       const std::string hint = json::closest_name(v.string, names);
@@ -227,12 +244,11 @@ class GraphCompiler {
   /// A clip named by the string v; -1 (reported) otherwise.
   int clip(const Value& v, const std::string& role) {
     if (!check_.expect(v, Type::String, role + " (a clip name)")) return -1;
-    for (size_t c = 0; c < g_.clips.size(); ++c) {
-      if (g_.clips[c] == v.string) {
-        clip_used_[c] = true;
-        return static_cast<int>(c);
-      }
+    if (const auto found = clip_index_.find(v.string); found != clip_index_.end()) {
+      clip_used_[static_cast<size_t>(found->second)] = true;
+      return found->second;
     }
+    if (check_.full()) return check_.error(v.pos, "unknown clip '" + v.string + "'"), -1;
     const std::string hint = json::closest_name(v.string, g_.clips);
     check_.error(v.pos, "unknown clip '" + v.string + "'" + (hint.empty() ? "" : " (did you mean '" + hint + "'?)") +
                             (g_.clips.empty() ? "; \"clips\" declares none" : "; clips: " + quoted(g_.clips)));
@@ -264,13 +280,17 @@ class GraphCompiler {
 
   void read_clips(const Value& root, const GraphManifest& manifest) {
     const Value* clips = root.find("clips");
+    std::unordered_map<std::string_view, const GraphClipInfo*> imported;
+    for (const GraphClipInfo& c : ctx_.clips) imported[c.name] = &c;  // the last of a name, as a scan found it
+    std::unordered_map<std::string_view, const Value*> written;
+    if (clips && clips->is(Type::Object))
+      for (const Member& m : clips->members) written.emplace(m.key, &m.value);
     for (const GraphClipSource& entry : manifest.clips) {
       g_.clips.push_back(entry.name);
       clip_used_.push_back(false);
       clip_pos_.push_back(entry.pos);
-      const GraphClipInfo* info = nullptr;
-      for (const GraphClipInfo& c : ctx_.clips)
-        if (c.name == entry.name) info = &c;
+      const auto found = imported.find(entry.name);
+      const GraphClipInfo* info = found == imported.end() ? nullptr : found->second;
       std::vector<SourceEvent> events;
       float duration = 0.0f;
       if (!info) {
@@ -278,7 +298,8 @@ class GraphCompiler {
       } else {
         duration = info->duration;
         events = info->events;
-        const Value* value = clips ? clips->find(entry.name) : nullptr;
+        const auto w = written.find(entry.name);
+        const Value* value = w == written.end() ? nullptr : w->second;
         const Value* list = value && value->is(Type::Object) ? value->find("events") : nullptr;
         if (list && list->is(Type::Array))
           read_event_list(check_, *list, duration, "clip '" + entry.name + "'", events);
@@ -287,6 +308,7 @@ class GraphCompiler {
       clip_events_.push_back(std::move(events));
       clip_duration_.push_back(duration);
     }
+    for (size_t c = 0; c < g_.clips.size(); ++c) clip_index_.emplace(g_.clips[c], static_cast<int>(c));
   }
 
   void read_parameters(const Value* params) {
@@ -300,6 +322,7 @@ class GraphCompiler {
       g_.parameters.push_back(std::move(p));
       param_bad_.push_back(!ok);
     }
+    for (size_t p = 0; p < g_.parameters.size(); ++p) param_index_.emplace(g_.parameters[p].name, static_cast<int>(p));
   }
 
   bool read_parameter(const Member& m, GraphParameter& p) {
@@ -394,6 +417,7 @@ class GraphCompiler {
         if (!check_.expect(*values, Type::Array, what + " \"values\"")) return false;
         if (values->items.empty()) return check_.error(values->pos, what + " needs at least one value");
         if (values->items.size() > 65535) return check_.error(values->pos, what + " has more than 65535 values");
+        std::unordered_set<std::string_view> seen;
         for (const Value& name : values->items) {
           if (!check_.expect(name, Type::String, "an enum value")) {
             ok = false;
@@ -403,7 +427,7 @@ class GraphCompiler {
             ok = check_.error(name.pos, "enum value '" + name.string +
                                             "' must be an identifier (letters, digits and '_', not starting with a "
                                             "digit, not true/false/and/or/not) so conditions can name it");
-          } else if (std::find(p.enum_values.begin(), p.enum_values.end(), name.string) != p.enum_values.end()) {
+          } else if (!seen.insert(name.string).second) {
             ok = check_.error(name.pos, what + ": value '" + name.string + "' is listed twice");
           }
           p.enum_values.push_back(name.string);
@@ -427,6 +451,7 @@ class GraphCompiler {
     if (!nodes || !check_.expect(*nodes, Type::Object, "\"nodes\" (named nodes)")) return;
     for (const Member& m : nodes->members) {
       if (m.key.empty()) check_.error(m.key_pos, "a named node's name must not be empty");
+      named_index_.emplace(m.key, named_.size());
       named_.push_back({&m, 0});
     }
   }
@@ -437,6 +462,8 @@ class GraphCompiler {
     for (Named& n : named_) {
       if (n.uses > 0) continue;
       warn(n.member->key_pos, "named node '" + n.member->key + "' is never used");
+      // Compiled once already, inside another unused node's expansion: its problems are known.
+      if (n.checked) continue;
       const size_t nodes = g_.nodes.size(), machines = g_.machines.size();
       visits_ = 0;
       too_many_ = false;
@@ -444,6 +471,7 @@ class GraphCompiler {
       use_stack_ = {n.member->key};
       ++n.uses;
       (void)node(n.member->value, n.member->key);
+      n.checked = true;
       use_stack_.clear();
       g_.nodes.resize(nodes);
       g_.machines.resize(machines);
@@ -496,12 +524,22 @@ class GraphCompiler {
       check_.error(v.pos, "nodes nested deeper than " + std::to_string(kMaxNodeDepth) + " levels");
       return -1;
     }
+    // The loader's limit counts the nodes written (a use is the node it copies): a path of more
+    // than kMaxGraphDepth + 1 of them.
+    const bool output = kind->key != "use";
+    if (output && output_depth_ > kMaxGraphDepth) {
+      check_.error(v.pos,
+                   "nodes nested deeper than " + std::to_string(kMaxGraphDepth) +
+                       " levels below the root (the runtime's limit; each {\"use\"} counts as the node it copies)");
+      return -1;
+    }
     std::string name = default_name;
     if (const Value* n = v.find("name")) {
       if (!check_.expect(*n, Type::String, "a node's \"name\"")) return -1;
       name = n->string;
     }
     ++depth_;
+    output_depth_ += output ? 1 : 0;
     int index = -1;
     const std::string& k = kind->key;
     if (k == "clip") index = clip_node(v, name);
@@ -519,6 +557,7 @@ class GraphCompiler {
     else if (k == "spring") index = spring_node(v, name);
     else index = use_node(v, name, v.find("name") != nullptr);
     --depth_;
+    output_depth_ -= output ? 1 : 0;
     return index;
   }
 
@@ -526,10 +565,10 @@ class GraphCompiler {
     check_.expect_keys(v, {"use", "name"}, "a use");
     const Value& target = *v.find("use");
     if (!check_.expect(target, Type::String, "\"use\" (a named node)")) return -1;
-    Named* found = nullptr;
-    for (Named& n : named_)
-      if (n.member->key == target.string) found = &n;
+    const auto at = named_index_.find(target.string);
+    Named* found = at == named_index_.end() ? nullptr : &named_[at->second];
     if (!found) {
+      if (check_.full()) return check_.error(target.pos, "unknown named node '" + target.string + "'"), -1;
       std::vector<std::string> names;
       for (const Named& n : named_) names.push_back(n.member->key);
       const std::string hint = json::closest_name(target.string, names);
@@ -547,9 +586,15 @@ class GraphCompiler {
       return -1;
     }
     ++found->uses;
+    // While unused nodes are checked, a named node compiled once is not expanded again: its
+    // problems are known, and re-expanding every use made a chain of them quadratic. (The output
+    // of that pass is thrown away; any valid index does.)
+    if (checking_unused_ && found->checked) return 0;
     use_stack_.push_back(target.string);
+    const bool enters = !too_many_ && depth_ < kMaxNodeDepth;  // node() compiles its body
     const int index = node(found->member->value, named_here ? name : target.string);
     use_stack_.pop_back();
+    if (enters && !too_many_) found->checked = true;
     return index;
   }
 
@@ -559,7 +604,7 @@ class GraphCompiler {
     bool ok = true;
     const int index = clip(*v.find("clip"), "a clip node");
     ok &= index >= 0;
-    if (const Value* r = v.find("rate")) ok &= read_float(*r, "\"rate\"", &c.rate);
+    if (const Value* r = v.find("rate")) ok &= read_float(*r, "\"rate\"", &c.rate, -kMaxRate, kMaxRate);
     if (const Value* p = v.find("rate_parameter")) {
       const int param = parameter(*p, {ParamType::Float}, "\"rate_parameter\"");
       ok &= param >= 0;
@@ -613,7 +658,7 @@ class GraphCompiler {
     bool ok = true;
     const int param = parameter(*v.find("select"), {ParamType::Bool, ParamType::Int, ParamType::Enum}, "a select node");
     ok &= param >= 0;
-    if (const Value* t = v.find("blend_time")) ok &= read_float(*t, "\"blend_time\"", &s.blend_time, 0.0);
+    if (const Value* t = v.find("blend_time")) ok &= read_float(*t, "\"blend_time\"", &s.blend_time, 0.0, kMaxSeconds);
     const Value* children = required(v, "children", "a select node");
     if (!children) return -1;
     if (!children->is(Type::Array) && !children->is(Type::Object)) {
@@ -677,8 +722,11 @@ class GraphCompiler {
     if (!check_.expect(v, Type::String, role + "'s \"joint\"")) return -1;
     if (!ctx_.skeleton) return -1;
     const auto& joints = ctx_.skeleton->joints;
-    for (size_t j = 0; j < joints.size(); ++j)
-      if (joints[j].name == v.string) return static_cast<int>(j);
+    if (joint_index_.empty())
+      for (size_t j = joints.size(); j-- > 0;)
+        joint_index_[joints[j].name] = static_cast<int>(j);  // the first of a name
+    if (const auto found = joint_index_.find(v.string); found != joint_index_.end()) return found->second;
+    if (check_.full()) return check_.error(v.pos, "unknown joint '" + v.string + "' in " + role), -1;
     std::vector<std::string> names;
     for (const SourceJoint& j : joints) names.push_back(j.name);
     const std::string hint = json::closest_name(v.string, names);
@@ -741,7 +789,7 @@ class GraphCompiler {
         layer.weight_parameter = static_cast<int16_t>(param);
       }
       if (const Value* t = lv.find("blend_time"))
-        ok &= read_float(*t, "a layer's \"blend_time\"", &layer.blend_time, 0.0);
+        ok &= read_float(*t, "a layer's \"blend_time\"", &layer.blend_time, 0.0, kMaxSeconds);
       if (const Value* m = lv.find("mesh_space_rotation"))
         ok &= read_bool(*m, "\"mesh_space_rotation\"", &layer.mesh_space_rotation);
       if (const Value* mt = lv.find("morph_targets")) {
@@ -778,10 +826,14 @@ class GraphCompiler {
       ok &= y >= 0;
       b.y_parameter = static_cast<int16_t>(y);
     }
-    if (const Value* r = v.find("rate")) ok &= read_float(*r, "\"rate\"", &b.rate);
+    if (const Value* r = v.find("rate")) ok &= read_float(*r, "\"rate\"", &b.rate, -kMaxRate, kMaxRate);
     if (const Value* l = v.find("loop")) ok &= read_bool(*l, "\"loop\"", &b.loop);
     const Value* samples = required(v, "samples", "a blend space");
     if (!samples || !check_.expect(*samples, Type::Array, "\"samples\"")) return -1;
+    if (samples->items.size() > kMaxBlendSamples)
+      return check_.error(samples->pos, "a blend space has " + std::to_string(samples->items.size()) +
+                                            " samples; at most " + std::to_string(kMaxBlendSamples)),
+             -1;
     const bool two_d = yv != nullptr;
     std::vector<Pos> where;  // each sample's position, for the checks across samples
     for (const Value& s : samples->items) {
@@ -796,11 +848,11 @@ class GraphCompiler {
       ok &= ci >= 0;
       sample.clip = static_cast<uint16_t>(std::max(ci, 0));
       const Value* sx = required(s, "x", "a sample");
-      ok &= sx && read_float(*sx, "a sample's \"x\"", &sample.x);
+      ok &= sx && read_float(*sx, "a sample's \"x\"", &sample.x, -kMaxCoordinate, kMaxCoordinate);
       const Value* sy = s.find("y");
       if (two_d && !sy) ok = check_.error(s.pos, "a sample of a 2D blend space needs \"y\"");
       if (!two_d && sy) ok = check_.error(sy->pos, "\"y\" given but the blend space has no \"y\" parameter (1D)");
-      if (two_d && sy) ok &= read_float(*sy, "a sample's \"y\"", &sample.y);
+      if (two_d && sy) ok &= read_float(*sy, "a sample's \"y\"", &sample.y, -kMaxCoordinate, kMaxCoordinate);
       b.samples.push_back(sample);
       where.push_back(s.pos);
     }
@@ -850,7 +902,7 @@ class GraphCompiler {
     const Value* add = required(v, "add", "an additive node");
     const int added = add ? node(*add, "") : -1;
     ok &= added >= 0;
-    if (const Value* w = v.find("weight")) ok &= read_float(*w, "\"weight\"", &a.weight);
+    if (const Value* w = v.find("weight")) ok &= read_float(*w, "\"weight\"", &a.weight, -kMaxWeight, kMaxWeight);
     if (const Value* p = v.find("weight_parameter")) {
       const int param = parameter(*p, {ParamType::Float, ParamType::Bool}, "\"weight_parameter\"");
       ok &= param >= 0;
@@ -891,7 +943,8 @@ class GraphCompiler {
       const int param = p ? parameter(*p, {ParamType::Float, ParamType::Bool}, "a drive's \"parameter\"") : -1;
       ok &= param >= 0;
       drive.parameter = static_cast<uint16_t>(std::max(param, 0));
-      if (const Value* sc = d.find("scale")) ok &= read_float(*sc, "a drive's \"scale\"", &drive.scale);
+      if (const Value* sc = d.find("scale"))
+        ok &= read_float(*sc, "a drive's \"scale\"", &drive.scale, -kMaxWeight, kMaxWeight);
       m.drives.push_back(std::move(drive));
     }
     if (!ok) return -1;
@@ -1269,8 +1322,8 @@ class GraphCompiler {
     const Value* states = required(m, "states", "a state machine");
     if (states && check_.expect(*states, Type::Object, "\"states\" ({\"<state>\": {\"node\": ...}, ...})")) {
       if (states->members.empty()) ok = check_.error(states->pos, label + " has no states");
-      if (states->members.size() > 32767)
-        ok = check_.error(states->pos, label + " has more than 32767 states");  // Transition.from is int16
+      // Transition.from is int16. Past that nothing in the machine can be compiled: say so alone.
+      if (states->members.size() > 32767) return check_.error(states->pos, label + " has more than 32767 states"), -1;
       for (const Member& s : states->members) {
         StateDef st;
         st.name = s.key;
@@ -1293,12 +1346,14 @@ class GraphCompiler {
     } else {
       ok = false;
     }
+    std::unordered_map<std::string_view, int> states_by_name;
+    for (size_t i = 0; i < sm.states.size(); ++i) states_by_name.emplace(sm.states[i].name, static_cast<int>(i));
     const auto state_index = [&](const std::string& s) {
-      for (size_t i = 0; i < sm.states.size(); ++i)
-        if (sm.states[i].name == s) return static_cast<int>(i);
-      return -1;
+      const auto found = states_by_name.find(s);
+      return found == states_by_name.end() ? -1 : found->second;
     };
     const auto unknown_state = [&](const Value& at, const std::string& what) {
+      if (check_.full()) return check_.error(at.pos, what + " '" + at.string + "' is not a state of " + label);
       std::vector<std::string> names;
       for (const StateDef& s : sm.states) names.push_back(s.name);
       const std::string hint = json::closest_name(at.string, names);
@@ -1351,13 +1406,16 @@ class GraphCompiler {
       std::vector<bool> reached(sm.states.size(), false);
       std::vector<size_t> stack = {sm.entry};
       reached[sm.entry] = true;
-      for (const TransitionDef& t : sm.transitions)  // "any" leaves every state, the entry included
-        if (t.from < 0 && !reached[t.to]) reached[t.to] = true, stack.push_back(t.to);
+      std::vector<std::vector<uint16_t>> leads_to(sm.states.size());  // per state, where its transitions go
+      for (const TransitionDef& t : sm.transitions) {
+        if (t.from < 0 && !reached[t.to]) reached[t.to] = true, stack.push_back(t.to);  // "any" leaves every state
+        if (t.from >= 0) leads_to[static_cast<size_t>(t.from)].push_back(t.to);
+      }
       while (!stack.empty()) {
         const size_t s = stack.back();
         stack.pop_back();
-        for (const TransitionDef& t : sm.transitions)
-          if (t.from == static_cast<int>(s) && !reached[t.to]) reached[t.to] = true, stack.push_back(t.to);
+        for (const uint16_t to : leads_to[s])
+          if (!reached[to]) reached[to] = true, stack.push_back(to);
       }
       for (size_t s = 0; s < sm.states.size(); ++s)
         if (!reached[s])
@@ -1400,9 +1458,13 @@ class GraphCompiler {
     } else {
       ok = false;
     }
+    if (ok && out.from >= 0 && out.from == static_cast<int>(out.to))
+      ok = check_.error(t.find("to")->pos, "a transition from state '" + t.find("to")->string +
+                                               "' to itself: a state cannot transition to itself (\"restart\" on the "
+                                               "state replays it when it is entered again)");
     if (const Value* when = t.find("when")) {
       if (check_.expect(*when, Type::String, "\"when\" (a condition)")) {
-        ConditionResult c = compile_condition(when->string, g_.parameters);
+        ConditionResult c = compile_condition(when->string, g_.parameters, &param_index_, !check_.full());
         if (!c.ok) {
           ok = check_.error_in_string(*when, c.error_offset, c.error);
         } else {
@@ -1416,9 +1478,10 @@ class GraphCompiler {
     }
     if (const Value* e = t.find("exit_time")) {
       ok &= read_float(*e, "\"exit_time\" (normalized time of the source state; leave it out for none)", &out.exit_time,
-                       0.0);
+                       0.0, kMaxSeconds);
     }
-    if (const Value* d = t.find("duration")) ok &= read_float(*d, "\"duration\" (seconds)", &out.duration, 0.0);
+    if (const Value* d = t.find("duration"))
+      ok &= read_float(*d, "\"duration\" (seconds)", &out.duration, 0.0, kMaxSeconds);
     if (const Value* mode = t.find("mode")) {
       static const std::vector<std::string_view> kModes = {"crossfade", "sync_crossfade", "inertialize"};
       if (!check_.expect(*mode, Type::String, "\"mode\"")) {

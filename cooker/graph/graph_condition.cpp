@@ -39,7 +39,9 @@ const char* op_text(CondOp op) {
 
 class ConditionParser {
  public:
-  ConditionParser(std::string_view text, std::span<const GraphParameter> parameters) : s_(text), params_(parameters) {}
+  ConditionParser(std::string_view text, std::span<const GraphParameter> parameters, const ParameterIndex* index,
+                  bool hints)
+      : s_(text), params_(parameters), index_(index), hints_(hints) {}
 
   ConditionResult run() {
     ConditionResult r;
@@ -51,6 +53,9 @@ class ConditionParser {
       else if (tok_.kind == Tok::RParen) fail(tok_.offset, "')' without a matching '('");
       else fail(tok_.offset, "expected '&&', '||' or the end of the condition, found '" + std::string(tok_.text) + "'");
     }
+    if (error_.empty() && too_deep_at_ != 0)
+      fail(too_deep_at_ - 1, "the condition holds more than " + std::to_string(kMaxConditionStack) +
+                                 " values at once here (the runtime's limit): group fewer terms inside parentheses");
     r.ok = error_.empty();
     if (r.ok) r.code = std::move(code_);
     r.error = error_;
@@ -61,12 +66,16 @@ class ConditionParser {
  private:
   std::string_view s_;
   std::span<const GraphParameter> params_;
+  const ParameterIndex* index_ = nullptr;
+  bool hints_ = true;
   size_t i_ = 0;
   Token tok_;
   std::vector<CondInstr> code_;
   std::string error_;
   size_t error_offset_ = 0;
   int depth_ = 0;
+  int stack_ = 0;           // values on the evaluation stack after the code so far
+  size_t too_deep_at_ = 0;  // 1 + the offset where the stack first passed the limit; 0: never
 
   bool fail(size_t offset, std::string what) {
     if (error_.empty()) {
@@ -143,7 +152,16 @@ class ConditionParser {
     take(Tok::Bad, len);
   }
 
-  void emit(CondOp op, uint16_t parameter = 0, float value = 0.0f) { code_.push_back({op, parameter, value}); }
+  /// Appends one instruction and follows the evaluation stack it needs (RPN: emission order is
+  /// evaluation order): a loader runs conditions on a fixed stack of kMaxConditionStack values.
+  void emit(CondOp op, uint16_t parameter = 0, float value = 0.0f) {
+    code_.push_back({op, parameter, value});
+    if (op == CondOp::And || op == CondOp::Or)
+      --stack_;
+    else if (op != CondOp::Not)
+      ++stack_;
+    if (stack_ > kMaxConditionStack && !too_deep_at_) too_deep_at_ = tok_.offset + 1;  // +1: 0 means "not yet"
+  }
 
   bool bad_token() {
     if (tok_.text == "=") return fail(tok_.offset, "'=' is not an operator; compare with '=='");
@@ -221,6 +239,10 @@ class ConditionParser {
   }
 
   int find_parameter(std::string_view name) const {
+    if (index_ != nullptr) {
+      const auto found = index_->find(name);
+      return found == index_->end() ? -1 : found->second;
+    }
     for (size_t p = 0; p < params_.size(); ++p)
       if (params_[p].name == name) return static_cast<int>(p);
     return -1;
@@ -230,12 +252,14 @@ class ConditionParser {
     const Token name = tok_;
     const int index = find_parameter(name.text);
     if (index < 0) {
+      if (!hints_) return fail(name.offset, "unknown parameter '" + std::string(name.text) + "'");
       std::string known;
       std::vector<std::string> names;
       for (const GraphParameter& p : params_) {
-        known += (known.empty() ? "" : ", ") + p.name;
+        if (names.size() < 20) known += (known.empty() ? "" : ", ") + p.name;
         names.push_back(p.name);
       }
+      if (names.size() > 20) known += ", ... (" + std::to_string(names.size()) + " in all)";
       const std::string hint = json::closest_name(name.text, names);
       return fail(name.offset,
                   "unknown parameter '" + std::string(name.text) + "'" +
@@ -278,6 +302,10 @@ class ConditionParser {
           return fail(lit.offset, "'" + param.name + "' is " + (param.type == ParamType::Int ? "an int" : "a float") +
                                       " parameter: compare it with a number");
         }
+        // A value past float's range would be stored as infinity, which no comparison can use.
+        if (!(std::fabs(lit.number) <= 3.4028234663852886e38))
+          return fail(lit.offset,
+                      "the number " + std::string(lit.text) + " is outside the range of a float (+-3.4e38)");
         emit(op.op, p16, static_cast<float>(lit.number));
         next();
         return true;
@@ -328,8 +356,9 @@ const char* type_word(ParamType t) {
   return "?";
 }
 
-ConditionResult compile_condition(std::string_view text, std::span<const GraphParameter> parameters) {
-  return ConditionParser(text, parameters).run();
+ConditionResult compile_condition(std::string_view text, std::span<const GraphParameter> parameters,
+                                  const ParameterIndex* index, bool hints) {
+  return ConditionParser(text, parameters, index, hints).run();
 }
 
 bool is_condition_identifier(std::string_view name) {

@@ -18,6 +18,7 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <unordered_map>
 #include <vector>
 
 #include "cooker/model/graph_def.h"
@@ -34,8 +35,19 @@ struct ConditionResult {
   std::string error;            // what is wrong, without a position
 };
 
-/// Compiles `text` against the graph's parameters. O(text length * parameters).
-ConditionResult compile_condition(std::string_view text, std::span<const GraphParameter> parameters);
+/// The deepest evaluation stack a condition may need: the loader's limit (validate_graph.cpp).
+inline constexpr int kMaxConditionStack = 16;
+
+/// The parameters' indices by name, for compile_condition (a graph compiles thousands of
+/// conditions against thousands of parameters).
+using ParameterIndex = std::unordered_map<std::string_view, int>;
+
+/// Compiles `text` against the graph's parameters, found through `index` when given (else by a
+/// scan). `hints` false: an unknown parameter's message names it without searching the
+/// parameters for a near name or listing them (the caller keeps no more messages). O(text length)
+/// with an index, O(text length * parameters) without.
+ConditionResult compile_condition(std::string_view text, std::span<const GraphParameter> parameters,
+                                  const ParameterIndex* index = nullptr, bool hints = true);
 
 /// True when `name` can be written in a condition: [A-Za-z_][A-Za-z0-9_]* and not one of the
 /// words true, false, and, or, not.

@@ -5,6 +5,7 @@
 #include <cctype>
 #include <cstring>
 #include <string_view>
+#include <unordered_map>
 
 #include <nlohmann/json.hpp>
 
@@ -84,6 +85,149 @@ uint64_t fbx_binary_depth(std::span<const uint8_t> b) {
     const uint64_t children = at + header + name_length + property_bytes;
     if (children > end) return deepest;
     at = static_cast<size_t>(children);
+  }
+  return deepest;
+}
+
+/// The value of attribute `name` in the attribute text of one tag (between the name and '>'),
+/// or empty. Enough for Collada's `id="..."` and `url="#..."`.
+std::string_view attribute(std::string_view attrs, std::string_view name) {
+  for (size_t at = attrs.find(name); at != std::string_view::npos; at = attrs.find(name, at + 1)) {
+    const bool starts = at == 0 || std::isspace(static_cast<unsigned char>(attrs[at - 1]));
+    size_t i = at + name.size();
+    while (i < attrs.size() && std::isspace(static_cast<unsigned char>(attrs[i]))) ++i;
+    if (!starts || i >= attrs.size() || attrs[i] != '=') continue;
+    ++i;
+    while (i < attrs.size() && std::isspace(static_cast<unsigned char>(attrs[i]))) ++i;
+    if (i >= attrs.size() || (attrs[i] != '"' && attrs[i] != '\'')) continue;
+    const size_t end = attrs.find(attrs[i], i + 1);
+    if (end == std::string_view::npos) return {};
+    return attrs.substr(i + 1, end - i - 1);
+  }
+  return {};
+}
+
+/// The deepest node hierarchy a Collada file makes: `<node>` elements nested in each other, and
+/// through `<instance_node url="#id">`, which Assimp expands in place (a chain of library nodes
+/// each instancing the next is as deep as a nested chain). By a scan of the XML's tags (comments,
+/// CDATA, processing instructions and declarations skipped; quoted values may hold '>'), then the
+/// longest path over that graph, iteratively. A cycle of instances (Assimp would recurse forever)
+/// counts as too deep. Malformed XML is scanned as far as it reads; Assimp reports the rest.
+uint64_t collada_node_depth(std::span<const uint8_t> bytes) {
+  const std::string_view text(reinterpret_cast<const char*>(bytes.data()), bytes.size());
+  struct Node {
+    std::vector<uint32_t> children;           // nested <node>s
+    std::vector<std::string_view> instances;  // ids named by <instance_node> directly inside
+  };
+  std::vector<Node> nodes;
+  std::unordered_map<std::string_view, uint32_t> by_id;
+  std::vector<int64_t> open;  // per open element: its node index, or -1
+  const auto skip_to = [&](size_t from, std::string_view end) {
+    const size_t at = text.find(end, from);
+    return at == std::string_view::npos ? text.size() : at + end.size();
+  };
+  const auto is_name_char = [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.' || c == ':' ||
+           static_cast<unsigned char>(c) >= 0x80;
+  };
+  const auto enclosing_node = [&]() -> int64_t {
+    for (auto it = open.rbegin(); it != open.rend(); ++it)
+      if (*it >= 0) return *it;
+    return -1;
+  };
+  size_t i = 0;
+  while ((i = text.find('<', i)) != std::string_view::npos) {
+    const std::string_view rest = text.substr(i);
+    if (rest.substr(0, 4) == "<!--") {
+      i = skip_to(i + 4, "-->");
+      continue;
+    }
+    if (rest.substr(0, 9) == "<![CDATA[") {
+      i = skip_to(i + 9, "]]>");
+      continue;
+    }
+    if (rest.substr(0, 2) == "<?") {
+      i = skip_to(i + 2, "?>");
+      continue;
+    }
+    if (rest.substr(0, 2) == "<!") {
+      i = skip_to(i + 2, ">");
+      continue;
+    }
+    const bool closing = rest.substr(0, 2) == "</";
+    const size_t name_at = i + (closing ? 2 : 1);
+    size_t name_end = name_at;
+    while (name_end < text.size() && is_name_char(text[name_end])) ++name_end;
+    const std::string_view name = text.substr(name_at, name_end - name_at);
+    size_t j = name_end;  // the tag's '>', past quoted attribute values
+    for (char quote = 0; j < text.size(); ++j) {
+      if (quote) {
+        if (text[j] == quote) quote = 0;
+      } else if (text[j] == '"' || text[j] == '\'') {
+        quote = text[j];
+      } else if (text[j] == '>') {
+        break;
+      }
+    }
+    if (j >= text.size()) break;  // a tag never closed
+    const std::string_view attrs = text.substr(name_end, j - name_end);
+    if (closing) {
+      if (!open.empty()) open.pop_back();
+    } else if (name == "instance_node") {
+      const std::string_view url = attribute(attrs, "url");
+      if (const int64_t parent = enclosing_node(); parent >= 0 && url.size() > 1 && url[0] == '#')
+        nodes[static_cast<size_t>(parent)].instances.push_back(url.substr(1));
+      if (text[j - 1] != '/') open.push_back(-1);
+    } else if (!name.empty() && text[j - 1] != '/') {
+      int64_t index = -1;
+      if (name == "node") {
+        index = static_cast<int64_t>(nodes.size());
+        if (const int64_t parent = enclosing_node(); parent >= 0)
+          nodes[static_cast<size_t>(parent)].children.push_back(static_cast<uint32_t>(index));
+        nodes.emplace_back();
+        if (const std::string_view id = attribute(attrs, "id"); !id.empty())
+          by_id.emplace(id, static_cast<uint32_t>(index));
+      }
+      open.push_back(index);
+    }
+    i = j + 1;
+  }
+  // Longest path (in nodes) from each node, by an explicit stack; 0 = not started, 1 = on the
+  // stack (seen again: a cycle), 2 = done.
+  std::vector<uint64_t> depth(nodes.size(), 0);
+  std::vector<uint8_t> state(nodes.size(), 0);
+  const auto edges = [&](uint32_t n, auto&& visit) {
+    for (uint32_t c : nodes[n].children) visit(c);
+    for (std::string_view id : nodes[n].instances)
+      if (const auto it = by_id.find(id); it != by_id.end()) visit(it->second);
+  };
+  uint64_t deepest = 0;
+  for (uint32_t start = 0; start < nodes.size(); ++start) {
+    if (state[start] != 0) continue;
+    std::vector<uint32_t> stack{start};
+    while (!stack.empty()) {
+      const uint32_t n = stack.back();
+      if (state[n] == 0) {
+        state[n] = 1;
+        bool cycle = false;
+        edges(n, [&](uint32_t c) {
+          if (state[c] == 0)
+            stack.push_back(c);
+          else if (state[c] == 1)
+            cycle = true;
+        });
+        if (cycle) return uint64_t{kMaxHierarchyDepth} + 1;
+        continue;
+      }
+      stack.pop_back();
+      if (state[n] == 2) continue;
+      uint64_t below = 0;
+      edges(n, [&](uint32_t c) { below = std::max(below, depth[c]); });
+      depth[n] = below + 1;
+      state[n] = 2;
+      deepest = std::max(deepest, depth[n]);
+      if (deepest > kMaxHierarchyDepth) return deepest;
+    }
   }
   return deepest;
 }
@@ -253,6 +397,9 @@ Result<std::optional<std::vector<uint8_t>>> precheck_source(std::span<const uint
           return Error{"declares \"Frames: " + std::string(text.substr(i, std::min<size_t>(12, text.find_first_of("\r\n", i) - i))) +
                        "\": a BVH motion needs at least one frame"};
       }
+    } else if (extension == ".dae") {
+      if (const uint64_t d = collada_node_depth(bytes); d > kMaxHierarchyDepth)
+        return too_deep(d, "node tree (nested <node>s and the <instance_node>s they expand)");
     } else if (extension == ".fbx") {
       constexpr std::string_view kBinary = "Kaydara FBX Binary  ";
       const bool binary = bytes.size() >= kBinary.size() && std::memcmp(bytes.data(), kBinary.data(), kBinary.size()) == 0;

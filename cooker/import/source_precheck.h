@@ -5,8 +5,9 @@
 // the cause is cheap to see in the bytes, it is handled here first, in ossa's own code:
 //   - hierarchies deeper than kMaxHierarchyDepth are refused with a message: Assimp's importers
 //     and post-processing recurse once per level and overflow the stack (a 20,000-node glTF
-//     chain, a 100,000-level FBX). Measured by an iterative scan of the glTF node tree, the BVH
-//     and ASCII FBX brace nesting and the binary FBX record nesting;
+//     chain or Collada `<node>` chain, a 100,000-level FBX). Measured by an iterative scan of the
+//     glTF node tree, the Collada `<node>` tree (nesting, and `<instance_node>` references, which
+//     Assimp expands in place), the BVH and ASCII FBX brace nesting and the binary FBX records;
 //   - a glTF skin without `inverseBindMatrices` (optional in the spec: identity matrices) gets
 //     an explicit accessor of identity matrices, because Assimp dereferences the missing one;
 //     a skin without joints, or with indices that name no node or accessor, is refused (found by

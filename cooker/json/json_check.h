@@ -26,6 +26,9 @@ class Checker {
 
   const Document& doc() const { return doc_; }
   bool ok() const { return errors_.empty(); }
+  /// True once kMaxErrors messages are kept: a further one is only counted, so a caller may skip
+  /// what makes a message costly (a hint searched among thousands of names, a list of them).
+  bool full() const { return errors_.size() >= kMaxErrors; }
   /// The messages in the order found.
   const std::vector<std::string>& errors() const { return errors_; }
   /// Every message, one per line, in the order of their positions in the file.

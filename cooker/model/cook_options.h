@@ -61,6 +61,9 @@ struct CookOptions {
   /// input's own folder tree, and inside each of `allow_dirs` (--allow-dir).
   std::filesystem::path root;
   std::vector<std::filesystem::path> allow_dirs;
+  /// --allow-hard-links: read regular files that have other links (refused by default: a hard
+  /// link is another name for bytes that may lie outside the allowed folders).
+  bool allow_hard_links = false;
   bool force = false;  // --force: cook even when the output is up to date
   bool write = true;   // false (--list-inputs): cook in memory, write nothing
 };

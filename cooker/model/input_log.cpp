@@ -10,36 +10,34 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
-#include <fstream>
+#include <memory>
 
 #include "common/message.h"
+#include "common/open_beneath.h"
 #include <ossa/version.h>
 
 namespace ossa::cook {
 namespace fs = std::filesystem;
 
+/// The limits of ReadSandboxScope: the folders' descriptors and the hard-link rule.
+struct ReadSandbox {
+  ReadRoots roots;
+  bool allow_hard_links = false;
+};
+
 namespace {
 
 thread_local InputLog* t_current = nullptr;
-thread_local const std::vector<fs::path>* t_sandbox = nullptr;  // null: no limit
+thread_local const ReadSandbox* t_sandbox = nullptr;  // null: no limit
 
-/// `path` absolute, with `..` and every symlink of its existing part resolved.
+/// `path` absolute, with `..` and every symlink of its existing part resolved: for messages only
+/// (what a refused name led to); the sandbox itself never decides by a resolved path.
 fs::path canonical_path(const fs::path& path) {
   std::error_code ec;
   fs::path abs = fs::absolute(path, ec);
   if (ec) return path.lexically_normal();
   fs::path canon = fs::weakly_canonical(abs, ec);
   return ec ? abs.lexically_normal() : canon;
-}
-
-bool inside_sandbox(const fs::path& path) {
-  if (t_sandbox == nullptr) return true;
-  const fs::path canon = canonical_path(path);
-  for (const fs::path& dir : *t_sandbox) {
-    const fs::path rel = canon.lexically_relative(dir);
-    if (!rel.empty() && *rel.begin() != "..") return true;
-  }
-  return false;
 }
 
 fs::path normal_absolute(const fs::path& path) {
@@ -76,9 +74,9 @@ InputLog* current_input_log() { return t_current; }
 InputLogScope::InputLogScope(InputLog* log) : previous_(t_current) { t_current = log; }
 InputLogScope::~InputLogScope() { t_current = previous_; }
 
-ReadSandboxScope::ReadSandboxScope(const std::vector<fs::path>& allowed_dirs) : previous_(t_sandbox) {
-  for (const fs::path& d : allowed_dirs) allowed_.push_back(canonical_path(d));
-  t_sandbox = &allowed_;
+ReadSandboxScope::ReadSandboxScope(const std::vector<fs::path>& allowed_dirs, bool allow_hard_links)
+    : previous_(t_sandbox), sandbox_(new ReadSandbox{ReadRoots(allowed_dirs), allow_hard_links}) {
+  t_sandbox = sandbox_.get();
 }
 ReadSandboxScope::~ReadSandboxScope() { t_sandbox = previous_; }
 
@@ -86,7 +84,7 @@ namespace {
 
 std::string allowed_list() {
   std::string s;
-  for (const fs::path& d : *t_sandbox) s += (s.empty() ? "" : ", ") + d.string();
+  for (const ReadRoots::Root& r : t_sandbox->roots.roots()) s += (s.empty() ? "" : ", ") + r.canonical.string();
   return s;
 }
 
@@ -110,55 +108,44 @@ std::string outside_message() {
          "; widen them with --root DIR or --allow-dir DIR)";
 }
 
-const char* kind_of(const struct stat& st) {
-  if (S_ISDIR(st.st_mode)) return "a directory";
-  if (S_ISFIFO(st.st_mode)) return "a FIFO";
-  if (S_ISCHR(st.st_mode) || S_ISBLK(st.st_mode)) return "a device";
-  if (S_ISSOCK(st.st_mode)) return "a socket";
-  return "not a regular file";
+std::string hard_link_message(const struct stat& st) {
+  return "has " + std::to_string(st.st_nlink) +
+         " hard links: another name for the same bytes may lie outside the folders this cook may read "
+         "(--allow-hard-links reads such files)";
 }
-
-}  // namespace
-
-namespace {
 
 struct OpenedInput {
   int fd = -1;
   uint64_t size = 0;
 };
 
-/// The checks every read makes (NUL byte, sandbox, regular file, size), then the open file.
+/// The sandbox's one door: resolved and opened in one step beneath the allowed folders
+/// (open_beneath.h), then checked on the opened descriptor (regular file, links, size).
 Result<OpenedInput> open_input(const fs::path& path, uint64_t max_bytes, std::string_view reference) {
   // A NUL byte (a JSON "\u0000") would cut the path short for the operating system: another file.
   if (path.native().find('\0') != std::string::npos)
     return Error{refuse(path, "contains a NUL byte", reference)};
-  if (!inside_sandbox(path)) return Error{refuse(path, outside_message(), reference)};
-  struct stat st{};
-  if (::stat(path.c_str(), &st) != 0) {
-    const int err = errno;
-    if (err == ENOENT || err == ENOTDIR) {
+  const ReadSandbox* sandbox = t_sandbox;
+  const OpenedFile f =
+      open_beneath(sandbox ? &sandbox->roots : nullptr, path, true, !sandbox || sandbox->allow_hard_links);
+  switch (f.outcome) {
+    case OpenOutcome::kOpened: break;
+    case OpenOutcome::kAbsent:
       if (InputLog* log = current_input_log()) log->add_absent(path);
-    }
-    return Error{detail::printable(path.string(), 400) + ": cannot open: " + std::strerror(err)};
+      return Error{detail::printable(path.string(), 400) + ": cannot open: " + std::strerror(f.error)};
+    case OpenOutcome::kOutside: return Error{refuse(path, outside_message(), reference)};
+    case OpenOutcome::kNotRegular:
+      return Error{refuse(path, std::string("is ") + file_kind(f.st) + ", not a regular file", reference)};
+    case OpenOutcome::kHardLinked: return Error{refuse(path, hard_link_message(f.st), reference)};
+    case OpenOutcome::kError:
+      return Error{detail::printable(path.string(), 400) + ": cannot open: " + std::strerror(f.error)};
   }
-  if (!S_ISREG(st.st_mode)) return Error{refuse(path, std::string("is ") + kind_of(st) + ", not a regular file", reference)};
-  if (static_cast<uint64_t>(st.st_size) > max_bytes)
-    return Error{detail::printable(path.string(), 400) + ": is " + std::to_string(st.st_size) + " bytes, over the limit of " +
-                 std::to_string(max_bytes)};
-  // O_NONBLOCK: should the path have become a FIFO since stat, open must not wait for a writer;
-  // fstat then sees what was actually opened.
-  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
-  if (fd < 0) return Error{detail::printable(path.string(), 400) + ": cannot open: " + std::strerror(errno)};
-  struct stat opened{};
-  if (::fstat(fd, &opened) != 0 || !S_ISREG(opened.st_mode)) {
-    ::close(fd);
-    return Error{refuse(path, "is not a regular file", reference)};
+  if (static_cast<uint64_t>(f.st.st_size) > max_bytes) {
+    ::close(f.fd);
+    return Error{detail::printable(path.string(), 400) + ": is " + std::to_string(f.st.st_size) +
+                 " bytes, over the limit of " + std::to_string(max_bytes)};
   }
-  if (static_cast<uint64_t>(opened.st_size) > max_bytes) {
-    ::close(fd);
-    return Error{detail::printable(path.string(), 400) + ": grew over the limit while being opened"};
-  }
-  return OpenedInput{fd, static_cast<uint64_t>(opened.st_size)};
+  return OpenedInput{f.fd, static_cast<uint64_t>(f.st.st_size)};
 }
 
 }  // namespace
@@ -217,13 +204,31 @@ bool probe_input(const fs::path& path, std::string_view reference) {
     refuse(path, "contains a NUL byte", reference);
     return false;
   }
-  if (!inside_sandbox(path)) {
-    refuse(path, outside_message(), reference);
-    return false;
+  // Resolved as a read would resolve it, nothing opened for reading: a name that exists but is no
+  // regular file (a FIFO called walk.events.json) is refused, not taken for absent.
+  const ReadSandbox* sandbox = t_sandbox;
+  const OpenedFile f =
+      open_beneath(sandbox ? &sandbox->roots : nullptr, path, false, !sandbox || sandbox->allow_hard_links);
+  switch (f.outcome) {
+    case OpenOutcome::kOpened: return true;
+    case OpenOutcome::kAbsent:
+      if (InputLog* log = current_input_log()) log->add_absent(path);
+      return false;
+    case OpenOutcome::kOutside: refuse(path, outside_message(), reference); return false;
+    case OpenOutcome::kNotRegular:
+      // A folder is no file of that name (an importer probes folders, e.g. an empty "mtllib"); a
+      // FIFO, device or socket is a file the cook cannot read, and must not pass for absent.
+      if (S_ISDIR(f.st.st_mode)) {
+        if (InputLog* log = current_input_log()) log->add_absent(path);
+        return false;
+      }
+      refuse(path, std::string("is ") + file_kind(f.st) + ", not a regular file", reference);
+      return false;
+    case OpenOutcome::kHardLinked: refuse(path, hard_link_message(f.st), reference); return false;
+    case OpenOutcome::kError:
+      refuse(path, std::string("cannot be opened: ") + std::strerror(f.error), reference);
+      return false;
   }
-  std::error_code ec;
-  if (fs::is_regular_file(path, ec)) return true;
-  if (InputLog* log = current_input_log()) log->add_absent(path);
   return false;
 }
 

@@ -12,11 +12,13 @@
 // `walk.events.json` later must make the output out of date, so its absence is part of the key.
 //
 // The same door is the read sandbox (ReadSandboxScope): while a cook runs, a file outside the
-// folders it may read (the input's own tree, or --root, and --allow-dir), after `..` and symlinks
-// are resolved, is refused by name and never opened, and so is anything that is not a regular file
-// (a device, a FIFO, a directory). Each refusal is kept in the log with the reference that named
-// the file, and fails the cook: a source cannot pull /etc/passwd or a neighbour's files into an
-// output, whichever importer reads them.
+// folders it may read (the input's own tree, or --root, and --allow-dir) is refused by name and
+// never opened, and so is anything that is not a regular file (a device, a FIFO, a directory) and
+// a file with other hard links. Each path is resolved and opened in one step from a descriptor of
+// an allowed folder (open_beneath.h) and checked on the opened descriptor, so a symlink swapped in
+// while the cook runs cannot lead it out. Each refusal is kept in the log with the reference that
+// named the file, and fails the cook: a source cannot pull /etc/passwd or a neighbour's files into
+// an output, whichever importer reads them.
 //
 // The hash is XXH3-64 (Debian's libxxhash): ~30 GB/s against FNV-1a's ~1 GB/s, so keying a cook
 // costs nothing next to importing it (ossa-bench-cook measures both).
@@ -24,6 +26,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <span>
 #include <string>
 #include <string_view>
@@ -81,24 +84,29 @@ class InputLogScope {
   InputLog* previous_;
 };
 
-/// Limits this thread's reads to regular files inside `allowed_dirs` (made canonical here) until
-/// destroyed. Scopes nest; the previous limit is restored.
+struct ReadSandbox;
+
+/// Limits this thread's reads to regular files beneath `allowed_dirs` until destroyed (scopes
+/// nest; the previous limit is restored). The folders are opened here and every read is resolved
+/// from their descriptors (open_beneath.h), so no change to the tree while a cook runs can lead a
+/// read outside. Unless `allow_hard_links`, a regular file with more than one link is refused.
 class ReadSandboxScope {
  public:
-  explicit ReadSandboxScope(const std::vector<std::filesystem::path>& allowed_dirs);
+  explicit ReadSandboxScope(const std::vector<std::filesystem::path>& allowed_dirs, bool allow_hard_links = false);
   ~ReadSandboxScope();
   ReadSandboxScope(const ReadSandboxScope&) = delete;
   ReadSandboxScope& operator=(const ReadSandboxScope&) = delete;
 
  private:
-  const std::vector<std::filesystem::path>* previous_;
-  std::vector<std::filesystem::path> allowed_;
+  const ReadSandbox* previous_;
+  std::unique_ptr<ReadSandbox> sandbox_;
 };
 
 /// Reads the whole of `path` and records it in the current log (a missing file is recorded absent).
-/// Refused without opening: a path outside the sandbox, anything not a regular file, a file over
-/// `max_bytes`; a refusal is also kept in the log. `reference` says what named the file (e.g.
-/// "a texture of material 'skin'") for the messages. Errors name the file. O(file size).
+/// Refused without reading: a path outside the sandbox, anything not a regular file, a file with
+/// other hard links, a file over `max_bytes`; a refusal is also kept in the log. `reference` says
+/// what named the file (e.g. "a texture of material 'skin'") for the messages. Errors name the
+/// file. O(file size).
 Result<std::vector<uint8_t>> read_input(const std::filesystem::path& path, uint64_t max_bytes = UINT64_MAX,
                                         std::string_view reference = {});
 
@@ -107,8 +115,10 @@ Result<std::vector<uint8_t>> read_input(const std::filesystem::path& path, uint6
 /// of the file's size.
 Status hash_input(const std::filesystem::path& path, std::string_view reference = {});
 
-/// True when `path` is a regular file inside the sandbox; a missing file is recorded absent, one
-/// outside the sandbox is recorded as a refusal (it was named by the input, and cannot be read).
+/// True when `path` is a regular file inside the sandbox; a missing file (or a folder) is recorded
+/// absent; one outside the sandbox, a FIFO, device or socket (one named like a sidecar),
+/// has other hard links or cannot be opened is recorded as a refusal (the cook must fail, not
+/// carry on as if it were absent). Opens nothing for reading.
 bool probe_input(const std::filesystem::path& path, std::string_view reference = {});
 
 /// `files` (absolute paths) with each path made relative to `base` (the input's directory) and

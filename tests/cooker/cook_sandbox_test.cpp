@@ -149,6 +149,67 @@ TEST_F(CookSandbox, FifosAndDevicesAreRefusedWithoutBeingOpened) {
   EXPECT_FALSE(fs::exists(dir / "out"));
 }
 
+// A hard link is another name for the same bytes: `ln /secret tree/x.png` would read the secret
+// through a name inside the tree. Regular files with more than one link are refused unless
+// --allow-hard-links (docs/COOKING-SECURITY.md), whatever reads them: an image, a buffer, an OBJ
+// source and the material library it names.
+TEST_F(CookSandbox, HardLinkedFilesAreRefusedUnlessAllowed) {
+  const auto png = ossa::test::tiny_png();
+  ASSERT_TRUE(ossa::test::write_file(secret / "real.png", png));
+  const std::string obj = "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl skin\nf 1 2 3\n";
+  ASSERT_TRUE(ossa::test::write_file(secret / "s.obj", obj));
+  ASSERT_TRUE(ossa::test::write_file(secret / "m.mtl", std::string_view("newmtl skin\nKd 1 0 0\n")));
+  struct Case {
+    const char* name;    // the input, in tree/chars
+    const char* linked;  // the name in tree/chars that is a hard link to a file in secret/
+    const char* target;
+  };
+  const Case cases[] = {{"img.gltf", "hl.png", "real.png"},
+                        {"buf.gltf", "hl.bin", "creds.bin"},
+                        {"hl.obj", "hl.obj", "s.obj"},
+                        {"mat.obj", "m.mtl", "m.mtl"}};
+  ASSERT_TRUE(ossa::test::write_file(tree / "chars" / "img.gltf", triangle_gltf("tri.bin", "hl.png")));
+  ASSERT_TRUE(ossa::test::write_file(tree / "chars" / "buf.gltf", triangle_gltf("hl.bin")));
+  ASSERT_TRUE(ossa::test::write_file(tree / "chars" / "mat.obj", obj));
+  for (const Case& c : cases) {
+    const fs::path link = tree / "chars" / c.linked;
+    fs::remove(link);
+    fs::create_hard_link(secret / c.target, link);
+    const auto r = cook(tree / "chars" / c.name, "--force");
+    EXPECT_EQ(r.exit_code, 1) << c.name << ": " << r.err;
+    EXPECT_NE(r.err.find(std::string(c.linked) + ": refused: has 2 hard links"), std::string::npos)
+        << c.name << ": " << r.err;
+    EXPECT_NE(r.err.find("--allow-hard-links"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(dir / "out" / (fs::path(c.name).stem().string() + ".ossa"))) << c.name;
+    const auto allowed = cook(tree / "chars" / c.name, "--force --allow-hard-links");
+    EXPECT_EQ(allowed.exit_code, 0) << c.name << ": " << allowed.err;
+    fs::remove_all(dir / "out");
+  }
+}
+
+// Wherever the cooker looks for a file that may be absent (settings, the events sidecar), a name
+// that exists but is not a regular file fails the input: it is not taken for "absent".
+TEST_F(CookSandbox, FifosNamedLikeSettingsOrSidecarsFailTheInput) {
+  const std::string obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+  for (const char* name : {"ossa.cook.json", "a.cook.json", "a.events.json"}) {
+    const fs::path folder = tree / ("f-" + std::string(name));
+    fs::create_directories(folder);
+    ASSERT_TRUE(ossa::test::write_file(folder / "a.obj", obj));
+    ASSERT_EQ(::mkfifo((folder / name).c_str(), 0644), 0);
+    const auto start = std::chrono::steady_clock::now();
+    const auto r = cook(folder / "a.obj", "--timeout 20");
+    EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 10.0) << name;
+    EXPECT_EQ(r.exit_code, 1) << name << ": " << r.err;
+    EXPECT_NE(r.err.find(std::string(name) + ": refused: is a FIFO, not a regular file"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("a.obj"), std::string::npos) << "names the input: " << r.err;
+    EXPECT_FALSE(fs::exists(dir / "out" / "a.ossa")) << name;
+    // The same source with nothing of that name cooks.
+    fs::remove(folder / name);
+    EXPECT_EQ(cook(folder / "a.obj").exit_code, 0) << name;
+    fs::remove_all(dir / "out");
+  }
+}
+
 // Textures are identified by their bytes and must decode (cooker/import/image_check.h).
 TEST_F(CookSandbox, TexturesMustBeTheImagesTheyClaimToBe) {
   const auto png = ossa::test::tiny_png();
@@ -246,12 +307,49 @@ TEST_F(CookSandbox, DeepHierarchiesAreRefusedBeforeTheImporterRecurses) {
   bvh += "MOTION\nFrames: 1\nFrame Time: 0.033\n";
   for (int i = 0; i < 20000; ++i) bvh += "0 0 0 ";
   ASSERT_TRUE(ossa::test::write_file(tree / "chars" / "chainb.bvh", bvh));
+  // Collada: <node>s nested 2,000 and 20,000 deep (Assimp cooked the first despite the documented
+  // limit and crashed on the second), and a chain of 20,000 library nodes each instancing the next
+  // (as deep once Assimp expands it, with no nesting in the XML).
+  const auto collada = [](const std::string& library, const std::string& scene) {
+    return "<?xml version=\"1.0\"?>\n<COLLADA xmlns=\"http://www.collada.org/2005/11/COLLADASchema\" version=\"1.4.1\">"
+           "<asset><unit meter=\"1\"/><up_axis>Y_UP</up_axis></asset><library_nodes>" +
+           library + "</library_nodes><library_visual_scenes><visual_scene id=\"s\">" + scene +
+           "</visual_scene></library_visual_scenes><scene><instance_visual_scene url=\"#s\"/></scene></COLLADA>\n";
+  };
+  for (int n : {2000, 20000}) {
+    std::string nested;
+    for (int i = 0; i < n; ++i)
+      nested += "<node id=\"n" + std::to_string(i) + "\" type=\"JOINT\"><translate>0 1 0</translate>";
+    for (int i = 0; i < n; ++i) nested += "</node>";
+    ASSERT_TRUE(ossa::test::write_file(tree / "chars" / ("chain" + std::to_string(n) + ".dae"), collada("", nested)));
+  }
+  std::string instanced;
+  for (int i = 0; i < 20000; ++i)
+    instanced += "<node id=\"n" + std::to_string(i) + "\">" +
+                 (i + 1 < 20000 ? "<instance_node url=\"#n" + std::to_string(i + 1) + "\"/>" : "") + "</node>";
+  ASSERT_TRUE(ossa::test::write_file(tree / "chars" / "chaini.dae",
+                                     collada(instanced, "<node id=\"root\"><instance_node url=\"#n0\"/></node>")));
+  // Within the limit: 999 nested nodes (a skeleton of 999 joints) cook.
+  std::string ok;
+  for (int i = 0; i < 999; ++i)
+    ok += "<node id=\"j" + std::to_string(i) + "\" sid=\"j" + std::to_string(i) +
+          "\" type=\"JOINT\"><translate>0 1 0</translate>";
+  for (int i = 0; i < 999; ++i) ok += "</node>";
+  ASSERT_TRUE(ossa::test::write_file(tree / "chars" / "deep999.dae", collada("", ok)));
   const auto r = run_command(cook_cmd() + " " + q(tree / "chars") + " -o " + q(dir / "out") + " --report " +
                              q(dir / "report.json"));
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find("chain.gltf: its node tree is nested over 1000+ levels deep"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("chainb.bvh: its joint hierarchy is nested over 1000+ levels deep"), std::string::npos) << r.err;
+  for (const char* dae : {"chain2000.dae", "chain20000.dae", "chaini.dae"})
+    EXPECT_NE(
+        r.err.find(std::string(dae) + ": its node tree (nested <node>s and the <instance_node>s they expand) is nested "
+                                      "over 1000+ levels deep"),
+        std::string::npos)
+        << r.err;
   EXPECT_EQ(r.err.find("signal"), std::string::npos) << "refused, not crashed: " << r.err;
+  EXPECT_EQ(r.err.find("deep999.dae: "), std::string::npos) << "within the limit: " << r.err;
+  EXPECT_TRUE(fs::exists(dir / "out" / "deep999.ossa"));
 }
 
 TEST_F(CookSandbox, AGltfSkinWithoutInverseBindMatricesMeansIdentity) {

@@ -4,6 +4,7 @@
 // provenance hash follows every file a graph reads; the Pab foot events sit where the feet plant.
 #include <gtest/gtest.h>
 
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <set>
@@ -268,6 +269,60 @@ TEST(GraphCli, ABadGraphFailsAloneInABatch) {
   EXPECT_TRUE(ossa::Asset::open((out / "good.ossa").string()).ok());
   EXPECT_TRUE(ossa::Asset::open((out / "RiggedSimple.ossa").string()).ok());
   EXPECT_EQ(count_files(out), 2u);
+}
+
+// Values the runtime's loader refuses compiled into files that then failed verification ("internal
+// error, cooked bytes fail verification", no position). Through ossa-cook, each is refused with
+// `file:line:col`, and the same graph within bounds cooks into a file that loads.
+TEST(GraphCli, WhatTheLoaderWouldRefuseIsRefusedWithAPosition) {
+  const fs::path dir = ossa::test::make_temp_dir("graph-bounds");
+  const auto graph = [](const std::string& root) {
+    return "{\n  \"ossa_graph\": 1,\n  \"name\": \"b\",\n  \"skeleton\": \"" + pab("skeleton.fbx").string() +
+           "\",\n  \"clips\": {\"walk\": \"" + pab("walk.fbx").string() + "\", \"run\": \"" + pab("run.fbx").string() +
+           "\"},\n  \"parameters\": {\"speed\": {\"type\": \"float\"}, \"lean\": {\"type\": \"float\"}, "
+           "\"stop\": {\"type\": \"trigger\"}},\n  \"root\": " +
+           root + "\n}\n";
+  };
+  const auto machine = [](const std::string& transition) {
+    return R"({"state_machine": {"name": "m", "entry": "a", "states": {"a": {"node": {"clip": "walk"}}, "b": {"node": {"clip": "run"}}},
+      "transitions": [{"from": "a", "to": "b"}, )" +
+           transition + "]}}";
+  };
+  std::string grid;
+  for (int i = 0; i < 2000; ++i)
+    grid += std::string(i ? ", " : "") + R"({"clip": ")" + (i % 2 ? "walk" : "run") + R"(", "x": )" +
+            std::to_string(i % 50) + R"(, "y": )" + std::to_string(i / 50) + "}";
+  std::string deep = R"({"clip": "walk"})";
+  for (int i = 0; i < 70; ++i) deep = R"({"blend": [)" + deep + R"(, {"clip": "run"}], "alpha": "lean"})";
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"self", machine(R"({"from": "b", "to": "b", "when": "stop"})")},
+      {"far", R"({"blend_space": "speed", "y": "lean", "samples": [{"clip": "walk", "x": 0, "y": 0},
+        {"clip": "run", "x": 3.4e38, "y": 0}, {"clip": "walk", "x": 0, "y": 1}]})"},
+      {"grid", R"({"blend_space": "speed", "y": "lean", "samples": [)" + grid + "]}"},
+      {"rate", R"({"clip": "walk", "rate": 3.4e38})"},
+      {"weight", R"({"additive": {"clip": "walk"}, "add": {"clip": "run"}, "weight": 1e30})"},
+      {"duration", machine(R"({"from": "b", "to": "a", "duration": 1e30})")},
+      {"literal", machine(R"({"from": "b", "to": "a", "when": "speed > 1e39"})")},
+      {"deep", deep},
+  };
+  for (const auto& [name, root] : cases) ASSERT_TRUE(ossa::test::write_file(dir / (name + ".graph.json"), graph(root)));
+  ASSERT_TRUE(ossa::test::write_file(dir / "fine.graph.json",
+                                     graph(machine(R"({"from": "b", "to": "a", "when": "stop", "duration": 1e6})"))));
+  const auto r = run_command(cook_cmd() + " " + q(dir) + " -o " + q(dir / "out") + " --jobs 2");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_EQ(r.err.find("internal error"), std::string::npos) << r.err.substr(0, 3000);
+  for (const auto& [name, root] : cases) {
+    const std::string file = (dir / (name + ".graph.json")).string() + ":";
+    const size_t at = r.err.find(file);
+    ASSERT_NE(at, std::string::npos) << name << ": " << r.err.substr(0, 3000);
+    // file:LINE:COL: what
+    size_t k = at + file.size(), digits = 0;
+    while (k < r.err.size() && std::isdigit(static_cast<unsigned char>(r.err[k]))) ++k, ++digits;
+    EXPECT_TRUE(digits > 0 && r.err[k] == ':' && std::isdigit(static_cast<unsigned char>(r.err[k + 1])))
+        << name << ": " << r.err.substr(at, 200);
+    EXPECT_FALSE(fs::exists(dir / "out" / (name + ".ossa"))) << name;
+  }
+  EXPECT_TRUE(ossa::Asset::open((dir / "out" / "fine.ossa").string()).ok());
 }
 
 TEST(GraphCli, ErrorsFromASourceNameTheGraphAndTheSource) {

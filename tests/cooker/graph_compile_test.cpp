@@ -638,6 +638,57 @@ TEST_F(GraphCompile, TimesAndDurationsMustNotBeNegative) {
   EXPECT_HAS(dm, at(d, "\"weight\": 2", 0, 10) + "a layer's \"weight\" must be within [0, 1], not 2");
 }
 
+// What the loader refuses (runtime/loader/validate_graph.cpp) must be refused here, where the
+// file says it: these compiled, then failed with "internal error, cooked bytes fail verification".
+TEST_F(GraphCompile, WhatTheLoaderRefusesIsRefusedWhereTheFileSaysIt) {
+  const std::string self = graph(R"({"state_machine": {"name": "m", "entry": "a", "states": {
+      "a": {"node": {"clip": "walk"}}, "b": {"node": {"clip": "run"}}},
+    "transitions": [{"from": "a", "to": "b"}, {"from": "b", "to": "b", "when": "stop"}]}})");
+  EXPECT_HAS(errors(self), at(self, "\"b\", \"when\"") + "a transition from state 'b' to itself");
+  const std::string far = graph(R"({"blend_space": "speed", "y": "lean", "samples": [
+      {"clip": "walk", "x": 0, "y": 0}, {"clip": "run", "x": 3.4e38, "y": 0},
+      {"clip": "wave", "x": 0, "y": -3.4e38}]})");
+  const std::string fm = errors(far);
+  EXPECT_HAS(fm, at(far, "3.4e38") + "a sample's \"x\" must be within [-1e+06, 1e+06], not 3.4e+38");
+  EXPECT_HAS(fm, at(far, "-3.4e38") + "a sample's \"y\" must be within [-1e+06, 1e+06], not -3.4e+38");
+  std::string many = R"({"blend_space": "speed", "y": "lean", "samples": [)";
+  for (int i = 0; i < 2000; ++i)
+    many += std::string(i ? ", " : "") + "{\"clip\": \"walk\", \"x\": " + std::to_string(i % 50) +
+            ", \"y\": " + std::to_string(i / 50) + "}";
+  const std::string mg = graph(many + "]}");
+  EXPECT_HAS(errors(mg), at(mg, "[{") + "a blend space has 2000 samples; at most 1024");
+  // The other bounds of the loader: rates, weights, times, nesting, conditions.
+  const std::string rates = graph(R"({"additive": {"blend_space": "speed", "rate": 5000, "samples": [
+      {"clip": "walk", "x": 0}, {"clip": "run", "x": 1}]}, "add": {"clip": "wave", "rate": -3.4e38}, "weight": 1000})");
+  const std::string rm = errors(rates);
+  EXPECT_HAS(rm, at(rates, "5000") + "\"rate\" must be within [-1000, 1000], not 5000");
+  EXPECT_HAS(rm, at(rates, "-3.4e38") + "\"rate\" must be within [-1000, 1000], not -3.4e+38");
+  EXPECT_HAS(rm, at(rates, "1000}") + "\"weight\" must be within [-100, 100], not 1000");
+  const std::string times = graph(R"({"state_machine": {"name": "m", "entry": "a", "states": {
+      "a": {"node": {"select": "crossed", "children": [{"clip": "walk"}, {"clip": "run"}], "blend_time": 1e7}},
+      "b": {"node": {"clip": "run"}}},
+    "transitions": [{"from": "a", "to": "b", "duration": 2e6, "exit_time": 3e38, "when": "speed > 1e39"}]}})");
+  const std::string tm = errors(times);
+  EXPECT_HAS(tm, at(times, "1e7") + "\"blend_time\" must be within [0, 1e+06], not 1e+07");
+  EXPECT_HAS(tm, at(times, "2e6") + "\"duration\" (seconds) must be within [0, 1e+06], not 2e+06");
+  EXPECT_HAS(tm, at(times, "3e38") + "\"exit_time\"");
+  EXPECT_HAS(tm, at(times, "1e39") + "the number 1e39 is outside the range of a float");
+  std::string deep = R"({"clip": "walk"})";
+  for (int i = 0; i < 70; ++i) deep = R"({"blend": [)" + deep + R"(, {"clip": "run"}], "alpha": "lean"})";
+  const std::string dg = graph(deep);
+  EXPECT_HAS(errors(dg), "nodes nested deeper than 64 levels below the root");
+  std::string ok64 = R"({"clip": "walk"})";
+  for (int i = 0; i < 64; ++i) ok64 = R"({"blend": [)" + ok64 + R"(, {"clip": "run"}], "alpha": "lean"})";
+  ok(graph(ok64));
+  std::string cond = "speed > 0";
+  for (int i = 1; i < 17; ++i) cond = "speed > " + std::to_string(i) + " || (" + cond + ")";
+  const std::string cg = graph(R"({"state_machine": {"name": "m", "entry": "a", "states": {
+      "a": {"node": {"clip": "walk"}}, "b": {"node": {"clip": "run"}}},
+    "transitions": [{"from": "a", "to": "b", "when": ")" +
+                               cond + R"("}]}})");
+  EXPECT_HAS(errors(cg), "the condition holds more than 16 values at once here");
+}
+
 TEST_F(GraphCompile, UnknownKeysListTheAllowedOnes) {
   const std::string a =
       graph(R"({"select": "crossed", "children": [{"clip": "walk"}, {"clip": "run"}], "blendtime": 0.2})");

@@ -21,6 +21,8 @@ A mutated source is not stored (it is a derivative of a third-party asset): each
 asset's path under --assets plus a seed, and the mutation is a pure function of the two. Inputs the
 isolation had to end are written to WORK/crashers.json in the --replay format; recipes worth
 keeping go into tests/fuzz/cook_crashers.json, which CTest replays (the batch must survive them).
+A crash found by hand in a few lines of a format (an .mtl, a Collada accessor) is kept there as an
+inline recipe instead: {"input", "files": {name: text}} written as it is.
 Prints the figures the closing notes quote. Bounded by --seconds (each batch also by --timeout).
 """
 import argparse
@@ -187,17 +189,34 @@ def cause_of(error):
     return None
 
 
+def recipe_key(recipe):
+    """(asset, seed) of a mutation recipe, or (input name, None) of an inline one."""
+    if isinstance(recipe, dict):
+        return recipe["input"], None
+    return recipe
+
+
 def cook_batch(args, recipes, batch_dir, stats):
-    """Writes the recipes' mutated sources, cooks them in one batch; returns crashers."""
+    """Writes the recipes' sources, cooks them in one batch; returns crashers.
+
+    A recipe is (asset, seed): a mutation of a file under --assets; or a dict {"input", "files"}:
+    small files written as they are (sources authored for the corpus, no third-party bytes)."""
     shutil.rmtree(batch_dir, ignore_errors=True)
     src, out = os.path.join(batch_dir, "src"), os.path.join(batch_dir, "out")
     os.makedirs(src)
     names = []
-    for k, (rel, seed) in enumerate(recipes):
-        with open(os.path.join(args.assets, rel), "rb") as f:
-            data = f.read()
+    for k, recipe in enumerate(recipes):
         folder = os.path.join(src, str(k))  # each in a folder of its own (same stems, sidecars)
         os.makedirs(folder)
+        if isinstance(recipe, dict):
+            for file_name, text in recipe["files"].items():
+                with open(os.path.join(folder, file_name), "w") as f:
+                    f.write(text)
+            names.append(os.path.join(folder, recipe["input"]))
+            continue
+        rel, seed = recipe
+        with open(os.path.join(args.assets, rel), "rb") as f:
+            data = f.read()
         name = os.path.join(folder, os.path.basename(rel))
         with open(name, "wb") as f:
             f.write(mutate(rel, data, seed))
@@ -211,7 +230,8 @@ def cook_batch(args, recipes, batch_dir, stats):
     if proc.returncode not in (0, 1) or not os.path.exists(report):
         stats["batch_crashes"] += 1
         print(f"source_fuzz: BATCH CRASHED (exit {proc.returncode}): {proc.stderr[-2000:].decode(errors='replace')}")
-        return [{"asset": rel, "seed": seed, "cause": f"batch exit {proc.returncode}"} for rel, seed in recipes]
+        return [{"asset": recipe_key(r)[0], "seed": recipe_key(r)[1], "cause": f"batch exit {proc.returncode}"}
+                for r in recipes]
     with open(report) as f:
         doc = json.load(f)
     crashers = []
@@ -232,8 +252,8 @@ def cook_batch(args, recipes, batch_dir, stats):
         cause = cause_of(rec.get("error", ""))
         if cause:
             stats["isolated"][cause] = stats["isolated"].get(cause, 0) + 1
-            crashers.append({"asset": recipes[k][0], "seed": recipes[k][1], "cause": cause})
-        elif os.path.basename(recipes[k][0]).split(".")[0] not in rec.get("error", ""):
+            crashers.append({"asset": recipe_key(recipes[k])[0], "seed": recipe_key(recipes[k])[1], "cause": cause})
+        elif os.path.basename(recipe_key(recipes[k])[0]).split(".")[0] not in rec.get("error", ""):
             stats["unnamed_errors"] += 1
             print(f"source_fuzz: an error does not name its input: {rec.get('error', '')[:300]}")
     return crashers
@@ -298,7 +318,7 @@ def main():
     ap.add_argument("--max-memory", default="1536M")
     ap.add_argument("--replay", help="cook these recipes (a crashers.json) instead of fuzzing")
     args = ap.parse_args()
-    if not os.path.isdir(args.assets):
+    if not os.path.isdir(args.assets) and not args.replay:
         print(f"source_fuzz: no asset tree at {args.assets}: nothing to fuzz")
         return 0
     os.makedirs(args.work, exist_ok=True)
@@ -308,8 +328,10 @@ def main():
     rng = random.Random(args.seed)
     if args.replay:
         with open(args.replay) as f:
-            recipes = [(r["asset"], r["seed"]) for r in json.load(f)["recipes"]]
-        recipes = [r for r in recipes if os.path.exists(os.path.join(args.assets, r[0]))]
+            listed = json.load(f)["recipes"]
+        # Inline recipes always; mutation recipes where their asset is present.
+        recipes = [r if "files" in r else (r["asset"], r["seed"]) for r in listed]
+        recipes = [r for r in recipes if isinstance(r, dict) or os.path.exists(os.path.join(args.assets, r[0]))]
         if recipes:
             crashers += cook_batch(args, recipes, os.path.join(args.work, "replay"), stats)
     else:

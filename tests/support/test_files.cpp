@@ -685,4 +685,22 @@ size_t count_files(const std::filesystem::path& dir) {
 
 std::span<const uint8_t> tiny_png() { return kTinyPng; }
 
+std::string tiny_png_with_text(std::string_view text) {
+  std::string bytes(std::begin(kTinyPng), std::end(kTinyPng));
+  const std::string chunk = "tEXtComment" + std::string(1, '\0') + std::string(text);
+  uint32_t crc = 0xFFFFFFFFu;
+  for (unsigned char ch : chunk) {
+    crc ^= ch;
+    for (int k = 0; k < 8; ++k) crc = (crc >> 1) ^ (0xEDB88320u & (0u - (crc & 1u)));
+  }
+  crc ^= 0xFFFFFFFFu;
+  const auto length = static_cast<uint32_t>(chunk.size() - 4);
+  std::string framed;
+  for (int k = 3; k >= 0; --k) framed += static_cast<char>((length >> (8 * k)) & 0xFF);
+  framed += chunk;
+  for (int k = 3; k >= 0; --k) framed += static_cast<char>((crc >> (8 * k)) & 0xFF);
+  bytes.insert(8 + 25, framed);  // after the signature (8 bytes) and the IHDR chunk (25)
+  return bytes;
+}
+
 }  // namespace ossa::test

@@ -255,6 +255,10 @@ std::filesystem::path make_temp_dir(std::string_view prefix = "test");
 /// A valid 2x2 RGBA PNG (decodes with stb_image): a texture file for cooker tests.
 std::span<const uint8_t> tiny_png();
 
+/// tiny_png with a tEXt chunk carrying `text` after its header: the same image, other bytes (a
+/// texture that changed, or one whose bytes are recognisable when embedded as they are).
+std::string tiny_png_with_text(std::string_view text);
+
 /// Whole-file read; nullopt when the file cannot be opened or read.
 std::optional<std::vector<uint8_t>> read_file(const std::filesystem::path& path);
 std::optional<std::string> read_text(const std::filesystem::path& path);
