@@ -15,6 +15,12 @@
 //   blend3       blend_n of three poses / a per-joint GLM loop (weighted sums, nlerp)
 //   clone.avx2   blend_n + local_to_model in their AVX2 copy / in their baseline copy (AVX2 CPUs)
 //   sample       forward playback at 60 Hz / sampling from a reset cache (every key decoded)
+//   sample.plain forward playback of the walk / plain_sample (guard_reference.h: a scalar sampler
+//                over dense float keys, run with flush-to-zero, so its cost cannot move with ossa's)
+//   sample.noisy the same on a rig whose rest pose holds +-7.7e-34 for its zeros (noisy_rest_copy:
+//                a file cooked elsewhere); 1.9x sample.plain's ratio if the runtime's arithmetic meets them
+//   frame.plain  3 samples + blend_n + local_to_model + palette / the plain references of each
+//   skin.plain   skin_cpu positions + normals / plain_skin (4 influences per vertex, scalar)
 //   load         Asset::open (map, verify, every semantic check) / open + read + close of the bytes
 // Each limit sits at about 2-3x the ratio measured when it was set (see each row's comment in
 // main), so only a large regression fails — a lost fast path, an accidental O(n^2), a
@@ -22,6 +28,9 @@
 // a build without NDEBUG (debug, sanitizers) prints the table and skips (77), since its ratios
 // mean nothing. Output: one tab-separated row per check, after the machine line.
 #include <fcntl.h>
+#if defined(__SSE__)
+#include <xmmintrin.h>
+#endif
 #include <unistd.h>
 
 #include <algorithm>
@@ -42,6 +51,7 @@
 #include <glm/gtc/quaternion.hpp>
 
 #include "bench/bench_fixture.h"
+#include "bench/guard_reference.h"
 #include "bench/machine.h"
 #include "bench/plain_read.h"
 #include <ossa/anim/pose.h>
@@ -79,6 +89,123 @@ struct Row {
   double ossa_ns, reference_ns, limit;
   double ratio() const { return ossa_ns / reference_ns; }
 };
+
+/// Calls f with the MXCSR flush-to-zero and denormals-are-zero bits set (x86), restoring them after:
+/// the plain references run so, so that no value in the data can change their cost.
+template <class F>
+void flushed(F&& f) {
+#if defined(__SSE__)
+  const unsigned csr = _mm_getcsr();
+  _mm_setcsr(csr | 0x8040u);
+  f();
+  _mm_setcsr(csr);
+#else
+  f();
+#endif
+}
+
+/// The rows against guard_reference.h's plain scalar code: sample.plain, sample.noisy, frame.plain,
+/// skin.plain (see the header comment). False when a fixture cannot be made.
+bool plain_rows(int trials, const ossa::bench::BenchData& data, std::vector<Row>& rows) {
+  using ossa::bench::PlainTransform;
+  const ossa::SkeletonView skeleton = data.skeleton.skeleton();
+  const auto joints = static_cast<uint32_t>(skeleton.joint_count());
+  const ossa::ClipView clips[3] = {data.walk.clip(0), data.jog.clip(0), data.run.clip(0)};
+  const ossa::bench::PlainClip plain[3] = {ossa::bench::plain_clip(clips[0], skeleton),
+                                           ossa::bench::plain_clip(clips[1], skeleton),
+                                           ossa::bench::plain_clip(clips[2], skeleton)};
+  size_t noisy_values = 0;
+  const std::vector<uint8_t> noisy_bytes = ossa::bench::noisy_rest_copy(data.skeleton, &noisy_values);
+  auto noisy = ossa::Asset::from_bytes(noisy_bytes, "skeleton-noisy");
+  if (!noisy) {
+    std::fprintf(stderr, "ossa-bench-guard: %s\n", noisy.error().message.c_str());
+    return false;
+  }
+  std::optional<ossa::SamplingCache> caches[4];
+  for (int c = 0; c < 4; ++c) {
+    auto cache = ossa::make_sampling_cache(clips[c % 3], c == 3 ? noisy->skeleton() : skeleton);
+    if (!cache) {
+      std::fprintf(stderr, "ossa-bench-guard: %s\n", cache.error().message.c_str());
+      return false;
+    }
+    caches[c].emplace(std::move(*cache));
+  }
+  // 60 Hz playback times of the walk, and the walk's phase for the frame (each clip at its own
+  // duration), 256 of each, looping.
+  std::vector<float> times(256), phase(256);
+  float t = 0.0f;
+  for (size_t i = 0; i < times.size(); ++i) {
+    times[i] = t;
+    t = ossa::advance_time(t, 1.0f / 60.0f, 1.0f, clips[0].duration(), true);
+    phase[i] = times[i] / clips[0].duration();
+  }
+  ossa::Pose poses[3] = {ossa::Pose(joints), ossa::Pose(joints), ossa::Pose(joints)};
+  ossa::Pose blended(joints);
+  std::vector<PlainTransform> local[3] = {std::vector<PlainTransform>(joints), std::vector<PlainTransform>(joints),
+                                          std::vector<PlainTransform>(joints)};
+  std::vector<PlainTransform> plain_blended(joints);
+  std::vector<glm::mat4> model(joints), plain_model(joints);
+  const ossa::MeshView mesh = data.arnaud.mesh(0);
+  const size_t slots = std::max<size_t>(1, mesh.joints().size());
+  std::vector<glm::mat4> bind(slots), palette(slots), plain_palette(slots);
+  ossa::prepare_bind_matrices(mesh, bind);
+  size_t i = 0, k = 0;
+
+  const auto sample_row = [&](const char* name, ossa::SamplingCache& cache, double limit) {
+    const auto [ossa_s, plain_s] = interleaved_min(
+        trials, 64,
+        [&] { ossa::sample(clips[0], times[i++ & 255], {}, cache, poses[0]); g_sink = g_sink + static_cast<uint32_t>(poses[0].span().base[0]); },
+        [&] { flushed([&] { ossa::bench::plain_sample(plain[0], times[k++ & 255], local[0].data()); });
+              g_sink = g_sink + static_cast<uint32_t>(local[0][0].t[0]); });
+    rows.push_back({name, ossa_s * 1e9, plain_s * 1e9, limit});
+  };
+  sample_row("sample.plain", *caches[0], 0.6);
+  sample_row("sample.noisy", *caches[3], 0.6);
+
+  const std::span<const int16_t> parents = skeleton.parents();
+  const ossa::ConstPoseSpan inputs[3] = {poses[0], poses[1], poses[2]};
+  const PlainTransform* plain_inputs[3] = {local[0].data(), local[1].data(), local[2].data()};
+  const float weights[3] = {0.2f, 0.5f, 0.3f};
+  {
+    const auto [ossa_s, plain_s] = interleaved_min(
+        trials, 16,
+        [&] {
+          const float p = phase[i++ & 255];
+          for (int c = 0; c < 3; ++c) ossa::sample(clips[c], p * clips[c].duration(), {}, *caches[c], poses[c]);
+          ossa::blend_n(inputs, weights, blended);
+          ossa::local_to_model(parents, blended, model);
+          ossa::skinning_matrices(mesh.joints(), bind, model, palette);
+          g_sink = g_sink + static_cast<uint32_t>(palette[0][3][0]);
+        },
+        [&] {
+          flushed([&] {
+            const float p = phase[k++ & 255];
+            for (int c = 0; c < 3; ++c) ossa::bench::plain_sample(plain[c], p * plain[c].duration, local[c].data());
+            ossa::bench::plain_blend(plain_inputs, weights, joints, plain_blended.data());
+            ossa::bench::plain_model(parents, plain_blended.data(), plain_model.data());
+            ossa::bench::plain_palette(mesh.joints(), bind, plain_model.data(), plain_palette.data());
+          });
+          g_sink = g_sink + static_cast<uint32_t>(plain_palette[0][3][0]);
+        });
+    rows.push_back({"frame.plain", ossa_s * 1e9, plain_s * 1e9, 0.6});
+  }
+  {
+    // Skinning with the frame's last palette.
+    const ossa::bench::PlainMesh plain_mesh = ossa::bench::plain_mesh(mesh);
+    std::vector<float> positions(3 * size_t(mesh.vertex_count())), normals(positions.size());
+    std::vector<float> plain_positions(positions.size()), plain_normals(positions.size());
+    const ossa::SkinnedStreams streams{positions, normals, {}};
+    const auto [ossa_s, plain_s] = interleaved_min(
+        trials, 4,
+        [&] { ossa::skin_cpu(mesh, palette, ossa::SkinningMethod::Linear, streams); g_sink = g_sink + static_cast<uint32_t>(positions[0]); },
+        [&] {
+          flushed([&] { ossa::bench::plain_skin(plain_mesh, palette.data(), plain_positions.data(), plain_normals.data()); });
+          g_sink = g_sink + static_cast<uint32_t>(plain_positions[0]);
+        });
+    rows.push_back({"skin.plain", ossa_s * 1e9, plain_s * 1e9, 0.6});
+  }
+  return true;
+}
 
 
 }  // namespace
@@ -248,6 +375,10 @@ int main(int argc, char** argv) {
         });
     rows.push_back({"sample", forward * 1e9, reset * 1e9, 1.1});  // 0.54 measured
   }
+
+  // Against plain scalar references written once (guard_reference.h), run with flush-to-zero set so
+  // no value in the data can slow them: these rows move only when ossa's cost per frame moves.
+  if (!plain_rows(trials, data, rows)) return 1;
 
   // Load: open + verify against reading the same bytes.
   {
