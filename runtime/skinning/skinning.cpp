@@ -701,12 +701,16 @@ struct VertexPointers {
   float* tangent_out;
 };
 
-/// Transforms and stores one vertex's streams with its blended matrix (columns 0-1 in a01, 2-3 in
-/// a23). kWide: the xyz outputs may be stored as 16 bytes (another vertex follows in memory order
-/// and is written later).
-template <bool kWide, bool kPositions, bool kNormals, bool kTangents>
-[[gnu::always_inline]] OSSA_TARGET_AVX2 inline void finish_vertex(__m256 a01, __m256 a23, const VertexPointers& at,
-                                                                  uint32_t off_position) {
+/// Skins one vertex of class K. kWide: the xyz outputs may be stored as 16 bytes (another vertex
+/// follows in memory order and is written later). Returns outside_class<K> of its weights (only
+/// computed when kCheck).
+template <int K, bool kCheck, bool kWide, Slots kSlots, bool kPositions, bool kNormals, bool kTangents>
+[[gnu::always_inline]] OSSA_TARGET_AVX2 inline uint32_t skin_vertex(const float* palette, const VertexPointers& at,
+                                                                    uint32_t off_position, uint32_t off_joints,
+                                                                    uint32_t off_weights) {
+  __m256 a01, a23;
+  uint32_t wb;
+  blend_matrix<K, kSlots, kCheck>(palette, at.vx, off_joints, off_weights, a01, a23, wb);
   if constexpr (kPositions) {
     // The four unorm16 words twice (one duplicating load), widened: (x, y, z, 1) in both lanes.
     const __m256 scale = _mm256_setr_ps(1.0f / 65535.0f, 1.0f / 65535.0f, 1.0f / 65535.0f, 0.0f, 1.0f / 65535.0f,
@@ -724,18 +728,6 @@ template <bool kWide, bool kPositions, bool kNormals, bool kTangents>
     const __m128 r = transform_dup(a01, a23, _mm256_blend_ps(_mm256_broadcast_ps(reinterpret_cast<const __m128*>(at.tangent)), _mm256_setzero_ps(), 0x88));
     _mm_storeu_ps(at.tangent_out, _mm_blend_ps(r, t, 0x8));
   }
-}
-
-/// Skins one vertex of class K (see finish_vertex for kWide). Returns outside_class<K> of its
-/// weights (only computed when kCheck).
-template <int K, bool kCheck, bool kWide, Slots kSlots, bool kPositions, bool kNormals, bool kTangents>
-[[gnu::always_inline]] OSSA_TARGET_AVX2 inline uint32_t skin_vertex(const float* palette, const VertexPointers& at,
-                                                                    uint32_t off_position, uint32_t off_joints,
-                                                                    uint32_t off_weights) {
-  __m256 a01, a23;
-  uint32_t wb;
-  blend_matrix<K, kSlots, kCheck>(palette, at.vx, off_joints, off_weights, a01, a23, wb);
-  finish_vertex<kWide, kPositions, kNormals, kTangents>(a01, a23, at, off_position);
   return kCheck ? outside_class<K>(wb) : 0u;
 }
 
@@ -758,81 +750,6 @@ OSSA_TARGET_AVX2 void skin_class(const uint32_t* list, uint32_t n, const float* 
   }
 }
 
-/// The influences of a range's vertices in the cooker's packed layout, decoded eight vertices at a
-/// time before the range loop runs: per influence k < K, the palette offset in floats (slot * 16)
-/// and the weight, exactly kWeight's b / 255 (a multiply by 1 / 255 corrected by one FMA step,
-/// checked equal for all 256 bytes in skinning_test). The per-vertex loop then loads an offset and
-/// broadcasts a weight per influence and spends no integer instruction on them: taking the bytes
-/// apart per vertex was ~15 of its ~30 instructions, on the same ports as the vector work on Intel.
-struct RangeInfluences {
-  alignas(32) uint32_t offset[4][kBatch];
-  alignas(32) float weight[4][kBatch];
-};
-
-/// Fills f for vertices [first, first + n), n <= kBatch; returns the OR of outside_class<K> over them.
-template <int K>
-OSSA_TARGET_AVX2 uint32_t decode_range_influences(const FastMesh& m, uint32_t first, uint32_t n, RangeInfluences& f) {
-  constexpr int kBlend = K == 0 ? 1 : K;  // influences whose offsets the loop reads
-  const uint8_t* vx = m.base + static_cast<size_t>(first) * m.stride + m.off_joints;
-  const size_t stride = m.stride;
-  const __m256i split = _mm256_setr_epi32(0, 2, 4, 6, 1, 3, 5, 7), byte = _mm256_set1_epi32(0xff);
-  const __m256 r255 = _mm256_set1_ps(1.0f / 255.0f), k255 = _mm256_set1_ps(255.0f);
-  __m256i outside = _mm256_setzero_si256();
-  uint32_t i = 0;
-  for (; i + 8 <= n; i += 8, vx += 8 * stride) {
-    const auto word = [&](size_t l) { return static_cast<long long>(load_u64(vx + l * stride)); };
-    // Slot bytes in the low word of each vertex, weight bytes in the high one.
-    const __m256i a = _mm256_permutevar8x32_epi32(_mm256_set_epi64x(word(3), word(2), word(1), word(0)), split);
-    const __m256i b = _mm256_permutevar8x32_epi32(_mm256_set_epi64x(word(7), word(6), word(5), word(4)), split);
-    const __m256i slots = _mm256_permute2x128_si256(a, b, 0x20), weights = _mm256_permute2x128_si256(a, b, 0x31);
-    for (int k = 0; k < kBlend; ++k) {
-      const __m256i slot = _mm256_and_si256(_mm256_srli_epi32(slots, 8 * k), byte);
-      _mm256_store_si256(reinterpret_cast<__m256i*>(f.offset[k] + i), _mm256_slli_epi32(slot, 4));
-      if constexpr (K == 0) continue;
-      const __m256 w = _mm256_cvtepi32_ps(_mm256_and_si256(_mm256_srli_epi32(weights, 8 * k), byte));
-      const __m256 q = _mm256_mul_ps(w, r255);
-      _mm256_store_ps(f.weight[k] + i, _mm256_fmadd_ps(_mm256_fnmadd_ps(q, k255, w), r255, q));
-    }
-    if constexpr (K == 0) outside = _mm256_or_si256(outside, _mm256_xor_si256(weights, byte));
-    else if constexpr (K < 4) outside = _mm256_or_si256(outside, _mm256_srli_epi32(weights, 8 * K));
-  }
-  uint32_t tail = 0;
-  for (; i < n; ++i, vx += stride) {
-    const uint64_t both = load_u64(vx);
-    const auto wb = static_cast<uint32_t>(both >> 32);
-    for (int k = 0; k < kBlend; ++k) {
-      f.offset[k][i] = 16 * slot_of<Slots::Packed>(both, k);
-      f.weight[k][i] = kWeight[(wb >> (8 * k)) & 0xffu];
-    }
-    tail |= outside_class<K>(wb);
-  }
-  return tail | static_cast<uint32_t>(!_mm256_testz_si256(outside, outside));
-}
-
-/// skin_vertex with the blend's offsets and weights from decode_range_influences (vertex i of it).
-template <int K, bool kWide, bool kPositions, bool kNormals, bool kTangents>
-[[gnu::always_inline]] OSSA_TARGET_AVX2 inline void skin_decoded_vertex(const float* palette, const VertexPointers& at,
-                                                                        uint32_t off_position, const RangeInfluences& f,
-                                                                        uint32_t i) {
-  const float* p0 = palette + f.offset[0][i];
-  __m256 a01, a23;
-  if constexpr (K == 0) {
-    a01 = _mm256_loadu_ps(p0);
-    a23 = _mm256_loadu_ps(p0 + 8);
-  } else {
-    __m256 w = _mm256_broadcast_ss(&f.weight[0][i]);
-    a01 = _mm256_mul_ps(w, _mm256_loadu_ps(p0));
-    a23 = _mm256_mul_ps(w, _mm256_loadu_ps(p0 + 8));
-    for (int k = 1; k < K; ++k) {
-      const float* p = palette + f.offset[k][i];
-      w = _mm256_broadcast_ss(&f.weight[k][i]);
-      a01 = _mm256_fmadd_ps(w, _mm256_loadu_ps(p), a01);
-      a23 = _mm256_fmadd_ps(w, _mm256_loadu_ps(p + 8), a23);
-    }
-  }
-  finish_vertex<kWide, kPositions, kNormals, kTangents>(a01, a23, at, off_position);
-}
-
 /// Class K's loop over the contiguous vertices [b.first, b.first + b.n) of a class-ordered mesh,
 /// walking every pointer forward (no index arithmetic per vertex). Returns the OR of
 /// outside_class<K> over them: non-zero means some vertex did not belong to the range (and its
@@ -851,22 +768,6 @@ OSSA_TARGET_AVX2 uint32_t skin_range(const float* palette, const FastMesh& mesh,
   // The mesh's very last vertex stores 12 bytes per stream; every other one may store 16.
   const uint32_t wide = b.first + b.n == mesh.count ? b.n - 1 : b.n;
   uint32_t outside = 0;
-  if constexpr (kSlots == Slots::Packed) {
-    RangeInfluences f;
-    outside = decode_range_influences<K>(mesh, b.first, b.n, f);
-#pragma GCC unroll 2
-    for (uint32_t i = 0; i < wide; ++i) {
-      skin_decoded_vertex<K, true, kPositions, kNormals, kTangents>(palette, at, off_position, f, i);
-      at.vx += stride;
-      at.normal += 4;
-      at.tangent += 4;
-      if constexpr (kPositions) at.position_out += 3;
-      if constexpr (kNormals) at.normal_out += 3;
-      if constexpr (kTangents) at.tangent_out += 4;
-    }
-    if (wide < b.n) skin_decoded_vertex<K, false, kPositions, kNormals, kTangents>(palette, at, off_position, f, wide);
-    return outside;
-  }
 #pragma GCC unroll 2
   for (uint32_t i = 0; i < wide; ++i) {
     outside |= skin_vertex<K, true, true, kSlots, kPositions, kNormals, kTangents>(palette, at, off_position, off_joints, off_weights);
