@@ -159,8 +159,8 @@ bool plain_rows(int trials, const ossa::bench::BenchData& data, std::vector<Row>
               g_sink = g_sink + static_cast<uint32_t>(local[0][0].t[0]); });
     rows.push_back({name, ossa_s * 1e9, plain_s * 1e9, limit});
   };
-  sample_row("sample.plain", *caches[0], 0.6);
-  sample_row("sample.noisy", *caches[3], 0.6);
+  sample_row("sample.plain", *caches[0], 0.55);  // AMD Zen 5: 0.40-0.41 measured, 0.71-0.72 regressed
+  sample_row("sample.noisy", *caches[3], 0.55);  // the same; a runtime without FTZ/DAZ alone fails this row
 
   const std::span<const int16_t> parents = skeleton.parents();
   const ossa::ConstPoseSpan inputs[3] = {poses[0], poses[1], poses[2]};
@@ -187,7 +187,7 @@ bool plain_rows(int trials, const ossa::bench::BenchData& data, std::vector<Row>
           });
           g_sink = g_sink + static_cast<uint32_t>(plain_palette[0][3][0]);
         });
-    rows.push_back({"frame.plain", ossa_s * 1e9, plain_s * 1e9, 0.6});
+    rows.push_back({"frame.plain", ossa_s * 1e9, plain_s * 1e9, 0.32});  // Zen 5: 0.256-0.263, 0.349-0.352 regressed
   }
   {
     // Skinning with the frame's last palette.
@@ -202,7 +202,7 @@ bool plain_rows(int trials, const ossa::bench::BenchData& data, std::vector<Row>
           flushed([&] { ossa::bench::plain_skin(plain_mesh, palette.data(), plain_positions.data(), plain_normals.data()); });
           g_sink = g_sink + static_cast<uint32_t>(plain_positions[0]);
         });
-    rows.push_back({"skin.plain", ossa_s * 1e9, plain_s * 1e9, 0.6});
+    rows.push_back({"skin.plain", ossa_s * 1e9, plain_s * 1e9, 0.35});  // Zen 5: 0.20-0.23
   }
   return true;
 }
