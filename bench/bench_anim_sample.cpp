@@ -7,6 +7,10 @@
 //   BM_Sample      forward playback of the walk at 60 Hz through one SamplingCache (the common
 //                  case: keys are decoded only when playback passes them);
 //   BM_SampleSeek  a random time per call (cursor searches and two decodes per channel that moved);
+//   BM_SampleNoisyRest  BM_Sample on a copy of the skeleton whose bind pose carries +-7.7e-34 where
+//                  it holds 0 (noisy_rest_copy: a rig cooked elsewhere, as Pab's FBX is before the
+//                  cooker flushes it); with the runtime's flush-to-zero it costs what BM_Sample costs,
+//                  without it 1.9x as much on a Zen 5 EPYC;
 //   BM_Frame       walk, jog and run sampled at their own phase, blend_n of the three,
 //                  local_to_model and the skinning palette for the arnaud mesh (its constant
 //                  half prepared once, prepare_bind_matrices).
@@ -79,6 +83,32 @@ void BM_Sample(benchmark::State& state) {
   per_joint_counter(state, pose.joint_count());
 }
 BENCHMARK(BM_Sample);
+
+void BM_SampleNoisyRest(benchmark::State& state) {
+  const auto& data = ossa::bench::bench_data();
+  static size_t noisy = 0;
+  static const std::vector<uint8_t> bytes = ossa::bench::noisy_rest_copy(data.skeleton, &noisy);
+  auto rig = ossa::Asset::from_bytes(bytes, "skeleton-noisy");
+  if (!rig) {
+    state.SkipWithError(rig.error().message.c_str());
+    return;
+  }
+  const ossa::SkeletonView skeleton = rig->skeleton();
+  const ossa::ClipView clip = data.walk.clip(0);
+  ossa::SamplingCache cache = cache_or_die(clip, skeleton);
+  ossa::Pose pose(static_cast<uint32_t>(skeleton.joint_count()));
+  const std::vector<float> times = playback_times(clip, 4096);
+  size_t i = 0;
+  for (auto _ : state) {
+    ossa::sample(clip, times[i], {}, cache, pose);
+    benchmark::DoNotOptimize(pose.span().base);
+    benchmark::ClobberMemory();
+    i = (i + 1) & (times.size() - 1);
+  }
+  per_joint_counter(state, pose.joint_count());
+  state.counters["noisy_values"] = static_cast<double>(noisy);
+}
+BENCHMARK(BM_SampleNoisyRest);
 
 void BM_SampleSeek(benchmark::State& state) {
   const auto& data = ossa::bench::bench_data();

@@ -86,6 +86,27 @@ std::vector<uint8_t> dealt_copy(const Asset& asset) {
   return out;
 }
 
+std::vector<uint8_t> noisy_rest_copy(const Asset& skeleton, size_t* noisy) {
+  const std::span<const uint8_t> file = skeleton.bytes();
+  std::vector<uint8_t> out(file.begin(), file.end());
+  const SkeletonView view = skeleton.skeleton();
+  size_t changed = 0;
+  const auto add_noise = [&](const void* values, size_t floats) {
+    const size_t at = static_cast<size_t>(static_cast<const uint8_t*>(values) - file.data());
+    for (size_t i = 0; i < floats; ++i) {
+      float v;
+      std::memcpy(&v, out.data() + at + 4 * i, 4);
+      if (v != 0.0f) continue;
+      v = changed++ % 2 ? -7.7e-34f : 7.7e-34f;
+      std::memcpy(out.data() + at + 4 * i, &v, 4);
+    }
+  };
+  add_noise(view.bind_rotations().data(), 4 * view.bind_rotations().size());
+  add_noise(view.bind_translations().data(), 3 * view.bind_translations().size());
+  *noisy = changed;
+  return out;
+}
+
 const BenchData& bench_data() {
   static const std::unique_ptr<BenchData> data = load();
   return *data;

@@ -26,4 +26,12 @@ const BenchData& bench_data();
 /// index buffer is not renumbered: skinning does not read it). O(file size).
 std::vector<uint8_t> dealt_copy(const Asset& asset);
 
+/// A copy of a skeleton file's bytes whose bind pose carries decomposition noise: every rotation and
+/// translation component that is exactly 0 holds +-7.7e-34 instead (alternating signs), as Pab's
+/// own FBX has in five of them and as a file cooked without the cooker's flush of tiny values
+/// keeps them (cooker/import/tiny_values.h). What a rig cooked elsewhere looks like to the
+/// runtime: the same pose to 1e-33, and every such value squared below FLT_MIN by interpolation.
+/// Sets *noisy to the number of values changed. O(joints).
+std::vector<uint8_t> noisy_rest_copy(const Asset& skeleton, size_t* noisy);
+
 }  // namespace ossa::bench

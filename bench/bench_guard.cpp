@@ -15,6 +15,12 @@
 //   blend3       blend_n of three poses / a per-joint GLM loop (weighted sums, nlerp)
 //   clone.avx2   blend_n + local_to_model in their AVX2 copy / in their baseline copy (AVX2 CPUs)
 //   sample       forward playback at 60 Hz / sampling from a reset cache (every key decoded)
+//   sample.plain forward playback of the walk / plain_sample (guard_reference.h: a scalar sampler
+//                over dense float keys, run with flush-to-zero, so its cost cannot move with ossa's)
+//   sample.noisy the same on a rig whose rest pose holds +-7.7e-34 for its zeros (noisy_rest_copy:
+//                a file cooked elsewhere); 1.9x sample.plain's ratio if the runtime's arithmetic meets them
+//   frame.plain  3 samples + blend_n + local_to_model + palette / the plain references of each
+//   skin.plain   skin_cpu positions + normals / plain_skin (4 influences per vertex, scalar)
 //   verify       Asset::borrow of bytes in memory (verify + every semantic check) / one plain pass
 //                that reads every 8-byte word of the same bytes (no system call on either side)
 //   load         Asset::open (open, fstat, read, verify, checks) / the same system calls done plainly
@@ -31,6 +37,9 @@
 // a build without NDEBUG (debug, sanitizers) prints the table and skips (77), since its ratios
 // mean nothing. Output: one tab-separated row per check, after the machine line.
 #include <fcntl.h>
+#if defined(__SSE__)
+#include <xmmintrin.h>
+#endif
 #include <unistd.h>
 
 #include <algorithm>
@@ -51,6 +60,7 @@
 #include <glm/gtc/quaternion.hpp>
 
 #include "bench/bench_fixture.h"
+#include "bench/guard_reference.h"
 #include "bench/machine.h"
 #include "bench/plain_read.h"
 #include <ossa/anim/pose.h>
@@ -96,6 +106,123 @@ double limit_for(double amd, double intel) {
     case ossa::bench::CpuVendor::Intel: return intel;
     default: return std::max(amd, intel);
   }
+}
+
+/// Calls f with the MXCSR flush-to-zero and denormals-are-zero bits set (x86), restoring them after:
+/// the plain references run so, so that no value in the data can change their cost.
+template <class F>
+void flushed(F&& f) {
+#if defined(__SSE__)
+  const unsigned csr = _mm_getcsr();
+  _mm_setcsr(csr | 0x8040u);
+  f();
+  _mm_setcsr(csr);
+#else
+  f();
+#endif
+}
+
+/// The rows against guard_reference.h's plain scalar code: sample.plain, sample.noisy, frame.plain,
+/// skin.plain (see the header comment). False when a fixture cannot be made.
+bool plain_rows(int trials, const ossa::bench::BenchData& data, std::vector<Row>& rows) {
+  using ossa::bench::PlainTransform;
+  const ossa::SkeletonView skeleton = data.skeleton.skeleton();
+  const auto joints = static_cast<uint32_t>(skeleton.joint_count());
+  const ossa::ClipView clips[3] = {data.walk.clip(0), data.jog.clip(0), data.run.clip(0)};
+  const ossa::bench::PlainClip plain[3] = {ossa::bench::plain_clip(clips[0], skeleton),
+                                           ossa::bench::plain_clip(clips[1], skeleton),
+                                           ossa::bench::plain_clip(clips[2], skeleton)};
+  size_t noisy_values = 0;
+  const std::vector<uint8_t> noisy_bytes = ossa::bench::noisy_rest_copy(data.skeleton, &noisy_values);
+  auto noisy = ossa::Asset::from_bytes(noisy_bytes, "skeleton-noisy");
+  if (!noisy) {
+    std::fprintf(stderr, "ossa-bench-guard: %s\n", noisy.error().message.c_str());
+    return false;
+  }
+  std::optional<ossa::SamplingCache> caches[4];
+  for (int c = 0; c < 4; ++c) {
+    auto cache = ossa::make_sampling_cache(clips[c % 3], c == 3 ? noisy->skeleton() : skeleton);
+    if (!cache) {
+      std::fprintf(stderr, "ossa-bench-guard: %s\n", cache.error().message.c_str());
+      return false;
+    }
+    caches[c].emplace(std::move(*cache));
+  }
+  // 60 Hz playback times of the walk, and the walk's phase for the frame (each clip at its own
+  // duration), 256 of each, looping.
+  std::vector<float> times(256), phase(256);
+  float t = 0.0f;
+  for (size_t i = 0; i < times.size(); ++i) {
+    times[i] = t;
+    t = ossa::advance_time(t, 1.0f / 60.0f, 1.0f, clips[0].duration(), true);
+    phase[i] = times[i] / clips[0].duration();
+  }
+  ossa::Pose poses[3] = {ossa::Pose(joints), ossa::Pose(joints), ossa::Pose(joints)};
+  ossa::Pose blended(joints);
+  std::vector<PlainTransform> local[3] = {std::vector<PlainTransform>(joints), std::vector<PlainTransform>(joints),
+                                          std::vector<PlainTransform>(joints)};
+  std::vector<PlainTransform> plain_blended(joints);
+  std::vector<glm::mat4> model(joints), plain_model(joints);
+  const ossa::MeshView mesh = data.arnaud.mesh(0);
+  const size_t slots = std::max<size_t>(1, mesh.joints().size());
+  std::vector<glm::mat4> bind(slots), palette(slots), plain_palette(slots);
+  ossa::prepare_bind_matrices(mesh, bind);
+  size_t i = 0, k = 0;
+
+  const auto sample_row = [&](const char* name, ossa::SamplingCache& cache, double limit) {
+    const auto [ossa_s, plain_s] = interleaved_min(
+        trials, 64,
+        [&] { ossa::sample(clips[0], times[i++ & 255], {}, cache, poses[0]); g_sink = g_sink + static_cast<uint32_t>(poses[0].span().base[0]); },
+        [&] { flushed([&] { ossa::bench::plain_sample(plain[0], times[k++ & 255], local[0].data()); });
+              g_sink = g_sink + static_cast<uint32_t>(local[0][0].t[0]); });
+    rows.push_back({name, ossa_s * 1e9, plain_s * 1e9, limit});
+  };
+  sample_row("sample.plain", *caches[0], limit_for(0.55, 1.1));  // AMD Zen 5: 0.40-0.41 measured, 0.71-0.72 regressed; Intel: not yet measured
+  sample_row("sample.noisy", *caches[3], limit_for(0.55, 1.1));  // the same; a runtime without FTZ/DAZ alone fails this row
+
+  const std::span<const int16_t> parents = skeleton.parents();
+  const ossa::ConstPoseSpan inputs[3] = {poses[0], poses[1], poses[2]};
+  const PlainTransform* plain_inputs[3] = {local[0].data(), local[1].data(), local[2].data()};
+  const float weights[3] = {0.2f, 0.5f, 0.3f};
+  {
+    const auto [ossa_s, plain_s] = interleaved_min(
+        trials, 16,
+        [&] {
+          const float p = phase[i++ & 255];
+          for (int c = 0; c < 3; ++c) ossa::sample(clips[c], p * clips[c].duration(), {}, *caches[c], poses[c]);
+          ossa::blend_n(inputs, weights, blended);
+          ossa::local_to_model(parents, blended, model);
+          ossa::skinning_matrices(mesh.joints(), bind, model, palette);
+          g_sink = g_sink + static_cast<uint32_t>(palette[0][3][0]);
+        },
+        [&] {
+          flushed([&] {
+            const float p = phase[k++ & 255];
+            for (int c = 0; c < 3; ++c) ossa::bench::plain_sample(plain[c], p * plain[c].duration, local[c].data());
+            ossa::bench::plain_blend(plain_inputs, weights, joints, plain_blended.data());
+            ossa::bench::plain_model(parents, plain_blended.data(), plain_model.data());
+            ossa::bench::plain_palette(mesh.joints(), bind, plain_model.data(), plain_palette.data());
+          });
+          g_sink = g_sink + static_cast<uint32_t>(plain_palette[0][3][0]);
+        });
+    rows.push_back({"frame.plain", ossa_s * 1e9, plain_s * 1e9, limit_for(0.32, 0.7)});  // Zen 5: 0.256-0.263, 0.349-0.352 regressed; Intel: not yet measured
+  }
+  {
+    // Skinning with the frame's last palette.
+    const ossa::bench::PlainMesh plain_mesh = ossa::bench::plain_mesh(mesh);
+    std::vector<float> positions(3 * size_t(mesh.vertex_count())), normals(positions.size());
+    std::vector<float> plain_positions(positions.size()), plain_normals(positions.size());
+    const ossa::SkinnedStreams streams{positions, normals, {}};
+    const auto [ossa_s, plain_s] = interleaved_min(
+        trials, 4,
+        [&] { ossa::skin_cpu(mesh, palette, ossa::SkinningMethod::Linear, streams); g_sink = g_sink + static_cast<uint32_t>(positions[0]); },
+        [&] {
+          flushed([&] { ossa::bench::plain_skin(plain_mesh, palette.data(), plain_positions.data(), plain_normals.data()); });
+          g_sink = g_sink + static_cast<uint32_t>(plain_positions[0]);
+        });
+    rows.push_back({"skin.plain", ossa_s * 1e9, plain_s * 1e9, limit_for(0.35, 0.7)});  // Zen 5: 0.20-0.23; Intel: not yet measured
+  }
+  return true;
 }
 
 
@@ -273,6 +400,10 @@ int main(int argc, char** argv) {
     // Measured: AMD EPYC Zen 5 0.54-0.60; Intel Xeon 6/207: within the limit.
     rows.push_back({"sample", forward * 1e9, reset * 1e9, limit_for(1.1, 1.1)});
   }
+
+  // Against plain scalar references written once (guard_reference.h), run with flush-to-zero set so
+  // no value in the data can slow them: these rows move only when ossa's cost per frame moves.
+  if (!plain_rows(trials, data, rows)) return 1;
 
   // Verify: the loader's checks on bytes in memory against one plain pass over the same bytes.
   const std::span<const uint8_t> skeleton_bytes = data.skeleton.bytes();

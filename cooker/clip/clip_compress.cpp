@@ -93,6 +93,7 @@
 #include <map>
 
 #include "cooker/clip/clip_error.h"
+#include "cooker/import/tiny_values.h"
 #include <ossa/format/clip_codec.h>
 #include <ossa/format/ossa_generated.h>
 
@@ -177,6 +178,7 @@ ClipSamples reference_samples(const SourceClip& clip, const SourceSkeleton& skel
       std::fill_n(ref.channel(j, ch), grid.frame_count, bind);
     }
   }
+  flush_tiny_values(ref.values);  // interpolated across zero: 1e-21 where 0 is meant (tiny_values.h)
   return ref;
 }
 

@@ -30,6 +30,7 @@
 #include "cooker/import/import_internal.h"
 #include "cooker/import/import_io.h"
 #include "cooker/import/import_scene.h"
+#include "cooker/import/tiny_values.h"
 #include "cooker/import/value_check.h"
 
 namespace ossa::cook {
@@ -108,6 +109,8 @@ Result<SourceScene> convert_scene(const aiScene& scene, const std::string& path,
   }
   // Values the format cannot hold are named here, not found by the writer's own verification.
   if (Status st = check_scene_values(out); !st) return ctx.error(st.message());
+  // Decomposition noise (1e-33 where 0 is meant) would cost the runtime subnormal arithmetic.
+  flush_tiny_values(out);
   // One line per thing said: a texture two materials share, or a slot Assimp fills twice, would
   // otherwise say the same twice. The first occurrence keeps its place.
   std::set<std::string> seen;

@@ -21,6 +21,7 @@
 #include <cstddef>
 
 #include <ossa/anim/pose_ops.h>
+#include "internal/float_env.h"
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -136,6 +137,7 @@ OSSA_INLINE Columns mul_affine(const Columns& p, const AffineLanes& a, size_t l)
 }  // namespace
 
 OSSA_INLINE static void local_to_model_body(std::span<const int16_t> parents, ConstPoseSpan local, std::span<glm::mat4> out_model) {
+  const detail::FlushDenormals flush;  // internal/float_env.h
   const size_t n = std::min({size_t(local.joint_count), parents.size(), out_model.size()});
   AffineLanes a;
   Columns previous{};  // model matrix of joint i - 1

@@ -36,6 +36,7 @@
 #include <cstddef>
 
 #include <ossa/anim/pose_ops.h>
+#include "internal/float_env.h"
 #include "internal/vector_clones.h"
 
 
@@ -235,6 +236,7 @@ OSSA_INLINE void blend_n_pass(ConstPoseSpan ref, const ConstPoseSpan (&in)[3], c
 }  // namespace
 
 OSSA_INLINE static void blend_body(ConstPoseSpan a, ConstPoseSpan b, float alpha, PoseSpan out) {
+  const detail::FlushDenormals flush;  // internal/float_env.h
   const float t = clamp01(alpha);
   // The ends are copies: exact, and cheaper than blending with a zero weight.
   if (t == 0.0f) return copy_pose(a, out);
@@ -252,6 +254,7 @@ OSSA_INLINE static void blend_body(ConstPoseSpan a, ConstPoseSpan b, float alpha
 OSSA_VECTOR_DISPATCH(blend, (ConstPoseSpan a, ConstPoseSpan b, float alpha, PoseSpan out), (a, b, alpha, out))
 
 OSSA_INLINE static void blend_n_body(std::span<const ConstPoseSpan> poses, std::span<const float> weights, PoseSpan out) {
+  const detail::FlushDenormals flush;  // internal/float_env.h
   const size_t count = std::min(poses.size(), weights.size());
   if (count == 0) return set_identity(out);
   // Normalize the weights; a non-positive (or NaN) total has no meaningful blend, so the first
@@ -311,6 +314,7 @@ OSSA_VECTOR_DISPATCH(blend_n, (std::span<const ConstPoseSpan> poses, std::span<c
 
 OSSA_INLINE static void blend_layered_body(ConstPoseSpan base, ConstPoseSpan layer, std::span<const float> joint_weights, float weight,
                    PoseSpan out) {
+  const detail::FlushDenormals flush;  // internal/float_env.h
   const size_t stride = common_stride(base, layer, out);
   // Joints past joint_weights (and padding lanes) get weight 0: they keep the base pose.
   const size_t weighted = std::min<size_t>(joint_weights.size(), out.joint_count);
@@ -360,6 +364,7 @@ void build_joint_mask(std::span<const int16_t> parents, int joint, int depth, st
 }
 
 OSSA_INLINE static void make_additive_body(ConstPoseSpan pose, ConstPoseSpan reference, PoseSpan out_additive) {
+  const detail::FlushDenormals flush;  // internal/float_env.h
   const size_t stride = common_stride(pose, reference, out_additive);
   const float *p = pose.base, *r = reference.base;
   float* o = out_additive.base;
@@ -390,6 +395,7 @@ OSSA_IVDEP
 OSSA_VECTOR_DISPATCH(make_additive, (ConstPoseSpan pose, ConstPoseSpan reference, PoseSpan out_additive), (pose, reference, out_additive))
 
 OSSA_INLINE static void add_body(ConstPoseSpan base, ConstPoseSpan additive, float weight, PoseSpan out) {
+  const detail::FlushDenormals flush;  // internal/float_env.h
   const size_t stride = common_stride(base, additive, out);
   const float *b = base.base, *d = additive.base;
   float* o = out.base;

@@ -52,6 +52,7 @@
 #endif
 
 #include <ossa/format/clip_codec.h>
+#include "internal/float_env.h"
 #include "internal/memory.h"
 #include "internal/vector_clones.h"
 
@@ -571,6 +572,7 @@ void reset(SamplingCache& cache) {
 }
 
 void sample(const ClipView& clip, float time, const SampleOptions& options, SamplingCache& cache, PoseSpan out) {
+  const detail::FlushDenormals flush;  // a rest value like 1e-33 squared must not cost an assist
   State& s = *cache.state();
   assert(clip.fb == s.clip && "a SamplingCache plays the clip it was made for");
   assert(out.joint_count == s.joint_count && out.stride == s.stride);

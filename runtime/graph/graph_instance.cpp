@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "graph/graph_internal.h"
+#include "internal/float_env.h"
 
 #include <cstring>
 #if defined(__SSE2__)
@@ -229,6 +230,8 @@ void GraphInstance::update(float dt) {
 void GraphInstance::update(float dt, GraphScratch& scratch) { update(dt, scratch.buffers()); }
 
 void GraphInstance::update(float dt, GraphScratch::Buffers& buffers) {
+  // One guard for the whole update: the kernels it calls find FTZ/DAZ set and leave MXCSR alone.
+  const detail::FlushDenormals flush;
   State& s = *state_;
   s.scratch = &buffers;
   if (!(dt >= 0.0f) || !std::isfinite(dt)) dt = 0.0f;

@@ -53,6 +53,7 @@
 #include <type_traits>
 
 #include "internal/cpu.h"
+#include "internal/float_env.h"
 
 #if OSSA_CPU_X86
 // GCC 12's AVX-512 headers trip -Wmaybe-uninitialized on their own _mm512_undefined_* helpers
@@ -1100,6 +1101,7 @@ OSSA_TARGET_AVX2 void palettes_avx2(const uint16_t* joints, const glm::mat4* bin
 }  // namespace
 
 void skinning_matrices(const MeshView& mesh, std::span<const glm::mat4> model, std::span<glm::mat4> palette) {
+  const detail::FlushDenormals flush;  // internal/float_env.h
   const MeshFacts m = mesh_facts(mesh);
   const std::span<const uint16_t> joints = mesh.joints();
   const std::span<const fb::Mat4> inverse_bind = mesh.inverse_bind();
@@ -1127,6 +1129,7 @@ void prepare_bind_matrices(const MeshView& mesh, std::span<glm::mat4> bind) {
 
 void skinning_matrices(std::span<const uint16_t> joints, std::span<const glm::mat4> bind,
                        std::span<const glm::mat4> model, std::span<glm::mat4> palette) {
+  const detail::FlushDenormals flush;  // internal/float_env.h
   if (joints.empty()) {
     if (!palette.empty() && !bind.empty()) palette[0] = bind[0];
     return;
@@ -1163,6 +1166,7 @@ void skin_cpu(const MeshView& mesh, std::span<const glm::mat4> palette, Skinning
     if (m.tangent != nullptr && out.tangents.size() >= 4 * n) o.tangents = out.tangents.data();
   }
   if (o.positions == nullptr && o.normals == nullptr && o.tangents == nullptr) return;
+  const detail::FlushDenormals flush;  // internal/float_env.h
   const size_t needed = m.joints != nullptr ? m.slot_count : 1;
   assert(palette.size() >= needed);
   if (palette.size() < needed || needed == 0) return;

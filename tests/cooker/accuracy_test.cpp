@@ -14,6 +14,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <bit>
 #include <cctype>
 #include <cmath>
 #include <cstring>
@@ -35,6 +36,7 @@
 
 #include "cooker/cook.h"
 #include "cooker/import/import_scene.h"
+#include "cooker/import/tiny_values.h"
 #include <ossa/format/vertex_codec.h>
 #include <ossa/loader/asset.h>
 #include <ossa/anim/pose.h>
@@ -551,6 +553,101 @@ TEST_P(Accuracy, ClipSamplesMatchAssimpAtFirstMiddleLastSourceTimes) {
     }
   }
   RecordProperty("negative_control", negative_control_ran ? "ran" : "no clip moved enough");
+}
+
+// No rest or constant value is cooked in (0, kTinyValue): rest values rebuilt from matrices carry
+// noise like 7.7e-34 where 0 is meant (Pab's skins put five in its hand and finger rotations),
+// which the runtime's interpolation would square into subnormals (cooker/import/tiny_values.h).
+// Checked: bind transforms, inverse binds of skeleton and meshes, clip constants. Animated keys
+// are the encoder's choice (a quantized key lands anywhere in its range, a rotation key's solved
+// component anywhere near its source) and may come near zero: the runtime's flush-to-zero covers
+// those (runtime/internal/float_env.h, tests/float_env_test.cpp).
+TEST_P(Accuracy, NoTinyValueIsCooked) {
+  size_t checked = 0;
+  // what, then where: a joint, mesh or clip index and an element index.
+  const auto check = [&](float v, const char* what, size_t at, size_t sub) {
+    ++checked;
+    EXPECT_FALSE(v != 0.0f && std::fabs(v) < ossa::cook::kTinyValue) << what << " " << at << "/" << sub << " = " << v;
+  };
+  const auto check_matrix = [&](const ossa::fb::Mat4& m, const char* what, size_t at) {
+    for (int i = 0; i < 16; ++i) check(m.m()->Get(static_cast<flatbuffers::uoffset_t>(i)), what, at, size_t(i));
+  };
+  const ossa::SkeletonView sk = asset_->skeleton();
+  for (size_t j = 0; j < sk.joint_count(); ++j) {
+    const auto& t = sk.bind_translations()[j];
+    const auto& r = sk.bind_rotations()[j];
+    const auto& sc = sk.bind_scales()[j];
+    for (float v : {t.x(), t.y(), t.z()}) check(v, "bind translation of joint", j, 0);
+    for (float v : {r.x(), r.y(), r.z(), r.w()}) check(v, "bind rotation of joint", j, 0);
+    for (float v : {sc.x(), sc.y(), sc.z()}) check(v, "bind scale of joint", j, 0);
+    check_matrix(sk.inverse_bind()[j], "inverse bind of joint", j);
+  }
+  for (size_t m = 0; m < asset_->mesh_count(); ++m)
+    for (const ossa::fb::Mat4& ib : asset_->mesh(m).inverse_bind()) check_matrix(ib, "inverse bind of mesh", m);
+  for (size_t c = 0; c < asset_->clip_count(); ++c) {
+    const ossa::ClipView clip = asset_->clip(c);
+    for (const ossa::fb::ConstantChannel& k : clip.constants())
+      for (float v : {k.value().x(), k.value().y(), k.value().z(), k.value().w()}) check(v, "constant of clip", c, 0);
+  }
+  EXPECT_GT(checked, 0u);
+}
+
+// flush_tiny_values on every field the runtime computes with: below the bound (subnormals and -0
+// included) becomes +0, the bound itself and everything above it stay.
+TEST(TinyValues, EveryRuntimeFloatBelowTheBoundIsFlushedAndNothingElse) {
+  using ossa::cook::kTinyValue;
+  const float below[] = {0.99f * kTinyValue, -0.5f * kTinyValue, 7.7e-34f, -1.97e-31f, 1e-40f, -0.0f};
+  const float kept[] = {kTinyValue, -kTinyValue, 1e-18f, 1.0f, -3.5f, 0.0f};
+  ossa::cook::SourceScene scene;
+  std::vector<float*> low, high;  // where each kind of value was put
+  const auto fill = [&](float* v, size_t n) {
+    for (size_t i = 0; i < n; ++i) {
+      const bool is_low = i % 2 == 0;
+      v[i] = is_low ? below[(i / 2) % 6] : kept[(i / 2) % 6];
+      (is_low ? low : high).push_back(&v[i]);
+    }
+  };
+  ossa::cook::SourceJoint& joint = scene.skeleton.joints.emplace_back();
+  ossa::cook::SourceMesh& mesh = scene.meshes.emplace_back();
+  mesh.positions.resize(2);
+  mesh.normals.resize(2);
+  mesh.tangents.resize(2);
+  mesh.bind.emplace_back(uint16_t(0), glm::mat4(1.0f));
+  ossa::cook::SourceMorphTarget& target = mesh.morph_targets.emplace_back();
+  target.positions.resize(2);
+  target.normals.resize(2);
+  target.tangents.resize(2);
+  ossa::cook::SourceClip& clip = scene.clips.emplace_back();
+  ossa::cook::SourceTrack& track = clip.tracks.emplace_back();
+  track.translations.resize(2);
+  track.rotations.resize(2);
+  track.scales.resize(2);
+  clip.root_motion.translations.resize(2);
+  clip.root_motion.yaws.resize(4);
+  clip.morph_weights.emplace_back().weights.resize(4);
+  fill(&joint.translation.x, 3);
+  fill(&joint.rotation.x, 4);
+  fill(&joint.scale.x, 3);
+  fill(&joint.inverse_bind[0][0], 16);
+  fill(&mesh.positions[0].x, 6);
+  fill(&mesh.normals[0].x, 6);
+  fill(&mesh.tangents[0].x, 8);
+  fill(&mesh.bind[0].second[0][0], 16);
+  fill(&target.positions[0].x, 6);
+  fill(&target.normals[0].x, 6);
+  fill(&target.tangents[0].x, 6);
+  fill(&track.translations[0].x, 6);
+  fill(&track.rotations[0].x, 8);
+  fill(&track.scales[0].x, 6);
+  fill(&clip.root_motion.translations[0].x, 6);
+  fill(clip.root_motion.yaws.data(), 4);
+  fill(clip.morph_weights[0].weights.data(), 4);
+  std::vector<float> before;
+  for (float* v : high) before.push_back(*v);
+  EXPECT_EQ(ossa::cook::flush_tiny_values(scene), low.size());
+  for (float* v : low) EXPECT_TRUE(*v == 0.0f && !std::signbit(*v)) << *v;
+  for (size_t i = 0; i < high.size(); ++i) EXPECT_EQ(std::bit_cast<uint32_t>(*high[i]), std::bit_cast<uint32_t>(before[i]));
+  EXPECT_EQ(ossa::cook::flush_tiny_values(scene), 0u);  // nothing left to flush
 }
 
 const AccuracyCase kCases[] = {

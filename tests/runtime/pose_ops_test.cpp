@@ -591,17 +591,26 @@ TEST(Additive, RoundTripAndWeights) {
 }
 
 TEST(Additive, TinyReferenceScalesAndDeepStacksStayFinite) {
-  // A denormal reference scale (the loader accepts any scale within +-1e7, zero and denormals
+  // A tiny reference scale (the loader accepts any scale within +-1e7, zero and denormals
   // included) has a ratio beyond float range; stacking additive layers multiplies scales again.
   // Every result must stay finite and within the loader's bound of 1e7. (Found by fuzz_load.)
   Pose pose(1), reference(1), delta(1), out(1);
   ossa::set_transform(pose, 0, {glm::vec3(1e7f, -1e7f, 0), about_z(30.0f), glm::vec3(1e7f, 1.0f, -1e7f)});
-  ossa::set_transform(reference, 0, {glm::vec3(-1e7f, 1e7f, 0), about_z(0.0f), glm::vec3(1e-40f, 0.0f, 1e-38f)});
+  ossa::set_transform(reference, 0, {glm::vec3(-1e7f, 1e7f, 0), about_z(0.0f), glm::vec3(2e-38f, 0.0f, 3e-38f)});
   ossa::make_additive(pose, reference, delta);
   const Transform td = ossa::get_transform(delta, 0);
   EXPECT_EQ(td.scale.x, 1e7f);   // clamped ratio
   EXPECT_EQ(td.scale.y, 1.0f);   // zero reference: no change
   EXPECT_EQ(td.scale.z, -1e7f);  // clamped, sign kept
+  {
+    // A subnormal reference scale is a zero one: the kernels run with denormals-are-zero
+    // (runtime/internal/float_env.h), so it costs no assist and changes nothing.
+    Pose denormal(1), d(1);
+    ossa::set_transform(denormal, 0, {glm::vec3(0.0f), about_z(0.0f), glm::vec3(1e-40f, -1e-39f, 1e-45f)});
+    ossa::make_additive(pose, denormal, d);
+    const Transform t = ossa::get_transform(d, 0);
+    EXPECT_EQ(t.scale, glm::vec3(1.0f));
+  }
   ossa::copy_pose(pose, out);
   for (int layer = 0; layer < 40; ++layer) ossa::add(out, delta, 8.0f, out);
   const Transform t = ossa::get_transform(out, 0);

@@ -400,6 +400,66 @@ TEST(Skinning, OnlyRequestedStreamsAreWritten) {
   }
 }
 
+TEST(Skinning, RangeLoopsReadEveryWeightByteAsTheClassifiedLoopsDo) {
+  // A class-ordered mesh runs one loop per class range, anything else classified batches; both
+  // read the joint slots and weights their own way. Every byte value in every influence of every
+  // class, skinned both ways (the same vertices class-ordered, and in reverse so that the order
+  // probe fails), must give the same positions and tangents, bit for bit.
+  ossa::test::SyntheticSpec spec;
+  std::mt19937 gen(11);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  std::vector<ossa::test::SyntheticVertex>& vs = spec.meshes[0].vertices;
+  vs.clear();
+  for (int k = 1; k <= 4; ++k)
+    for (int b = 0; b < 256; ++b) {
+      ossa::test::SyntheticVertex v;
+      v.position = ossa::fb::Vec3(u(gen), 2.0f * u(gen) + 1.0f, u(gen));
+      v.normal = ossa::fb::Vec3(0.0f, 1.0f, 0.0f);
+      for (int i = 0; i < 4; ++i) v.slots[i] = static_cast<uint16_t>(gen() % 3);
+      v.weights = {0, 0, 0, 0};
+      for (int i = 0; i < k; ++i) v.weights[i] = static_cast<uint8_t>((b + 37 * i) % 256);
+      if (v.weights[k - 1] == 0) v.weights[k - 1] = 1;  // class k: its last influence is used
+      vs.push_back(v);
+    }
+  std::stable_sort(vs.begin(), vs.end(),
+                   [](const auto& a, const auto& b) { return influence_class(a.weights) < influence_class(b.weights); });
+  ossa::test::SyntheticSpec reversed = spec;
+  std::reverse(reversed.meshes[0].vertices.begin(), reversed.meshes[0].vertices.end());
+  // Tangents from each vertex's own position, so that both files give a vertex the same one.
+  const auto tangents = [](const ossa::test::SyntheticSpec& sp) {
+    std::vector<uint8_t> bytes = with_tangents(sp);
+    const ossa::fb::Mesh* mesh = ossa::fb::GetFile(bytes.data())->meshes()->Get(0);
+    const size_t at = static_cast<size_t>(mesh->vertices()->Data() - bytes.data());
+    const auto& v = sp.meshes[0].vertices;
+    for (size_t i = 0; i < v.size(); ++i) {
+      const glm::vec3 t = glm::normalize(glm::vec3(1.0f, v[i].position.x(), -0.2f));
+      const ossa::Float2 e = ossa::octahedral_encode({t.x, t.y, t.z});
+      const int16_t q[4] = {ossa::float_to_snorm16(e.x), ossa::float_to_snorm16(e.y), int16_t(v[i].position.z() < 0 ? -32767 : 32767), 0};
+      std::memcpy(bytes.data() + at + i * 32 + 12, q, 8);
+    }
+    return bytes;
+  };
+  SyntheticAsset ordered = load(tangents(spec)), dealt = load(tangents(reversed));
+  ASSERT_NE(ordered.asset, nullptr);
+  ASSERT_NE(dealt.asset, nullptr);
+  const size_t n = vs.size();
+  const auto palette = palette_of(ordered.asset->mesh(0), make_pose(ordered.asset->skeleton(), 0.8f, 5).model);
+  for (ossa::SkinningIsa isa : available_isas()) {
+    IsaScope scope(isa);
+    std::vector<float> p(3 * n), q(3 * n), t(4 * n), r(4 * n);
+    ossa::skin_cpu(ordered.asset->mesh(0), palette, ossa::SkinningMethod::Linear, {p, {}, {}});
+    ossa::skin_cpu(dealt.asset->mesh(0), palette, ossa::SkinningMethod::Linear, {q, {}, {}});
+    ossa::skin_cpu(ordered.asset->mesh(0), palette, ossa::SkinningMethod::Linear, {{}, {}, t});
+    ossa::skin_cpu(dealt.asset->mesh(0), palette, ossa::SkinningMethod::Linear, {{}, {}, r});
+    size_t differ = 0;
+    for (size_t v = 0; v < n; ++v) {
+      differ += std::memcmp(&p[3 * v], &q[3 * (n - 1 - v)], 12) != 0;
+      differ += std::memcmp(&t[4 * v], &r[4 * (n - 1 - v)], 16) != 0;
+    }
+    EXPECT_EQ(differ, 0u) << isa_name(isa);
+  }
+}
+
 TEST(Skinning, EveryStreamSelectionGivesBitIdenticalResults) {
   // skin_cpu's fast paths differ by the streams asked for (positions with normals run eight
   // vertices at a time, structure-of-arrays; positions alone, or with tangents, one at a time) and
