@@ -12,6 +12,8 @@
 // keeps its angle) and re-placing anchored feet at their shins.
 #include <ossa/retarget/retarget.h>
 
+#include "retarget/retarget_internal.h"
+
 #include <ossa/anim/ik.h>
 #include <ossa/anim/pose_ops.h>
 
@@ -32,19 +34,6 @@ glm::mat4 trs(const glm::vec3& t, const glm::quat& r, const glm::vec3& s) {
   return m;
 }
 
-glm::quat read_rotation(ConstPoseSpan p, uint32_t j) {
-  return glm::quat(p[kRw][j], p[kRx][j], p[kRy][j], p[kRz][j]);
-}
-glm::vec3 read3(ConstPoseSpan p, PoseComponent first, uint32_t j) {
-  return {p[first][j], p[PoseComponent(first + 1)][j], p[PoseComponent(first + 2)][j]};
-}
-
-void write(PoseSpan out, uint32_t j, const glm::vec3& t, const glm::quat& r, const glm::vec3& s) {
-  out[kTx][j] = t.x, out[kTy][j] = t.y, out[kTz][j] = t.z;
-  out[kRx][j] = r.x, out[kRy][j] = r.y, out[kRz][j] = r.z, out[kRw][j] = r.w;
-  out[kSx][j] = s.x, out[kSy][j] = s.y, out[kSz][j] = s.z;
-}
-
 /// Shortest-arc slerp (the deltas of neighbouring chain joints are close; nlerp would do too, but
 /// slerp keeps a 50 % blend exactly halfway).
 glm::quat blend(const glm::quat& a, glm::quat b, float w) {
@@ -52,15 +41,21 @@ glm::quat blend(const glm::quat& a, glm::quat b, float w) {
   return glm::normalize(glm::slerp(a, b, w));
 }
 
+/// a / b per axis (1 where b is 0).
+glm::vec3 ratio(const glm::vec3& a, const glm::vec3& b) {
+  return {b.x != 0.0f ? a.x / b.x : 1.0f, b.y != 0.0f ? a.y / b.y : 1.0f, b.z != 0.0f ? a.z / b.z : 1.0f};
+}
+
 glm::quat delta(const RetargetMap& map, const RetargetScratch& s, int source_joint) {
   return s.source_rotation[static_cast<size_t>(source_joint)] * map.source_rest_inverse[static_cast<size_t>(source_joint)];
 }
 
-/// Target local and model space from the steps. With `pinned` (after IK), the pose already in
-/// `out` is read instead of recomputed for rotating joints, except that each leg's foot takes the
-/// model rotation kept in scratch.foot_rotation.
+}  // namespace
+
+namespace detail {
+
 void evaluate(const RetargetMap& map, const RetargetInput& in, RetargetScratch& s, PoseSpan out, bool pinned,
-              const std::array<bool, 2>& legs, const glm::vec3& hips_shift) {
+              std::span<const Kept> kept, const glm::vec3& hips_shift) {
   const float scale = map.scale;
   for (const Step& step : map.steps) {
     const auto j = static_cast<uint32_t>(step.joint);
@@ -84,16 +79,14 @@ void evaluate(const RetargetMap& map, const RetargetInput& in, RetargetScratch& 
         const Transform& sb = map.source_bind[a];
         r = glm::normalize(step.rest * (step.source_rest_local_inverse * read_rotation(in.source, a)));
         t = bind.translation + scale * (read3(in.source, kTx, a) - sb.translation);
-        const glm::vec3 ss = read3(in.source, kSx, a);
-        sc = bind.scale * glm::vec3(sb.scale.x != 0.0f ? ss.x / sb.scale.x : 1.0f, sb.scale.y != 0.0f ? ss.y / sb.scale.y : 1.0f,
-                                    sb.scale.z != 0.0f ? ss.z / sb.scale.z : 1.0f);
+        sc = bind.scale * ratio(read3(in.source, kSx, a), sb.scale);
         break;
       }
       default: {
         glm::quat model;
         bool foot = false;
-        for (size_t leg = 0; leg < 2; ++leg)
-          if (pinned && legs[leg] && step.joint == map.legs[leg].foot) model = s.foot_rotation[leg], foot = true;
+        for (const Kept& k : kept)
+          if (pinned && k.joint == step.joint) model = k.model, foot = true;
         if (pinned && !foot) {
           r = read_rotation(out, j);
           model = glm::normalize(parent_rotation * r);
@@ -104,14 +97,40 @@ void evaluate(const RetargetMap& map, const RetargetInput& in, RetargetScratch& 
           model = glm::normalize(map.rotation * d * step.rest);
         }
         if (!pinned || foot) r = glm::normalize(glm::inverse(parent_rotation) * model);
+        if (step.same_joint) {
+          // The same joint's squash and stretch: the source's scale as a ratio of its bind's.
+          sc *= ratio(read3(in.source, kSx, static_cast<uint32_t>(step.source_a)),
+                      map.source_bind[static_cast<size_t>(step.source_a)].scale);
+        }
+        if (step.same_joint && step.kind == RetargetStep::Rotate) {
+          // The same joint's translation away from its bind (a stretch, or keys that differ from the
+          // skin's bind) rides along, carried through model space.
+          const auto a = static_cast<uint32_t>(step.source_a);
+          const glm::vec3 moved = read3(in.source, kTx, a) - map.source_bind[a].translation;
+          const int sp = map.source_parents[a];
+          if (moved != glm::vec3(0.0f)) {
+            const glm::quat source_parent =
+                sp >= 0 ? s.source_rotation[static_cast<size_t>(sp)] : glm::quat(1.0f, 0.0f, 0.0f, 0.0f);
+            t += glm::inverse(parent_rotation) * (map.scale * (map.rotation * (source_parent * moved)));
+          }
+        }
         if (step.kind == RetargetStep::Hips) {
           const HumanoidMap& sh = map.source_humanoid;
           const glm::vec3 pelvis = 0.5f * (glm::vec3(s.source_model[static_cast<size_t>(sh[HumanoidBone::LeftUpperLeg])][3]) +
                                            glm::vec3(s.source_model[static_cast<size_t>(sh[HumanoidBone::RightUpperLeg])][3]));
-          const glm::vec3 p = map.map_point(pelvis, in.source_floor) + hips_shift + model * step.offset;
+          // What the source's hips move against its own legs (an animated leg root) rides along.
+          const auto sj = static_cast<size_t>(step.source_a);
+          const glm::vec3 own = step.same_joint ? glm::vec3(s.source_model[sj][3]) - pelvis -
+                                s.source_rotation[sj] * (map.source_rest_inverse[sj] * map.source_hips_offset) : glm::vec3(0.0f);
+          const glm::vec3 p = map.map_point(pelvis, in.source_floor) + hips_shift + model * step.offset +
+                              map.scale * (map.rotation * own);
           t = parent >= 0 ? glm::vec3(glm::inverse(parent_model) * glm::vec4(p, 1.0f)) : p;
         } else if (step.kind == RetargetStep::Anchored) {
-          const glm::vec3 p(s.target_model[static_cast<size_t>(step.anchor)] * glm::vec4(step.offset, 1.0f));
+          const RetargetMap::Leg& leg = map.legs[step.joint == map.legs[0].foot ? 0 : 1];
+          const glm::vec3 own = step.same_joint ? glm::vec3(s.source_model[static_cast<size_t>(leg.source_foot)][3]) -
+                                glm::vec3(s.source_model[static_cast<size_t>(leg.source_lower)] * glm::vec4(leg.source_offset, 1.0f)) : glm::vec3(0.0f);
+          const glm::vec3 p = glm::vec3(s.target_model[static_cast<size_t>(step.anchor)] * glm::vec4(step.offset, 1.0f)) +
+                              map.scale * (map.rotation * own);
           t = parent >= 0 ? glm::vec3(glm::inverse(parent_model) * glm::vec4(p, 1.0f)) : p;
         }
         break;
@@ -122,6 +141,10 @@ void evaluate(const RetargetMap& map, const RetargetInput& in, RetargetScratch& 
     s.target_rotation[j] = glm::normalize(parent_rotation * r);
   }
 }
+
+}  // namespace detail
+
+namespace {
 
 bool fits(const RetargetMap& map, const RetargetScratch& s) {
   return s.source_model.size() == map.source_joint_count && s.source_rotation.size() == map.source_joint_count &&
@@ -145,7 +168,7 @@ bool pose_source(const RetargetMap& map, ConstPoseSpan source, RetargetScratch& 
   local_to_model(map.source_parents, source, s.source_model);
   for (uint32_t j = 0; j < map.source_joint_count; ++j) {
     const int p = map.source_parents[j];
-    const glm::quat r = glm::normalize(read_rotation(source, j));
+    const glm::quat r = glm::normalize(detail::read_rotation(source, j));
     s.source_rotation[j] = p >= 0 ? glm::normalize(s.source_rotation[static_cast<size_t>(p)] * r) : r;
   }
   return true;
@@ -156,63 +179,10 @@ bool retarget(const RetargetMap& map, const RetargetInput& in, RetargetScratch& 
   if (in.target_base.base != nullptr && in.target_base.joint_count != map.target_joint_count) return false;
   if (!in.contacts.empty() && in.contacts.size() != 2) return false;
   if (!pose_source(map, in.source, s)) return false;
-  std::array<bool, 2> legs{false, false};
-  evaluate(map, in, s, out, false, legs, glm::vec3(0.0f));
-  if (in.contacts.empty()) return true;
-
-  // Where each planted foot should be, and how much of that the pelvis takes across the ground.
-  const glm::vec3 up = map.target_pose.up;
-  std::array<glm::vec3, 2> goal{};
-  glm::vec3 shift(0.0f);
-  float weights = 0.0f;
-  for (size_t leg = 0; leg < 2; ++leg) {
-    const FootContact& c = in.contacts[leg];
-    const RetargetMap::Leg& l = map.legs[leg];
-    if (!(c.weight > 0.0f) || l.upper < 0 || l.lower < 0 || l.foot < 0) continue;
-    const glm::vec3 ankle(s.target_model[static_cast<size_t>(l.foot)][3]);
-    const glm::vec3 error = c.weight >= 1.0f ? map.map_point(c.position, in.source_floor) - ankle
-                                             : std::min(c.weight, 1.0f) * map.scale * (map.rotation * c.shift);
-    if (!std::isfinite(error.x + error.y + error.z)) continue;
-    goal[leg] = ankle + error;
-    shift += error - glm::dot(error, up) * up;
-    weights += std::min(c.weight, 1.0f);
-    legs[leg] = true;
-  }
-  if (!legs[0] && !legs[1]) return true;
-  shift /= std::max(1.0f, weights);
-  evaluate(map, in, s, out, false, {false, false}, shift);
-
-  for (size_t leg = 0; leg < 2; ++leg) {
-    if (!legs[leg]) continue;
-    const RetargetMap::Leg& l = map.legs[leg];
-    TwoBoneIkInput ik;
-    ik.start = s.target_model[static_cast<size_t>(l.upper)];
-    ik.mid = s.target_model[static_cast<size_t>(l.lower)];
-    ik.end = s.target_model[static_cast<size_t>(l.foot)];
-    ik.target = goal[leg];
-    // Bend the way the knee already bends; a straight leg bends towards the body's forward.
-    const glm::vec3 hip(ik.start[3]), knee(ik.mid[3]), ankle(ik.end[3]);
-    const glm::vec3 axis = ankle - hip;
-    const float len2 = glm::dot(axis, axis);
-    glm::vec3 pole = knee - hip - (len2 > 0.0f ? glm::dot(knee - hip, axis) / len2 : 0.0f) * axis;
-    if (glm::dot(pole, pole) < 1e-6f * len2) {
-      const auto hips = static_cast<size_t>(map.target_humanoid[HumanoidBone::Hips]);
-      pole = s.target_rotation[hips] * (map.target_hips_rest_inverse * map.target_forward);
-    }
-    ik.pole = pole;
-    TwoBoneIkOutput result;
-    if (!two_bone_ik(ik, &result)) {
-      legs[leg] = false;
-      continue;
-    }
-    s.foot_rotation[leg] = s.target_rotation[static_cast<size_t>(l.foot)];
-    const auto upper = static_cast<uint32_t>(l.upper), lower = static_cast<uint32_t>(l.lower);
-    const glm::quat ru = glm::normalize(read_rotation(out, upper) * result.start_correction);
-    const glm::quat rl = glm::normalize(read_rotation(out, lower) * result.mid_correction);
-    out[kRx][upper] = ru.x, out[kRy][upper] = ru.y, out[kRz][upper] = ru.z, out[kRw][upper] = ru.w;
-    out[kRx][lower] = rl.x, out[kRy][lower] = rl.y, out[kRz][lower] = rl.z, out[kRw][lower] = rl.w;
-  }
-  evaluate(map, in, s, out, true, legs, shift);
+  s.adjusted = 0;
+  detail::evaluate(map, in, s, out, false, {}, glm::vec3(0.0f));
+  detail::guard_mid_plane(map, in, s, out);
+  if (!in.contacts.empty()) detail::hold_contacts(map, in, s, out);
   return true;
 }
 

@@ -52,8 +52,17 @@ Chain make_chain(std::span<const int16_t> parents, const RetargetPose& pose, int
   c.joints.push_back(end);
   c.at.assign(c.joints.size(), 0.0f);
   float total = 0.0f;
+  std::vector<float> length(c.joints.size(), 0.0f);
   for (size_t k = 1; k < c.joints.size(); ++k) {
-    total += glm::length(position(pose, c.joints[k]) - position(pose, c.joints[k - 1]));
+    length[k] = glm::length(position(pose, c.joints[k]) - position(pose, c.joints[k - 1]));
+    total += length[k];
+  }
+  // Joints at one place (a zero-length bone) still get increasing positions, so each keeps its
+  // own partner in a chain of the same shape (a rig retargeted onto itself maps joint to joint).
+  const float least = 1e-3f * total;
+  total = 0.0f;
+  for (size_t k = 1; k < c.joints.size(); ++k) {
+    total += std::max(length[k], least);
     c.at[k] = total;
   }
   for (size_t k = 1; k < c.joints.size(); ++k)
@@ -161,6 +170,7 @@ Result<RetargetMap> make_retarget_map(const RetargetRig& source, const RetargetR
     Step& hips = steps[static_cast<size_t>(th[B::Hips])];
     hips.kind = RetargetStep::Hips;
     hips.offset = map.target_rest_inverse[static_cast<size_t>(th[B::Hips])] * (position(tp, th[B::Hips]) - tp.pelvis);
+    map.source_hips_offset = position(sp, sh[B::Hips]) - sp.pelvis;
   }
 
   // Trunk: hips .. head, cut at the neck when both rigs have one.
@@ -212,6 +222,9 @@ Result<RetargetMap> make_retarget_map(const RetargetRig& source, const RetargetR
     leg.lower = static_cast<int16_t>(shin);
     leg.foot = static_cast<int16_t>(foot);
     leg.source_foot = sh[side == 0 ? B::LeftFoot : B::RightFoot];
+    leg.source_lower = sh[side == 0 ? B::LeftLowerLeg : B::RightLowerLeg];
+    leg.source_offset = glm::vec3(glm::inverse(sp.model[static_cast<size_t>(leg.source_lower)]) *
+                                  sp.model[static_cast<size_t>(leg.source_foot)][3]);
     if (below(target.parents, shin, foot)) continue;
     Step& s = steps[static_cast<size_t>(foot)];
     s.kind = RetargetStep::Anchored;
@@ -239,6 +252,17 @@ Result<RetargetMap> make_retarget_map(const RetargetRig& source, const RetargetR
       s.source_a = static_cast<int16_t>(it->second);
       s.rest = tp.local[j].rotation;
       s.source_rest_local_inverse = glm::inverse(sp.local[static_cast<size_t>(it->second)].rotation);
+    }
+  }
+
+  // One-to-one joints that are the same joint on both rigs (name and parent's name).
+  if (source.names.size() == source.parents.size() && target.names.size() == target.parents.size()) {
+    for (Step& s : steps) {
+      if (s.kind != RetargetStep::Rotate && s.kind != RetargetStep::Hips && s.kind != RetargetStep::Anchored) continue;
+      const auto a = static_cast<size_t>(s.source_a), j = static_cast<size_t>(s.joint);
+      const int pa = source.parents[a], pj = target.parents[j];
+      s.same_joint = source.names[a] == target.names[j] && (pa < 0) == (pj < 0) &&
+                     (pa < 0 || source.names[static_cast<size_t>(pa)] == target.names[static_cast<size_t>(pj)]);
     }
   }
 

@@ -95,7 +95,9 @@ enum class RetargetStep : uint8_t {
   Rotate,    // one source joint's model-space delta
   Blend,     // slerp of two source joints' deltas (chains of other bone counts)
   Hips,      // Rotate, and placed so the pelvis lands on the source's pelvis mapped by map_point
-  Anchored,  // Rotate, placed at a fixed offset from another target joint (an IK rig's foot)
+             // (with whatever the source's hips move against its own legs, scaled)
+  Anchored,  // Rotate, placed at its rest offset from its shin (an IK rig's foot), plus whatever
+             // the source's foot moves away from its own shin's offset, scaled
 };
 
 /// Everything a retarget needs, decided once. Plain data; share it between characters and threads.
@@ -107,13 +109,19 @@ struct RetargetMap {
     float weight = 0.0f;                     // Blend: slerp(delta_a, delta_b, weight)
     glm::quat rest{1.0f, 0.0f, 0.0f, 0.0f};  // inverse(R) * target retarget-pose model rotation; Copy: target rest local
     glm::quat source_rest_local_inverse{1.0f, 0.0f, 0.0f, 0.0f};  // Copy
+    /// Rotate/Hips/Anchored: the source joint has this joint's name under a parent of the same name
+    /// (the same rig, or one of its family): its own translation and scale away from its bind
+    /// ride along too, so a rig retargeted onto itself is reproduced exactly. Across rigs only
+    /// rotations are carried (a clip's translation keys may disagree with its skin's bind).
+    bool same_joint = false;
     int16_t anchor = -1;                     // Anchored: the target joint it hangs from
     glm::vec3 offset{0.0f};                  // Anchored: its position in the anchor's frame; Hips: its
                                              // position from the pelvis, in its retarget-pose frame
   };
   struct Leg {
     int16_t upper = -1, lower = -1, foot = -1;  // target joints
-    int16_t source_foot = -1;
+    int16_t source_lower = -1, source_foot = -1;
+    glm::vec3 source_offset{0.0f};  // the source foot's retarget-pose position in its shin's frame
   };
 
   uint32_t source_joint_count = 0, target_joint_count = 0;
@@ -127,6 +135,7 @@ struct RetargetMap {
   float scale = 1.0f;                          // target hips height / source hips height (over the ankles)
   std::vector<Step> steps;                     // every target joint once, parents (and anchors) first
   std::array<Leg, 2> legs;                     // left, right
+  glm::vec3 source_hips_offset{0.0f};          // source hips minus pelvis in its retarget pose
   glm::quat target_hips_rest_inverse{1.0f, 0.0f, 0.0f, 0.0f};  // the target hips' retarget-pose model rotation, inverted
   glm::vec3 target_forward{0.0f, 0.0f, 1.0f};  // the target's forward, model space (a straight knee bends along it)
 
@@ -153,7 +162,13 @@ Result<RetargetMap> make_retarget_map(const RetargetRig& source, const RetargetR
 struct RetargetScratch {
   std::vector<glm::mat4> source_model, target_model;
   std::vector<glm::quat> source_rotation, target_rotation;
-  std::array<glm::quat, 2> foot_rotation{};
+  /// What the last retarget's fix-ups moved (kAdjusted... bits): a limb swung back to its side
+  /// of the mid-plane, a leg bent to hold a planted foot.
+  uint8_t adjusted = 0;
+};
+enum RetargetAdjusted : uint8_t {
+  kAdjustedLeftArm = 1, kAdjustedRightArm = 2, kAdjustedLeftLeg = 4, kAdjustedRightLeg = 8,  // mid-plane guard
+  kHeldLeftFoot = 16, kHeldRightFoot = 32,                                                    // contacts
 };
 RetargetScratch make_retarget_scratch(const RetargetMap& map);
 
