@@ -60,6 +60,14 @@ std::string CookOptions::canonical() const {
     s += ";skeleton=" + reference_name;
     if (reference_input.present) s += "@" + hex64(reference_input.hash);
   }
+  if (retarget_target != nullptr) {
+    s += ";retarget=" + retarget_name;
+    if (retarget_input.present) s += "@" + hex64(retarget_input.hash);
+  }
+  if (retarget_map != nullptr) {
+    s += ";map=" + retarget_map_name;
+    if (retarget_map_input.present) s += "@" + hex64(retarget_map_input.hash);
+  }
   return s;
 }
 
@@ -244,6 +252,11 @@ void cook_into(CookRecord& record, const fs::path& input, const fs::path& output
     record.error = input.string() + ": is a directory, not a source file";
     return;
   }
+  if (is_graph_file(input) && options.retarget_target != nullptr) {
+    record.error = input.string() + ": --retarget-to applies to sources, not graph files (a graph's retarget node "
+                   "plays clips of another rig: docs/RETARGET.md)";
+    return;
+  }
   if (is_graph_file(input)) {
     if (!settings.clip_names.empty())
       record.warnings.push_back("\"clip_names\" in cook settings is not used for a graph file: the graph names its clips");
@@ -279,6 +292,14 @@ void cook_into(CookRecord& record, const fs::path& input, const fs::path& output
     record.error = st.message();
     return;
   }
+  if (options.retarget_target != nullptr) {
+    RetargetTarget target{options.retarget_target, options.retarget_name, options.retarget_map, options.retarget_map_name};
+    if (Status st = retarget_scene(*scene, target, input.string(), &record.retarget_records); !st) {
+      record.error = st.message();
+      return;
+    }
+    count_scene(record, *scene);
+  }
 
   MeshOptions mesh_options;
   mesh_options.float_vertices = options.float_vertices;
@@ -306,7 +327,7 @@ void cook_into(CookRecord& record, const fs::path& input, const fs::path& output
   // A clip-only file binds to its rig by hash and carries no skeleton; a file with meshes always
   // carries the rig its joint palettes index (with --skeleton, the reference's, hash-identical).
   WriteOptions write_options;
-  write_options.include_skeleton = options.reference == nullptr || !meshes->empty();
+  write_options.include_skeleton = (options.reference == nullptr && options.retarget_target == nullptr) || !meshes->empty();
   const std::vector<uint8_t> bytes = write_ossa(*scene, *meshes, *clips, provenance, write_options);
   if (!detail::write_verified(record, bytes, input, output, options.write)) return;
 
@@ -356,11 +377,18 @@ std::optional<CookRecord> cook_or_check(const fs::path& input, const fs::path& o
   // A read the sandbox refused is the cause to name, whatever the importer made of the missing file.
   if (!record.ok && !log.refusals().empty() && record.error.find(log.refusals().front()) == std::string::npos)
     record.error = detail::refusal_error(input, log) + "; then: " + record.error;
-  // --skeleton's file is keyed through the options (canonical()); the depfile still names it.
-  if (options.reference != nullptr && options.reference_input.present && !is_graph_file(input)) {
-    record.inputs_read.push_back(options.reference_input);
-    std::sort(record.inputs_read.begin(), record.inputs_read.end(),
-              [](const InputFile& a, const InputFile& b) { return a.path < b.path; });
+  // --skeleton's, --retarget-to's and --map's files are keyed through the options (canonical());
+  // the depfile still names them.
+  if (!is_graph_file(input)) {
+    const std::pair<bool, const InputFile*> keyed[] = {{options.reference != nullptr, &options.reference_input},
+                                                       {options.retarget_target != nullptr, &options.retarget_input},
+                                                       {options.retarget_map != nullptr, &options.retarget_map_input}};
+    bool added = false;
+    for (const auto& [used, file] : keyed)
+      if (used && file->present) record.inputs_read.push_back(*file), added = true;
+    if (added)
+      std::sort(record.inputs_read.begin(), record.inputs_read.end(),
+                [](const InputFile& a, const InputFile& b) { return a.path < b.path; });
   }
   record.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return record;
@@ -407,6 +435,16 @@ Result<SourceSkeleton> load_reference_skeleton(const fs::path& ossa_file, InputF
       for (int r4 = 0; r4 < 4; ++r4) j.inverse_bind[c][r4] = m->Get(static_cast<flatbuffers::uoffset_t>(c * 4 + r4));
   }
   return out;
+}
+
+Result<tools::HumanoidMapFile> load_humanoid_map_file(const fs::path& path, InputFile* as_read) {
+  InputLog log;
+  InputLogScope scope(&log);
+  auto bytes = read_input(path);
+  if (!bytes) return bytes.error();
+  if (as_read != nullptr) *as_read = log.files().front();
+  return tools::parse_humanoid_map_file(std::string_view(reinterpret_cast<const char*>(bytes->data()), bytes->size()),
+                                        path.string());
 }
 
 namespace {

@@ -15,6 +15,7 @@
 #include "cooker/clip/clip_compress.h"
 #include "cooker/import/input_log.h"
 #include "cooker/import/source_scene.h"
+#include "cooker/retarget/retarget_clips.h"
 #include <ossa/format/result.h>
 
 namespace ossa::cook {
@@ -38,6 +39,14 @@ struct CookOptions {
   const SourceSkeleton* reference = nullptr;
   std::string reference_name;  // REF.ossa's file name, recorded in the options string
   InputFile reference_input;   // REF.ossa as read (absolute path, hash): its hash is in canonical()
+  /// --retarget-to TARGET.ossa: the source's clips are retargeted onto this rig
+  /// (cooker/retarget/retarget_clips.h) and cooked as clip-only files of it; null otherwise.
+  const SourceSkeleton* retarget_target = nullptr;
+  std::string retarget_name;          // TARGET.ossa's file name
+  InputFile retarget_input;           // TARGET.ossa as read: its hash is in canonical()
+  const tools::HumanoidMapFile* retarget_map = nullptr;  // --map FILE.json, or null
+  std::string retarget_map_name;
+  InputFile retarget_map_input;       // the map file as read: its hash is in canonical()
   /// Canonical text of the options that change output bytes, recorded in provenance.
   std::string canonical() const;
 
@@ -106,6 +115,7 @@ struct CookRecord {
   std::vector<ClipRecord> clip_records;  // one per clip compressed before any failure
   std::vector<MorphRecord> morph_records;  // one per morph target, once meshes are built
   std::vector<TextureRecord> texture_records;  // one per distinct embedded texture, once textures are cooked
+  std::vector<RetargetRecord> retarget_records;  // --retarget-to: one per clip retargeted
   /// Every file the cook read or looked for (absolute paths, sorted), as far as it got; for an
   /// up-to-date output, the inputs its provenance lists. The depfile and --list-inputs print these.
   std::vector<InputFile> inputs_read;
@@ -143,6 +153,10 @@ bool is_graph_file(const std::filesystem::path& path);
 /// Loads the skeleton of a cooked file (for --skeleton). Errors name the file. `as_read`, when
 /// given, receives the file's input record (absolute path, hash, size) for the cooks' input logs.
 Result<SourceSkeleton> load_reference_skeleton(const std::filesystem::path& ossa_file, InputFile* as_read = nullptr);
+
+/// Reads and parses a humanoid map file (for --map; runtime/tools/retarget/map_file.h). Errors name
+/// the file. `as_read`, when given, receives its input record (absolute path, hash, size).
+Result<tools::HumanoidMapFile> load_humanoid_map_file(const std::filesystem::path& path, InputFile* as_read = nullptr);
 
 /// Writes bytes to a temporary file in path's directory, flushes, then renames it onto path.
 /// On any failure the temporary is removed and path is untouched. A read-only file at path is

@@ -281,6 +281,34 @@ nlohmann::ordered_json report_json(const std::vector<CookRecord>& records, const
       }
       j["morph_targets"] = std::move(morphs);
     }
+    if (!r.retarget_records.empty()) {
+      nlohmann::ordered_json retargets = nlohmann::ordered_json::array();
+      for (const RetargetRecord& t : r.retarget_records) {
+        nlohmann::ordered_json tj;
+        tj["clip"] = t.clip;
+        tj["frames"] = t.frames;
+        tj["hips_ratio"] = t.hips_ratio;
+        tj["floor_mm"] = t.floor_mm;
+        tj["limb_max_deg"] = t.limb_max_deg;
+        tj["hand_max_deg"] = t.hand_max_deg;
+        tj["foot_max_deg"] = t.foot_max_deg;
+        tj["crossing_frames"] = t.crossing_frames;
+        tj["guarded_frames"] = t.guarded_frames;
+        nlohmann::ordered_json contacts = nlohmann::ordered_json::array();
+        for (const RetargetContactRecord& c : t.contacts) {
+          nlohmann::ordered_json cj;
+          cj["foot"] = c.foot == 0 ? "left" : "right";
+          cj["start"] = c.start;
+          cj["end"] = c.end;
+          cj["slide_mm"] = c.slide_mm;
+          cj["source_slide_mm"] = c.source_slide_mm;
+          contacts.push_back(std::move(cj));
+        }
+        tj["contacts"] = std::move(contacts);
+        retargets.push_back(std::move(tj));
+      }
+      j["retarget"] = std::move(retargets);
+    }
     j["source_bytes"] = r.source_bytes;
     if (r.ok) j["cooked_bytes"] = r.cooked_bytes;
     if (r.ok) j["up_to_date"] = r.up_to_date;

@@ -41,7 +41,7 @@ using Clock = std::chrono::steady_clock;
 // back without it. Sizes are checked on the one platform the cooker is built for (64-bit
 // libstdc++); a field that fits in padding slips through, so the round-trip test is the other half.
 #if defined(__GLIBCXX__) && defined(__LP64__)
-static_assert(sizeof(CookRecord) == 336,
+static_assert(sizeof(CookRecord) == 360,
               "CookRecord changed: extend record_to_json / record_from_json (cooker/cli/worker.cpp) and "
               "the round trip in tests/cook_isolation_test.cpp, then update this size");
 static_assert(sizeof(MorphRecord) == 88,
@@ -49,6 +49,12 @@ static_assert(sizeof(MorphRecord) == 88,
               "the round trip in tests/cook_isolation_test.cpp, then update this size");
 static_assert(sizeof(TextureRecord) == 152,
               "TextureRecord changed: extend record_to_json / record_from_json (cooker/cli/worker.cpp) and "
+              "the round trip in tests/cook_isolation_test.cpp, then update this size");
+static_assert(sizeof(RetargetRecord) == 88,
+              "RetargetRecord changed: extend record_to_json / record_from_json (cooker/cli/worker.cpp) and "
+              "the round trip in tests/cook_isolation_test.cpp, then update this size");
+static_assert(sizeof(RetargetContactRecord) == 20,
+              "RetargetContactRecord changed: extend record_to_json / record_from_json (cooker/cli/worker.cpp) and "
               "the round trip in tests/cook_isolation_test.cpp, then update this size");
 static_assert(sizeof(ClipRecord) == 88,
               "ClipRecord changed: extend record_to_json / record_from_json (cooker/cli/worker.cpp) and "
@@ -111,6 +117,23 @@ json record_to_json(const CookRecord& r) {
                      {"max_error_mm", c.max_error_mm},
                      {"mean_error_mm", c.mean_error_mm},
                      {"worst_joint", c.worst_joint}});
+  json retargets = json::array();
+  for (const RetargetRecord& t : r.retarget_records) {
+    json contacts = json::array();
+    for (const RetargetContactRecord& c : t.contacts)
+      contacts.push_back({{"foot", c.foot}, {"start", c.start}, {"end", c.end}, {"slide_mm", c.slide_mm},
+                          {"source_slide_mm", c.source_slide_mm}});
+    retargets.push_back({{"clip", t.clip},
+                         {"hips_ratio", t.hips_ratio},
+                         {"floor_mm", t.floor_mm},
+                         {"frames", t.frames},
+                         {"limb_max_deg", t.limb_max_deg},
+                         {"hand_max_deg", t.hand_max_deg},
+                         {"foot_max_deg", t.foot_max_deg},
+                         {"crossing_frames", t.crossing_frames},
+                         {"guarded_frames", t.guarded_frames},
+                         {"contacts", std::move(contacts)}});
+  }
   json inputs = json::array();
   for (const InputFile& f : r.inputs_read)
     inputs.push_back({{"path", f.path}, {"hash", f.hash}, {"size", f.size}, {"present", f.present}});
@@ -134,6 +157,7 @@ json record_to_json(const CookRecord& r) {
           {"clip_records", std::move(clips)},
           {"morph_records", std::move(morphs)},
           {"texture_records", std::move(textures)},
+          {"retarget_records", std::move(retargets)},
           {"inputs_read", std::move(inputs)},
           {"cook_key", r.cook_key},
           {"up_to_date", r.up_to_date}};
@@ -204,6 +228,30 @@ std::optional<CookRecord> record_from_json(const json& j) {
         read_field(mj, "position_error_mm", m.position_error_mm);
         read_field(mj, "normal_error_deg", m.normal_error_deg);
         r.morph_records.push_back(std::move(m));
+      }
+    }
+    if (const auto it = j.find("retarget_records"); it != j.end() && it->is_array()) {
+      for (const json& tj : *it) {
+        RetargetRecord t;
+        read_field(tj, "clip", t.clip);
+        read_field(tj, "hips_ratio", t.hips_ratio);
+        read_field(tj, "floor_mm", t.floor_mm);
+        read_field(tj, "frames", t.frames);
+        read_field(tj, "limb_max_deg", t.limb_max_deg);
+        read_field(tj, "hand_max_deg", t.hand_max_deg);
+        read_field(tj, "foot_max_deg", t.foot_max_deg);
+        read_field(tj, "crossing_frames", t.crossing_frames);
+        read_field(tj, "guarded_frames", t.guarded_frames);
+        for (const json& cj : tj.at("contacts")) {
+          RetargetContactRecord c;
+          read_field(cj, "foot", c.foot);
+          read_field(cj, "start", c.start);
+          read_field(cj, "end", c.end);
+          read_field(cj, "slide_mm", c.slide_mm);
+          read_field(cj, "source_slide_mm", c.source_slide_mm);
+          t.contacts.push_back(c);
+        }
+        r.retarget_records.push_back(std::move(t));
       }
     }
     const json& inputs = j.at("inputs_read");
