@@ -14,9 +14,10 @@
 // body on the source stays across on the target.
 //
 // Contacts: each planted ankle's error (from the contact's position carried over, or an easing
-// shift) is taken by the pelvis across the ground first, as the mean over the planted feet, so a
-// single planted foot is held without bending the leg away from the source's; the IK takes the
-// rest: height, and what two planted feet disagree on.
+// shift) is taken by the pelvis first, as the mean over the planted feet, so a single planted
+// foot is held without bending the leg away from the source's (the pelvis path strays from the
+// scaled source's by what the target's proportions make of the pose, a few percent of the hips
+// height); the IK takes the rest: what two planted feet disagree on.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -107,7 +108,6 @@ void guard_mid_plane(const RetargetMap& map, const RetargetInput& in, RetargetSc
 }
 
 void hold_contacts(const RetargetMap& map, const RetargetInput& in, RetargetScratch& s, PoseSpan out) {
-  const glm::vec3 up = map.target_pose.up;
   std::array<glm::vec3, 2> goal{};
   std::array<bool, 2> held{false, false};
   glm::vec3 shift(0.0f);
@@ -121,7 +121,7 @@ void hold_contacts(const RetargetMap& map, const RetargetInput& in, RetargetScra
                                              : std::min(c.weight, 1.0f) * map.scale * (map.rotation * c.shift);
     if (!std::isfinite(error.x + error.y + error.z)) continue;
     goal[leg] = ankle + error;
-    shift += error - glm::dot(error, up) * up;
+    shift += error;
     weights += std::min(c.weight, 1.0f);
     held[leg] = true;
   }

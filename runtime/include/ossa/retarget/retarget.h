@@ -24,10 +24,10 @@
 //
 // Feet: given contacts (a weight and a planted position, in the source's model space; find them
 // over a clip with find_foot_contacts), each planted target ankle is held at the planted position
-// carried over by map_point: the pelvis first moves across the ground by what the planted feet
-// need (their mean, so a single planted foot costs the legs nothing and the limbs keep the
-// source's directions), then a two-bone IK pass (ik.h) takes the rest (height, and the two feet
-// of a double support disagreeing), keeping each foot's own orientation.
+// carried over by map_point: the pelvis first moves by what the planted feet need (their mean, so
+// a single planted foot costs the legs nothing and the limbs keep the source's directions), then a
+// two-bone IK pass (ik.h) takes the rest (the two feet of a double support disagreeing), keeping
+// each foot's own orientation.
 //
 // Shape: make_retarget_map (setup: allocates, validates, builds both retarget poses and every
 // per-joint decision into a plain struct) and retarget (per frame: spans in, pose out, no
