@@ -290,6 +290,7 @@ nlohmann::ordered_json report_json(const std::vector<CookRecord>& records, const
         tj["hips_ratio"] = t.hips_ratio;
         tj["floor_mm"] = t.floor_mm;
         tj["limb_max_deg"] = t.limb_max_deg;
+        tj["guard_max_deg"] = t.guard_max_deg;
         tj["hand_max_deg"] = t.hand_max_deg;
         tj["foot_max_deg"] = t.foot_max_deg;
         tj["crossing_frames"] = t.crossing_frames;

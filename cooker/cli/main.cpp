@@ -140,9 +140,10 @@ void print_details(const CookRecord& r) {
   }
   for (const RetargetRecord& t : r.retarget_records) {
     std::fprintf(stderr, "    retarget '%s': %u frames, hips ratio %.3f, limbs within %.2f deg, hands %.2f, feet %.2f, "
-                         "%u frames crossing, %u guarded, %zu contacts", shown(t.clip).c_str(), t.frames,
+                         "%u frames crossing, %u guarded (limbs %.2f deg), %zu contacts", shown(t.clip).c_str(), t.frames,
                  static_cast<double>(t.hips_ratio), static_cast<double>(t.limb_max_deg), static_cast<double>(t.hand_max_deg),
-                 static_cast<double>(t.foot_max_deg), t.crossing_frames, t.guarded_frames, t.contacts.size());
+                 static_cast<double>(t.foot_max_deg), t.crossing_frames, t.guarded_frames,
+                 static_cast<double>(t.guard_max_deg), t.contacts.size());
     float slide = 0.0f;
     for (const RetargetContactRecord& c : t.contacts) slide = std::max(slide, c.slide_mm);
     if (!t.contacts.empty()) std::fprintf(stderr, " (slide up to %.2f mm)", static_cast<double>(slide));

@@ -50,7 +50,7 @@ static_assert(sizeof(MorphRecord) == 88,
 static_assert(sizeof(TextureRecord) == 152,
               "TextureRecord changed: extend record_to_json / record_from_json (cooker/cli/worker.cpp) and "
               "the round trip in tests/cook_isolation_test.cpp, then update this size");
-static_assert(sizeof(RetargetRecord) == 88,
+static_assert(sizeof(RetargetRecord) == 96,
               "RetargetRecord changed: extend record_to_json / record_from_json (cooker/cli/worker.cpp) and "
               "the round trip in tests/cook_isolation_test.cpp, then update this size");
 static_assert(sizeof(RetargetContactRecord) == 20,
@@ -128,6 +128,7 @@ json record_to_json(const CookRecord& r) {
                          {"floor_mm", t.floor_mm},
                          {"frames", t.frames},
                          {"limb_max_deg", t.limb_max_deg},
+                         {"guard_max_deg", t.guard_max_deg},
                          {"hand_max_deg", t.hand_max_deg},
                          {"foot_max_deg", t.foot_max_deg},
                          {"crossing_frames", t.crossing_frames},
@@ -238,6 +239,7 @@ std::optional<CookRecord> record_from_json(const json& j) {
         read_field(tj, "floor_mm", t.floor_mm);
         read_field(tj, "frames", t.frames);
         read_field(tj, "limb_max_deg", t.limb_max_deg);
+        read_field(tj, "guard_max_deg", t.guard_max_deg);
         read_field(tj, "hand_max_deg", t.hand_max_deg);
         read_field(tj, "foot_max_deg", t.foot_max_deg);
         read_field(tj, "crossing_frames", t.crossing_frames);

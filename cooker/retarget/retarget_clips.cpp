@@ -199,7 +199,12 @@ Status retarget_scene(SourceScene& scene, const RetargetTarget& target, const st
       }
       RetargetMeasure m;
       measure_retarget(map, scratch, &m);
-      for (float d : m.limb_degrees) record.limb_max_deg = std::max(record.limb_max_deg, d);
+      for (size_t i = 0; i < kRetargetLimbCount; ++i) {
+        // Limb i belongs to the left arm, left leg, right arm, right leg: guard bits 1, 4, 2, 8.
+        static constexpr uint8_t kGuardBit[kRetargetLimbCount] = {1, 1, 4, 4, 2, 2, 8, 8};
+        float& worst = (scratch.adjusted & kGuardBit[i]) != 0 ? record.guard_max_deg : record.limb_max_deg;
+        worst = std::max(worst, m.limb_degrees[i]);
+      }
       for (float d : m.hand_degrees) record.hand_max_deg = std::max(record.hand_max_deg, d);
       for (float d : m.foot_degrees) record.foot_max_deg = std::max(record.foot_max_deg, d);
       bool crossing = false;

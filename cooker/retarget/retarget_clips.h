@@ -37,7 +37,9 @@ struct RetargetRecord {
   float hips_ratio = 0.0f;           // target hips height / source's, both in metres over the ankles
   float floor_mm = 0.0f;             // the source clip's floor above its rest pose's (0: none)
   uint32_t frames = 0;
-  float limb_max_deg = 0.0f;         // upper arm, forearm, thigh, shin: largest angle to the source's
+  float limb_max_deg = 0.0f;         // upper arm, forearm, thigh, shin: largest angle to the source's,
+                                     // over the limbs the mid-plane guard left alone
+  float guard_max_deg = 0.0f;        // the same over the limbs it swung back (what keeping them on their side cost)
   float hand_max_deg = 0.0f;         // hands' outward axis, either hand
   float foot_max_deg = 0.0f;         // feet's forward axis, either foot
   uint32_t crossing_frames = 0;      // frames with a hand or foot across the mid-plane where the source's is not
