@@ -319,18 +319,21 @@ TEST(Retarget, PlantedFeetStayPlanted) {
   std::array<FootContact, 2> held{};
   in.contacts = held;
   float slide = 0.0f;
+  glm::vec3 planted_lo(1e9f), planted_hi(-1e9f);
   for (uint32_t f = 0; f < frames; ++f) {
     foot_contacts_at(contacts, static_cast<float>(f), 30.0f, ContactSettings{}.blend_time, held);
     in.source = source[f];
     ASSERT_TRUE(retarget(map, in, scratch, out));
     if (f < contacts.front().first || f > contacts.front().last) continue;
     const glm::vec3 ankle(scratch.target_model[static_cast<size_t>(map.legs[0].foot)][3]);
-    slide = std::max(slide, glm::length(ankle - map.map_point(contacts.front().position, floor)));
+    slide = std::max(slide, glm::length(ankle - held_ankle(map, scratch, 0, held[0], floor)));
+    planted_lo = glm::min(planted_lo, ankle), planted_hi = glm::max(planted_hi, ankle);
     RetargetMeasure m;
     measure_retarget(map, scratch, &m);
     for (float d : m.limb_degrees) EXPECT_LT(d, 5.0f) << "frame " << f;
   }
   EXPECT_LT(slide, 1e-4f * h);
+  EXPECT_LT(glm::length(planted_hi - planted_lo), 1e-4f * h);  // the source's foot is planted: so is the target's
 }
 
 TEST(Retarget, FramesAllocateNothing) {
@@ -341,7 +344,7 @@ TEST(Retarget, FramesAllocateNothing) {
   RetargetScratch scratch = make_retarget_scratch(*map);
   Pose in(static_cast<uint32_t>(s.names.size())), out(static_cast<uint32_t>(t.names.size())), base(static_cast<uint32_t>(t.names.size()));
   test::bind_pose(t, base);
-  std::array<FootContact, 2> contacts{FootContact{1.0f, glm::vec3(0.1f, 0.08f, 0.0f), {}},
+  std::array<FootContact, 2> contacts{FootContact{1.0f, glm::vec3(0.01f, 0.0f, 0.0f), {}},
                                       FootContact{0.5f, glm::vec3(0.0f), glm::vec3(0.01f, 0.0f, 0.0f)}};
   RetargetInput input;
   input.source = in;

@@ -301,6 +301,7 @@ nlohmann::ordered_json report_json(const std::vector<CookRecord>& records, const
           cj["foot"] = c.foot == 0 ? "left" : "right";
           cj["start"] = c.start;
           cj["end"] = c.end;
+          cj["held_mm"] = c.held_mm;
           cj["slide_mm"] = c.slide_mm;
           cj["source_slide_mm"] = c.source_slide_mm;
           contacts.push_back(std::move(cj));

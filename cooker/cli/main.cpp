@@ -144,9 +144,12 @@ void print_details(const CookRecord& r) {
                  static_cast<double>(t.hips_ratio), static_cast<double>(t.limb_max_deg), static_cast<double>(t.hand_max_deg),
                  static_cast<double>(t.foot_max_deg), t.crossing_frames, t.guarded_frames,
                  static_cast<double>(t.guard_max_deg), t.contacts.size());
-    float slide = 0.0f;
-    for (const RetargetContactRecord& c : t.contacts) slide = std::max(slide, c.slide_mm);
-    if (!t.contacts.empty()) std::fprintf(stderr, " (slide up to %.2f mm)", static_cast<double>(slide));
+    float held = 0.0f, slide = 0.0f, source = 0.0f;
+    for (const RetargetContactRecord& c : t.contacts)
+      held = std::max(held, c.held_mm), slide = std::max(slide, c.slide_mm), source = std::max(source, c.source_slide_mm);
+    if (!t.contacts.empty())
+      std::fprintf(stderr, " (held within %.2f mm; feet slide up to %.2f mm, the source's %.2f mm)", static_cast<double>(held),
+                   static_cast<double>(slide), static_cast<double>(source));
     std::fprintf(stderr, "\n");
   }
   for (const ClipRecord& c : r.clip_records)

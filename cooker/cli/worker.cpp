@@ -53,7 +53,7 @@ static_assert(sizeof(TextureRecord) == 152,
 static_assert(sizeof(RetargetRecord) == 96,
               "RetargetRecord changed: extend record_to_json / record_from_json (cooker/cli/worker.cpp) and "
               "the round trip in tests/cook_isolation_test.cpp, then update this size");
-static_assert(sizeof(RetargetContactRecord) == 20,
+static_assert(sizeof(RetargetContactRecord) == 24,
               "RetargetContactRecord changed: extend record_to_json / record_from_json (cooker/cli/worker.cpp) and "
               "the round trip in tests/cook_isolation_test.cpp, then update this size");
 static_assert(sizeof(ClipRecord) == 88,
@@ -121,8 +121,8 @@ json record_to_json(const CookRecord& r) {
   for (const RetargetRecord& t : r.retarget_records) {
     json contacts = json::array();
     for (const RetargetContactRecord& c : t.contacts)
-      contacts.push_back({{"foot", c.foot}, {"start", c.start}, {"end", c.end}, {"slide_mm", c.slide_mm},
-                          {"source_slide_mm", c.source_slide_mm}});
+      contacts.push_back({{"foot", c.foot}, {"start", c.start}, {"end", c.end}, {"held_mm", c.held_mm},
+                          {"slide_mm", c.slide_mm}, {"source_slide_mm", c.source_slide_mm}});
     retargets.push_back({{"clip", t.clip},
                          {"hips_ratio", t.hips_ratio},
                          {"floor_mm", t.floor_mm},
@@ -249,6 +249,7 @@ std::optional<CookRecord> record_from_json(const json& j) {
           read_field(cj, "foot", c.foot);
           read_field(cj, "start", c.start);
           read_field(cj, "end", c.end);
+          read_field(cj, "held_mm", c.held_mm);
           read_field(cj, "slide_mm", c.slide_mm);
           read_field(cj, "source_slide_mm", c.source_slide_mm);
           t.contacts.push_back(c);

@@ -75,6 +75,7 @@ std::vector<Pose> sample_clip(const SourceClip& clip, const SourceSkeleton& skel
 
 /// A rig as the retarget job reads it, with its names and bind pose kept alive.
 struct Rig {
+  std::string name;
   std::vector<std::string_view> names;
   std::vector<int16_t> parents;
   std::vector<Transform> bind;
@@ -95,7 +96,7 @@ Result<Rig> make_rig(const SourceSkeleton& skeleton, const std::string& name, co
   auto applied = tools::apply_rig_map(spec, r.names, r.parents, label);
   if (!applied) return applied.error();
   r.rest_rotations = std::move(applied->rest_rotations);
-  r.rig.name = name;
+  r.name = name;
   r.rig.parents = r.parents;
   r.rig.bind = r.bind;
   r.rig.names = r.names;
@@ -120,6 +121,8 @@ Status retarget_scene(SourceScene& scene, const RetargetTarget& target, const st
   if (!source) return source.error();
   auto dest = make_rig(*target.skeleton, target.name + " (target rig)", target, "target");
   if (!dest) return dest.error();
+  source->rig.name = source->name;  // the names live in the Rigs, which stay where they are from here
+  dest->rig.name = dest->name;
   auto built = make_retarget_map(source->rig, dest->rig);
   if (!built) return Error{"retarget: " + built.error().message};
   const RetargetMap& map = *built;
@@ -178,6 +181,8 @@ Status retarget_scene(SourceScene& scene, const RetargetTarget& target, const st
         cr.source_slide_mm = std::max(cr.source_slide_mm, distance_mm(feet[f].source_ankle[c.foot], glm::vec3(mean), source_mpu));
       record.contacts.push_back(cr);
     }
+    std::vector<glm::dvec3> held_sum(contacts.size(), glm::dvec3(0.0));
+    std::vector<std::vector<glm::vec3>> held_path(contacts.size());
     std::array<FootContact, 2> held{};
     in.contacts = held;
     for (size_t f = 0; f < frames.size(); ++f) {
@@ -217,9 +222,16 @@ Status retarget_scene(SourceScene& scene, const RetargetTarget& target, const st
       for (size_t k = 0; k < contacts.size(); ++k) {
         const ContactSpan& c = contacts[k];
         if (f < c.first || f > c.last) continue;
-        const glm::vec3 goal = map.map_point(c.position, floor);
-        record.contacts[k].slide_mm = std::max(record.contacts[k].slide_mm, distance_mm(m.target_ankle[c.foot], goal, target_mpu));
+        const glm::vec3 goal = held_ankle(map, scratch, c.foot, held[c.foot], floor);
+        record.contacts[k].held_mm = std::max(record.contacts[k].held_mm, distance_mm(m.target_ankle[c.foot], goal, target_mpu));
+        held_path[k].push_back(m.target_ankle[c.foot]);
+        held_sum[k] += glm::dvec3(m.target_ankle[c.foot]);
       }
+    }
+    for (size_t k = 0; k < contacts.size(); ++k) {
+      const glm::vec3 mean(held_sum[k] / static_cast<double>(std::max<size_t>(1, held_path[k].size())));
+      for (const glm::vec3& p : held_path[k])
+        record.contacts[k].slide_mm = std::max(record.contacts[k].slide_mm, distance_mm(p, mean, target_mpu));
     }
     out_clips.push_back(std::move(result));
     if (records != nullptr) records->push_back(std::move(record));

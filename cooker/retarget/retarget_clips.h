@@ -10,9 +10,10 @@
 // the target rig by its skeleton hash, compressed like any other clip.
 //
 // The measures a report gives come from the last pass (ossa/retarget/retarget_measure.h):
-// direction errors in degrees, each contact's foot slide in millimetres (the target's ankle away
-// from where the contact holds it, and the source's own slide for comparison), the hips height
-// ratio applied (in metres over metres, so a centimetre rig and a metre rig compare).
+// direction errors in degrees, each contact's foot slide in millimetres (how far the target's ankle
+// strays from where the contact holds it and from its own mean, and the source's own slide for
+// comparison), the hips height ratio applied (in metres over metres, so a centimetre rig and a
+// metre rig compare).
 #pragma once
 #include <string>
 #include <vector>
@@ -27,7 +28,8 @@ namespace ossa::cook {
 struct RetargetContactRecord {
   uint32_t foot = 0;                 // 0 left, 1 right
   float start = 0.0f, end = 0.0f;    // seconds
-  float slide_mm = 0.0f;             // the target ankle's largest distance from its held position
+  float held_mm = 0.0f;              // the target ankle's largest distance from where the contact holds it
+  float slide_mm = 0.0f;             // the target ankle's largest distance from its mean (how far it slides)
   float source_slide_mm = 0.0f;      // the source ankle's largest distance from its mean (its own slide)
 };
 

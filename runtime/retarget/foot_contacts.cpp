@@ -57,13 +57,18 @@ std::vector<ContactSpan> find_foot_contacts(const RetargetMap& map, std::span<co
         c.foot = foot;
         c.first = static_cast<uint32_t>(f);
         c.last = static_cast<uint32_t>(last);
+        // The offset: the target's ankle against the mapped source ankle, averaged, back in source units.
         glm::dvec3 sum(0.0);
-        for (size_t k = f; k <= last; ++k) sum += glm::dvec3(feet[k].target_ankle[foot]);
-        const glm::vec3 held(sum / static_cast<double>(last - f + 1));
-        c.position = map.unmap_point(held, floor);
+        for (size_t k = f; k <= last; ++k)
+          sum += glm::dvec3(feet[k].target_ankle[foot] - map.map_point(feet[k].source_ankle[foot], floor));
         const glm::quat back = glm::inverse(map.rotation);
-        c.entry_shift = back * (held - feet[f].target_ankle[foot]) / map.scale;
-        c.exit_shift = back * (held - feet[last].target_ankle[foot]) / map.scale;
+        const glm::vec3 mean_error(sum / static_cast<double>(last - f + 1));
+        c.offset = back * mean_error / map.scale;
+        auto held_minus_free = [&](size_t k) {
+          return back * (map.map_point(feet[k].source_ankle[foot], floor) + mean_error - feet[k].target_ankle[foot]) / map.scale;
+        };
+        c.entry_shift = held_minus_free(f);
+        c.exit_shift = held_minus_free(last);
         out.push_back(c);
       }
       f = last + 1;
@@ -86,7 +91,7 @@ void foot_contacts_at(std::span<const ContactSpan> contacts, float frame, float 
     w = w * w * (3.0f - 2.0f * w);  // smoothstep: no velocity jump where the fix-up starts
     FootContact& o = out[c.foot];
     if (w > o.weight)
-      o = FootContact{outside > 0.0f ? std::min(w, 0.999f) : 1.0f, c.position,
+      o = FootContact{outside > 0.0f ? std::min(w, 0.999f) : 1.0f, c.offset,
                       frame < first ? c.entry_shift : frame > last ? c.exit_shift : glm::vec3(0.0f)};
   }
 }

@@ -174,6 +174,12 @@ bool pose_source(const RetargetMap& map, ConstPoseSpan source, RetargetScratch& 
   return true;
 }
 
+glm::vec3 held_ankle(const RetargetMap& map, const RetargetScratch& s, int foot, const FootContact& contact,
+                     float source_floor) {
+  const auto j = static_cast<size_t>(map.legs[foot == 0 ? 0 : 1].source_foot);
+  return map.map_point(glm::vec3(s.source_model[j][3]) + contact.offset, source_floor);
+}
+
 bool retarget(const RetargetMap& map, const RetargetInput& in, RetargetScratch& s, PoseSpan out) {
   if (out.base == nullptr || out.joint_count != map.target_joint_count) return false;
   if (in.target_base.base != nullptr && in.target_base.joint_count != map.target_joint_count) return false;

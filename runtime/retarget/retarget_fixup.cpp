@@ -13,8 +13,7 @@
 // and hands across the body; the swing costs the limb a few degrees. A hand reaching across the
 // body on the source stays across on the target.
 //
-// Contacts: each planted ankle's error (from the contact's position carried over, or an easing
-// shift) is taken by the pelvis first, as the mean over the planted feet, so a single planted
+// Contacts: each planted ankle's error (from where the contact holds it, or an easing shift) is taken by the pelvis first, as the mean over the planted feet, so a single planted
 // foot is held without bending the leg away from the source's (the pelvis path strays from the
 // scaled source's by what the target's proportions make of the pose, a few percent of the hips
 // height); the IK takes the rest: what two planted feet disagree on.
@@ -109,6 +108,7 @@ void guard_mid_plane(const RetargetMap& map, const RetargetInput& in, RetargetSc
 
 void hold_contacts(const RetargetMap& map, const RetargetInput& in, RetargetScratch& s, PoseSpan out) {
   std::array<glm::vec3, 2> goal{};
+  std::array<float, 2> weight{0.0f, 0.0f};
   std::array<bool, 2> held{false, false};
   glm::vec3 shift(0.0f);
   float weights = 0.0f;
@@ -117,16 +117,20 @@ void hold_contacts(const RetargetMap& map, const RetargetInput& in, RetargetScra
     const RetargetMap::Leg& l = map.legs[leg];
     if (!(c.weight > 0.0f) || l.upper < 0 || l.lower < 0 || l.foot < 0) continue;
     const glm::vec3 ankle = at(s.target_model, l.foot);
-    const glm::vec3 error = c.weight >= 1.0f ? map.map_point(c.position, in.source_floor) - ankle
+    const glm::vec3 error = c.weight >= 1.0f ? held_ankle(map, s, static_cast<int>(leg), c, in.source_floor) - ankle
                                              : std::min(c.weight, 1.0f) * map.scale * (map.rotation * c.shift);
     if (!std::isfinite(error.x + error.y + error.z)) continue;
     goal[leg] = ankle + error;
+    weight[leg] = std::min(c.weight, 1.0f);
     shift += error;
-    weights += std::min(c.weight, 1.0f);
+    weights += weight[leg];
     held[leg] = true;
   }
   if (!held[0] && !held[1]) return;
   shift /= std::max(1.0f, weights);
+  // A foot easing in or out holds its ground only as much as its weight: the rest of it goes
+  // with the pelvis (its IK does not undo the shift a planted foot asked for).
+  for (size_t leg = 0; leg < 2; ++leg) goal[leg] += (1.0f - weight[leg]) * shift;
   evaluate(map, in, s, out, true, {}, shift);
 
   std::array<Kept, 2> kept;

@@ -101,10 +101,6 @@ glm::vec3 RetargetMap::map_point(const glm::vec3& p, float floor) const {
   return target_pose.origin + scale * (rotation * (p - source_pose.origin - floor * source_pose.up));
 }
 
-glm::vec3 RetargetMap::unmap_point(const glm::vec3& p, float floor) const {
-  return source_pose.origin + floor * source_pose.up + (glm::inverse(rotation) * (p - target_pose.origin)) / scale;
-}
-
 Result<RetargetMap> make_retarget_map(const RetargetRig& source, const RetargetRig& target, const RetargetOptions& options) {
   auto source_pose = make_retarget_pose(source);
   if (!source_pose) return source_pose.error();

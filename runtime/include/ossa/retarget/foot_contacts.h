@@ -32,13 +32,13 @@ struct ContactSettings {
   float blend_time = 0.12f;    // seconds of easing either side of a contact
 };
 
-/// One contact: frames [first, last] of the clip's grid, and the ankle's planted position
-/// (source model space).
+/// One contact: frames [first, last] of the clip's grid, its FootContact offset, and the shifts
+/// easing into and out of it (all source model space vectors).
 struct ContactSpan {
   uint8_t foot = 0;  // 0 left, 1 right
   uint32_t first = 0, last = 0;
-  glm::vec3 position{0.0f};
-  glm::vec3 entry_shift{0.0f}, exit_shift{0.0f};  // position minus the ankle without contacts at first / last
+  glm::vec3 offset{0.0f};
+  glm::vec3 entry_shift{0.0f}, exit_shift{0.0f};  // the held ankle minus the ankle without contacts at first / last
 };
 
 /// What contact finding reads of one frame.
@@ -55,15 +55,13 @@ ContactFrame contact_frame(const RetargetMap& map, const RetargetScratch& scratc
 /// capture's rest pose has its root at the origin, wherever the capture's floor was).
 float clip_floor(const RetargetMap& map, std::span<const ContactFrame> frames);
 
-/// Contacts over a clip, one ContactFrame per frame of its grid. A contact's position is the
-/// target ankles' mean over it, in source model space (RetargetMap::unmap_point), which is what
-/// the retarget job takes. Sorted by foot, then frame.
+/// Contacts over a clip, one ContactFrame per frame of its grid. Sorted by foot, then frame.
 std::vector<ContactSpan> find_foot_contacts(const RetargetMap& map, std::span<const ContactFrame> frames,
                                             float sample_rate, float floor = 0.0f, const ContactSettings& settings = {});
 
 /// The contact input for the retarget job at a (fractional) frame (FootContact): inside a contact
-/// weight 1 and its position; within blend_time before or after one, the eased weight and its
-/// entry or exit shift. Allocation-free.
+/// weight 1 and its offset; within blend_time before or after one, the eased weight and its entry
+/// or exit shift. Allocation-free.
 void foot_contacts_at(std::span<const ContactSpan> contacts, float frame, float sample_rate, float blend_time,
                       std::span<FootContact, 2> out);
 

@@ -22,9 +22,8 @@
 // the same name on both rigs follows the source's local motion, which is what makes a rig
 // retargeted onto itself reproduce the source exactly.
 //
-// Feet: given contacts (a weight and a planted position, in the source's model space; find them
-// over a clip with find_foot_contacts), each planted target ankle is held at the planted position
-// carried over by map_point: the pelvis first moves by what the planted feet need (their mean, so
+// Feet: given contacts (find them over a clip with find_foot_contacts), each planted target ankle
+// is held where the scaled source holds its own, at the target's own stance (FootContact): the pelvis first moves by what the planted feet need (their mean, so
 // a single planted foot costs the legs nothing and the limbs keep the source's directions), then a
 // two-bone IK pass (ik.h) takes the rest (the two feet of a double support disagreeing), keeping
 // each foot's own orientation.
@@ -144,8 +143,6 @@ struct RetargetMap {
   /// planted source ankle onto the target's ankle level whatever each rig's ankle height.
   /// `floor`: how high the source clip's floor stands above its rest pose's (clip_floor).
   glm::vec3 map_point(const glm::vec3& source_point, float floor = 0.0f) const;
-  /// The inverse of map_point: a target model-space point in the source's model space.
-  glm::vec3 unmap_point(const glm::vec3& target_point, float floor = 0.0f) const;
 };
 
 struct RetargetOptions {
@@ -173,16 +170,19 @@ enum RetargetAdjusted : uint8_t {
 RetargetScratch make_retarget_scratch(const RetargetMap& map);
 
 /// One foot's contact for one frame (foot_contacts_at makes them from a clip's ContactSpans).
-///   weight 1: planted: the target's ankle is held at map_point(position);
+///   weight 1: planted: the target's ankle is held at map_point(source ankle now + offset): where
+///     the scaled source holds its foot, moved by `offset` (the target's own stance: how far its
+///     proportions put its ankle from the scaled source's, averaged over the contact), so what
+///     the retarget adds to the foot's motion is removed and what the source's foot does is kept;
 ///   weight in (0, 1): easing in or out of a contact: the ankle is moved from where the retarget
 ///     puts it by weight * (shift carried over: scale * R * shift), shift being how far the contact
 ///     holds the ankle from there at the contact's edge (so a swinging foot is not pulled across
 ///     the ground towards where it will land);
 ///   weight 0: free.
-/// position is a point and shift a vector in the source's model space.
+/// offset and shift are vectors in the source's model space.
 struct FootContact {
   float weight = 0.0f;
-  glm::vec3 position{0.0f};
+  glm::vec3 offset{0.0f};
   glm::vec3 shift{0.0f};
 };
 
@@ -202,6 +202,11 @@ bool retarget(const RetargetMap& map, const RetargetInput& input, RetargetScratc
 
 /// Only the source's model space (scratch.source_model / source_rotation), e.g. to find contacts.
 bool pose_source(const RetargetMap& map, ConstPoseSpan source, RetargetScratch& scratch);
+
+/// Where a planted contact (weight 1) holds the target's ankle, once pose_source (or retarget) has
+/// posed the source: map_point(source ankle + contact.offset). Target model space.
+glm::vec3 held_ankle(const RetargetMap& map, const RetargetScratch& scratch, int foot, const FootContact& contact,
+                     float source_floor = 0.0f);
 
 
 }  // namespace ossa
