@@ -221,6 +221,11 @@ void cook_into(CookRecord& record, const fs::path& input, const fs::path& output
     record.error = input.string() + ": is a directory, not a source file";
     return;
   }
+  if (is_graph_file(input) && options.retarget_target != nullptr) {
+    record.error = input.string() + ": --retarget-to applies to sources, not graph files (a graph's retarget node "
+                   "plays clips of another rig: docs/RETARGET.md)";
+    return;
+  }
   if (is_graph_file(input)) {
     if (!settings.clip_names.empty())
       record.warnings.push_back("\"clip_names\" in cook settings is not used for a graph file: the graph names its clips");
@@ -256,6 +261,14 @@ void cook_into(CookRecord& record, const fs::path& input, const fs::path& output
     record.error = st.message();
     return;
   }
+  if (options.retarget_target != nullptr) {
+    RetargetTarget target{options.retarget_target, options.retarget_name, options.retarget_map, options.retarget_map_name};
+    if (Status st = retarget_scene(*scene, target, input.string(), &record.retarget_records); !st) {
+      record.error = st.message();
+      return;
+    }
+    count_scene(record, *scene);
+  }
 
   MeshOptions mesh_options;
   mesh_options.float_vertices = options.float_vertices;
@@ -283,7 +296,7 @@ void cook_into(CookRecord& record, const fs::path& input, const fs::path& output
   // A clip-only file binds to its rig by hash and carries no skeleton; a file with meshes always
   // carries the rig its joint palettes index (with --skeleton, the reference's, hash-identical).
   WriteOptions write_options;
-  write_options.include_skeleton = options.reference == nullptr || !meshes->empty();
+  write_options.include_skeleton = (options.reference == nullptr && options.retarget_target == nullptr) || !meshes->empty();
   const std::vector<uint8_t> bytes = write_ossa(*scene, *meshes, *clips, provenance, write_options);
   if (!detail::write_verified(record, bytes, input, output, options.write)) return;
 
@@ -333,11 +346,18 @@ std::optional<CookRecord> cook_or_check(const fs::path& input, const fs::path& o
   // A read the sandbox refused is the cause to name, whatever the importer made of the missing file.
   if (!record.ok && !log.refusals().empty() && record.error.find(log.refusals().front()) == std::string::npos)
     record.error = detail::refusal_error(input, log) + "; then: " + record.error;
-  // --skeleton's file is keyed through the options (canonical()); the depfile still names it.
-  if (options.reference != nullptr && options.reference_input.present && !is_graph_file(input)) {
-    record.inputs_read.push_back(options.reference_input);
-    std::sort(record.inputs_read.begin(), record.inputs_read.end(),
-              [](const InputFile& a, const InputFile& b) { return a.path < b.path; });
+  // --skeleton's, --retarget-to's and --map's files are keyed through the options (canonical());
+  // the depfile still names them.
+  if (!is_graph_file(input)) {
+    const std::pair<bool, const InputFile*> keyed[] = {{options.reference != nullptr, &options.reference_input},
+                                                       {options.retarget_target != nullptr, &options.retarget_input},
+                                                       {options.retarget_map != nullptr, &options.retarget_map_input}};
+    bool added = false;
+    for (const auto& [used, file] : keyed)
+      if (used && file->present) record.inputs_read.push_back(*file), added = true;
+    if (added)
+      std::sort(record.inputs_read.begin(), record.inputs_read.end(),
+                [](const InputFile& a, const InputFile& b) { return a.path < b.path; });
   }
   record.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return record;
@@ -352,6 +372,16 @@ CookRecord cook_file(const fs::path& input, const fs::path& output, const CookOp
 std::optional<CookRecord> up_to_date_record(const fs::path& input, const fs::path& output,
                                             const CookOptions& batch_options) {
   return cook_or_check(input, output, batch_options, true);
+}
+
+Result<tools::HumanoidMapFile> load_humanoid_map_file(const fs::path& path, InputFile* as_read) {
+  InputLog log;
+  InputLogScope scope(&log);
+  auto bytes = read_input(path);
+  if (!bytes) return bytes.error();
+  if (as_read != nullptr) *as_read = log.files().front();
+  return tools::parse_humanoid_map_file(std::string_view(reinterpret_cast<const char*>(bytes->data()), bytes->size()),
+                                        path.string());
 }
 
 }  // namespace ossa::cook

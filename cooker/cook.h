@@ -20,6 +20,7 @@
 #include "cooker/model/cook_record.h"
 #include "cooker/model/reference_skeleton.h"
 #include "cooker/write/atomic_file.h"
+#include "tools/retarget/map_file.h"
 #include <ossa/format/result.h>
 
 namespace ossa::cook {
@@ -47,5 +48,9 @@ CookRecord cook_file(const std::filesystem::path& input, const std::filesystem::
 /// and an all-up-to-date run costs no process per input. O(bytes of the listed inputs).
 std::optional<CookRecord> up_to_date_record(const std::filesystem::path& input, const std::filesystem::path& output,
                                             const CookOptions& options);
+
+/// Reads and parses a humanoid map file (for --map; tools/retarget/map_file.h). Errors name the
+/// file. `as_read`, when given, receives its input record (absolute path, hash, size).
+Result<tools::HumanoidMapFile> load_humanoid_map_file(const std::filesystem::path& path, InputFile* as_read = nullptr);
 
 }  // namespace ossa::cook

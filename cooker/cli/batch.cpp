@@ -319,6 +319,36 @@ nlohmann::ordered_json input_json(const InputFile& f) {
   return j;
 }
 
+/// A retargeted clip's contact: its fields, the foot by name.
+nlohmann::ordered_json retarget_contact_json(const RetargetContactRecord& c) {
+  nlohmann::ordered_json j;
+  retarget_contact_record_fields(
+      [&](const char* key, const auto& value) {
+        if (std::string_view(key) == "foot") j[key] = c.foot == 0 ? "left" : "right";
+        else j[key] = value;
+      },
+      c);
+  return j;
+}
+
+/// A retargeted clip: its fields, contacts as above.
+nlohmann::ordered_json retarget_json(const RetargetRecord& t) {
+  nlohmann::ordered_json j;
+  retarget_record_fields(
+      [&](const char* key, const auto& value) {
+        using T = std::decay_t<decltype(value)>;
+        if constexpr (std::is_same_v<T, std::vector<RetargetContactRecord>>) {
+          nlohmann::ordered_json list = nlohmann::ordered_json::array();
+          for (const RetargetContactRecord& c : value) list.push_back(retarget_contact_json(c));
+          j[key] = std::move(list);
+        } else {
+          j[key] = value;
+        }
+      },
+      t);
+  return j;
+}
+
 template <class Record>
 nlohmann::ordered_json json_list(const std::vector<Record>& records,
                                  nlohmann::ordered_json (*one)(const Record&)) {
@@ -346,6 +376,8 @@ nlohmann::ordered_json report_record(const CookRecord& r) {
           if (!value.empty()) j["textures_cooked"] = json_list(value, texture_json);
         } else if constexpr (std::is_same_v<T, std::vector<MorphRecord>>) {
           if (!value.empty()) j["morph_targets"] = json_list(value, morph_json);
+        } else if constexpr (std::is_same_v<T, std::vector<RetargetRecord>>) {
+          if (!value.empty()) j["retarget"] = json_list(value, retarget_json);
         } else if constexpr (std::is_same_v<T, std::vector<InputFile>>) {
           j[key] = json_list(relative_inputs(value, fs::path(r.input).parent_path()), input_json);
         } else if (k == "ok") {

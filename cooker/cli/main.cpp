@@ -2,7 +2,8 @@
 // Inputs are sources (FBX, glTF, ...) and animation graph files (`*.graph.json`, docs/GRAPH.md).
 //
 //   ossa-cook INPUT... -o OUTDIR [--root DIR] [--jobs N] [--max-memory SIZE] [--timeout SECONDS]
-//             [--report FILE.json] [--skeleton REF.ossa] [--float-vertices] [--clip-tolerance MM]
+//             [--report FILE.json] [--skeleton REF.ossa] [--retarget-to TARGET.ossa [--map MAP.json]]
+//             [--float-vertices] [--clip-tolerance MM]
 //             [--no-clip-compression] [--root-motion] [--up-axis x|y|z] [--metres-per-unit M] [--force] [--depfile FILE]
 //             [--list-inputs] [-q | -v] [--version] [--help]
 //
@@ -138,6 +139,20 @@ void print_details(const CookRecord& r) {
                    static_cast<double>(t.normal_max_deg));
     std::fprintf(stderr, "\n");
   }
+  for (const RetargetRecord& t : r.retarget_records) {
+    std::fprintf(stderr, "    retarget '%s': %u frames, hips ratio %.3f, limbs within %.2f deg, hands %.2f, feet %.2f, "
+                         "%u frames crossing, %u guarded (limbs %.2f deg), %zu contacts", shown(t.clip).c_str(), t.frames,
+                 static_cast<double>(t.hips_ratio), static_cast<double>(t.limb_max_deg), static_cast<double>(t.hand_max_deg),
+                 static_cast<double>(t.foot_max_deg), t.crossing_frames, t.guarded_frames,
+                 static_cast<double>(t.guard_max_deg), t.contacts.size());
+    float held = 0.0f, slide = 0.0f, source = 0.0f;
+    for (const RetargetContactRecord& c : t.contacts)
+      held = std::max(held, c.held_mm), slide = std::max(slide, c.slide_mm), source = std::max(source, c.source_slide_mm);
+    if (!t.contacts.empty())
+      std::fprintf(stderr, " (held within %.2f mm; feet slide up to %.2f mm, the source's %.2f mm)", static_cast<double>(held),
+                   static_cast<double>(slide), static_cast<double>(source));
+    std::fprintf(stderr, "\n");
+  }
   for (const ClipRecord& c : r.clip_records)
     std::fprintf(stderr, "    clip '%s': %u frames, %u joints, max error %.4f mm (mean %.4f mm, at '%s'), %u -> %u bytes (%.1f:1)\n",
                  shown(c.name).c_str(), c.frames, c.joints, static_cast<double>(c.max_error_mm),
@@ -192,6 +207,13 @@ int main(int argc, char** argv) {
                  "(default 600; 0: no limit)");
   app.add_option("--report", report_path, "write a JSON record per input to this file (docs/JSON.md)");
   app.add_option("--skeleton", skeleton_path, "cook clip-only files against this cooked skeleton (.ossa)");
+  std::string retarget_path, map_path;
+  app.add_option("--retarget-to", retarget_path,
+                 "retarget the inputs' clips onto this cooked humanoid rig (.ossa) and cook them as its clips; the "
+                 "clips play on their own rig, or on --skeleton's for clip-only files (docs/RETARGET.md)");
+  app.add_option("--map", map_path,
+                 "a humanoid map file naming which joints play which humanoid bones, for rigs whose names do not say "
+                 "(with --retarget-to; docs/RETARGET.md)");
   app.add_flag("--float-vertices", float_vertices, "store vertices as float32 instead of quantized");
   std::string texture_format = "bc";
   app.add_option("--texture-format", texture_format,
@@ -255,6 +277,31 @@ int main(int argc, char** argv) {
     reference = std::move(*loaded);
     options.reference = &reference;
     options.reference_name = fs::path(skeleton_path).filename().string();
+  }
+
+  SourceSkeleton retarget_target;
+  ossa::tools::HumanoidMapFile map_file;
+  if (!map_path.empty() && retarget_path.empty())
+    return command.usage_error("--map is read with --retarget-to (ossa-inspect --humanoid --map shows a rig's mapping)");
+  if (!retarget_path.empty()) {
+    auto loaded = load_reference_skeleton(retarget_path, &options.retarget_input);
+    if (!loaded) {
+      std::fprintf(stderr, "ossa-cook: --retarget-to %s\n", loaded.error().message.c_str());
+      return ossa::cli::kExitUsage;
+    }
+    retarget_target = std::move(*loaded);
+    options.retarget_target = &retarget_target;
+    options.retarget_name = fs::path(retarget_path).filename().string();
+  }
+  if (!map_path.empty()) {
+    auto parsed = load_humanoid_map_file(map_path, &options.retarget_map_input);
+    if (!parsed) {
+      std::fprintf(stderr, "ossa-cook: --map %s\n", parsed.error().message.c_str());
+      return ossa::cli::kExitUsage;
+    }
+    map_file = std::move(*parsed);
+    options.retarget_map = &map_file;
+    options.retarget_map_name = fs::path(map_path).filename().string();
   }
 
   std::vector<fs::path> input_paths(inputs.begin(), inputs.end());

@@ -54,7 +54,8 @@ struct is_optional<std::optional<T>> : std::true_type {};
 /// Records that have a field list (and are sent as objects), as opposed to plain values.
 template <class T>
 constexpr bool kIsRecord = std::is_same_v<T, ClipRecord> || std::is_same_v<T, TextureRecord> ||
-                           std::is_same_v<T, MorphRecord> || std::is_same_v<T, InputFile>;
+                           std::is_same_v<T, MorphRecord> || std::is_same_v<T, InputFile> ||
+                           std::is_same_v<T, RetargetRecord> || std::is_same_v<T, RetargetContactRecord>;
 
 template <class T>
 struct record_vector : std::false_type {};

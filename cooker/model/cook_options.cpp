@@ -52,6 +52,14 @@ std::string CookOptions::canonical() const {
     s += ";skeleton=" + reference_name;
     if (reference_input.present) s += "@" + hex64(reference_input.hash);
   }
+  if (retarget_target != nullptr) {
+    s += ";retarget=" + retarget_name;
+    if (retarget_input.present) s += "@" + hex64(retarget_input.hash);
+  }
+  if (retarget_map != nullptr) {
+    s += ";map=" + retarget_map_name;
+    if (retarget_map_input.present) s += "@" + hex64(retarget_map_input.hash);
+  }
   return s;
 }
 

@@ -16,6 +16,10 @@
 #include "cooker/model/input_log.h"
 #include "cooker/model/source_scene.h"
 
+namespace ossa::tools {
+struct HumanoidMapFile;  // tools/retarget/map_file.h (--map)
+}
+
 namespace ossa::cook {
 
 /// What the cooker makes of a texture (--texture-format; cooker/texture/texture_cook.h).
@@ -53,6 +57,14 @@ struct CookOptions {
   const SourceSkeleton* reference = nullptr;
   std::string reference_name;  // REF.ossa's file name, recorded in the options string
   InputFile reference_input;   // REF.ossa as read (absolute path, hash): its hash is in canonical()
+  /// --retarget-to TARGET.ossa: the source's clips are retargeted onto this rig
+  /// (cooker/retarget/retarget_clips.h) and cooked as clip-only files of it; null otherwise.
+  const SourceSkeleton* retarget_target = nullptr;
+  std::string retarget_name;          // TARGET.ossa's file name
+  InputFile retarget_input;           // TARGET.ossa as read: its hash is in canonical()
+  const tools::HumanoidMapFile* retarget_map = nullptr;  // --map FILE.json, or null
+  std::string retarget_map_name;
+  InputFile retarget_map_input;       // the map file as read: its hash is in canonical()
   /// Canonical text of the options that change output bytes, recorded in provenance.
   std::string canonical() const;
 

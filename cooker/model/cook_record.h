@@ -1,5 +1,5 @@
 // cook_record.h — what one cook reports: counts, sizes, errors, warnings, per-clip / per-morph /
-// per-texture records, the inputs it read and its cook key.
+// per-texture / per-retargeted-clip records, the inputs it read and its cook key.
 //
 // Part of the cooker's model: every stage adds what it learns (cook.cpp fills the counts as each
 // stage finishes), the worker sends the record to the batch over a pipe (cli/worker.cpp), and the
@@ -53,6 +53,31 @@ struct TextureRecord {
   float normal_mean_deg = 0.0f, normal_max_deg = 0.0f;  // normal maps: angle to the source's normals
 };
 
+/// One contact of a retargeted clip.
+struct RetargetContactRecord {
+  uint32_t foot = 0;                 // 0 left, 1 right
+  float start = 0.0f, end = 0.0f;    // seconds
+  float held_mm = 0.0f;              // the target ankle's largest distance from where the contact holds it
+  float slide_mm = 0.0f;             // the target ankle's largest distance from its mean (how far it slides)
+  float source_slide_mm = 0.0f;      // the source ankle's largest distance from its mean (its own slide)
+};
+
+/// What a retarget achieved on one clip (--report "retarget"; docs/RETARGET.md).
+struct RetargetRecord {
+  std::string clip;
+  float hips_ratio = 0.0f;           // target hips height / source's, both in metres over the ankles
+  float floor_mm = 0.0f;             // the source clip's floor above its rest pose's (0: none)
+  uint32_t frames = 0;
+  float limb_max_deg = 0.0f;         // upper arm, forearm, thigh, shin: largest angle to the source's,
+                                     // over the limbs the mid-plane guard left alone
+  float guard_max_deg = 0.0f;        // the same over the limbs it swung back (what keeping them on their side cost)
+  float hand_max_deg = 0.0f;         // hands' outward axis, either hand
+  float foot_max_deg = 0.0f;         // feet's forward axis, either foot
+  uint32_t crossing_frames = 0;      // frames with a hand or foot across the mid-plane where the source's is not
+  uint32_t guarded_frames = 0;       // frames where the mid-plane guard swung a limb back
+  std::vector<RetargetContactRecord> contacts;
+};
+
 /// One line of the --report file (docs/schemas/ossa-cook-report.schema.json).
 ///
 /// A failed cook keeps what it learnt before it stopped: the counts are filled in as each stage
@@ -76,6 +101,7 @@ struct CookRecord {
   std::vector<ClipRecord> clip_records;  // one per clip compressed before any failure
   std::vector<MorphRecord> morph_records;  // one per morph target, once meshes are built
   std::vector<TextureRecord> texture_records;  // one per distinct embedded texture, once textures are cooked
+  std::vector<RetargetRecord> retarget_records;  // --retarget-to: one per clip retargeted
   /// Every file the cook read or looked for (absolute paths, sorted), as far as it got; for an
   /// up-to-date output, the inputs its provenance lists. The depfile and --list-inputs print these.
   std::vector<InputFile> inputs_read;
@@ -128,6 +154,31 @@ constexpr void morph_record_fields(F&& f, R&... r) {
 }
 
 template <class F, class... R>
+constexpr void retarget_contact_record_fields(F&& f, R&... r) {
+  f("foot", r.foot...);
+  f("start", r.start...);
+  f("end", r.end...);
+  f("held_mm", r.held_mm...);
+  f("slide_mm", r.slide_mm...);
+  f("source_slide_mm", r.source_slide_mm...);
+}
+
+template <class F, class... R>
+constexpr void retarget_record_fields(F&& f, R&... r) {
+  f("clip", r.clip...);
+  f("frames", r.frames...);
+  f("hips_ratio", r.hips_ratio...);
+  f("floor_mm", r.floor_mm...);
+  f("limb_max_deg", r.limb_max_deg...);
+  f("guard_max_deg", r.guard_max_deg...);
+  f("hand_max_deg", r.hand_max_deg...);
+  f("foot_max_deg", r.foot_max_deg...);
+  f("crossing_frames", r.crossing_frames...);
+  f("guarded_frames", r.guarded_frames...);
+  f("contacts", r.contacts...);
+}
+
+template <class F, class... R>
 constexpr void input_file_fields(F&& f, R&... r) {
   f("path", r.path...);
   f("hash", r.hash...);
@@ -155,6 +206,7 @@ constexpr void cook_record_fields(F&& f, R&... r) {
   f("clip_records", r.clip_records...);
   f("texture_records", r.texture_records...);
   f("morph_records", r.morph_records...);
+  f("retarget_records", r.retarget_records...);
   f("source_bytes", r.source_bytes...);
   f("cooked_bytes", r.cooked_bytes...);
   f("up_to_date", r.up_to_date...);
@@ -164,13 +216,15 @@ constexpr void cook_record_fields(F&& f, R&... r) {
   f("warnings", r.warnings...);
 }
 
-/// Calls the field list of `Record`'s type (one of the five above).
+/// Calls the field list of `Record`'s type (one of the seven above).
 template <class F, class Record, class... More>
 constexpr void record_fields(F&& f, Record& r, More&... more) {
   using T = std::remove_const_t<Record>;
   if constexpr (std::is_same_v<T, ClipRecord>) clip_record_fields(f, r, more...);
   else if constexpr (std::is_same_v<T, TextureRecord>) texture_record_fields(f, r, more...);
   else if constexpr (std::is_same_v<T, MorphRecord>) morph_record_fields(f, r, more...);
+  else if constexpr (std::is_same_v<T, RetargetRecord>) retarget_record_fields(f, r, more...);
+  else if constexpr (std::is_same_v<T, RetargetContactRecord>) retarget_contact_record_fields(f, r, more...);
   else if constexpr (std::is_same_v<T, InputFile>) input_file_fields(f, r, more...);
   else {
     static_assert(std::is_same_v<T, CookRecord>, "not a record with a field list");
@@ -200,6 +254,8 @@ constexpr size_t listed_count() {
   if constexpr (std::is_same_v<T, ClipRecord>) clip_record_fields(count);
   else if constexpr (std::is_same_v<T, TextureRecord>) texture_record_fields(count);
   else if constexpr (std::is_same_v<T, MorphRecord>) morph_record_fields(count);
+  else if constexpr (std::is_same_v<T, RetargetRecord>) retarget_record_fields(count);
+  else if constexpr (std::is_same_v<T, RetargetContactRecord>) retarget_contact_record_fields(count);
   else if constexpr (std::is_same_v<T, InputFile>) input_file_fields(count);
   else cook_record_fields(count);
   return n;
@@ -215,6 +271,11 @@ static_assert(record_check::member_count<TextureRecord>() == record_check::liste
               "TextureRecord: add the new member to texture_record_fields");
 static_assert(record_check::member_count<MorphRecord>() == record_check::listed_count<MorphRecord>(),
               "MorphRecord: add the new member to morph_record_fields");
+static_assert(record_check::member_count<RetargetRecord>() == record_check::listed_count<RetargetRecord>(),
+              "RetargetRecord: add the new member to retarget_record_fields");
+static_assert(record_check::member_count<RetargetContactRecord>() ==
+                  record_check::listed_count<RetargetContactRecord>(),
+              "RetargetContactRecord: add the new member to retarget_contact_record_fields");
 static_assert(record_check::member_count<InputFile>() == record_check::listed_count<InputFile>(),
               "InputFile: add the new member to input_file_fields");
 static_assert(record_check::member_count<CookRecord>() == record_check::listed_count<CookRecord>(),

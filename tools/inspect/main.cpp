@@ -1,13 +1,14 @@
 // main.cpp — ossa-inspect: print what a cooked .ossa file holds, as text or as JSON.
 //
-//   ossa-inspect FILE.ossa [--json] [-q | -v] [--version] [--help]
+//   ossa-inspect FILE.ossa [--json | --humanoid [--map MAP.json]] [-q | -v] [--version] [--help]
 //
 // The tool is the runtime's loader plus describe.h: it opens the file exactly as a game would
 // (mmap, verify, validate), so "ossa-inspect says it is fine" means "the runtime will load it";
 // -q prints nothing and answers that question with the exit status alone. -v adds every clip
 // channel (joint, kind, constant or animated, keys, bits). The JSON form is what the golden
 // regression tests compare and is described in docs/schemas/ossa-inspect.schema.json; it names the
-// file without its directory so goldens do not depend on where a tree is checked out.
+// file without its directory so goldens do not depend on where a tree is checked out. --humanoid
+// prints the rig's humanoid mapping for retargeting instead (describe_humanoid.h).
 //
 // Exit status (tools/cli/cli.h): 0 the file loads; 1 it is not a valid .ossa file (the
 // loader's message, naming the file, on stderr); 2 usage error, or the file cannot be read at all.
@@ -19,6 +20,10 @@
 #include <ossa/loader/asset.h>
 #include "tools/cli/cli.h"
 #include "tools/inspect/describe.h"
+#include "tools/inspect/describe_humanoid.h"
+
+#include <fstream>
+#include <sstream>
 
 int main(int argc, char** argv) {
   ossa::cli::Command command("ossa-inspect",
@@ -28,7 +33,15 @@ int main(int argc, char** argv) {
   bool json = false;
   command.app().add_option("file", path, "the .ossa file to inspect")->required();
   command.app().add_flag("--json", json, "print JSON with a stable key order (docs/JSON.md; what the golden tests compare)");
+  bool humanoid = false;
+  std::string map_path;
+  command.app().add_flag("--humanoid", humanoid,
+                         "print the rig's humanoid mapping for retargeting (which joint plays which bone, what is missing, "
+                         "its retarget pose; docs/RETARGET.md) instead of the summary");
+  command.app().add_option("--map", map_path, "with --humanoid: a humanoid map file to apply (docs/RETARGET.md)");
   if (const auto exit_now = command.parse(argc, argv)) return *exit_now;
+  if (humanoid && json) return command.usage_error("--humanoid prints text; it does not combine with --json");
+  if (!map_path.empty() && !humanoid) return command.usage_error("--map is read with --humanoid");
 
   // A file that is not there or not a regular file is a usage problem, not an invalid .ossa.
   std::error_code ec;
@@ -44,6 +57,32 @@ int main(int argc, char** argv) {
   }
   if (command.quiet()) return ossa::cli::kExitOk;
 
+  if (humanoid) {
+    ossa::tools::HumanoidMapFile map;
+    if (!map_path.empty()) {
+      std::ifstream in(map_path, std::ios::binary);
+      std::stringstream text;
+      text << in.rdbuf();
+      if (!in) {
+        std::fprintf(stderr, "ossa-inspect: --map %s: cannot be read\n", map_path.c_str());
+        return ossa::cli::kExitUsage;
+      }
+      auto parsed = ossa::tools::parse_humanoid_map_file(text.str(), map_path);
+      if (!parsed) {
+        std::fprintf(stderr, "ossa-inspect: --map %s\n", parsed.error().message.c_str());
+        return ossa::cli::kExitUsage;
+      }
+      map = std::move(*parsed);
+    }
+    auto text = ossa::inspect::describe_humanoid(*asset, map_path.empty() ? nullptr : &map, map_path);
+    if (!text) {
+      std::fprintf(stderr, "ossa-inspect: %s\n", text.error().message.c_str());
+      return ossa::cli::kExitFailed;
+    }
+    std::cout << *text;
+    std::cout.flush();
+    return std::cout.good() ? ossa::cli::kExitOk : ossa::cli::kExitUsage;
+  }
   const std::string file_name = std::filesystem::path(path).filename().string();
   ossa::inspect::DescribeOptions options;
   options.channels = command.verbose();

@@ -1,0 +1,335 @@
+// retarget_cook_test.cpp — retargeting the shared sample rigs, none of them tuned for: ossa-cook
+// --retarget-to across Pab (FBX, centimetres, Biped-style spine), a Quaternius character (the
+// Cowboy: FBX, IK feet hanging from the root, a T-pose), CesiumMan (glTF, names that say nothing:
+// mapped by its map file, arms half down) and a CMU BVH capture (its floor 17 m above its rest
+// pose), plus an A-pose Cowboy made from the T-pose one (ossa-test-apose).
+//
+// Per pair, from the cook's --report: limb directions within 5 degrees of the source's at every
+// frame (limbs the mid-plane guard swung back are reported apart), no hand or foot across the
+// mid-plane where the source's is not, every planted foot within 1 cm of where it is held. Then a
+// rig onto itself equals the source within 0.1 mm, missing bones are named, map file mistakes are
+// named, and the live job (ossa::retarget on the cooked source clip) equals the cooked clip within
+// 0.1 mm. Cooks go to one cache folder under the test tree; a second test process finds them up to
+// date (their cook keys match) instead of cooking again.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include <ossa/anim/pose_ops.h>
+#include <ossa/anim/sample.h>
+#include <ossa/loader/asset.h>
+#include <ossa/retarget/foot_contacts.h>
+#include <ossa/retarget/retarget.h>
+#include "tools/retarget/map_file.h"
+#include "test_files.h"
+
+namespace fs = std::filesystem;
+using ossa::test::run_command;
+
+namespace {
+
+std::string q(const fs::path& p) { return "'" + p.string() + "'"; }
+std::string tool(const char* name) { return q(ossa::test::bin_dir() / name); }
+fs::path shared(const char* rel) { return ossa::test::shared_assets() / rel; }
+fs::path cesium_map() { return ossa::test::source_dir() / "assets" / "CesiumMan" / "CesiumMan.humanoid.json"; }
+const char* kCmuUnit = " --metres-per-unit 0.056444";  // CMU's BVH units (the file states none)
+
+fs::path cache() {
+  const fs::path dir = fs::path(ossa::test::env_or("OSSA_TEST_TMP", OSSA_TEST_TMP_DIR)) / "retarget-cooked";
+  fs::create_directories(dir);
+  return dir;
+}
+
+bool have_assets() { return fs::exists(shared("Pab/walk.fbx")) && fs::exists(shared("CMU_BVH/01_03.bvh")); }
+
+/// Cooks (or finds up to date) `args` into cache()/sub; fails the test on a non-zero exit.
+bool cook(const std::string& args, const std::string& sub, std::string* err = nullptr) {
+  const auto r = run_command(tool("ossa-cook") + " -q " + args + " -o " + q(cache() / sub));
+  if (err != nullptr) *err = r.err;
+  EXPECT_EQ(r.exit_code, 0) << args << "\n" << r.err;
+  return r.exit_code == 0;
+}
+
+/// The four rigs and the A-pose Cowboy, cooked once.
+struct Rigs {
+  fs::path pab, cowboy, cesium, cmu, cowboy_a;
+};
+Rigs rigs() {
+  Rigs r;
+  r.pab = cache() / "rigs" / "skeleton.ossa";
+  r.cowboy = cache() / "rigs" / "Cowboy.ossa";
+  r.cesium = cache() / "rigs" / "CesiumMan.ossa";
+  r.cmu = cache() / "rigs" / "01_03.ossa";
+  r.cowboy_a = cache() / "rigs" / "CowboyA.ossa";
+  cook(q(shared("Pab/skeleton.fbx")) + " " + q(shared("Quaternius_Cowboy/Cowboy.fbx")) + " " +
+           q(shared("CesiumMan/CesiumMan.glb")) + " --jobs 2",
+       "rigs");
+  cook(q(shared("CMU_BVH/01_03.bvh")) + kCmuUnit, "rigs");
+  if (!fs::exists(r.cowboy_a)) {
+    const auto made = run_command(tool("ossa-test-apose") + " " + q(shared("Quaternius_Cowboy/Cowboy.fbx")) + " " + q(r.cowboy_a));
+    EXPECT_EQ(made.exit_code, 0) << made.err;
+  }
+  return r;
+}
+
+struct Source {
+  std::string label, args;  // the source file and its rig / unit / map options
+};
+
+/// Retargets `source` onto `target` and returns the report's retarget entries.
+nlohmann::json retarget(const Source& source, const fs::path& target, const std::string& sub,
+                        const std::string& extra = "") {
+  const fs::path report = cache() / (sub + ".json");
+  if (!cook(source.args + " --retarget-to " + q(target) + extra + " --report " + q(report), sub)) return {};
+  const auto text = ossa::test::read_text(report);
+  if (!text) return {};
+  const auto doc = nlohmann::json::parse(*text);
+  nlohmann::json all = nlohmann::json::array();
+  for (const auto& record : doc.at("records"))
+    if (record.contains("retarget"))
+      for (const auto& r : record.at("retarget")) all.push_back(r);
+  return all;
+}
+
+TEST(RetargetCook, CrossPairsOfUntunedRigs) {
+  if (!have_assets()) GTEST_SKIP() << "no ../shared/assets";
+  const Rigs r = rigs();
+  const std::string map = " --map " + q(cesium_map());
+  const Source pab{"Pab walk", q(shared("Pab/walk.fbx")) + " --skeleton " + q(r.pab)};
+  const Source cowboy{"Cowboy", q(shared("Quaternius_Cowboy/Cowboy.fbx"))};
+  const Source cesium{"CesiumMan", q(shared("CesiumMan/CesiumMan.glb")) + map};
+  const Source cmu{"CMU 01_03", q(shared("CMU_BVH/01_03.bvh")) + kCmuUnit};
+  struct Pair {
+    const Source* source;
+    fs::path target;
+    std::string name, extra;
+  };
+  const std::vector<Pair> pairs = {
+      {&pab, r.cowboy, "pab-cowboy", ""},       {&pab, r.cesium, "pab-cesium", map},   {&pab, r.cmu, "pab-cmu", ""},
+      {&cowboy, r.pab, "cowboy-pab", ""},       {&cowboy, r.cesium, "cowboy-cesium", map},
+      {&cowboy, r.cmu, "cowboy-cmu", ""},       {&cesium, r.pab, "cesium-pab", ""},    {&cesium, r.cowboy, "cesium-cowboy", ""},
+      {&cesium, r.cmu, "cesium-cmu", ""},       {&cmu, r.pab, "cmu-pab", ""},          {&cmu, r.cowboy, "cmu-cowboy", ""},
+      {&cmu, r.cesium, "cmu-cesium", map},      {&pab, r.cowboy_a, "pab-cowboy-apose", ""},
+      {&cowboy, r.cowboy_a, "cowboy-tpose-to-apose", ""},
+  };
+  std::printf("%-24s %-28s %7s %6s %6s %6s %6s %6s %5s %8s %7s %7s %7s\n", "pair", "clip", "frames", "hips", "limbs",
+              "guard", "hands", "feet", "cross", "contacts", "held", "slide", "source");
+  for (const Pair& p : pairs) {
+    SCOPED_TRACE(p.name);
+    const nlohmann::json clips = retarget(*p.source, p.target, p.name, p.extra);
+    ASSERT_FALSE(clips.empty());
+    for (const auto& c : clips) {
+      SCOPED_TRACE(c.at("clip").get<std::string>());
+      EXPECT_LT(c.at("limb_max_deg").get<double>(), 5.0);
+      EXPECT_EQ(c.at("crossing_frames").get<int>(), 0);
+      double held = 0.0, slide = 0.0, source_slide = 0.0;
+      for (const auto& contact : c.at("contacts")) {
+        held = std::max(held, contact.at("held_mm").get<double>());
+        slide = std::max(slide, contact.at("slide_mm").get<double>());
+        source_slide = std::max(source_slide, contact.at("source_slide_mm").get<double>());
+      }
+      EXPECT_LT(held, 10.0);  // planted feet within 1 cm of where they are held
+      std::printf("%-24s %-28.28s %7d %6.3f %6.2f %6.2f %6.2f %6.2f %5d %8zu %7.3f %7.2f %7.2f\n", p.name.c_str(),
+                  c.at("clip").get<std::string>().c_str(), c.at("frames").get<int>(), c.at("hips_ratio").get<double>(),
+                  c.at("limb_max_deg").get<double>(), c.at("guard_max_deg").get<double>(),
+                  c.at("hand_max_deg").get<double>(), c.at("foot_max_deg").get<double>(),
+                  c.at("crossing_frames").get<int>(), c.at("contacts").size(), held, slide, source_slide);
+    }
+    // The output is a clip of the target rig: it binds to it.
+    for (const auto& e : fs::directory_iterator(cache() / p.name)) {
+      auto clip = ossa::Asset::open(e.path().string());
+      auto rig = ossa::Asset::open(p.target.string());
+      ASSERT_TRUE(clip.ok() && rig.ok());
+      EXPECT_TRUE(clip->skeleton().empty());
+      for (size_t i = 0; i < clip->clip_count(); ++i)
+        EXPECT_TRUE(ossa::check_clip_binding(clip->clip(i), rig->skeleton(), e.path().string()).ok());
+    }
+  }
+  // The report of a retarget is valid against its schema.
+  const auto check = run_command("python3 " + q(ossa::test::source_dir() / "tests" / "json_schema_check.py") + " " +
+                                 q(ossa::test::source_dir() / "docs" / "schemas" / "ossa-cook-report.schema.json") + " " +
+                                 q(cache() / "cmu-cesium.json"));
+  EXPECT_EQ(check.exit_code, 0) << check.out << check.err;
+}
+
+/// Largest distance between the joints of two clips of one rig, in millimetres, at every frame.
+double clip_distance_mm(const ossa::Asset& rig, const ossa::ClipView& a, const ossa::ClipView& b) {
+  const ossa::SkeletonView sk = rig.skeleton();
+  auto ca = ossa::make_sampling_cache(a, sk), cb = ossa::make_sampling_cache(b, sk);
+  if (!ca.ok() || !cb.ok()) return 1e9;
+  const auto n = static_cast<uint32_t>(sk.joint_count());
+  ossa::Pose pa(n), pb(n);
+  std::vector<glm::mat4> ma(n), mb(n);
+  double worst = 0.0;
+  for (uint32_t f = 0; f < a.frame_count(); ++f) {
+    const float t = static_cast<float>(f) / a.sample_rate();
+    ossa::sample(a, t, {false}, *ca, pa);
+    ossa::sample(b, t, {false}, *cb, pb);
+    ossa::local_to_model(sk.parents(), pa, ma);
+    ossa::local_to_model(sk.parents(), pb, mb);
+    for (uint32_t j = 0; j < n; ++j) worst = std::max(worst, static_cast<double>(glm::length(glm::vec3(ma[j][3] - mb[j][3]))));
+  }
+  return worst * rig.file().metres_per_unit() * 1000.0;
+}
+
+TEST(RetargetCook, RigOntoItselfEqualsTheSource) {
+  if (!have_assets()) GTEST_SKIP() << "no ../shared/assets";
+  const Rigs r = rigs();
+  const std::string walk = q(shared("Pab/walk.fbx")) + " --skeleton " + q(r.pab) + " --no-clip-compression";
+  ASSERT_TRUE(cook(walk, "self-plain"));
+  ASSERT_TRUE(cook(walk + " --retarget-to " + q(r.pab), "self-retargeted"));
+  auto rig = ossa::Asset::open(r.pab.string());
+  auto plain = ossa::Asset::open((cache() / "self-plain" / "walk.ossa").string());
+  auto self = ossa::Asset::open((cache() / "self-retargeted" / "walk.ossa").string());
+  ASSERT_TRUE(rig.ok() && plain.ok() && self.ok());
+  const double mm = clip_distance_mm(*rig, plain->clip(0), self->clip(0));
+  std::printf("Pab walk onto Pab: largest joint distance %.5f mm\n", mm);
+  EXPECT_LT(mm, 0.1);
+}
+
+TEST(RetargetCook, MissingBonesAndMapMistakesAreNamed) {
+  if (!have_assets()) GTEST_SKIP() << "no ../shared/assets";
+  const Rigs r = rigs();
+  const auto run = [&](const std::string& args) {
+    return run_command(tool("ossa-cook") + " -q " + args + " -o " + q(ossa::test::make_temp_dir("retarget-bad")));
+  };
+  // CesiumMan's joint names say nothing: without its map file, the missing bones are named.
+  auto missing = run(q(shared("CesiumMan/CesiumMan.glb")) + " --retarget-to " + q(r.pab));
+  EXPECT_EQ(missing.exit_code, 1);
+  EXPECT_NE(missing.err.find("CesiumMan.glb (source rig): missing humanoid bones: hips, spine, head,"), std::string::npos)
+      << missing.err;
+  EXPECT_NE(missing.err.find("rightFoot"), std::string::npos) << missing.err;
+  // ... and as a target.
+  auto as_target = run(q(shared("Pab/walk.fbx")) + " --skeleton " + q(r.pab) + " --retarget-to " + q(r.cesium));
+  EXPECT_EQ(as_target.exit_code, 1);
+  EXPECT_NE(as_target.err.find("CesiumMan.ossa (target rig): missing humanoid bones: hips"), std::string::npos)
+      << as_target.err;
+
+  const fs::path dir = ossa::test::make_temp_dir("retarget-maps");
+  const auto with_map = [&](const std::string& text) {
+    const fs::path file = dir / "map.json";
+    EXPECT_TRUE(ossa::test::write_file(file, text));
+    return run(q(shared("CesiumMan/CesiumMan.glb")) + " --retarget-to " + q(r.pab) + " --map " + q(file));
+  };
+  auto typo = with_map(R"({"ossa_humanoid_map": 1, "rig": {"bones": {"leftUpperArmm": "x"}}})");
+  EXPECT_EQ(typo.exit_code, 2);
+  EXPECT_NE(typo.err.find("map.json: rig.bones: 'leftUpperArmm' is not a humanoid bone (did you mean 'leftUpperArm'?)"),
+            std::string::npos)
+      << typo.err;
+  auto twice = with_map(R"({"ossa_humanoid_map": 1, "source": {"rest": "bind", "rest": "straighten"}})");
+  EXPECT_EQ(twice.exit_code, 2);
+  EXPECT_NE(twice.err.find("key 'rest' appears twice"), std::string::npos) << twice.err;
+  auto no_joint = with_map(R"({"ossa_humanoid_map": 1, "source": {"bones": {"hips": "pelvis_joint"}}})");
+  EXPECT_EQ(no_joint.exit_code, 1);
+  EXPECT_NE(no_joint.err.find("bones.hips: the rig has no joint 'pelvis_joint'"), std::string::npos) << no_joint.err;
+  auto not_unit = with_map(R"({"ossa_humanoid_map": 1, "source": {"rest_rotations": {"leg_joint_L_1": [0, 0, 0, 2]}}})");
+  EXPECT_EQ(not_unit.exit_code, 2);
+  EXPECT_NE(not_unit.err.find("rest_rotations.leg_joint_L_1: is not a unit quaternion"), std::string::npos) << not_unit.err;
+  // ossa-inspect --humanoid says the same before any cook.
+  const auto inspect = run_command(tool("ossa-inspect") + " " + q(r.cesium) + " --humanoid");
+  EXPECT_EQ(inspect.exit_code, 0);
+  EXPECT_NE(inspect.out.find("not retargetable"), std::string::npos) << inspect.out;
+  const auto mapped = run_command(tool("ossa-inspect") + " " + q(r.cesium) + " --humanoid --map " + q(cesium_map()));
+  EXPECT_NE(mapped.out.find("leftUpperArm             Skeleton_arm_joint_L__4_"), std::string::npos) << mapped.out;
+  EXPECT_NE(mapped.out.find("retargetable:"), std::string::npos) << mapped.out;
+}
+
+/// The live job on a cooked source clip, frame by frame, against the cooked retargeted clip.
+double live_against_cooked(const fs::path& source_rig, const fs::path& source_clip, const fs::path& target_rig,
+                           const fs::path& cooked) {
+  auto sa = ossa::Asset::open(source_rig.string()), sc = ossa::Asset::open(source_clip.string());
+  auto ta = ossa::Asset::open(target_rig.string()), tc = ossa::Asset::open(cooked.string());
+  EXPECT_TRUE(sa.ok() && sc.ok() && ta.ok() && tc.ok());
+  if (!sa.ok() || !sc.ok() || !ta.ok() || !tc.ok()) return 1e9;
+  struct RigData {
+    std::vector<std::string_view> names;
+    std::vector<ossa::Transform> bind;
+    ossa::RetargetRig rig;
+  };
+  auto rig_of = [](const ossa::SkeletonView& sk, RigData& d) {
+    for (size_t j = 0; j < sk.joint_count(); ++j) {
+      d.names.push_back(sk.joint_name(j));
+      const auto& t = sk.bind_translations()[j];
+      const auto& r = sk.bind_rotations()[j];
+      const auto& s = sk.bind_scales()[j];
+      d.bind.push_back({{t.x(), t.y(), t.z()}, glm::quat(r.w(), r.x(), r.y(), r.z()), {s.x(), s.y(), s.z()}});
+    }
+    d.rig.parents = sk.parents();
+    d.rig.bind = d.bind;
+    d.rig.names = d.names;
+    d.rig.humanoid = ossa::map_humanoid(sk);
+  };
+  RigData s, t;
+  rig_of(sa->skeleton(), s);
+  rig_of(ta->skeleton(), t);
+  auto map = ossa::make_retarget_map(s.rig, t.rig);
+  EXPECT_TRUE(map.ok());
+  if (!map.ok()) return 1e9;
+  ossa::RetargetScratch scratch = ossa::make_retarget_scratch(*map);
+  const ossa::ClipView source = sc->clip(0), target = tc->clip(0);
+  auto cache_s = ossa::make_sampling_cache(source, sa->skeleton());
+  auto cache_t = ossa::make_sampling_cache(target, ta->skeleton());
+  EXPECT_TRUE(cache_s.ok() && cache_t.ok());
+  const auto ns = static_cast<uint32_t>(s.names.size()), nt = static_cast<uint32_t>(t.names.size());
+  std::vector<ossa::Pose> frames;
+  for (uint32_t f = 0; f < source.frame_count(); ++f) {
+    frames.emplace_back(ns);
+    ossa::sample(source, static_cast<float>(f) / source.sample_rate(), {false}, *cache_s, frames.back());
+  }
+  // The cook's three passes, with the runtime's functions.
+  std::vector<ossa::ContactFrame> feet(frames.size());
+  for (size_t f = 0; f < frames.size(); ++f) {
+    ossa::pose_source(*map, frames[f], scratch);
+    feet[f] = ossa::contact_frame(*map, scratch);
+  }
+  ossa::RetargetInput in;
+  in.source_floor = ossa::clip_floor(*map, feet);
+  ossa::Pose live(nt), cooked_pose(nt);
+  for (size_t f = 0; f < frames.size(); ++f) {
+    in.source = frames[f];
+    ossa::retarget(*map, in, scratch, live);
+    feet[f].target_ankle = ossa::contact_frame(*map, scratch).target_ankle;
+  }
+  const auto contacts = ossa::find_foot_contacts(*map, feet, source.sample_rate(), in.source_floor);
+  std::array<ossa::FootContact, 2> held{};
+  in.contacts = held;
+  std::vector<glm::mat4> ml(nt), mc(nt);
+  double worst = 0.0;
+  for (size_t f = 0; f < frames.size(); ++f) {
+    ossa::foot_contacts_at(contacts, static_cast<float>(f), source.sample_rate(), ossa::ContactSettings{}.blend_time, held);
+    in.source = frames[f];
+    EXPECT_TRUE(ossa::retarget(*map, in, scratch, live));
+    ossa::sample(target, static_cast<float>(f) / target.sample_rate(), {false}, *cache_t, cooked_pose);
+    ossa::local_to_model(t.rig.parents, live, ml);
+    ossa::local_to_model(t.rig.parents, cooked_pose, mc);
+    for (uint32_t j = 0; j < nt; ++j) worst = std::max(worst, static_cast<double>(glm::length(glm::vec3(ml[j][3] - mc[j][3]))));
+  }
+  return worst * ta->file().metres_per_unit() * 1000.0;
+}
+
+TEST(RetargetCook, LiveJobEqualsTheCookedClip) {
+  if (!have_assets()) GTEST_SKIP() << "no ../shared/assets";
+  const Rigs r = rigs();
+  const std::string walk = q(shared("Pab/walk.fbx")) + " --skeleton " + q(r.pab) + " --no-clip-compression";
+  ASSERT_TRUE(cook(walk, "live-source"));
+  ASSERT_TRUE(cook(walk + " --retarget-to " + q(r.cowboy), "live-cooked"));
+  const double pab_mm = live_against_cooked(r.pab, cache() / "live-source" / "walk.ossa", r.cowboy,
+                                            cache() / "live-cooked" / "walk.ossa");
+  // A capture whose floor is not its rig's: the floor rides along.
+  const std::string cmu = q(shared("CMU_BVH/01_03.bvh")) + kCmuUnit + " --no-clip-compression";
+  ASSERT_TRUE(cook(cmu, "live-cmu-source"));
+  ASSERT_TRUE(cook(cmu + " --retarget-to " + q(r.pab), "live-cmu"));
+  const fs::path cmu_source = cache() / "live-cmu-source" / "01_03.ossa";
+  const double cmu_mm = live_against_cooked(cmu_source, cmu_source, r.pab, cache() / "live-cmu" / "01_03.ossa");
+  std::printf("live against cooked: Pab walk on the Cowboy %.5f mm, CMU 01_03 on Pab %.5f mm\n", pab_mm, cmu_mm);
+  EXPECT_LT(pab_mm, 0.1);
+  EXPECT_LT(cmu_mm, 0.1);
+}
+
+}  // namespace

@@ -1,0 +1,72 @@
+// map_file.h — the humanoid map file: which joint plays which profile bone when names do not say
+// (docs/RETARGET.md), read by ossa-cook (--map), ossa-inspect (--map) and ossa-view.
+//
+//   {
+//     "ossa_humanoid_map": 1,
+//     "source": { "bones": { "leftUpperArm": "arm_joint_L__4_", "leftToes": null },
+//                 "rest": "straighten" | "bind",
+//                 "rest_rotations": { "arm_joint_L__4_": [x, y, z, w] } },
+//     "target": { ... },
+//     "rig":    { ... }
+//   }
+//
+// "source" and "target" apply to the rig a retarget reads from / writes to; "rig" applies to any
+// rig that has every joint it names, so one file describing a character serves it in either role
+// (and ossa-inspect). "bones" sets (a joint name) or clears (null) bones over the automatic
+// mapping; "rest" picks how the retarget pose is made; "rest_rotations" sets joints' retarget-pose
+// local rotations (quaternions, x y z w) after that. Every mistake is an error naming the file and
+// the key: unknown keys, duplicate keys (nlohmann keeps the last silently; this reader refuses),
+// unknown bone names (with the closest one), joint names the rig lacks.
+//
+// Tool-side code (nlohmann::json); the runtime takes the result as plain data (HumanoidMap,
+// RestPose, RestRotation).
+#pragma once
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include <glm/gtc/quaternion.hpp>
+
+#include <ossa/format/result.h>
+#include <ossa/retarget/humanoid.h>
+#include <ossa/retarget/retarget.h>
+
+namespace ossa::tools {
+
+/// One rig's section of a map file.
+struct RigMapSpec {
+  std::vector<std::pair<HumanoidBone, std::string>> bones;  // bone -> joint name
+  std::vector<HumanoidBone> cleared;                         // bones set to null
+  std::optional<RestPose> rest;
+  std::vector<std::pair<std::string, glm::quat>> rest_rotations;
+};
+
+struct HumanoidMapFile {
+  std::optional<RigMapSpec> source, target, rig;
+};
+
+/// Parses a map file's text; `file` names it in errors.
+Result<HumanoidMapFile> parse_humanoid_map_file(std::string_view text, std::string_view file);
+
+/// Whether every joint the section names is among `names` (so a "rig" section fits this rig).
+bool rig_map_fits(const RigMapSpec& spec, std::span<const std::string_view> names);
+
+/// One rig ready for make_retarget_map's RetargetRig: the automatic mapping with the section's
+/// overrides, the rest mode and rotations. Errors name `label` (the file and section) and the joint.
+struct AppliedRigMap {
+  HumanoidMap humanoid;
+  RestPose rest = RestPose::Straighten;
+  std::vector<RestRotation> rest_rotations;
+};
+Result<AppliedRigMap> apply_rig_map(const RigMapSpec* spec, std::span<const std::string_view> names,
+                                    std::span<const int16_t> parents, std::string_view label);
+
+/// The section of `file` for a rig in a role ("source" or "target"): that role's section if the
+/// file has one, else "rig" when it fits the rig's names, else null.
+const RigMapSpec* section_for(const HumanoidMapFile& file, std::string_view role,
+                              std::span<const std::string_view> names);
+
+}  // namespace ossa::tools
