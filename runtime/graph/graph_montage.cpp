@@ -50,9 +50,10 @@ double section_end(const MontageInfo& mi, int k) {
 /// the links loop.
 double distance_to_end(const MontageInfo& mi, const MontagePlay& p) {
   if (p.at_end) return 0.0;
+  int k = p.next[p.section];
+  if (k == p.section) return kNever;  // the common loop, without walking it
   double d = section_end(mi, p.section) - p.position;
   const size_t sections = mi.section_start.size();
-  int k = p.next[p.section];
   for (size_t steps = 0; k >= 0; ++steps) {
     if (steps >= sections) return kNever;
     d += section_end(mi, k) - mi.section_start[static_cast<size_t>(k)];

@@ -16,7 +16,6 @@
 // history.
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 
 #include "graph/graph_internal.h"
 #include <ossa/anim/morph.h>
@@ -34,9 +33,10 @@ struct Entry {
 
 /// Copies the masked joints (ranges of joints) of `from` into `to`; the others keep their bits.
 void copy_ranges(const std::vector<std::pair<uint32_t, uint32_t>>& ranges, ConstPoseSpan from, PoseSpan to) {
-  for (uint32_t k = 0; k < kPoseComponents; ++k)
-    for (const auto& [first, last] : ranges)
-      std::memcpy(to[PoseComponent(k)] + first, from[PoseComponent(k)] + first, sizeof(float) * (last - first));
+  const size_t components = kPoseComponents * static_cast<size_t>(to.stride);
+  for (const auto& [first, last] : ranges)
+    for (size_t c = 0; c < components; c += to.stride)  // a plain loop: a memcpy call per run costs more
+      for (uint32_t j = first; j < last; ++j) to.base[c + j] = from.base[c + j];
 }
 
 /// Puts the entries' poses, at weight `now` or `before`, over `out` (and their morph weights over ow).
@@ -82,6 +82,29 @@ void combine(State& s, const SlotInfo& slot, const Entry* entries, uint32_t coun
   }
   if (!(acc > 0.0f)) return;
   const float t = std::min(acc, 1.0f);
+  if (masked && t >= 1.0f) {  // at full weight the masked joints are the montages' pose: no blend
+    const auto& ranges = d.slot_ranges[static_cast<size_t>(slot.mask)];
+    if (!slot.mesh_space) return copy_ranges(ranges, sum, out);
+    // In mesh space the mask roots take the montages' model rotation under the input's parents.
+    const LayerJoints& lj = d.slot_joints[static_cast<size_t>(slot.mask)];
+    const auto parents = d.skeleton.parents();
+    GraphScratch::Buffers& b = *s.scratch;
+    for (const uint16_t j : lj.chain) {
+      const int p = parents[j];
+      const glm::quat qb = rotation_at(out, j), ql = rotation_at(sum, j);
+      b.model_base[j] = p >= 0 ? b.model_base[static_cast<size_t>(p)] * qb : qb;
+      b.model_layer[j] = p >= 0 ? b.model_layer[static_cast<size_t>(p)] * ql : ql;
+    }
+    copy_ranges(ranges, sum, out);
+    for (size_t k = 0; k < lj.chain.size(); ++k) {
+      if (!lj.root[k]) continue;
+      const uint16_t j = lj.chain[k];
+      const int p = parents[j];
+      const glm::quat parent = p >= 0 ? b.model_base[static_cast<size_t>(p)] : glm::quat(1.0f, 0.0f, 0.0f, 0.0f);
+      set_rotation(out, j, glm::normalize(glm::conjugate(parent) * glm::normalize(b.model_layer[j])));
+    }
+    return;
+  }
   if (masked) {
     const std::vector<float>& mask = d.slot_masks[static_cast<size_t>(slot.mask)];
     if (slot.mesh_space) {
