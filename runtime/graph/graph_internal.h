@@ -272,6 +272,7 @@ struct GraphInstance::State {
   std::vector<MontageEvent> montage_events;       // capacity event_capacity
   size_t montage_events_old = 0;                  // events before this index are dropped by the next update
   uint64_t play_serial = 0;
+  bool montages_active = false;                   // some play is in use (else updates skip montages)
   MontageListener listener = nullptr;
   void* listener_user = nullptr;
   GraphInstance* self = nullptr;                  // handed to the listener

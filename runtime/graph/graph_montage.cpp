@@ -410,10 +410,13 @@ Status bind_montages(GraphDefinition::Impl& d, const std::string& where) {
 
 void advance_montages(State& s, float dt) {
   // The events of the update before last go; those host calls raised since the last one stay.
-  s.montage_events.erase(s.montage_events.begin(),
-                         s.montage_events.begin() + static_cast<std::ptrdiff_t>(std::min(s.montage_events_old, s.montage_events.size())));
-  s.montage_events_old = 0;
+  if (s.montage_events_old > 0) {
+    s.montage_events.erase(s.montage_events.begin(),
+                           s.montage_events.begin() + static_cast<std::ptrdiff_t>(std::min(s.montage_events_old, s.montage_events.size())));
+    s.montage_events_old = 0;
+  }
   s.root_motion = RootMotionDelta{};
+  if (!s.montages_active) return;  // nothing plays: a graph with montages costs this much per update
   for (MontagePlay& p : s.plays) {
     p.weight_before = p.weight;
     p.slot_weight = 0.0f;
@@ -425,13 +428,20 @@ void advance_montages(State& s, float dt) {
 }
 
 void finish_montages(State& s) {
-  for (MontagePlay& p : s.plays)
-    if (p.montage >= 0 && p.blending_out && !(p.weight > 0.0f)) end_play(s, p);
+  if (s.montages_active) {
+    bool any = false;
+    for (MontagePlay& p : s.plays) {
+      if (p.montage >= 0 && p.blending_out && !(p.weight > 0.0f)) end_play(s, p);
+      any |= p.montage >= 0;
+    }
+    s.montages_active = any;
+  }
   s.montage_events_old = s.montage_events.size();
 }
 
 void clear_montages(State& s) {
   for (MontagePlay& p : s.plays) p.montage = -1;
+  s.montages_active = false;
   for (MachineState& m : s.slot_inertia) {
     m.inertial = false;
     m.last_update = m.before_last_update = 0;
@@ -509,6 +519,7 @@ bool GraphInstance::play_montage(int montage, float rate, int start_section) {
   slot->next = links;
   slot->montage = montage;
   slot->serial = ++s.play_serial;
+  s.montages_active = true;
   slot->section = static_cast<uint16_t>(section);
   slot->position = mi.section_start[static_cast<size_t>(section)];
   slot->rate = rate * fm.rate();

@@ -16,6 +16,7 @@
 // history.
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 #include "graph/graph_internal.h"
 #include <ossa/anim/morph.h>
@@ -33,10 +34,9 @@ struct Entry {
 
 /// Copies the masked joints (ranges of joints) of `from` into `to`; the others keep their bits.
 void copy_ranges(const std::vector<std::pair<uint32_t, uint32_t>>& ranges, ConstPoseSpan from, PoseSpan to) {
-  const size_t components = kPoseComponents * static_cast<size_t>(to.stride);
-  for (const auto& [first, last] : ranges)
-    for (size_t c = 0; c < components; c += to.stride)  // a plain loop: a memcpy call per run costs more
-      for (uint32_t j = first; j < last; ++j) to.base[c + j] = from.base[c + j];
+  for (uint32_t k = 0; k < kPoseComponents; ++k)
+    for (const auto& [first, last] : ranges)
+      std::memcpy(to[PoseComponent(k)] + first, from[PoseComponent(k)] + first, sizeof(float) * (last - first));
 }
 
 /// Puts the entries' poses, at weight `now` or `before`, over `out` (and their morph weights over ow).
@@ -150,6 +150,8 @@ void evaluate_slot(State& s, uint16_t n, const Advance& advance, float weight, b
                    std::span<float> ow, uint32_t depth) {
   const GraphDefinition::Impl& d = *s.def;
   const SlotInfo& slot = d.slots[d.nodes[n].aux];
+  if (!s.montages_active && slot.inertia < 0)  // nothing plays and nothing to remember: the input as it is
+    return evaluate(s, slot.input, advance, weight, dominant, out, ow, depth);
   Entry entries[kMaxMontagePlays];
   uint32_t count = 0;
   float total = 0.0f, total_before = 0.0f, switch_time = 0.0f;
