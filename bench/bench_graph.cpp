@@ -21,6 +21,9 @@
 // Each row also says the CPU time per character and frame, all threads together (std::clock): on
 // a machine whose other jobs take the cores away, wall time says how long the frame took and CPU
 // time what the characters cost; 2 x 16,667 / cpu_us is what two threads of their own would fit.
+// A row plays the sample's upper-body montage (cross_arms, looping in its loop section) on every
+// character next to the same graph without it; `montage_cost_percent_of_frame` is how much of a
+// frame the montages take at the count that fits without them (characters without / with - 1).
 // The last line reads `characters_per_frame_2_threads: N`, N from 1000 characters on two threads
 // of the plain graph: how many characters fit in a 16.7 ms frame.
 #include <algorithm>
@@ -63,6 +66,7 @@ struct Params {
   std::vector<std::pair<int, float>> fixed;  // float parameters set once per character (procedural weights)
   int ground_left = -1, ground_right = -1;   // varied per character when >= 0 (uneven ground)
   int look = -1;                             // a look-at target moved every frame when >= 0
+  int montage = -1;                          // a montage every character plays (and keeps looping) when >= 0
 };
 
 void drive(Character& c, const Params& p, GraphScratch& scratch) {
@@ -94,6 +98,7 @@ std::vector<Character> make_characters(const GraphDefinition& def, const Params&
     }
     out[i].instance = std::make_unique<GraphInstance>(std::move(*inst));
     for (const auto& [param, value] : p.fixed) out[i].instance->set_float(param, value);
+    if (p.montage >= 0) out[i].instance->play_montage(p.montage);
     out[i].rng.seed(static_cast<uint32_t>(1000 + i));
     out[i].frame = static_cast<int>(i * 7 % 240);
     for (int pre = 0; pre < static_cast<int>(i % 90); ++pre) drive(out[i], p, scratch);  // pre-roll
@@ -259,6 +264,34 @@ int main(int argc, char** argv) {
         row(*def, p, "+ look-at (3-joint aim chain)", many, 2);
       }
     }
+  }
+  // The sample's upper-body montage (cross_arms: its loop section repeats until told) on every
+  // character, next to the same graph without it, both at the largest count on two threads. The
+  // two are timed in turn, repetition by repetition (best of each), so a neighbour's load falls on
+  // both alike.
+  if (const int montage = def->find_montage("cross_arms"); montage >= 0) {
+    Params with = plain;
+    with.montage = montage;
+    const int n = frames / 5;
+    double best[2] = {1e300, 1e300};
+    for (int rep = 0; rep < repeat; ++rep) {
+      for (int k = 0; k < 2; ++k) {
+        const Params& p = k == 0 ? plain : with;
+        std::vector<Character> chars = make_characters(*def, p, many);
+        time_frames(*def, chars, p, std::max(3, n / 10), 2);
+        best[k] = std::min(best[k], time_frames(*def, chars, p, n, 2));
+      }
+    }
+    double fit[2];
+    for (int k = 0; k < 2; ++k) {
+      const double per_char = best[k] / (static_cast<double>(n) * static_cast<double>(many));
+      fit[k] = kFrameMicros / per_char;
+      std::printf("%-40s %-11zu %-8u %14.3f %22.0f\n",
+                  k == 0 ? "locomotion, no montage (interleaved)" : "+ upper-body montage on every character", many,
+                  2u, per_char, fit[k]);
+    }
+    // What the montages take of a frame filled with characters that play none: with / without - 1.
+    std::printf("montage_cost_percent_of_frame: %.1f\n", 100.0 * (fit[0] / fit[1] - 1.0));
   }
   // A spring chain: the Fox sample's tail (3 joints, 3 colliders) at weight 0 and 1. At weight 0 the
   // chain still simulates (its state stays continuous), so the two rows cost the same.

@@ -1,5 +1,6 @@
 // graph_driver.cpp — see graph_driver.h.
 #include "viewer/graph_driver.h"
+#include "viewer/montage_control.h"
 
 #include <algorithm>
 
@@ -13,7 +14,6 @@
 namespace ossa::view {
 namespace {
 
-constexpr size_t kEventLog = 12;
 
 std::string graph_names(const Scene& scene) {
   std::string names;
@@ -179,16 +179,18 @@ Status set_graph_parameter(GraphDriver& driver, std::string_view name, std::stri
 }
 
 void update_graph(GraphDriver& driver, float dt) {
+  run_montage_commands(driver);
   for (GraphInstance& g : driver.instances) g.update(dt);
   driver.time += dt;
   if (driver.instances.empty()) return;
+  log_montage_events(driver);
   for (const GraphEvent& e : driver.instances.front().events()) {
     char line[160];
     std::snprintf(line, sizeof line, "%8.2f s  %.*s  (%.*s @ %.2f s)", driver.time, static_cast<int>(e.name.size()),
                   e.name.data(), static_cast<int>(driver.definition->clip(e.clip).name().size()),
                   driver.definition->clip(e.clip).name().data(), e.time);
     driver.recent_events.emplace_front(line);
-    if (driver.recent_events.size() > kEventLog) driver.recent_events.pop_back();
+    if (driver.recent_events.size() > kGraphEventLog) driver.recent_events.pop_back();
   }
 }
 

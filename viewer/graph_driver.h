@@ -24,6 +24,19 @@
 
 namespace ossa::view {
 
+/// Lines GraphDriver::recent_events keeps.
+inline constexpr size_t kGraphEventLog = 12;
+
+/// A montage call the viewer makes at a graph time (--montage, --montage-next, --montage-jump;
+/// montage_control.h): when the graph's time reaches `time`, before the update that passes it.
+struct MontageCommand {
+  enum class Kind { Play, Next, Jump } kind = Kind::Play;
+  double time = 0.0;
+  int montage = -1;
+  int section = -1, next = -1;  // Next: section's next becomes next (-1: the end); Jump: section
+  bool done = false;
+};
+
 struct GraphDriver {
   std::string name;
   size_t asset = 0;                                // Scene::assets index of the file holding it
@@ -35,6 +48,10 @@ struct GraphDriver {
   std::vector<int32_t> morph_map;
   /// What the procedural nodes read and move, for the overlays and the panel's ground controls.
   ProceduralInfo procedural;
+  /// Montages: calls waiting for their time, and the montage the panel and the timeline show
+  /// (the last one played; -1 before any).
+  std::vector<MontageCommand> montage_commands;
+  int shown_montage = -1;
 };
 
 /// Finds graph `name` in the scene's files and instantiates it `instances` times. Instance i > 0

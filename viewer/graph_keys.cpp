@@ -4,6 +4,7 @@
 #include <algorithm>
 
 #include "viewer/gl.h"
+#include "viewer/montage_control.h"
 
 namespace ossa::view {
 namespace {
@@ -43,6 +44,7 @@ bool graph_key(GraphDriver& graph, GraphKeys& keys, int key, int action) {
     if (action != GLFW_REPEAT) keys.walk = down;
     return true;
   }
+  if (key == GLFW_KEY_M && action == GLFW_PRESS) return toggle_montage(graph);
   if (key == GLFW_KEY_C && action == GLFW_PRESS) {
     const int arms = graph_parameter(graph, "crossed_arms");
     if (arms < 0 || graph.instances.empty()) return false;

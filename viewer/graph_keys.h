@@ -5,7 +5,8 @@
 // layering the crossarms clip over the upper body. Keys, when the graph has those parameters: W
 // held walks (speed eases to the blend space's slowest sample, the walk), Shift+W runs (its
 // fastest sample), releasing W eases speed to 0 (the sample graph then strikes its pose); C
-// toggles crossed_arms. The target speeds are read from the blend space driven by `speed`, not
+// toggles crossed_arms; M plays the graph's montage (the one shown, or its first) and, pressed while
+// it plays, lets it finish (montage_control.h toggle_montage). The target speeds are read from the blend space driven by `speed`, not
 // hard-coded (1.0 and 3.0 without one). Speed eases at 3 units/s, as a game's input smoothing
 // would, so the blend space and the transitions are visible. The keys take over `speed` only once
 // W has been pressed; the panel's slider hands it back.

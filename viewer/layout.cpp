@@ -7,6 +7,8 @@
 
 #include <imgui.h>
 
+#include "viewer/montage_panel.h"
+
 namespace ossa::view {
 
 SceneLayout compute_layout(int window_w, int window_h, int fb_w, int fb_h, float panel_width, float timeline_height) {
@@ -77,11 +79,13 @@ TimelineGrab timeline_grab(float x, bool in_handle_row, float loop_start_x, floa
 
 float timeline_height(const App& app, float ui_scale) {
   const Animator& a = app.animator;
-  if (app.scene.assets.empty() || a.playback.clip < 0 || (a.graph && a.use_graph)) return 0.0f;
+  if (!app.scene.assets.empty() && a.graph && a.use_graph) return montage_timeline_height(app, ui_scale);
+  if (app.scene.assets.empty() || a.playback.clip < 0) return 0.0f;
   return std::round(56.0f * ui_scale);
 }
 
 void timeline_panel(App& app, TimelineState& st, const Rect& strip, float ui_scale) {
+  if (app.animator.graph && app.animator.use_graph) return montage_timeline(app, strip, ui_scale);  // montages
   if (strip.height <= 0.0f || app.animator.playback.clip < 0) return;
   Playback& p = app.animator.playback;
   const ClipView clip = app.scene.clips[static_cast<size_t>(p.clip)].clip;

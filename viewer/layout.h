@@ -95,11 +95,13 @@ struct TimelineState {
   bool was_playing = false;     // playback is paused while the playhead is dragged
 };
 
-/// The strip's height in window units for the UI scale, or 0 when no clip is shown (no clip
-/// selected, or a graph drives the character).
+/// The strip's height in window units for the UI scale, or 0 when nothing is shown (no clip
+/// selected; or a graph without montages drives the character, whose montages are shown otherwise:
+/// montage_panel.h).
 float timeline_height(const App& app, float ui_scale);
 
-/// Draws the timeline into `strip` and applies the user's drags to app's playback.
+/// Draws the timeline into `strip` and applies the user's drags to app's playback (a graph driving
+/// the character: its montage timeline, montage_panel.h).
 void timeline_panel(App& app, TimelineState& state, const Rect& strip, float ui_scale);
 
 }  // namespace ossa::view

@@ -69,6 +69,19 @@ ParsedOptions parse_options(int argc, const char* const* argv) {
   app.add_flag("--show-procedural", o.show_procedural,
                "draw the procedural overlays (targets, ground under the feet, springs) in headless images too")
       ->needs("--graph");
+  app.add_option("--montage", o.montage, "play the graph's montage NAME when the graph's time reaches T (default 0); repeatable")
+      ->type_name("NAME[@T]")
+      ->needs("--graph")
+      ->allow_extra_args(false);
+  app.add_option("--montage-next", o.montage_next,
+                 "at graph time T, link the last --montage's SECTION to NEXT (NEXT empty: the end); repeatable")
+      ->type_name("SECTION=NEXT[@T]")
+      ->needs("--montage")
+      ->allow_extra_args(false);
+  app.add_option("--montage-jump", o.montage_jump, "at graph time T, jump the last --montage to SECTION; repeatable")
+      ->type_name("SECTION[@T]")
+      ->needs("--montage")
+      ->allow_extra_args(false);
   std::vector<std::string> morphs;
   app.add_option("--morph", morphs, "hold the morph targets named NAME at WEIGHT (clips no longer drive them); repeatable")
       ->type_name("NAME=WEIGHT")

@@ -4,7 +4,8 @@
 //             [--bind-pose] [--cpu-skinning] [--crowd N] [--wireframe] [--skeleton] [--no-grid]
 //             [--yaw DEG] [--pitch DEG] [--size WxH] [--msaa N]
 //             [--frames N] [--screenshot OUT.png] [--first-frame-time] [--stats]
-//             [--window-frames N] [--graph NAME [--set|--param PARAM=VALUE ...] [--show-procedural]]
+//             [--window-frames N] [--graph NAME [--set|--param PARAM=VALUE ...] [--show-procedural]
+//              [--montage NAME[@T] [--montage-next SECTION=NEXT[@T]] [--montage-jump SECTION[@T]]]]
 //             [--morph NAME=WEIGHT ...]
 //             [--panel open|collapsed] [--ui-scale S] [--browse DIR] [--cook-and-open SOURCE ...]
 //             [-q | -v] [--version] [--help]
@@ -20,6 +21,9 @@
 // draws the procedural nodes' overlays in headless images too: IK / aim targets, the ground
 // under each placed foot, spring chains and colliders (procedural_draw.h). A graph cannot
 // seek, so headless --time T plays T seconds of the graph in 1/60 s steps before the N frames.
+// --montage NAME@T plays the graph's montage NAME (format v9) once the graph has played T seconds
+// (default 0); --montage-next SECTION=NEXT@T and --montage-jump SECTION@T change its section links
+// or jump at their times (montage_control.h), so a headless image can show a montage at any point.
 // --morph NAME=WEIGHT holds a morph target channel (every target of that name) at WEIGHT, as the
 // panel's slider does: clips no longer drive it; repeatable; a name the character lacks is an
 // error listing the names it has.
@@ -74,6 +78,9 @@ struct ViewerOptions {
   std::string graph;            // drive the character with this graph
   std::vector<std::string> set; // graph parameter start values, "name=value" (or "trigger"; a vector "name=x,y,z")
   bool show_procedural = false; // headless: draw the procedural overlays (the window shows them by default)
+  std::vector<std::string> montage;       // --montage NAME[@T]: montages played at graph times
+  std::vector<std::string> montage_next;  // --montage-next SECTION=NEXT[@T]
+  std::vector<std::string> montage_jump;  // --montage-jump SECTION[@T]
   std::vector<std::pair<std::string, float>> morphs;  // --morph: channels held at a weight
   bool panel_collapsed = false; // --panel collapsed: the window starts with the panel hidden
   float ui_scale = 0.0f;        // --ui-scale: panel size factor (0: from the monitor's content scale)

@@ -1,6 +1,8 @@
 // setup.cpp — see setup.h.
 #include "viewer/setup.h"
 
+#include "viewer/montage_control.h"
+
 #include <cstdio>
 #include <utility>
 
@@ -51,6 +53,8 @@ Status setup_app(App& app, Scene scene, const ViewerOptions& o, float aspect) {
       const std::string value = eq == std::string::npos ? "1" : assignment.substr(eq + 1);
       if (Status s = set_graph_parameter(*app.animator.graph, parameter, value); !s) return Error{name + ": " + s.message()};
     }
+    if (Status s = add_montage_commands(*app.animator.graph, o.montage, o.montage_next, o.montage_jump); !s)
+      return Error{name + ": " + s.message()};
   }
   for (const auto& [morph, weight] : o.morphs) {
     const int c = find_morph_channel(app.scene, morph);

@@ -10,6 +10,8 @@
 
 #include <imgui.h>
 
+#include "viewer/montage_panel.h"
+
 namespace ossa::view {
 namespace {
 
@@ -240,8 +242,9 @@ void graph_panel(App& app, UiState& ui) {
   graph_parameters(*a.graph, ui);
   procedural_panel(app);
   ImGui::PushStyleColor(ImGuiCol_Text, ImGui::GetStyleColorVec4(ImGuiCol_TextDisabled));
-  ImGui::TextWrapped("keys: W walk, Shift+W run (release to stop), C crossed arms");
+  ImGui::TextWrapped("keys: W walk, Shift+W run (release to stop), C crossed arms, M montage");
   ImGui::PopStyleColor();
+  montage_panel(*a.graph);
   graph_status(*a.graph);
 }
 

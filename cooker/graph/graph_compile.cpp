@@ -14,6 +14,7 @@
 
 #include "cooker/clip/clip_events.h"
 #include "cooker/graph/graph_condition.h"
+#include "cooker/graph/graph_montage.h"
 #include "cooker/json/json_check.h"
 #include <ossa/anim/blend_space.h>
 #include <ossa/loader/validate.h>
@@ -31,7 +32,7 @@ constexpr double kFloatMax = 3.4e38;      // Parameter.min_value / max_value def
 constexpr double kIntLimit = 16777216.0;  // ints are held as floats: exact up to 2^24
 const std::vector<std::string_view> kNodeKinds = {
     "clip",  "blend",      "select",         "layered",   "blend_space", "additive", "state_machine", "morph",
-    "use",   "two_bone_ik", "aim",           "foot_placement", "foot_lock", "spring"};
+    "use",   "two_bone_ik", "aim",           "foot_placement", "foot_lock", "spring", "slot"};
 constexpr double kDegrees = 3.14159265358979323846 / 180.0;
 // The loader's bounds (runtime/loader/validate_graph.cpp). A value past one compiled into a file
 // that failed verification ("internal error, cooked bytes fail verification"): each is refused
@@ -63,7 +64,8 @@ std::string number_text(double v) {
 /// compile_graph, so both report the same problems).
 void read_manifest(Checker& check, const Value& root, GraphManifest& out) {
   if (!check.expect(root, Type::Object, "a graph file")) return;
-  check.expect_keys(root, {"ossa_graph", "name", "skeleton", "meshes", "clips", "parameters", "nodes", "root"},
+  check.expect_keys(root, {"ossa_graph", "name", "skeleton", "meshes", "clips", "parameters", "nodes", "root",
+                           "montages"},
                     "a graph file");
   const Value* version = root.find("ossa_graph");
   if (!version) {
@@ -130,6 +132,7 @@ void read_manifest(Checker& check, const Value& root, GraphManifest& out) {
 class GraphCompiler {
  public:
   GraphCompiler(const json::Document& doc, const GraphContext& context) : check_(doc), ctx_(context) {}
+  GraphCompiler(const GraphCompiler&) = delete;  // montage_ points into this object
 
   Result<CompiledGraph> run() {
     const Value& root = check_.doc().root;
@@ -147,6 +150,8 @@ class GraphCompiler {
     if (!root_node) check_.error(root.pos, "a graph needs a \"root\" node");
     else index = node(*root_node, "");
     if (index >= 0) g_.root = static_cast<uint16_t>(index);
+    montage_.montages(root.find("montages"));  // after the root: tracks name its slots
+    montage_.check_slot_placement();
     check_unused();
     if (!check_.ok()) return Error{check_.message()};
 
@@ -184,6 +189,12 @@ class GraphCompiler {
   bool checking_unused_ = false;  // the node limit then only bounds the work, it is no error
   uint32_t depth_ = 0;            // node() frames on the path, uses included (bounds the recursion)
   uint32_t output_depth_ = 0;     // nodes on the path that are written (uses excluded)
+  MontageCompiler montage_{check_, g_, clip_duration_,
+                           [this](const Value& v, const std::string& role) { return clip(v, role); },
+                           [this](const Value& v, const std::string& role) { return joint(v, role); },
+                           [this](const Value& v, const std::string& name) { return node(v, name); },
+                           {},
+                           true};
 
   void warn(Pos pos, const std::string& what) { warnings_.push_back(json::where(check_.doc().file, pos) + what); }
 
@@ -468,6 +479,7 @@ class GraphCompiler {
       visits_ = 0;
       too_many_ = false;
       checking_unused_ = true;
+      montage_.collecting = false;
       use_stack_ = {n.member->key};
       ++n.uses;
       (void)node(n.member->value, n.member->key);
@@ -505,11 +517,11 @@ class GraphCompiler {
     if (!kind) {
       if (check_.expect_keys(
               v, {"clip", "blend", "select", "layered", "blend_space", "additive", "state_machine", "morph", "use",
-                  "two_bone_ik", "aim", "foot_placement", "foot_lock", "spring", "name"},
+                  "two_bone_ik", "aim", "foot_placement", "foot_lock", "spring", "slot", "name"},
               "a node"))
         check_.error(v.pos,
                      "a node needs one of the keys clip, blend, select, layered, blend_space, additive, "
-                     "state_machine, morph, two_bone_ik, aim, foot_placement, foot_lock, spring, use");
+                     "state_machine, morph, two_bone_ik, aim, foot_placement, foot_lock, spring, slot, use");
       return -1;
     }
     // Every node but a use (which stands for the node it copies) becomes one output node.
@@ -555,6 +567,7 @@ class GraphCompiler {
     else if (k == "foot_placement") index = foot_node(v, name, false);
     else if (k == "foot_lock") index = foot_node(v, name, true);
     else if (k == "spring") index = spring_node(v, name);
+    else if (k == "slot") index = montage_.slot_node(v, name);
     else index = use_node(v, name, v.find("name") != nullptr);
     --depth_;
     output_depth_ -= output ? 1 : 0;

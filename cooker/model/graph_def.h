@@ -160,9 +160,18 @@ struct SpringDef {
   int16_t weight_parameter = -1;
 };
 
+// Montages and the slots they play on (format v9): graph_montage.h compiles them.
+struct SlotDef {
+  uint16_t input = 0;
+  std::string slot, group;
+  std::vector<MaskEntryDef> mask;  // empty: every joint
+  bool additive = false;
+  bool mesh_space_rotation = false;
+};
+
 using NodeKind = std::variant<ClipNodeDef, BlendAlphaDef, SelectDef, LayeredDef, BlendSpaceDef, AdditiveDef,
                               StateMachineRefDef, MorphWeightsDef, TwoBoneIkDef, AimDef, FootPlacementDef,
-                              FootLockDef, SpringDef>;
+                              FootLockDef, SpringDef, SlotDef>;
 
 struct NodeDef {
   std::string name;
@@ -192,6 +201,41 @@ struct StateMachineDef {
   std::vector<TransitionDef> transitions;  // priority order
 };
 
+/// Same numbering as fb::MontageCurve / fb::MontageNotifyKind.
+enum class MontageCurveDef : uint8_t { Linear = 0, Cubic = 1, Inertialize = 2 };
+enum class MontageNotifyKindDef : uint8_t { Instant = 0, Window = 1, BranchingPoint = 2 };
+
+struct MontageSegmentDef {
+  uint16_t clip = 0;
+  float start = 0.0f, end = 0.0f;  // clip seconds
+  float rate = 1.0f;
+};
+struct MontageTrackDef {
+  std::string slot;
+  std::vector<MontageSegmentDef> segments;
+};
+struct MontageSectionDef {
+  std::string name;
+  float start = 0.0f;  // timeline seconds
+  int16_t next = -1;   // -1: the montage ends after it
+};
+struct MontageNotifyDef {
+  std::string name;
+  float time = 0.0f, duration = 0.0f;
+  MontageNotifyKindDef kind = MontageNotifyKindDef::Instant;
+};
+struct MontageDef {
+  std::string name, group;
+  std::vector<MontageTrackDef> tracks;
+  std::vector<MontageSectionDef> sections;  // by start time
+  std::vector<MontageNotifyDef> notifies;   // by time
+  float rate = 1.0f;
+  float blend_in = 0.0f, blend_out = 0.0f;
+  MontageCurveDef blend_in_curve = MontageCurveDef::Linear, blend_out_curve = MontageCurveDef::Linear;
+  float blend_out_trigger = -1.0f;
+  bool root_motion = false;
+};
+
 struct GraphDef {
   std::string name;
   uint64_t skeleton_hash = 0;
@@ -201,6 +245,7 @@ struct GraphDef {
   std::vector<NodeDef> nodes;  // children first
   std::vector<StateMachineDef> machines;
   uint16_t root = 0;
+  std::vector<MontageDef> montages;  // format v9
 };
 
 }  // namespace ossa::cook

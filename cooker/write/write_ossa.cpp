@@ -10,6 +10,7 @@
 // force_align on vectors in the schema but generates nothing for it. The builder raises its minimum alignment to 16 with it, and
 // Finish pads the whole buffer to that, so "aligned from the end" is also "aligned from the start".
 #include "cooker/write/write_ossa.h"
+#include "cooker/write/write_montage.h"
 
 #include <flatbuffers/flatbuffers.h>
 
@@ -262,6 +263,9 @@ Offset<fb::Node> write_node(FlatBufferBuilder& fbb, const NodeDef& node) {
     data = fb::CreateSpringNode(fbb, sp->input, chains_v, colliders_v, sp->step, sp->teleport_distance, sp->weight,
                                 sp->weight_parameter)
                .Union();
+  } else if (const auto* slot = std::get_if<SlotDef>(&node.kind)) {
+    type = fb::NodeData::SlotNode;
+    data = write_slot_node(fbb, *slot).Union();
   }
   return fb::CreateNode(fbb, name, type, data);
 }
@@ -308,8 +312,9 @@ Offset<fb::Graph> write_graph(FlatBufferBuilder& fbb, const GraphDef& graph) {
   std::vector<Offset<fb::StateMachine>> machines;
   for (const StateMachineDef& machine : graph.machines) machines.push_back(write_machine(fbb, machine));
   const auto machines_v = fbb.CreateVector(machines);
+  const auto montages_v = write_montages(fbb, graph.montages);
   return fb::CreateGraph(fbb, name, graph.skeleton_hash, graph.joint_count, parameters_v, clips_v, nodes_v,
-                         machines_v, graph.root);
+                         machines_v, graph.root, montages_v);
 }
 
 /// `written` holds the Texture table of every texture written so far, in the scene's order

@@ -106,6 +106,10 @@ uint32_t scratch_needed(const GraphDefinition::Impl& def, uint16_t n) {
     case Kind::FootLock:
     case Kind::Spring:
       return scratch_needed(def, procedural_input(info));
+    case Kind::Slot: {  // the montages' pose and one more, plus the pose before a switch when inertialized
+      const SlotInfo& slot = def.slots[info.aux];
+      return std::max(scratch_needed(def, slot.input), slot.inertia >= 0 ? 3u : 2u);
+    }
   }
   return 0;
 }
@@ -169,6 +173,8 @@ void mark_driven_channels(const GraphDefinition::Impl& d, uint16_t n, std::vecto
     case Kind::FootLock:
     case Kind::Spring:
       return mark_driven_channels(d, procedural_input(info), mask);
+    case Kind::Slot:
+      return mark_driven_channels(d, d.slots[info.aux].input, mask);
   }
 }
 
@@ -412,6 +418,10 @@ Result<GraphDefinition> GraphDefinition::create(const Asset& asset, std::string_
         d.procedural = true;
         break;
       }
+      case fb::NodeData::SlotNode:  // decoded with the montages (bind_montages)
+        info.kind = Kind::Slot;
+        info.table = node.data_as_SlotNode();
+        break;
       default:
         return Error{where + ": node " + std::to_string(i) + " has no kind"};  // validation forbids it
     }
@@ -453,6 +463,8 @@ Result<GraphDefinition> GraphDefinition::create(const Asset& asset, std::string_
       }
     }
   }
+
+  if (Status st = bind_montages(d, where); !st) return Error{st.message()};  // slots first: mark_driven_channels
 
   // Each layer's morph mask: the channels some clip under it has a track for.
   for (size_t i = 0; i < d.nodes.size(); ++i) {

@@ -269,6 +269,8 @@ glm::quat nlerp(const glm::quat& a, glm::quat b, float t) {
   return glm::normalize(a * (1.0f - t) + b * t);
 }
 
+}  // namespace
+
 /// A layer whose rotations blend in model space at the mask roots: the masked subtree is blended
 /// locally (vectorized, like any layer), then each mask root gets the local rotation that puts its
 /// model rotation at nlerp(base model, layer model, w) under its unmasked parent. At full weight
@@ -298,6 +300,8 @@ void blend_mesh_space(State& s, const LayerJoints& lj, std::span<const float> ma
     set_rotation(out, j, glm::normalize(glm::conjugate(parent) * model));
   }
 }
+
+namespace {
 
 void evaluate_layered(State& s, const NodeInfo& info, const Advance& advance, float weight, bool dominant,
                       PoseSpan out, std::span<float> ow, uint32_t depth) {
@@ -400,6 +404,8 @@ void evaluate(State& s, uint16_t n, const Advance& advance, float weight, bool d
     case Kind::FootLock:
     case Kind::Spring:
       return evaluate_procedural(s, n, advance, weight, dominant, out, ow, depth);
+    case Kind::Slot:
+      return evaluate_slot(s, n, advance, weight, dominant, out, ow, depth);
   }
 }
 
@@ -456,6 +462,8 @@ void restart(State& s, uint16_t n) {
     case Kind::FootLock:
     case Kind::Spring:
       return restart_procedural(s, n);
+    case Kind::Slot:
+      return restart(s, s.def->slots[info.aux].input);
   }
 }
 
@@ -502,6 +510,8 @@ Cycle cycle(const State& s, uint16_t n) {
     case Kind::FootLock:
     case Kind::Spring:
       return cycle(s, procedural_input(info));
+    case Kind::Slot:
+      return cycle(s, s.def->slots[info.aux].input);
   }
   return {};
 }
@@ -550,6 +560,8 @@ void set_phase(State& s, uint16_t n, float p) {
     case Kind::FootLock:
     case Kind::Spring:
       return set_phase(s, procedural_input(info), p);
+    case Kind::Slot:
+      return set_phase(s, s.def->slots[info.aux].input, p);
   }
 }
 

@@ -118,6 +118,24 @@ Result<GraphInstance> GraphInstance::create(const GraphDefinition& definition, s
   s->springs = d.springs;  // each instance its own chain state, copied from the checked prototypes
   s->event_capacity = event_capacity;
   s->events.reserve(event_capacity);
+  if (!d.montages.empty()) {  // montages: fixed plays, their section links, a cache per montage clip
+    s->plays.resize(kMaxMontagePlays);
+    s->montage_links.assign(size_t{kMaxMontagePlays} * d.max_sections, -1);
+    for (size_t k = 0; k < s->plays.size(); ++k) s->plays[k].next = s->montage_links.data() + k * d.max_sections;
+    for (uint16_t clip : d.montage_cache_clips) {
+      auto cache = make_sampling_cache(d.clips[clip], d.skeleton, &d.prototypes[clip]);
+      if (!cache) return cache.error();
+      s->montage_caches.push_back(std::move(*cache));
+    }
+    s->montage_events.reserve(event_capacity);
+  }
+  s->slot_inertia.resize(d.inertial_slots);
+  for (MachineState& m : s->slot_inertia) {
+    m.translation.resize(d.joints);
+    m.rotation.resize(d.joints);
+    m.last = Pose(d.joints);
+    m.before_last = Pose(d.joints);
+  }
   GraphInstance instance(std::move(s));
   instance.reset();
   return instance;
@@ -214,6 +232,7 @@ void GraphInstance::reset() {
     s.vectors[i] = v ? glm::vec3(v->x(), v->y(), v->z()) : glm::vec3(0.0f);
   }
   for (size_t m = 0; m < s.machines.size(); ++m) restart_machine(s, static_cast<uint16_t>(m));
+  clear_montages(s);
   restart(s, s.def->graph->root());
   std::fill(s.node_weights.begin(), s.node_weights.end(), 0.0f);
   s.events.clear();
@@ -238,6 +257,8 @@ void GraphInstance::update(float dt, GraphScratch::Buffers& buffers) {
   s.events.clear();
   s.dropped = 0;
   ++s.update_counter;
+  s.self = this;
+  if (!s.plays.empty()) advance_montages(s, dt);
   std::fill(s.node_weights.begin(), s.node_weights.end(), 0.0f);
   Advance advance;
   advance.dt = dt;
@@ -245,6 +266,7 @@ void GraphInstance::update(float dt, GraphScratch::Buffers& buffers) {
   PoseSpan root = buffers.poses[0].span();
   const std::span<float> root_weights = buffers.weights[0];
   evaluate(s, s.def->graph->root(), advance, 1.0f, true, root, root_weights, 1);
+  if (!s.plays.empty()) finish_montages(s);
   stream_pose(root, s.output);
   std::copy(root_weights.begin(), root_weights.end(), s.morph.begin());
 #if defined(__SSE2__)

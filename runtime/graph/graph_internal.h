@@ -25,6 +25,7 @@ namespace ossa::graph_detail {
 enum class Kind : uint8_t {
   Clip, BlendAlpha, Select, Layered, BlendSpace, Additive, Machine, Morph,
   TwoBoneIk, Aim, FootPlacement, FootLock, Spring,  // procedural: graph_procedural.cpp
+  Slot,                                             // montages: graph_slot.cpp
 };
 
 struct NodeInfo {
@@ -33,6 +34,7 @@ struct NodeInfo {
   uint32_t floats = 0;          // offset of this node's variable state in State::floats
   uint32_t caches = 0;          // first sampling cache (clip: 1, blend space: one per sample)
   uint32_t aux = 0;             // layered: first mask (Impl::masks); blend space: 2D space index;
+                                // slot: its SlotInfo (Impl::slots);
                                 // morph: first drive channel (Impl::drive_channels);
                                 // spring: first chain (State::springs), foot lock: first leg's
                                 // events (Impl::leg_events)
@@ -56,6 +58,48 @@ struct MachineInfo {
   const fb::StateMachine* fb = nullptr;
   uint16_t node = 0;                          // the StateMachineNode that plays it
   std::vector<TransitionInfo> transitions;    // priority order
+};
+
+/// A slot node, decoded (graph_slot.cpp).
+struct SlotInfo {
+  uint16_t input = 0;
+  uint16_t slot = 0;       // index into Impl::slot_names
+  uint16_t group = 0;      // index into Impl::groups
+  int32_t mask = -1;       // index into Impl::slot_masks / slot_joints; -1: every joint
+  int32_t inertia = -1;    // index into State::slot_inertia; -1: no montage of its group inertializes
+  bool additive = false, mesh_space = false;
+};
+
+/// A montage segment placed on its montage's timeline (graph_montage.cpp).
+struct SegmentInfo {
+  uint16_t clip = 0;
+  uint32_t cache = 0;                     // index into State::montage_caches
+  float clip_start = 0.0f, clip_end = 0.0f, rate = 1.0f;
+  double begin = 0.0, end = 0.0;          // timeline seconds
+};
+struct TrackInfo {
+  uint16_t slot = 0;                      // index into Impl::slot_names
+  uint32_t first_segment = 0, segment_count = 0;
+  double length = 0.0;
+};
+/// A point where something happens on a montage's timeline: a notify, a window's begin or end, a
+/// branching point. Sorted by time, ends before instants before branches before begins at one time.
+enum class MarkerType : uint8_t { End = 0, Instant = 1, Branch = 2, Begin = 3 };
+struct Marker {
+  double time = 0.0;
+  uint16_t notify = 0;                    // index into the montage's notifies
+  MarkerType type = MarkerType::Instant;
+  uint8_t window = 0;                     // Begin / End: the window's bit in MontagePlay::open
+};
+struct MontageInfo {
+  const fb::Montage* fb = nullptr;
+  uint16_t group = 0;
+  double length = 0.0;                    // the longest track
+  uint32_t first_track = 0, track_count = 0;
+  uint32_t first_marker = 0, marker_count = 0;
+  std::vector<double> section_start;      // per section; section k ends where k + 1 starts (the last: length)
+  std::vector<uint16_t> windows;          // per window bit: its notify
+  bool inertial = false;                  // a blend curve is Inertialize
 };
 
 /// Per-layer joint data for a mesh-space rotation blend: the mask roots (masked joints whose parent
@@ -104,6 +148,23 @@ struct GraphDefinition::Impl {
   std::vector<std::vector<SpringCollider>> colliders; // per spring node, indexed by NodeInfo::samples
   std::vector<std::string_view> leg_events;           // per foot lock leg: plant, lift ("" none)
   bool procedural = false;                            // any procedural node: model matrices needed
+  // Montages and slots (format v9).
+  std::vector<graph_detail::SlotInfo> slots;          // per slot node, indexed by NodeInfo::aux
+  std::vector<std::vector<float>> slot_masks;
+  std::vector<graph_detail::LayerJoints> slot_joints; // parallel to slot_masks
+  /// Parallel to slot_masks: the masked joints as ranges [first, last) (a subtree is contiguous in
+  /// depth-first order), so a slot writes exactly those and leaves every other joint's bits alone.
+  std::vector<std::vector<std::pair<uint32_t, uint32_t>>> slot_ranges;
+  std::vector<std::string_view> slot_names, groups;   // distinct names
+  std::vector<graph_detail::MontageInfo> montages;
+  std::vector<graph_detail::TrackInfo> tracks;
+  std::vector<graph_detail::SegmentInfo> segments;
+  std::vector<graph_detail::Marker> markers;
+  std::vector<uint16_t> montage_cache_clips;          // per montage sampling cache: its clip
+  std::vector<Pose> track_reference;                  // per track: its first frame (additive slots)
+  Pose identity;                                      // every joint at identity (masked additives)
+  uint32_t max_sections = 0;                          // sections of the largest montage
+  uint32_t inertial_slots = 0;                        // slots with an inertialization state
 };
 
 namespace graph_detail {
@@ -152,6 +213,34 @@ struct GraphScratch::Buffers {
                                       // built it; null when partly stale)
 };
 
+namespace graph_detail {
+
+/// Montage plays per character: the playing montage of each group and those still blending out.
+inline constexpr uint32_t kMaxMontagePlays = 8;
+
+/// One montage being played (graph_montage.cpp).
+struct MontagePlay {
+  int32_t montage = -1;          // -1: free
+  uint64_t serial = 0;           // play order (later plays are blended over earlier ones)
+  uint32_t revision = 0;         // bumped by jumps, so an advance notices a listener's jump
+  uint16_t section = 0;
+  double position = 0.0;         // timeline seconds
+  float rate = 1.0f;             // the host's rate times the montage's
+  float weight = 0.0f, weight_before = 0.0f;  // now, and at the start of the update
+  float blend_from = 0.0f, blend_to = 1.0f, blend_time = 0.0f;
+  double blend_elapsed = 0.0;    // seconds (double: a blend's end lands on the frame it should, not one later)
+  fb::MontageCurve curve = fb::MontageCurve::Linear;
+  bool blend_fresh = false;      // the blend began inside this update with blend_elapsed already set
+  bool blending_out = false, interrupted = false, at_end = false, ended = false;
+  uint64_t open = 0;             // open window notifies (bit per window)
+  uint64_t switch_update = 0;    // the update in which an inertialized blend switched it (0: none)
+  float switch_time = 0.0f;      // that blend's time
+  float slot_weight = 0.0f;      // the most weight a slot applied it with in the last update
+  int16_t* next = nullptr;       // per section: the section after it (State::montage_links)
+};
+
+}  // namespace graph_detail
+
 struct GraphInstance::State {
   const GraphDefinition::Impl* def = nullptr;
   const GraphDefinition* owner = nullptr;
@@ -175,6 +264,20 @@ struct GraphInstance::State {
   glm::mat4 transform{1.0f};        // model to world, set by the host (set_transform)
   glm::mat4 inverse_transform{1.0f};
   std::vector<SpringChain> springs; // every spring node's chains' state
+  // Montages (graph_montage.cpp), last for the same reason: a graph without them reads none of it.
+  std::vector<graph_detail::MontagePlay> plays;   // kMaxMontagePlays when the graph has montages
+  std::vector<int16_t> montage_links;             // plays * max_sections
+  std::vector<SamplingCache> montage_caches;
+  std::vector<graph_detail::MachineState> slot_inertia;  // inertialized montage switches per slot
+  std::vector<MontageEvent> montage_events;       // capacity event_capacity
+  size_t montage_events_old = 0;                  // events before this index are dropped by the next update
+  uint64_t play_serial = 0;
+  bool montages_active = false;                   // some play is in use (else updates skip montages)
+  MontageListener listener = nullptr;
+  void* listener_user = nullptr;
+  GraphInstance* self = nullptr;                  // handed to the listener
+  RootMotionDelta root_motion;                    // the last update's, from root-motion montages
+  glm::vec3 root_motion_up{0.0f, 1.0f, 0.0f};
 };
 
 namespace graph_detail {
@@ -211,6 +314,33 @@ void evaluate_procedural(GraphInstance::State& s, uint16_t n, const Advance& adv
 uint16_t procedural_input(const NodeInfo& info);
 /// Back to the animated pose: foot locks released, spring chains restarted at the next update.
 void restart_procedural(GraphInstance::State& s, uint16_t n);
+
+/// Slot node (graph_slot.cpp) and montage playback (graph_montage.cpp).
+void evaluate_slot(GraphInstance::State& s, uint16_t n, const Advance& advance, float weight, bool dominant,
+                   PoseSpan out, std::span<float> ow, uint32_t depth);
+/// Decodes the slot nodes and montages of a definition (tracks, segments, markers, masks, reference
+/// poses); errors name the montage (a segment past its clip's end, a clip bound to no sampler).
+Status bind_montages(GraphDefinition::Impl& d, const std::string& where);
+/// Advances every playing montage by dt: blend weights, positions, sections, notifies, root motion.
+void advance_montages(GraphInstance::State& s, float dt);
+/// After the graph is evaluated: montages blended out are ended and their plays freed.
+void finish_montages(GraphInstance::State& s);
+/// Back to no montage playing (reset()): plays freed without events.
+void clear_montages(GraphInstance::State& s);
+/// Samples a montage track at timeline `position` into out; *clip and *time say what was sampled.
+void sample_track(GraphInstance::State& s, const TrackInfo& track, double position, PoseSpan out, uint16_t* clip,
+                  float* time);
+/// The montage's track for slot `slot`, or null.
+const TrackInfo* track_for(const GraphDefinition::Impl& d, const MontageInfo& m, uint16_t slot);
+
+/// A mesh-space rotation blend of a layer over `out` on a mask (graph_eval.cpp).
+void blend_mesh_space(GraphInstance::State& s, const LayerJoints& lj, std::span<const float> mask, float w,
+                      ConstPoseSpan layer, PoseSpan out);
+
+/// Inertialization pieces shared by the machine and the slot (graph_machine.cpp).
+void init_channel(InertialChannel& c, const glm::vec3& offset, const glm::vec3& velocity, float duration);
+glm::vec3 rotation_vector(glm::quat q);
+void apply_offset(const GraphInstance::State& s, const MachineState& m, PoseSpan out);
 
 /// State machine node (graph_machine.cpp).
 void evaluate_machine(GraphInstance::State& s, uint16_t n, const Advance& advance, float weight, bool dominant,

@@ -82,6 +82,8 @@ void enter_state(State& s, MachineState& m, const MachineInfo& mi, int state) {
 /// taken from them).
 bool has_last(const State& s, const MachineState& m) { return m.last_update != 0 && m.last_update + 1 == s.update_counter; }
 
+}  // namespace
+
 float quintic(const InertialChannel& c, float t) {
   if (t >= c.t1) return 0.0f;
   const float t1 = c.t1, x0 = c.x0, v0 = c.v0, a0 = c.a0;
@@ -103,6 +105,10 @@ void init_channel(InertialChannel& c, const glm::vec3& offset, const glm::vec3& 
   c.v0 = std::min(0.0f, glm::dot(velocity, c.direction));  // never let the offset grow
   c.t1 = duration;
   if (c.v0 < 0.0f) c.t1 = std::min(duration, -5.0f * x0 / c.v0);
+  if (!(c.t1 > 1e-4f)) {  // gone within 0.1 ms (a tiny offset against a fast motion): t1^5 would underflow
+    c = InertialChannel{};
+    return;
+  }
   const float t1 = c.t1;
   c.a0 = std::max(0.0f, (-8.0f * c.v0 * t1 - 20.0f * x0) / (t1 * t1));
 }
@@ -115,6 +121,8 @@ glm::vec3 rotation_vector(glm::quat q) {
   if (!(s > 1e-12f)) return glm::vec3(0.0f);
   return v * (2.0f * std::atan2(s, q.w) / s);
 }
+
+namespace {
 
 /// Starts an offset that carries the last output into `now` (this frame's pose before offsets).
 void capture_offset(State& s, MachineState& m, ConstPoseSpan now, float duration) {
@@ -139,6 +147,8 @@ void capture_offset(State& s, MachineState& m, ConstPoseSpan now, float duration
   m.inertial_duration = duration;
 }
 
+}  // namespace
+
 void apply_offset(const State& s, const MachineState& m, PoseSpan out) {
   const float t = m.inertial_elapsed;
   for (uint32_t j = 0; j < s.def->joints; ++j) {
@@ -157,6 +167,8 @@ void apply_offset(const State& s, const MachineState& m, PoseSpan out) {
     }
   }
 }
+
+namespace {
 
 /// Checks the transitions; starts the first that holds. Returns whether an offset must be captured
 /// this frame (an inertialization or an interrupted crossfade), and its duration in *capture.

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "common/message.h"
+#include "internal/validate_montage.h"
 #include <ossa/loader/validate.h>
 
 namespace ossa {
@@ -56,6 +57,9 @@ class GraphChecker {
       if (machine_player_[m] < 0) return fail(format("state machine %zu is not played by any node", m));
       if (Status st = check_machine(m); !st) return st;
     }
+    bool over = false;
+    if (const std::string e = detail::check_montages(g_, budget_, &over); over) return over_budget();
+    else if (!e.empty()) return fail(e);
     return {};
   }
 
@@ -270,6 +274,14 @@ class GraphChecker {
         if (!weight_ok(a.weight())) return fail(at + format(": weight must be finite and within +-%g", kMaxWeight));
         return check_param_ref(at + " weight", a.weight_parameter(), true,
                                {fb::ParameterType::Float, fb::ParameterType::Bool});
+      }
+      case fb::NodeData::SlotNode: {  // format v9 (validate_montage.cpp)
+        const auto& slot = *node.data_as_SlotNode();
+        if (Status st = child(n, slot.input(), "input"); !st) return st;
+        bool over = false;
+        const std::string e = detail::check_slot_node(slot, n, g_.joint_count(), budget_, &over);
+        if (over) return over_budget();
+        return e.empty() ? Status{} : fail(e);
       }
       case fb::NodeData::MorphWeightsNode: {
         const auto& m = *node.data_as_MorphWeightsNode();

@@ -112,8 +112,8 @@ TEST_F(PabGraph, CooksIntoACharacterThatLoads) {
   ASSERT_NE(look.default_vector(), nullptr);
   EXPECT_FLOAT_EQ(look.default_vector()->y(), 160.0f) << "1.6 m in Pab's centimetres";
 
-  // Root: a look-at over foot placement over foot locking over a layer of crossed arms over the
-  // locomotion machine, from the spine up.
+  // Root: a look-at over foot placement over foot locking over the upper-body montage slot over a
+  // layer of crossed arms over the locomotion machine, from the spine up.
   const ossa::fb::Node& aim = *g.nodes()->Get(g.root());
   EXPECT_EQ(g.root(), g.nodes()->size() - 1);
   ASSERT_EQ(aim.data_type(), ossa::fb::NodeData::AimNode);
@@ -126,7 +126,19 @@ TEST_F(PabGraph, CooksIntoACharacterThatLoads) {
   const ossa::fb::Node& lock = *g.nodes()->Get(feet.data_as_FootPlacementNode()->input());
   ASSERT_EQ(lock.data_type(), ossa::fb::NodeData::FootLockNode);
   EXPECT_EQ(str(lock.data_as_FootLockNode()->legs()->Get(0)->plant_event()), "foot_left");
-  const ossa::fb::Node& root = *g.nodes()->Get(lock.data_as_FootLockNode()->input());
+  const ossa::fb::Node& slot = *g.nodes()->Get(lock.data_as_FootLockNode()->input());
+  ASSERT_EQ(slot.data_type(), ossa::fb::NodeData::SlotNode);
+  EXPECT_EQ(str(slot.data_as_SlotNode()->slot()), "upper_body");
+  ASSERT_NE(slot.data_as_SlotNode()->mask(), nullptr);
+  EXPECT_EQ(slot.data_as_SlotNode()->mask()->Get(0)->joint(), find_joint(sk, "Spine1"));
+  ASSERT_NE(g.montages(), nullptr);
+  ASSERT_EQ(g.montages()->size(), 1u);
+  const ossa::fb::Montage& montage = *g.montages()->Get(0);
+  EXPECT_EQ(str(montage.name()), "cross_arms");
+  ASSERT_EQ(montage.sections()->size(), 3u);
+  EXPECT_EQ(montage.sections()->Get(1)->next(), 1) << "the loop section repeats until told";
+  EXPECT_EQ(montage.sections()->Get(2)->next(), -1);
+  const ossa::fb::Node& root = *g.nodes()->Get(slot.data_as_SlotNode()->input());
   ASSERT_EQ(root.data_type(), ossa::fb::NodeData::LayeredBlendNode);
   const auto* layered = root.data_as_LayeredBlendNode();
   ASSERT_EQ(layered->layers()->size(), 1u);

@@ -29,6 +29,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <limits>
 #include <mutex>
 #include <random>
@@ -314,6 +315,64 @@ TEST(NotOssa, GlbFile) {
   const std::filesystem::path path = source_dir() / "assets" / "CesiumMan" / "CesiumMan.glb";
   ASSERT_TRUE(std::filesystem::exists(path)) << path;
   EXPECT_TRUE(rejected(Asset::open(path.string()), path.string(), {{"identifier", "not an ossa", "not a .ossa"}}));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Montages and slot nodes (format v9): every stored field refused by name when hostile.
+
+TEST(Montage, HostileFieldsRejectedByName) {
+  const Keywords kMontage = {{"graph 0 'g'"}, {"montage 0", "node 16"}};
+  struct Case {
+    const char* what;
+    std::function<void(SyntheticMontage&)> spoil;
+    std::vector<std::string> words;
+  };
+  const float nan = kNaN, inf = kInf;
+  const std::vector<Case> cases = {
+      {"montage name", [](SyntheticMontage& m) { m.name.clear(); }, {"empty name"}},
+      {"group", [](SyntheticMontage& m) { m.group.clear(); }, {"empty group"}},
+      {"segment clip", [](SyntheticMontage& m) { m.clip = 5; }, {"clip 5 is out of range"}},
+      {"segment start", [](SyntheticMontage& m) { m.start = -1.0f; }, {"start -1"}},
+      {"segment end before start", [](SyntheticMontage& m) { m.end = 0.0f; }, {"end after start"}},
+      {"segment end NaN", [=](SyntheticMontage& m) { m.end = nan; }, {"end nan"}},
+      {"segment end huge", [](SyntheticMontage& m) { m.end = 1e7f; }, {"within [0, 1e6]"}},
+      {"segment rate 0", [](SyntheticMontage& m) { m.segment_rate = 0.0f; }, {"segment 0: rate 0"}},
+      {"segment rate inf", [=](SyntheticMontage& m) { m.segment_rate = inf; }, {"segment 0: rate inf"}},
+      {"first section", [](SyntheticMontage& m) { m.section_starts = {0.1f, 0.25f}; }, {"first section starts at 0"}},
+      {"section order", [](SyntheticMontage& m) { m.section_starts = {0.0f, 0.0f}; }, {"not after the section before"}},
+      {"section past the end", [](SyntheticMontage& m) { m.section_starts = {0.0f, 5.0f}; }, {"before the montage's end"}},
+      {"section start NaN", [=](SyntheticMontage& m) { m.section_starts = {0.0f, nan}; }, {"section 1"}},
+      {"next section", [](SyntheticMontage& m) { m.section_next = {1, 7}; }, {"next section 7 is out of range"}},
+      {"next section negative", [](SyntheticMontage& m) { m.section_next = {-2, 1}; }, {"next section -2"}},
+      {"no sections", [](SyntheticMontage& m) { m.section_starts.clear(); }, {"0 sections"}},
+      {"section name", [](SyntheticMontage& m) { m.section_names = {"start", ""}; }, {"section 1: has an empty name"}},
+      {"notify time", [](SyntheticMontage& m) { m.notify_time = 5.0f; }, {"outside the montage"}},
+      {"notify time NaN", [=](SyntheticMontage& m) { m.notify_time = nan; }, {"notify 0: time nan"}},
+      {"window duration", [](SyntheticMontage& m) { m.notify_duration = 0.0f; }, {"above 0 for a window"}},
+      {"notify duration inf", [=](SyntheticMontage& m) { m.notify_duration = inf; }, {"duration inf"}},
+      {"notify kind", [](SyntheticMontage& m) { m.notify_kind = static_cast<fb::MontageNotifyKind>(9); }, {"unknown kind 9"}},
+      {"notify name", [](SyntheticMontage& m) { m.notify.clear(); }, {"notify 0: has an empty name"}},
+      {"montage rate", [](SyntheticMontage& m) { m.rate = 0.0f; }, {"'wave': rate 0"}},
+      {"montage rate huge", [](SyntheticMontage& m) { m.rate = 1e9f; }, {"rate 1e+09"}},
+      {"blend in", [](SyntheticMontage& m) { m.blend_in = -1.0f; }, {"blend in -1"}},
+      {"blend out NaN", [=](SyntheticMontage& m) { m.blend_out = nan; }, {"blend out nan"}},
+      {"blend curve", [](SyntheticMontage& m) { m.blend_in_curve = static_cast<fb::MontageCurve>(7); }, {"unknown blend curve 7"}},
+      {"trigger", [=](SyntheticMontage& m) { m.trigger = nan; }, {"trigger nan"}},
+      {"trigger huge", [](SyntheticMontage& m) { m.trigger = 1e7f; }, {"trigger 1e+07"}},
+      {"track slot", [](SyntheticMontage& m) { m.track_slot.clear(); }, {"track 0: names no slot"}},
+      {"slot name", [](SyntheticMontage& m) { m.slot.clear(); }, {"(slot): has an empty slot name"}},
+      {"slot mask joint", [](SyntheticMontage& m) { m.mask_joint = 200; }, {"mask joint 200 is out of range"}},
+      {"slot mask depth", [](SyntheticMontage& m) { m.mask_depth = -5; }, {"mask depth -5"}},
+  };
+  SyntheticSpec spec;
+  spec.graph = true;
+  spec.montage = SyntheticMontage{};
+  ASSERT_TRUE(accepts(make_valid_file(spec)));
+  for (const Case& c : cases) {
+    SyntheticSpec bad = spec;
+    c.spoil(*bad.montage);
+    EXPECT_TRUE(rejects(bad, with(kMontage, c.words))) << c.what;
+  }
 }
 
 // ---------------------------------------------------------------------------------------------

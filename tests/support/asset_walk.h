@@ -414,6 +414,14 @@ class AssetWalker {
     if (!inst.ok()) return fail(where, "binds but cannot be instantiated: " + inst.error().message);
     const float steps[] = {0.0f, 0.016f, 0.5f, 0.033f, 3.7f, 0.016f, 0.25f, 0.016f};
     for (size_t k = 0; k < std::size(steps); ++k) {
+      for (size_t m = 0; m < def->montage_count(); ++m) {  // montages played, jumped and stopped on the way
+        const int idx = static_cast<int>(m);
+        if (k % 4 == 0) inst->play_montage(idx, 0.5f + static_cast<float>(k), -1);
+        if (k % 4 == 1) inst->jump_to_section(idx, static_cast<int>(def->section_count(m)) - 1);
+        if (k % 4 == 2) inst->set_next_section(idx, 0, -1);
+        if (k == 6) inst->stop_montage(idx, 0.1f);
+        sum_ += static_cast<uint64_t>(inst->montage_status(idx).section + 1);
+      }
       for (size_t p = 0; p < def->parameter_count(); ++p) {
         const int idx = static_cast<int>(p);
         const float v = static_cast<float>((k * 7 + p * 3) % 5) * 0.75f;
@@ -429,6 +437,7 @@ class AssetWalker {
         for (uint32_t c = 0; c < kPoseComponents; ++c)
           if (!std::isfinite(pose[PoseComponent(c)][j])) return fail(where, "update produced a non-finite pose");
       for (const GraphEvent& e : inst->events()) touch(e.name, where + " event name");
+      for (const MontageEvent& e : inst->montage_events()) touch(e.name, where + " montage event name");
       for (size_t m = 0; m < def->machine_count(); ++m) sum_ += static_cast<uint64_t>(inst->machine_status(m).current);
     }
   }

@@ -298,8 +298,28 @@ flatbuffers::Offset<fb::Clip> write_clip(flatbuffers::FlatBufferBuilder& fbb, co
 
 /// The synthetic graph (SyntheticSpec::graph): every node kind (the procedural ones on top), parameter
 /// type and transition mode.
+/// The synthetic montage's tables: Graph.montages.
+flatbuffers::Offset<flatbuffers::Vector<flatbuffers::Offset<fb::Montage>>> write_montages(
+    flatbuffers::FlatBufferBuilder& fbb, const SyntheticMontage& m) {
+  const std::vector<fb::MontageSegment> segments = {{m.clip, m.start, m.end, m.segment_rate}};
+  std::vector<flatbuffers::Offset<fb::MontageTrack>> tracks = {
+      fb::CreateMontageTrack(fbb, fbb.CreateString(m.track_slot), fbb.CreateVectorOfStructs(segments))};
+  std::vector<flatbuffers::Offset<fb::MontageSection>> sections;
+  for (size_t k = 0; k < m.section_starts.size(); ++k)
+    sections.push_back(fb::CreateMontageSection(fbb, fbb.CreateString(k < m.section_names.size() ? m.section_names[k] : "s"),
+                                                m.section_starts[k], k < m.section_next.size() ? m.section_next[k] : -1));
+  std::vector<flatbuffers::Offset<fb::MontageNotify>> notifies = {
+      fb::CreateMontageNotify(fbb, fbb.CreateString(m.notify), m.notify_time, m.notify_duration, m.notify_kind)};
+  std::vector<flatbuffers::Offset<fb::Montage>> montages = {fb::CreateMontage(
+      fbb, fbb.CreateString(m.name), fbb.CreateString(m.group), fbb.CreateVector(tracks), fbb.CreateVector(sections),
+      fbb.CreateVector(notifies), m.rate, m.blend_in, m.blend_in_curve, m.blend_out, m.blend_out_curve, m.trigger,
+      m.root_motion)};
+  return fbb.CreateVector(montages);
+}
+
 flatbuffers::Offset<fb::Graph> write_graph(flatbuffers::FlatBufferBuilder& fbb, const std::string& clip,
-                                           uint64_t skeleton_hash, uint16_t joint_count) {
+                                           uint64_t skeleton_hash, uint16_t joint_count,
+                                           const std::optional<SyntheticMontage>& montage) {
   using PT = fb::ParameterType;
   std::vector<flatbuffers::Offset<fb::Parameter>> params;
   params.push_back(fb::CreateParameterDirect(fbb, "speed", PT::Float, 1.0f, 0.0f, 4.0f));
@@ -372,9 +392,19 @@ flatbuffers::Offset<fb::Graph> write_graph(flatbuffers::FlatBufferBuilder& fbb, 
                                                         fb::CreateStateDirect(fbb, "s1", 7, false)};
   std::vector<flatbuffers::Offset<fb::StateMachine>> machines = {
       fb::CreateStateMachine(fbb, fbb.CreateString("m"), fbb.CreateVector(states), 0, fbb.CreateVector(transitions))};
+  uint16_t root = 15;
+  flatbuffers::Offset<flatbuffers::Vector<flatbuffers::Offset<fb::Montage>>> montages_v;
+  if (montage) {  // format v9: a slot over the root, and the montage playing on it
+    const std::vector<fb::MaskEntry> slot_mask = {{montage->mask_joint, montage->mask_depth}};
+    nodes.push_back(node(fb::NodeData::SlotNode,
+                         fb::CreateSlotNode(fbb, 15, fbb.CreateString(montage->slot), fbb.CreateString(montage->group),
+                                            fbb.CreateVectorOfStructs(slot_mask), false, true).Union()));  // 16
+    root = 16;
+    montages_v = write_montages(fbb, *montage);
+  }
   std::vector<flatbuffers::Offset<flatbuffers::String>> clips = {fbb.CreateString(clip)};
   return fb::CreateGraph(fbb, fbb.CreateString("g"), skeleton_hash, joint_count, fbb.CreateVector(params),
-                         fbb.CreateVector(clips), fbb.CreateVector(nodes), fbb.CreateVector(machines), 15);
+                         fbb.CreateVector(clips), fbb.CreateVector(nodes), fbb.CreateVector(machines), root, montages_v);
 }
 
 flatbuffers::Offset<fb::Material> write_material(flatbuffers::FlatBufferBuilder& fbb, const SyntheticMaterial& m) {
@@ -540,6 +570,7 @@ std::vector<std::pair<std::string, SyntheticSpec>> valid_variants() {
   out.emplace_back("two-meshes", spec);
   spec = {};
   spec.graph = true;
+  spec.montage = SyntheticMontage{};
   spec.clips[0].events = {{"start", 0.0f}, {"step", 0.25f}, {"step", 0.75f}, {"end", 1.0f}};
   out.emplace_back("graph", spec);
 
@@ -599,7 +630,8 @@ std::vector<uint8_t> make_valid_file(const SyntheticSpec& spec) {
                                             kCookerVersion, "synthetic");
   }
   std::vector<flatbuffers::Offset<fb::Graph>> graphs;
-  if (spec.graph && !spec.clips.empty()) graphs.push_back(write_graph(fbb, spec.clips[0].name, hash, joint_count));
+  if (spec.graph && !spec.clips.empty())
+    graphs.push_back(write_graph(fbb, spec.clips[0].name, hash, joint_count, spec.montage));
   const auto root = fb::CreateFileDirect(fbb, spec.version, spec.metres_per_unit, skeleton,
                                          spec.meshes.empty() ? nullptr : &meshes, spec.clips.empty() ? nullptr : &clips,
                                          spec.materials.empty() ? nullptr : &materials, provenance,

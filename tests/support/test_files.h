@@ -194,6 +194,26 @@ struct SyntheticMaterial {
   static std::vector<SyntheticTexture> default_textures();
 };
 
+/// A montage and the slot node it plays on (format v9), written with the synthetic graph: the slot
+/// over the graph's root, the montage a segment of the first clip cut into sections with a window
+/// notify. One field per stored value, so a bad-input case spoils exactly one.
+struct SyntheticMontage {
+  std::string name = "wave", group = "upper", slot = "upper", track_slot = "upper";
+  uint16_t clip = 0;
+  float start = 0.0f, end = 0.75f, segment_rate = 1.0f;
+  std::vector<std::string> section_names = {"start", "loop"};
+  std::vector<float> section_starts = {0.0f, 0.25f};
+  std::vector<int16_t> section_next = {1, 1};
+  std::string notify = "swing";
+  float notify_time = 0.1f, notify_duration = 0.3f;
+  fb::MontageNotifyKind notify_kind = fb::MontageNotifyKind::Window;
+  float rate = 1.0f, blend_in = 0.2f, blend_out = 0.2f, trigger = -1.0f;
+  fb::MontageCurve blend_in_curve = fb::MontageCurve::Cubic, blend_out_curve = fb::MontageCurve::Inertialize;
+  uint16_t mask_joint = 1;
+  int16_t mask_depth = -1;
+  bool root_motion = false;
+};
+
 struct SyntheticSpec {
   std::string identifier = "OSSA";  // exactly 4 characters
   uint32_t version = default_version();
@@ -206,6 +226,8 @@ struct SyntheticSpec {
   /// Add an animation graph "g" over the skeleton and the first clip using every node kind, every
   /// parameter type, nested conditions and each transition mode (needs the default skeleton).
   bool graph = false;
+  /// With `graph`: a slot node over its root and this montage (format v9).
+  std::optional<SyntheticMontage> montage;
 
   static uint32_t default_version();  // kFormatVersion
 };
@@ -217,7 +239,7 @@ std::vector<uint8_t> make_valid_file(const SyntheticSpec& spec = {});
 /// Valid files of different shapes, by name: default, uint32-indices, float32-layout (16-bit joint
 /// slots), static-mesh (no skeleton), clip-only, empty-channels (plus a clip without channels),
 /// single-frame (a 1-frame clip of constants), root-motion, low-bits (1- and 3-bit keys), drop-y
-/// (a rotation storing x, z, w in 19 bits), two-meshes, graph (an animation graph and clip events),
+/// (a rotation storing x, z, w in 19 bits), two-meshes, graph (an animation graph with a montage, and clip events),
 /// morph (a mesh with two morph targets and a clip driving them). For suites that must not over-fit the default, and for seeding fuzz corpora.
 std::vector<std::pair<std::string, SyntheticSpec>> valid_variants();
 

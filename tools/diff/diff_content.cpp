@@ -139,6 +139,8 @@ GraphItem compare_graph(Context& c, const std::string& label, const json& a, con
   if (a["node_count"] != b["node_count"] || a["nodes"] != b["nodes"])
     item.changed.push_back("nodes " + a["nodes"].dump() + " -> " + b["nodes"].dump());
   compare_named(a["machines"], b["machines"], "name", "state machine", item.changed);
+  compare_named(a.value("montages", json::array()), b.value("montages", json::array()), "name", "montage",
+                item.changed);
   // Anything the named parts above do not show (the order of parameters or machines, the rig).
   if (item.changed.empty() && a != b) item.changed.push_back("structure changed");
   item.same = item.changed.empty();

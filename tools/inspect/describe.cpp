@@ -18,6 +18,16 @@
 namespace ossa::inspect {
 namespace {
 
+/// A montage track's length on its timeline: the sum of (end - start) / rate over its segments
+/// (the loader has checked that every rate is positive).
+double track_length(const fb::MontageTrack& track) {
+  double length = 0.0;
+  if (track.segments() == nullptr) return length;
+  for (const fb::MontageSegment* s : *track.segments())
+    length += (static_cast<double>(s->end()) - static_cast<double>(s->start())) / static_cast<double>(s->rate());
+  return length;
+}
+
 using json = nlohmann::ordered_json;
 using detail::format;
 
@@ -289,10 +299,44 @@ json describe_graph(const fb::Graph& g) {
   }
   json clips = json::array();
   for (const flatbuffers::String* c : *g.clips()) clips.push_back(str(c));
-  return json{{"name", str(g.name())},        {"skeleton_hash", hex16(g.skeleton_hash())},
-              {"parameters", std::move(params)}, {"clips", std::move(clips)},
-              {"node_count", g.nodes()->size()}, {"nodes", std::move(kinds)},
-              {"machines", std::move(machines)}};
+  json out{{"name", str(g.name())},        {"skeleton_hash", hex16(g.skeleton_hash())},
+           {"parameters", std::move(params)}, {"clips", std::move(clips)},
+           {"node_count", g.nodes()->size()}, {"nodes", std::move(kinds)},
+           {"machines", std::move(machines)}};
+  if (const auto* ms = g.montages(); ms && ms->size() > 0) {  // format v9
+    json montages = json::array();
+    for (const fb::Montage* m : *ms) {
+      json tracks = json::array(), sections = json::array();
+      double length = 0.0;
+      for (const fb::MontageTrack* t : *m->tracks()) {
+        length = std::max(length, track_length(*t));
+        tracks.push_back(json{{"slot", str(t->slot())}, {"segments", t->segments()->size()}});
+      }
+      for (const fb::MontageSection* sec : *m->sections()) {
+        const int next = sec->next();
+        sections.push_back(json{{"name", str(sec->name())},
+                                {"start", round6(sec->start())},
+                                {"next", next >= 0 && next < static_cast<int>(m->sections()->size())
+                                             ? str(m->sections()->Get(static_cast<flatbuffers::uoffset_t>(next))->name())
+                                             : std::string()}});
+      }
+      const auto blend = [](float t, fb::MontageCurve c) {
+        return format("%g s ", static_cast<double>(t)) + fb::EnumNameMontageCurve(c);
+      };
+      montages.push_back(json{{"name", str(m->name())},
+                              {"group", str(m->group())},
+                              {"length", round6(static_cast<float>(length))},
+                              {"tracks", std::move(tracks)},
+                              {"sections", std::move(sections)},
+                              {"notifies", m->notifies() ? m->notifies()->size() : 0u},
+                              {"blend_in", blend(m->blend_in(), m->blend_in_curve())},
+                              {"blend_out", blend(m->blend_out(), m->blend_out_curve())},
+                              {"rate", round6(m->rate())},
+                              {"root_motion", m->root_motion()}});
+    }
+    out["montages"] = std::move(montages);
+  }
+  return out;
 }
 
 json describe_material(const fb::Material& m) {
@@ -528,6 +572,14 @@ std::string describe_text(const json& d) {
           line("    " + text(t["from"]) + " -> " + text(t["to"]) + " when " + text(t["when"]) +
                (t.contains("exit_time") ? ", exit time " + text(t["exit_time"]) : std::string()) + ": " +
                text(t["mode"]) + " " + text(t["duration"]) + " s");
+      }
+      for (const json& m : g.value("montages", json::array())) {
+        std::string sections;
+        for (const json& sec : m["sections"])
+          sections += (sections.empty() ? "" : ", ") + text(sec["name"]) + " -> " +
+                      (sec["next"].get<std::string>().empty() ? std::string("end") : text(sec["next"]));
+        line("  montage        " + text(m["name"]) + " (group " + text(m["group"]) + "): " + text(m["length"]) +
+             " s, sections " + sections + "; blend in " + text(m["blend_in"]) + ", out " + text(m["blend_out"]));
       }
     }
   }

@@ -41,6 +41,18 @@
 // subtree, puts them back on the animated pose; a spring node's teleport_distance does so when the
 // character jumps further than that in one update.
 //
+// Montages (format v9) are one-shot actions the host plays over the graph (Unreal's Animation
+// Montages): play_montage starts one, and it shows wherever a slot node names one of its tracks,
+// replacing (or adding to) the slot's input on the slot's joints by its blend weight; with none
+// playing a slot passes its input through bit for bit. A montage's timeline is cut into sections
+// whose next-section links the host may change (set_next_section) or follow at once
+// (jump_to_section); it blends in and out along a linear, cubic or inertialized curve, starts its
+// blend out on its own so that it has blended out when it reaches its end, and reports its
+// notifies over exactly the interval played, so none is lost or doubled across loops, jumps, rate
+// changes or long frames. One montage per group plays: a new one blends the old one out with its
+// own blend in. Everything is reserved when the instance is made; playing, stopping and updating
+// allocate nothing.
+//
 // Events: a clip player reports the events its clip crosses in [previous time, new time) (wrapped
 // across loops, reversed for negative rates), only when it lies on the dominant path: at every blend
 // the child with the most weight (ties: the later child, i.e. a transition's target) passes dominance
@@ -56,8 +68,11 @@
 #include <ossa/format/result.h>
 #include <ossa/loader/asset.h>
 #include <ossa/anim/pose.h>
+#include <ossa/anim/root_motion.h>
 
 namespace ossa {
+
+class GraphInstance;
 
 /// Graphs in a file.
 size_t graph_count(const Asset& asset);
@@ -70,6 +85,42 @@ struct GraphEvent {
   uint16_t clip = 0;      // index into the graph's clips
   uint16_t node = 0;      // the clip player or blend space that played it
   float time = 0.0f;      // the event's time in the clip, seconds
+};
+
+/// What happened to a montage (GraphInstance::montage_events, MontageListener).
+enum class MontageEventType : uint8_t {
+  Started,      // play_montage
+  BlendingOut,  // its blend out began (interrupted: stopped or replaced before its end)
+  Ended,        // it has blended out and no longer plays (interrupted as for BlendingOut)
+  Notify,       // an instant notify was passed
+  NotifyBegin,  // playback entered a window notify
+  NotifyEnd,    // ... and left it (or the montage ended)
+  BranchingPoint,  // a branching point was reached: the montage is exactly at its time
+};
+
+struct MontageEvent {
+  MontageEventType type = MontageEventType::Started;
+  uint16_t montage = 0;     // index into the graph's montages
+  std::string_view name;    // the notify's (points into the file); empty for Started / BlendingOut / Ended
+  float position = 0.0f;    // the montage's timeline position when it happened, seconds
+  bool interrupted = false; // BlendingOut, Ended
+};
+
+/// Called as a montage event happens, during update() or the host call that caused it. At a
+/// branching point the montage stands exactly at the point's time, and what the listener does
+/// (jump_to_section, set_next_section, stop_montage) takes effect from there, within the same update.
+using MontageListener = void (*)(GraphInstance& instance, const MontageEvent& event, void* user);
+
+/// A montage's state, for the host and for tests.
+struct MontageStatus {
+  bool playing = false;        // it plays (blending in, at full weight or blending out)
+  bool blending_out = false;
+  float position = 0.0f;       // timeline seconds
+  int section = -1;            // the section playing
+  float weight = 0.0f;         // its blend weight, [0, 1]
+  float rate = 0.0f;           // host rate times the montage's rate
+  float slot_weight = 0.0f;    // the most weight a slot node showed it with in the last update (0: no
+                               // slot played it, e.g. every slot of its group lies in an inactive state)
 };
 
 /// Where a state machine is: for the host's UI and for tests.
@@ -117,6 +168,22 @@ class GraphDefinition {
   /// Morph channels: the distinct morph target names of the asset's meshes, in mesh order
   /// (ossa/anim/morph.h). GraphInstance::morph_weights() has one weight per channel.
   std::span<const std::string_view> morph_channels() const;
+
+  // Montages (format v9). Indices follow Graph.montages and each montage's sections.
+  size_t montage_count() const;
+  std::string_view montage_name(size_t montage) const;
+  /// Index of the montage, or -1. O(montages).
+  int find_montage(std::string_view name) const;
+  std::string_view montage_group(size_t montage) const;
+  /// The timeline's length in seconds (its longest track).
+  float montage_length(size_t montage) const;
+  size_t section_count(size_t montage) const;
+  std::string_view section_name(size_t montage, size_t section) const;
+  float section_start(size_t montage, size_t section) const;
+  /// The authored next section (-1: the montage ends after it).
+  int section_next(size_t montage, size_t section) const;
+  /// Index of the section, or -1. O(sections).
+  int find_section(size_t montage, std::string_view name) const;
 
   struct Impl;
   const Impl& impl() const { return *impl_; }
@@ -213,6 +280,39 @@ class GraphInstance {
   bool reached(size_t node) const;
   /// A node's normalized phase in [0, 1] (its leading clip's time / duration), for tools and tests.
   float node_phase(size_t node) const;
+
+  // ---- montages (format v9). Calls with an unknown montage or section, or a rate outside
+  // [0, 1000], return false and change nothing. O(plays + sections); allocation-free.
+
+  /// Starts `montage` at `start_section` (-1: its first) at rate `rate` (times the montage's own).
+  /// A montage of the same group still playing blends out (interrupted) over this one's blend in.
+  bool play_montage(int montage, float rate = 1.0f, int start_section = -1);
+  bool play_montage(std::string_view montage, float rate = 1.0f, std::string_view start_section = {});
+  /// Blends `montage` out (-1: every montage playing) over `blend_out` seconds (< 0: its own blend
+  /// out, with its curve); it reports BlendingOut and later Ended, both interrupted. False when
+  /// nothing was playing.
+  bool stop_montage(int montage = -1, float blend_out = -1.0f);
+  bool stop_montage(std::string_view montage, float blend_out = -1.0f);
+  /// While `montage` plays: the section after `section` becomes `next` (-1: the montage ends after it).
+  bool set_next_section(int montage, int section, int next);
+  bool set_next_section(std::string_view montage, std::string_view section, std::string_view next);
+  /// While `montage` plays: playback moves to the start of `section` now.
+  bool jump_to_section(int montage, int section);
+  bool jump_to_section(std::string_view montage, std::string_view section);
+  /// While `montage` plays: its rate (times the montage's own) from the next update on.
+  bool set_montage_rate(int montage, float rate);
+  /// The montage's latest play (the one not blending out when there is one).
+  MontageStatus montage_status(int montage) const;
+  bool montage_playing(int montage) const { return montage_status(montage).playing; }
+  /// Montage events since the update before last ended: those of the last update, and those host
+  /// calls raised after it, in the order they happened.
+  std::span<const MontageEvent> montage_events() const;
+  /// Called for every montage event as it happens (null: none).
+  void set_montage_listener(MontageListener listener, void* user = nullptr);
+  /// The root motion of the last update: what montages with root_motion that were not interrupted
+  /// played of their first track's clips (their Clip.root_motion), at full strength; zero otherwise.
+  /// In the character's frame at the start of the update (ossa/anim/root_motion.h).
+  RootMotionDelta root_motion() const;
 
   struct State;
 

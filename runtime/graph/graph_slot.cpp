@@ -1,0 +1,208 @@
+// graph_slot.cpp — the slot node: where montages show (graph.h, format/ossa.fbs SlotNode).
+//
+// The slot evaluates its input, then puts the montages of its group that have a track for it over
+// that pose. Override: the montages' poses are blended together by their weights (older first, each
+// later one over them, so an interrupting montage blending in covers the one blending out), and the
+// result replaces the input on the slot's joints by the weights' sum (at most 1); without a mask and
+// at full weight the input is not evaluated at all (it would not be seen), as any graph input with
+// no weight. Additive: each montage adds its track's change from the track's first frame, by its
+// weight. With no montage weight the input passes through untouched, bit for bit.
+//
+// An inertialized blend (a curve of Inertialize) switches weights at once; in the update where that
+// happens the slot evaluates the pose it would have had with the weights from before the switch,
+// and the difference to the new pose becomes an offset that decays to zero over the blend time along
+// the quintic the state machines use (graph_machine.cpp), starting with the velocity of the slot's
+// own last outputs: no pop, no lag. Only slots of a group with an inertializing montage keep that
+// history.
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+#include "graph/graph_internal.h"
+#include <ossa/anim/morph.h>
+#include <ossa/anim/pose_ops.h>
+
+namespace ossa::graph_detail {
+namespace {
+
+using State = GraphInstance::State;
+
+struct Entry {
+  MontagePlay* play = nullptr;
+  const TrackInfo* track = nullptr;
+};
+
+/// Copies the masked joints (ranges of joints) of `from` into `to`; the others keep their bits.
+void copy_ranges(const std::vector<std::pair<uint32_t, uint32_t>>& ranges, ConstPoseSpan from, PoseSpan to) {
+  for (uint32_t k = 0; k < kPoseComponents; ++k)
+    for (const auto& [first, last] : ranges)
+      std::memcpy(to[PoseComponent(k)] + first, from[PoseComponent(k)] + first, sizeof(float) * (last - first));
+}
+
+/// Puts the entries' poses, at weight `now` or `before`, over `out` (and their morph weights over ow).
+void combine(State& s, const SlotInfo& slot, const Entry* entries, uint32_t count, bool before, float weight,
+             PoseSpan out, std::span<float> ow, uint32_t depth) {
+  const GraphDefinition::Impl& d = *s.def;
+  PoseSpan sum = s.scratch->poses[depth].span(), tmp = s.scratch->poses[depth + 1].span();
+  const std::span<float> tw = scratch_weights(s, depth + 1);
+  // With a mask the result is made aside and only the masked joints are copied in: a blend at
+  // weight 0 renormalizes rotations, which would change unmasked joints' last bits.
+  const bool masked = slot.mask >= 0;
+  if (slot.additive && masked) copy_pose(out, sum);
+  PoseSpan added = masked ? sum : out;
+  bool any = false;
+  float acc = 0.0f;
+  for (uint32_t k = 0; k < count; ++k) {
+    MontagePlay& p = *entries[k].play;
+    const float w = before ? p.weight_before : p.weight;
+    if (!(w > 0.0f)) continue;
+    const bool first = acc == 0.0f;
+    uint16_t clip = 0;
+    float time = 0.0f;
+    PoseSpan target = slot.additive || !first ? tmp : sum;
+    sample_track(s, *entries[k].track, p.position, target, &clip, &time);
+    if (!before) p.slot_weight = std::max(p.slot_weight, weight * std::min(w, 1.0f));
+    if (!ow.empty()) {  // the channels the montage's clip drives move towards its weights
+      std::copy(ow.begin(), ow.end(), tw.begin());
+      sample_morph_weights(d.clips[clip], time, d.clip_channels[clip], tw);
+      blend_morph_weights(ow, tw, std::min(w, 1.0f), ow);
+    }
+    if (slot.additive) {
+      make_additive(tmp, d.track_reference[static_cast<size_t>(entries[k].track - d.tracks.data())], tmp);
+      add(added, tmp, w, added);
+      any = true;
+      continue;
+    }
+    acc += w;
+    if (!first) blend(sum, tmp, w / acc, sum);
+  }
+  if (slot.additive) {
+    if (masked && any) copy_ranges(d.slot_ranges[static_cast<size_t>(slot.mask)], sum, out);
+    return;
+  }
+  if (!(acc > 0.0f)) return;
+  const float t = std::min(acc, 1.0f);
+  if (masked && t >= 1.0f) {  // at full weight the masked joints are the montages' pose: no blend
+    const auto& ranges = d.slot_ranges[static_cast<size_t>(slot.mask)];
+    if (!slot.mesh_space) return copy_ranges(ranges, sum, out);
+    // In mesh space the mask roots take the montages' model rotation under the input's parents.
+    const LayerJoints& lj = d.slot_joints[static_cast<size_t>(slot.mask)];
+    const auto parents = d.skeleton.parents();
+    GraphScratch::Buffers& b = *s.scratch;
+    for (const uint16_t j : lj.chain) {
+      const int p = parents[j];
+      const glm::quat qb = rotation_at(out, j), ql = rotation_at(sum, j);
+      b.model_base[j] = p >= 0 ? b.model_base[static_cast<size_t>(p)] * qb : qb;
+      b.model_layer[j] = p >= 0 ? b.model_layer[static_cast<size_t>(p)] * ql : ql;
+    }
+    copy_ranges(ranges, sum, out);
+    for (size_t k = 0; k < lj.chain.size(); ++k) {
+      if (!lj.root[k]) continue;
+      const uint16_t j = lj.chain[k];
+      const int p = parents[j];
+      const glm::quat parent = p >= 0 ? b.model_base[static_cast<size_t>(p)] : glm::quat(1.0f, 0.0f, 0.0f, 0.0f);
+      set_rotation(out, j, glm::normalize(glm::conjugate(parent) * glm::normalize(b.model_layer[j])));
+    }
+    return;
+  }
+  if (masked) {
+    const std::vector<float>& mask = d.slot_masks[static_cast<size_t>(slot.mask)];
+    if (slot.mesh_space) {
+      copy_pose(out, tmp);
+      blend_mesh_space(s, d.slot_joints[static_cast<size_t>(slot.mask)], mask, t, sum, tmp);
+    } else {
+      blend_layered(out, sum, mask, t, tmp);
+    }
+    copy_ranges(d.slot_ranges[static_cast<size_t>(slot.mask)], tmp, out);
+  } else if (t >= 1.0f) {
+    copy_pose(sum, out);
+  } else {
+    blend(out, sum, t, out);
+  }
+}
+
+/// Starts the offset that carries `before` (the pose without the switch) into `after`, with the
+/// velocity of the slot's last two outputs when they are from the two updates before this one.
+void capture(const State& s, MachineState& m, ConstPoseSpan before, ConstPoseSpan after, float duration) {
+  const bool velocity = m.last_update != 0 && m.last_update + 1 == s.update_counter &&
+                        m.before_last_update + 1 == m.last_update && m.last_dt > 0.0f;
+  const float inv_dt = velocity ? 1.0f / m.last_dt : 0.0f;
+  const ConstPoseSpan last = m.last.span(), older = m.before_last.span();
+  for (uint32_t j = 0; j < s.def->joints; ++j) {
+    glm::vec3 vt(0.0f), vr(0.0f);
+    if (velocity) {
+      vt = glm::vec3(last[kTx][j] - older[kTx][j], last[kTy][j] - older[kTy][j], last[kTz][j] - older[kTz][j]) * inv_dt;
+      vr = rotation_vector(rotation_at(last, j) * glm::conjugate(rotation_at(older, j))) * inv_dt;
+    }
+    const glm::vec3 offset(before[kTx][j] - after[kTx][j], before[kTy][j] - after[kTy][j], before[kTz][j] - after[kTz][j]);
+    init_channel(m.translation[j], offset, vt, duration);
+    init_channel(m.rotation[j], rotation_vector(rotation_at(before, j) * glm::conjugate(rotation_at(after, j))), vr,
+                 duration);
+  }
+  m.inertial = true;
+  m.inertial_elapsed = 0.0f;
+  m.inertial_duration = duration;
+}
+
+}  // namespace
+
+void evaluate_slot(State& s, uint16_t n, const Advance& advance, float weight, bool dominant, PoseSpan out,
+                   std::span<float> ow, uint32_t depth) {
+  const GraphDefinition::Impl& d = *s.def;
+  const SlotInfo& slot = d.slots[d.nodes[n].aux];
+  if (!s.montages_active && slot.inertia < 0)  // nothing plays and nothing to remember: the input as it is
+    return evaluate(s, slot.input, advance, weight, dominant, out, ow, depth);
+  Entry entries[kMaxMontagePlays];
+  uint32_t count = 0;
+  float total = 0.0f, total_before = 0.0f, switch_time = 0.0f;
+  for (MontagePlay& p : s.plays) {
+    if (p.montage < 0 || (!(p.weight > 0.0f) && !(p.weight_before > 0.0f))) continue;
+    const MontageInfo& mi = d.montages[static_cast<size_t>(p.montage)];
+    if (mi.group != slot.group) continue;
+    const TrackInfo* track = track_for(d, mi, slot.slot);
+    if (!track) continue;
+    uint32_t at = count++;  // kept in play order
+    for (; at > 0 && entries[at - 1].play->serial > p.serial; --at) entries[at] = entries[at - 1];
+    entries[at] = {&p, track};
+    total += std::max(p.weight, 0.0f);
+    total_before += std::max(p.weight_before, 0.0f);
+    if (p.switch_update == s.update_counter) switch_time = std::max(switch_time, p.switch_time);
+  }
+  MachineState* inertia = slot.inertia >= 0 ? &s.slot_inertia[static_cast<size_t>(slot.inertia)] : nullptr;
+  const bool switched = inertia && switch_time > 0.0f;
+  const bool replaces_all = !slot.additive && slot.mask < 0;
+  const auto input_seen = [&](float t) { return !replaces_all || t < 1.0f; };
+  if (input_seen(total) || (switched && input_seen(total_before))) {
+    const float shown = replaces_all ? 1.0f - std::min(total, 1.0f) : 1.0f;
+    evaluate(s, slot.input, advance, weight * shown, dominant && shown >= 0.5f, out, ow, depth);
+  } else {
+    std::copy(d.default_weights.begin(), d.default_weights.end(), ow.begin());
+  }
+  if (count == 0 && !inertia) return;  // nothing playing here: the input as it is
+
+  if (switched) {  // the pose without the switch, into the third scratch pose
+    PoseSpan before = s.scratch->poses[depth + 2].span();
+    const std::span<float> before_weights = scratch_weights(s, depth + 2);
+    copy_pose(out, before);
+    std::copy(ow.begin(), ow.end(), before_weights.begin());
+    combine(s, slot, entries, count, true, weight, before, before_weights, depth);
+    combine(s, slot, entries, count, false, weight, out, ow, depth);
+    capture(s, *inertia, before, out, switch_time);
+  } else if (count > 0) {
+    combine(s, slot, entries, count, false, weight, out, ow, depth);
+  }
+  if (!inertia) return;
+  if (inertia->inertial && !switched) {
+    inertia->inertial_elapsed += advance.dt;
+    if (inertia->inertial_elapsed >= inertia->inertial_duration) inertia->inertial = false;
+  }
+  if (inertia->inertial) apply_offset(s, *inertia, out);
+  // Keep this output for a later capture's velocity: the older buffer becomes the newest.
+  std::swap(inertia->last, inertia->before_last);
+  inertia->before_last_update = inertia->last_update;
+  stream_pose(out, inertia->last);
+  inertia->last_update = s.update_counter;
+  inertia->last_dt = advance.dt;
+}
+
+}  // namespace ossa::graph_detail
