@@ -25,8 +25,8 @@ from collections import defaultdict
 
 # The cooker's stages in the order data flows through them. A stage may include the model, the
 # JSON reader and the stages before it (whose products it reads), never one after it.
-COOKER_STAGES = ["cooker/import", "cooker/mesh", "cooker/clip", "cooker/graph", "cooker/texture", "cooker/write"]
-RUNTIME_ROOMS = ["runtime/loader", "runtime/anim", "runtime/skinning", "runtime/graph"]
+COOKER_STAGES = ["cooker/import", "cooker/retarget", "cooker/mesh", "cooker/clip", "cooker/graph", "cooker/texture", "cooker/write"]
+RUNTIME_ROOMS = ["runtime/loader", "runtime/anim", "runtime/skinning", "runtime/graph", "runtime/retarget"]
 
 
 def allowed_table():
@@ -44,11 +44,14 @@ def allowed_table():
     a["cooker/model"] = {"format", "common", "cooker/json"} | runtime_public
     for i, stage in enumerate(COOKER_STAGES):
         a[stage] = {"format", "common", "cooker/json", "cooker/model"} | set(COOKER_STAGES[:i]) | runtime_public
-    a["cooker/cook"] = {"format", "common", "cooker/json", "cooker/model"} | set(COOKER_STAGES) | runtime_public
+    # Humanoid map files (--map) are read by the retarget stage, the orchestrator and the tools.
+    a["cooker/retarget"] |= {"tools/retarget"}
+    a["cooker/cook"] = {"format", "common", "cooker/json", "cooker/model", "tools/retarget"} | set(COOKER_STAGES) | runtime_public
     a["cooker/cli"] = a["cooker/cook"] | {"cooker/cook", "tools/cli"}
     # Programs over cooked files: the runtime's public headers, the shared command line.
     a["tools/cli"] = {"format", "common"}
-    a["tools/inspect"] = {"format", "common", "tools/cli"} | runtime_public
+    a["tools/retarget"] = {"format", "common"} | runtime_public
+    a["tools/inspect"] = {"format", "common", "tools/cli", "tools/retarget"} | runtime_public
     a["tools/diff"] = {"format", "common", "tools/cli", "tools/inspect"} | runtime_public
     a["viewer"] = {"format", "common", "tools/cli"} | runtime_public
     # Runtime suites build in the runtime-only build: the runtime, the format and test support, plus

@@ -18,7 +18,7 @@
 #include <cstddef>
 #include <span>
 
-#include "cooker/import/source_scene.h"
+#include "cooker/model/source_scene.h"
 
 namespace ossa::cook {
 

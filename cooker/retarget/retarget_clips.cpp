@@ -12,7 +12,7 @@
 
 #include <glm/gtc/quaternion.hpp>
 
-#include "cooker/clip/clip_grid.h"
+#include "cooker/model/clip_grid.h"
 #include <ossa/anim/pose.h>
 #include <ossa/retarget/foot_contacts.h>
 #include <ossa/retarget/retarget.h>

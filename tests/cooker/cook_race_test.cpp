@@ -23,7 +23,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "cooker/import/input_log.h"
+#include "cooker/model/input_log.h"
 #include "common/open_beneath.h"
 #include "test_files.h"
 
