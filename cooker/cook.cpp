@@ -22,6 +22,7 @@
 #include "cooker/import/import_scene.h"
 #include "cooker/mesh/mesh_build.h"
 #include "cooker/clip/root_motion.h"
+#include "cooker/retarget/retarget_clips.h"
 #include "cooker/write/write_ossa.h"
 #include "cooker/texture/texture_cook.h"
 #include <ossa/format/hash.h>
@@ -222,8 +223,8 @@ void cook_into(CookRecord& record, const fs::path& input, const fs::path& output
     return;
   }
   if (is_graph_file(input) && options.retarget_target != nullptr) {
-    record.error = input.string() + ": --retarget-to applies to sources, not graph files (a graph's retarget node "
-                   "plays clips of another rig: docs/RETARGET.md)";
+    record.error = input.string() + ": --retarget-to applies to sources, not graph files (retarget the clips a graph "
+                   "plays, then cook the graph: docs/RETARGET.md)";
     return;
   }
   if (is_graph_file(input)) {

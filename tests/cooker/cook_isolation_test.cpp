@@ -55,7 +55,9 @@ std::vector<std::string> files_below(const fs::path& dir) {
 template <class T>
 constexpr bool kIsRecord = std::is_same_v<T, ossa::cook::CookRecord> || std::is_same_v<T, ossa::cook::ClipRecord> ||
                            std::is_same_v<T, ossa::cook::TextureRecord> ||
-                           std::is_same_v<T, ossa::cook::MorphRecord> || std::is_same_v<T, ossa::cook::InputFile>;
+                           std::is_same_v<T, ossa::cook::MorphRecord> || std::is_same_v<T, ossa::cook::InputFile> ||
+                           std::is_same_v<T, ossa::cook::RetargetRecord> ||
+                           std::is_same_v<T, ossa::cook::RetargetContactRecord>;
 template <class T>
 struct RecordList : std::false_type {};
 template <class T>
@@ -382,6 +384,26 @@ TEST(CookIsolation, RecordRoundTripsEveryField) {
   t.normal_mean_deg = 0.5f;
   t.normal_max_deg = 3.75f;
   r.texture_records = {t, ossa::cook::TextureRecord{}};
+  ossa::cook::RetargetContactRecord contact;
+  contact.foot = 1;
+  contact.start = 0.25f;
+  contact.end = 0.75f;
+  contact.held_mm = 0.5f;
+  contact.slide_mm = 1.5f;
+  contact.source_slide_mm = 2.25f;
+  ossa::cook::RetargetRecord rt;
+  rt.clip = "walk";
+  rt.frames = 31;
+  rt.hips_ratio = 1.125f;
+  rt.floor_mm = 3.5f;
+  rt.limb_max_deg = 4.5f;
+  rt.guard_max_deg = 5.5f;
+  rt.hand_max_deg = 6.5f;
+  rt.foot_max_deg = 7.5f;
+  rt.crossing_frames = 2;
+  rt.guarded_frames = 3;
+  rt.contacts = {contact, ossa::cook::RetargetContactRecord{}};
+  r.retarget_records = {rt, ossa::cook::RetargetRecord{}};
   r.inputs_read = {{"/src/walk.fbx", 0xfedcba9876543210ull, (uint64_t{1} << 33) + 1, true},
                    {"/src/walk.events.json", 0, 0, false}};
   r.cook_key = 0x8000000000000001ull;
