@@ -229,7 +229,7 @@ TEST(CookIsolation, BatchAroundFailingWorkersCooksEverythingElseExactly) {
   EXPECT_GE((*hung)["seconds"].get<double>(), 20.0);
   EXPECT_LT((*hung)["seconds"].get<double>(), 60.0);
 
-  const auto check = run_command("/usr/bin/python3 " + q(ossa::test::source_dir() / "tests" / "json_schema_check.py") +
+  const auto check = run_command("/usr/bin/python3 " + q(ossa::test::source_dir() / "tests" / "support" / "json_schema_check.py") +
                                  " " + q(ossa::test::source_dir() / "docs" / "schemas" / "ossa-cook-report.schema.json") +
                                  " " + q(report_path));
   EXPECT_EQ(check.exit_code, 0) << check.out << check.err;

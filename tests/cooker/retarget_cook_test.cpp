@@ -152,7 +152,7 @@ TEST(RetargetCook, CrossPairsOfUntunedRigs) {
     }
   }
   // The report of a retarget is valid against its schema.
-  const auto check = run_command("python3 " + q(ossa::test::source_dir() / "tests" / "json_schema_check.py") + " " +
+  const auto check = run_command("python3 " + q(ossa::test::source_dir() / "tests" / "support" / "json_schema_check.py") + " " +
                                  q(ossa::test::source_dir() / "docs" / "schemas" / "ossa-cook-report.schema.json") + " " +
                                  q(cache() / "cmu-cesium.json"));
   EXPECT_EQ(check.exit_code, 0) << check.out << check.err;

@@ -247,7 +247,7 @@ TEST(DiffCli, JsonOutputMatchesItsSchema) {
     EXPECT_EQ(j["differences"].empty(), c.expected == 0);
     docs += " " + q(dir / c.out);
   }
-  const std::string check = "/usr/bin/python3 " + q(ossa::test::source_dir() / "tests" / "json_schema_check.py") + " " +
+  const std::string check = "/usr/bin/python3 " + q(ossa::test::source_dir() / "tests" / "support" / "json_schema_check.py") + " " +
                             q(ossa::test::source_dir() / "docs" / "schemas" / "ossa-diff.schema.json");
   auto r = run_command(check + docs);
   EXPECT_EQ(r.exit_code, 0) << r.out << r.err;
