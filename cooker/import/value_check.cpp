@@ -38,7 +38,14 @@ std::string text(const glm::quat& q) {
   return buf;
 }
 
-std::string quoted(const std::string& name) { return "'" + detail::printable(name) + "'"; }
+// Built with += rather than "'" + std::string&&: GCC 12 at -O2/-O3 reports a false -Wrestrict
+// inside the inlined std::string::insert that operator+(const char*, string&&) becomes.
+std::string quoted(const std::string& name) {
+  std::string out = "'";
+  out += detail::printable(name);
+  out += '\'';
+  return out;
+}
 
 const char* kBound = " (the format holds finite values within +-1e7 source units)";
 

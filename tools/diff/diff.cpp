@@ -40,7 +40,12 @@ NameMatch match_by_name(const std::vector<std::string>& old_names, const std::ve
 }
 
 std::string item_label(const std::vector<std::string>& names, size_t index) {
-  if (names[index].empty()) return "#" + std::to_string(index);
+  // Strings built with += (GCC 12's false -Wrestrict on "literal" + std::string&& at -O2/-O3).
+  if (names[index].empty()) {
+    std::string label = "#";
+    label += std::to_string(index);
+    return label;
+  }
   const auto repeats = std::count(names.begin(), names.begin() + static_cast<std::ptrdiff_t>(index), names[index]);
   std::string label = ossa::detail::printable(names[index]);
   return repeats > 0 ? label + "#" + std::to_string(repeats) : label;
@@ -91,7 +96,12 @@ JointMapping map_joints(const SkeletonView& old_skeleton, const SkeletonView& ne
 
 std::string num(double value) { return ossa::detail::format("%.4g", value); }
 
-std::string quote_name(std::string_view name) { return "'" + ossa::detail::printable(name) + "'"; }
+std::string quote_name(std::string_view name) {
+  std::string out = "'";
+  out += ossa::detail::printable(name);
+  out += '\'';
+  return out;
+}
 
 }  // namespace internal
 
