@@ -177,8 +177,10 @@ bool plain_rows(int trials, const ossa::bench::BenchData& data, std::vector<Row>
               g_sink = g_sink + static_cast<uint32_t>(local[0][0].t[0]); });
     rows.push_back({name, ossa_s * 1e9, plain_s * 1e9, limit});
   };
-  sample_row("sample.plain", *caches[0], limit_for(0.55, 1.1));  // AMD Zen 5: 0.40-0.41 measured, 0.71-0.72 regressed; Intel: not yet measured
-  sample_row("sample.noisy", *caches[3], limit_for(0.55, 1.1));  // the same; a runtime without FTZ/DAZ alone fails this row
+  // AMD Zen 5: 0.40-0.41 measured, 0.55 once in a CI run beside four other builds, 0.71-0.72 with
+  // the denormal regression put back; the limit sits between the last two. Intel: not yet measured.
+  sample_row("sample.plain", *caches[0], limit_for(0.63, 1.1));
+  sample_row("sample.noisy", *caches[3], limit_for(0.63, 1.1));  // the same; a runtime without FTZ/DAZ alone fails this row
 
   const std::span<const int16_t> parents = skeleton.parents();
   const ossa::ConstPoseSpan inputs[3] = {poses[0], poses[1], poses[2]};
