@@ -86,7 +86,16 @@ Result<SideBySideFile> cook_side_by_side(const std::string& path, const cook::Im
       raw.bind.push_back(RawTransform{{sj.translation.x, sj.translation.y, sj.translation.z},
                                       {sj.rotation.x, sj.rotation.y, sj.rotation.z, sj.rotation.w},
                                       {sj.scale.x, sj.scale.y, sj.scale.z}});
-      c.shell.push_back(c.probe);
+    }
+    // ossa's probe points sit `probe` from each joint in model space (probe_error); ACL takes one
+    // shell distance per joint in its local units, so the probe over the joint's model scale (at
+    // the first frame; real rigs' scales do not animate).
+    std::vector<cook::Affine> model(joints);
+    cook::model_at_frame(scene->skeleton, c.reference, 0, model);
+    for (uint32_t j = 0; j < joints; ++j) {
+      double scale = 0.0;
+      for (int k = 0; k < 3; ++k) scale = std::max(scale, glm::length(model[j].linear[k]));
+      c.shell.push_back(scale > 0.0 ? c.probe / scale : c.probe);
     }
     raw.samples.resize(static_cast<size_t>(raw.frames) * joints);
     for (uint32_t f = 0; f < raw.frames; ++f)

@@ -24,6 +24,7 @@
 #include "cooker/clip/clip_error.h"
 #include "cooker/import/import_scene.h"
 #include <ossa/anim/pose.h>
+#include <ossa/anim/pose_error.h>
 #include <ossa/anim/sample.h>
 #include <ossa/loader/asset.h>
 
@@ -32,8 +33,8 @@ namespace ossa::bench {
 /// ossa-cook's default bound: 0.1 mm at probe points 10 cm from each joint.
 inline constexpr double kToleranceMetres = 0.0001;
 inline constexpr double kProbeMetres = 0.1;
-/// Points measured between two frames (at 1/4, 2/4, 3/4 of the way).
-inline constexpr uint32_t kPointsBetweenFrames = 3;
+/// Points measured between two frames (at 1/4, 2/4, 3/4 of the way), as the cooker measures.
+inline constexpr uint32_t kPointsBetweenFrames = kClipErrorSubdivisions - 1;
 
 struct SideBySideClip {
   ClipView clip;            // ossa's cooked clip (in SideBySideFile::asset)
