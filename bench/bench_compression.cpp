@@ -30,8 +30,6 @@
 // key_values: they sum to cooked_bytes); the animated channels keyed at every frame (their key
 // frames are one shared run) against those with keys removed (values and key-frame bytes apart);
 // and how many channels of each kind use each bit count (32: raw floats).
-#include <unistd.h>
-
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -43,6 +41,7 @@
 #include "cooker/clip/clip_compress.h"
 #include "cooker/cook.h"
 #include "cooker/import/import_scene.h"
+#include "bench/cooked_rig.h"
 #include "bench/machine.h"
 #include <ossa/format/clip_codec.h>
 #include <ossa/format/ossa_generated.h>
@@ -57,18 +56,6 @@ int usage() {
                "usage: ossa-bench-compression [--skeleton REF_SOURCE] [--clip-tolerance MM] [--metres-per-unit M] "
                "[--breakdown] ASSET...\n");
   return 2;
-}
-
-/// Cooks `source` into a scratch directory and loads its skeleton back, as --skeleton REF.ossa does.
-ossa::Result<SourceSkeleton> cooked_reference(const fs::path& source) {
-  const fs::path dir = fs::temp_directory_path() / ("ossa-bench-compression-" + std::to_string(::getpid()));
-  const fs::path out = dir / (source.stem().string() + ".ossa");
-  const CookRecord record = cook_file(source, out, CookOptions{});
-  ossa::Result<SourceSkeleton> skeleton = record.ok ? load_reference_skeleton(out)
-                                                    : ossa::Result<SourceSkeleton>(ossa::Error{record.error});
-  std::error_code ec;
-  fs::remove_all(dir, ec);
-  return skeleton;
 }
 
 /// Bits of one channel's keys in key_values (raw floats start byte-aligned: up to 7 bits more each).
@@ -157,7 +144,7 @@ int main(int argc, char** argv) {
   import_options.metres_per_unit = static_cast<float>(metres_per_unit);
   SourceSkeleton reference;
   if (!skeleton_source.empty()) {
-    auto loaded = cooked_reference(skeleton_source);
+    auto loaded = ossa::bench::cooked_rig(skeleton_source);
     if (!loaded) {
       std::fprintf(stderr, "ossa-bench-compression: --skeleton %s\n", loaded.error().message.c_str());
       return 1;

@@ -14,9 +14,11 @@
 //    model-space linear part); rotation error of angle a (and relative scale error ds/s) moves a
 //    point at offset v from the joint by at most 2 sin(a/2) * kappa(parent) * |v| (resp. ds/s *
 //    kappa * |v|), where |v| reaches the furthest probe point of the joint's whole subtree and kappa
-//    is the parent's condition number (1 without non-uniform scale). With error compensation
-//    (step 4) a rotation's |v| stops at the origins of the descendants that compensate it. These
-//    turn each channel's local error into a model-space displacement bound ("channel error").
+//    is the parent's condition number (1 without non-uniform scale); probe points sit `probe` from
+//    their joint in model space (clip_error.h), whatever scale the armature carries. With error
+//    compensation (step 4) a rotation's |v| stops at the origins of the descendants that
+//    compensate it. These turn each channel's local error into a model-space displacement bound
+//    ("channel error").
 //
 // 3. Tolerance allocation ("hierarchical tolerance", as ozz-animation's optimizer and ACL's
 //    per-joint error do it). Errors of a chain of joints add up at its end, so a joint's channels
@@ -64,10 +66,12 @@
 //
 // 6. Verification. The clip is packed into the bytes the file will hold and decoded back exactly as
 //    a runtime decodes it (decode_key, rotation_from_stored, lerp/nlerp in float), model space is
-//    rebuilt at every frame and the probe error (clip_error.h) measured for every joint. Where a
-//    joint exceeds the tolerance, every channel on its chain (itself and its ancestors) gets its
-//    budget scaled by about tolerance / error and is recompressed; at most kMaxTightening rounds, then the chains
-//    still over are cooked losslessly (raw floats at every frame). The final measurement is what
+//    rebuilt at every frame and at three points between each pair of frames (clip_error.h: the
+//    source there is its frames interpolated as a runtime interpolates them), and the probe error
+//    measured for every joint. Where a joint exceeds the tolerance, every channel on its chain
+//    (itself and its ancestors) gets its budget scaled by about tolerance / error and is
+//    recompressed; at most kMaxTightening rounds, then the chains still over are cooked losslessly
+//    (raw floats at every frame). The final measurement is what
 //    the clip reports. A bound no float data can hold is reported as measured, never hidden (none
 //    of the shared assets has one: every clip of them cooks within the default 0.1 mm).
 //
@@ -93,7 +97,7 @@
 #include <map>
 
 #include "cooker/clip/clip_error.h"
-#include "cooker/import/tiny_values.h"
+#include "cooker/clip/clip_reference.h"
 #include <ossa/format/clip_codec.h>
 #include <ossa/format/ossa_generated.h>
 
@@ -111,76 +115,8 @@ constexpr uint64_t kModelCacheLimit = 1u << 19;
 // (Pab walk/jog/run/atlas, CMU, the rest together), at the same cook time.
 constexpr double kChainExponent = 0.3;
 constexpr uint32_t kKeyFrameBits = 16;
-// A grid time this close (in frames) to a source key takes the key's value exactly.
-constexpr double kSnapFrames = 1e-3;
 
 enum class Kind : uint8_t { Bind, Constant, Animated };
-
-// ---------------------------------------------------------------------------------------------
-// 1. Reference samples on the grid
-
-glm::vec4 to_vec4(const glm::vec3& v) { return glm::vec4(v, 0.0f); }
-glm::vec4 to_vec4(const glm::quat& q) { return glm::vec4(q.x, q.y, q.z, q.w); }
-
-glm::vec4 interpolate_source(const glm::vec3& a, const glm::vec3& b, double f) {
-  return to_vec4(glm::vec3(glm::mix(glm::dvec3(a), glm::dvec3(b), f)));
-}
-glm::vec4 interpolate_source(const glm::quat& a, const glm::quat& b, double f) {
-  glm::dquat qa(a), qb(b);
-  if (glm::dot(qa, qb) < 0.0) qb = -qb;
-  return to_vec4(glm::quat(glm::normalize(glm::slerp(qa, qb, f))));
-}
-
-/// Samples one source channel at every grid frame; false when it has no keys.
-template <class V>
-bool sample_channel(const std::vector<float>& times, const std::vector<V>& values, const FrameGrid& grid,
-                    glm::vec4* out) {
-  const size_t n = std::min(times.size(), values.size());
-  if (n == 0) return false;
-  const double rate = grid.sample_rate;
-  size_t i = 0;  // first key with time > t (times increase, frames increase)
-  for (uint32_t f = 0; f < grid.frame_count; ++f) {
-    const double t = static_cast<double>(f) / rate;
-    while (i < n && static_cast<double>(times[i]) <= t) ++i;
-    // The nearest key, when the grid time is on it.
-    const size_t near = (i < n && (i == 0 || static_cast<double>(times[i]) - t < t - static_cast<double>(times[i - 1])))
-                            ? i
-                            : i - 1;
-    if (std::abs(static_cast<double>(times[near]) - t) * rate <= kSnapFrames) {
-      out[f] = to_vec4(values[near]);
-    } else if (i == 0) {
-      out[f] = to_vec4(values[0]);
-    } else if (i == n) {
-      out[f] = to_vec4(values[n - 1]);
-    } else {
-      const double t0 = times[i - 1], t1 = times[i];
-      out[f] = interpolate_source(values[i - 1], values[i], (t - t0) / (t1 - t0));
-    }
-  }
-  return true;
-}
-
-ClipSamples reference_samples(const SourceClip& clip, const SourceSkeleton& skeleton, const FrameGrid& grid) {
-  ClipSamples ref;
-  const auto joints = static_cast<uint32_t>(skeleton.joints.size());
-  ref.resize(joints, grid.frame_count);
-  std::vector<bool> has(static_cast<size_t>(joints) * kChannelsPerJoint, false);
-  for (const SourceTrack& t : clip.tracks) {
-    has[t.joint * 3 + kTranslation] = sample_channel(t.translation_times, t.translations, grid,
-                                                     ref.channel(t.joint, kTranslation));
-    has[t.joint * 3 + kRotation] = sample_channel(t.rotation_times, t.rotations, grid, ref.channel(t.joint, kRotation));
-    has[t.joint * 3 + kScale] = sample_channel(t.scale_times, t.scales, grid, ref.channel(t.joint, kScale));
-  }
-  for (uint32_t j = 0; j < joints; ++j) {
-    for (uint32_t ch = 0; ch < kChannelsPerJoint; ++ch) {
-      if (has[j * 3 + ch]) continue;
-      const glm::vec4 bind = bind_value(skeleton.joints[j], ch);
-      std::fill_n(ref.channel(j, ch), grid.frame_count, bind);
-    }
-  }
-  flush_tiny_values(ref.values);  // interpolated across zero: 1e-21 where 0 is meant (tiny_values.h)
-  return ref;
-}
 
 // ---------------------------------------------------------------------------------------------
 // 2. Levers: model-space displacement per unit of local error
@@ -227,12 +163,12 @@ std::vector<Lever> compute_levers(const SourceSkeleton& skeleton, const ClipSamp
     model_at_frame(skeleton, ref, f, model);
     for (uint32_t j = 0; j < joints; ++j) {
       sigma[j] = sigma_max(model[j].linear);
-      reach[j] = reach_compensated[j] = probe * sigma[j];
+      reach[j] = reach_compensated[j] = probe;  // probe points sit `probe` from the joint in model space
     }
     // Every joint's probe points, pushed up to each ancestor: O(joints * depth). Walking up from
     // d, `stop` is the compensating joint closest below the current ancestor.
     for (uint32_t d = 0; d < joints; ++d) {
-      const double own = probe * sigma[d];
+      const double own = probe;
       int stop = (compensates[d] & kCompensatesRotation) ? static_cast<int>(d) : -1;
       for (int a = skeleton.joints[d].parent; a >= 0; a = skeleton.joints[static_cast<size_t>(a)].parent) {
         const auto ai = static_cast<size_t>(a);
@@ -334,14 +270,20 @@ glm::vec4 central_value(uint32_t channel, const glm::vec4* ref, uint32_t n) {
 }
 
 /// Greedy key removal on per-frame candidate key values `dec`: from each kept key, the furthest
-/// next key whose interpolation keeps every frame between them within tolerance.
-std::vector<uint16_t> reduce_keys(const Metric& m, const glm::vec4* ref, const glm::vec4* dec, uint32_t n,
+/// next key whose interpolation keeps every frame between them, and the points between frames
+/// (`ref_positions`: the reference at every position of kErrorSubdivisions per frame, as
+/// between_frames makes it), within tolerance. The points between frames matter where a channel
+/// turns fast: nlerp over a long span does not pass where two nlerps over its halves do (two
+/// keys 72 degrees apart put the quarter point 2 degrees from the midpoint of the first 36).
+std::vector<uint16_t> reduce_keys(const Metric& m, const glm::vec4* ref_positions, const glm::vec4* dec, uint32_t n,
                                   double tolerance) {
+  constexpr uint32_t kSub = kErrorSubdivisions;
   auto valid = [&](uint32_t a, uint32_t b) {
     const float inv_length = 1.0f / static_cast<float>(b - a);
-    for (uint32_t f = a + 1; f < b; ++f) {
-      const glm::vec4 v = interpolate_keys(m.channel, dec[a], dec[b], static_cast<float>(f - a) * inv_length);
-      if (channel_error(m, ref[f], v) > tolerance) return false;
+    for (uint32_t p = a * kSub + 1; p < b * kSub; ++p) {
+      const float x = static_cast<float>(p / kSub) + static_cast<float>(p % kSub) / static_cast<float>(kSub);
+      const glm::vec4 v = interpolate_keys(m.channel, dec[a], dec[b], (x - static_cast<float>(a)) * inv_length);
+      if (channel_error(m, ref_positions[p], v) > tolerance) return false;
     }
     return true;
   };
@@ -614,7 +556,16 @@ ChannelPlan encode_animated(const Metric& m, const glm::vec4* target, uint32_t n
     plan.frames = all_cost <= reduced_cost ? all_frames : std::move(frames);
     return true;
   };
-  std::vector<uint16_t> raw_frames = reduce_keys(m, target, dec.data(), n, tolerance);
+  // The target at every position between frames too, as the runtime would play it keyed at every
+  // frame (what verification measures against).
+  std::vector<glm::vec4> target_positions((n - 1) * kErrorSubdivisions + 1);
+  for (uint32_t p = 0; p < target_positions.size(); ++p) {
+    const uint32_t f = p / kErrorSubdivisions, k = p % kErrorSubdivisions;
+    target_positions[p] = k == 0 ? target[f]
+                                 : interpolate_keys(m.channel, target[f], target[f + 1],
+                                                    static_cast<float>(k) / static_cast<float>(kErrorSubdivisions));
+  }
+  std::vector<uint16_t> raw_frames = reduce_keys(m, target_positions.data(), dec.data(), n, tolerance);
   const size_t floor_keys = raw_frames.size();
   consider(kRawFloatBits, std::move(raw_frames));
 
@@ -629,7 +580,7 @@ ChannelPlan encode_animated(const Metric& m, const glm::vec4* target, uint32_t n
       dec[f] = decode_code(m.channel, plan.dropped, bits, plan.range_min, plan.range_extent, codes[f]);
       holds = channel_error(m, target[f], dec[f]) <= tolerance;
     }
-    if (holds && consider(bits, reduce_keys(m, target, dec.data(), n, tolerance))) plan.codes = codes;
+    if (holds && consider(bits, reduce_keys(m, target_positions.data(), dec.data(), n, tolerance))) plan.codes = codes;
   }
   return plan;
 }
@@ -676,7 +627,6 @@ class Models {
     }
   }
   bool cached() const { return !ref_model_.empty(); }
-  const std::vector<Affine>& reference_models() const { return ref_model_; }  // [joint * frames + frame]
 
   Affine reference(int joint, uint32_t frame) {
     return cached() ? ref_model_[static_cast<size_t>(joint) * frames_ + frame] : walk(ref_, joint, frame);
@@ -919,8 +869,8 @@ Result<CompressedClip> compress_clip(const SourceClip& clip, const SourceSkeleto
       for (uint32_t ch = 0; ch < kChannelsPerJoint; ++ch)
         layout.plans[j * 3 + ch] = plan_lossless(ch, ref.channel(j, ch), frames, bind_value(skeleton.joints[j], ch));
     if (Status st = pack(layout, joints, frames, out); !st) return st.error();
-    decode_clip(out, skeleton, decoded);
-    finish(measure_clip_error(skeleton, ref, decoded, probe));
+    decode_clip(out, skeleton, decoded, kErrorSubdivisions);
+    finish(measure_clip_error(skeleton, between_frames(ref), decoded, probe, nullptr, kErrorSubdivisions));
     return out;
   }
 
@@ -966,6 +916,18 @@ Result<CompressedClip> compress_clip(const SourceClip& clip, const SourceSkeleto
   };
   std::vector<Cached> cache(channel_count);
   Models models(skeleton, ref, planned);
+  // Verification measures every frame and the points between them (clip_error.h) against the
+  // source played as a runtime plays it; its model space is computed once when it fits the cache.
+  const ClipSamples ref_positions = between_frames(ref);
+  std::vector<Affine> ref_position_models;
+  if (static_cast<uint64_t>(joints) * ref_positions.frame_count <= kModelCacheLimit) {
+    ref_position_models.resize(static_cast<size_t>(joints) * ref_positions.frame_count);
+    std::vector<Affine> at(joints);
+    for (uint32_t p = 0; p < ref_positions.frame_count; ++p) {
+      model_at_frame(skeleton, ref_positions, p, at);
+      for (uint32_t j = 0; j < joints; ++j) ref_position_models[static_cast<size_t>(j) * ref_positions.frame_count + p] = at[j];
+    }
+  }
   ClipError error;
   for (uint32_t round = 0;; ++round) {
     std::vector<uint8_t> compensates(joints, 0);
@@ -1010,8 +972,9 @@ Result<CompressedClip> compress_clip(const SourceClip& clip, const SourceSkeleto
       models.joint_planned(j);
     }
     if (Status st = pack(layout, joints, frames, out); !st) return st.error();
-    decode_clip(out, skeleton, decoded);
-    error = measure_clip_error(skeleton, ref, decoded, probe, models.cached() ? &models.reference_models() : nullptr);
+    decode_clip(out, skeleton, decoded, kErrorSubdivisions);
+    error = measure_clip_error(skeleton, ref_positions, decoded, probe, ref_position_models.empty() ? nullptr : &ref_position_models,
+                               kErrorSubdivisions);
     if (error.max <= tolerance || round > kMaxTightening) break;
 
     // Each joint over the tolerance scales the budget of its whole chain; a channel on several

@@ -35,17 +35,20 @@ glm::vec4 interpolate_keys(uint32_t channel, const glm::vec4& a, glm::vec4 b, fl
   return q * (1.0f / std::sqrt(q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w));
 }
 
-void decode_clip(const CompressedClip& clip, const SourceSkeleton& skeleton, ClipSamples& out) {
+void decode_clip(const CompressedClip& clip, const SourceSkeleton& skeleton, ClipSamples& out, uint32_t subdivisions) {
   const auto joints = static_cast<uint32_t>(skeleton.joints.size());
   const uint32_t frames = clip.grid.frame_count;
-  out.resize(joints, frames);
+  const uint32_t n = subdivisions == 0 ? 1 : subdivisions;
+  const uint32_t positions = (frames - 1) * n + 1;
+  out.resize(joints, positions);
   for (uint32_t j = 0; j < joints; ++j)
     for (uint32_t ch = 0; ch < kChannelsPerJoint; ++ch)
-      std::fill_n(out.channel(j, ch), frames, bind_value(skeleton.joints[j], ch));
+      std::fill_n(out.channel(j, ch), positions, bind_value(skeleton.joints[j], ch));
   for (const CompressedConstant& c : clip.constants) {
     if (c.joint >= joints || c.channel >= kChannelsPerJoint) continue;
-    std::fill_n(out.channel(c.joint, c.channel), frames, glm::vec4(c.value[0], c.value[1], c.value[2], c.value[3]));
+    std::fill_n(out.channel(c.joint, c.channel), positions, glm::vec4(c.value[0], c.value[1], c.value[2], c.value[3]));
   }
+  const float step = 1.0f / static_cast<float>(n);  // exact: n is a power of two in practice
   for (const CompressedAnimated& a : clip.animated) {
     if (a.joint >= joints || a.channel >= kChannelsPerJoint || a.key_count < 2) continue;
     glm::vec4* dst = out.channel(a.joint, a.channel);
@@ -58,12 +61,30 @@ void decode_clip(const CompressedClip& clip, const SourceSkeleton& skeleton, Cli
       const glm::vec4 next = key_sample(a.channel, a.dropped, xyz);
       const uint32_t f0 = key_frames[k - 1], f1 = key_frames[k];
       const float inv_length = 1.0f / static_cast<float>(f1 - f0);
-      for (uint32_t f = f0; f <= f1 && f < frames; ++f) {
-        dst[f] = interpolate_keys(a.channel, prev, next, static_cast<float>(f - f0) * inv_length);
+      for (uint32_t p = f0 * n; p <= f1 * n && p < positions; ++p) {
+        const float x = static_cast<float>(p / n) + static_cast<float>(p % n) * step;
+        dst[p] = interpolate_keys(a.channel, prev, next, (x - static_cast<float>(f0)) * inv_length);
       }
       prev = next;
     }
   }
+}
+
+ClipSamples between_frames(const ClipSamples& frames) {
+  ClipSamples out;
+  const uint32_t n = kErrorSubdivisions;
+  out.resize(frames.joint_count, frames.frame_count == 0 ? 0 : (frames.frame_count - 1) * n + 1);
+  for (uint32_t j = 0; j < frames.joint_count; ++j) {
+    for (uint32_t ch = 0; ch < kChannelsPerJoint; ++ch) {
+      const glm::vec4* src = frames.channel(j, ch);
+      glm::vec4* dst = out.channel(j, ch);
+      for (uint32_t p = 0; p < out.frame_count; ++p) {
+        const uint32_t f = p / n, k = p % n;
+        dst[p] = k == 0 ? src[f] : interpolate_keys(ch, src[f], src[f + 1], static_cast<float>(k) / static_cast<float>(n));
+      }
+    }
+  }
+  return out;
 }
 
 Affine affine_from_trs(const glm::vec4& t, const glm::vec4& r, const glm::vec4& s) {
@@ -87,25 +108,27 @@ void model_at_frame(const SourceSkeleton& skeleton, const ClipSamples& samples, 
 }
 
 ClipError measure_clip_error(const SourceSkeleton& skeleton, const ClipSamples& reference, const ClipSamples& test,
-                             double probe, const std::vector<Affine>* reference_models) {
+                             double probe, const std::vector<Affine>* reference_models, uint32_t subdivisions) {
   ClipError e;
   const uint32_t joints = reference.joint_count;
+  const uint32_t n = subdivisions == 0 ? 1 : subdivisions;
   e.joint_max.assign(joints, 0.0);
   std::vector<Affine> ref_model(joints), test_model(joints);
   double sum = 0.0;
-  for (uint32_t f = 0; f < reference.frame_count; ++f) {
-    if (reference_models == nullptr) model_at_frame(skeleton, reference, f, ref_model);
-    model_at_frame(skeleton, test, f, test_model);
+  for (uint32_t p = 0; p < reference.frame_count; ++p) {
+    if (reference_models == nullptr) model_at_frame(skeleton, reference, p, ref_model);
+    model_at_frame(skeleton, test, p, test_model);
     for (uint32_t j = 0; j < joints; ++j) {
-      const Affine& r = reference_models ? (*reference_models)[static_cast<size_t>(j) * reference.frame_count + f]
+      const Affine& r = reference_models ? (*reference_models)[static_cast<size_t>(j) * reference.frame_count + p]
                                          : ref_model[j];
       const double err = probe_error(r, test_model[j], probe);
       sum += err;
       e.joint_max[j] = std::max(e.joint_max[j], err);
+      if (p % n == 0) e.max_at_frames = std::max(e.max_at_frames, err);
       if (err > e.max) {
         e.max = err;
         e.worst_joint = static_cast<uint16_t>(j);
-        e.worst_frame = f;
+        e.worst_frame = static_cast<float>(p) / static_cast<float>(n);
       }
     }
   }

@@ -3,21 +3,28 @@
 // (cooker/clip/clip_compress.h), and the decoding it is measured through.
 //
 // The metric is the one the animation-compression literature uses (ACL's "virtual vertices", ozz's
-// error at a distance): for every joint at every frame, six probe points sit at ±probe along each
-// of the joint's three local axes; both the source pose and the cooked pose carry them into model
-// space (the joint's whole parent chain included, so errors accumulate down the hierarchy as a
-// skinned vertex would see them), and the joint's error is the largest displacement among its six
-// points. Six points rather than the three positive ones: with a translation error d and a rotation
-// error r, the displacement of a point is |d + r·p|, which is largest on whichever side r·p points
-// along d, so the negative side matters. A scaled joint scales its probe points with it, as it would
-// scale the vertices it carries.
+// error at a distance): for every joint six probe points sit at ±probe along each of the joint's
+// three axes, `probe` from the joint in the source pose's model space (whatever scale the armature
+// carries); both the source pose and the cooked pose carry them into model space (the joint's whole
+// parent chain included, so errors accumulate down the hierarchy as a skinned vertex would see
+// them), and the joint's error is the largest displacement among its six points. Six points rather
+// than the three positive ones: with a translation error d and a rotation error r, the
+// displacement of a point is |d + r·p|, which is largest on whichever side r·p points along d, so
+// the negative side matters.
+//
+// Where: at every frame and at kErrorSubdivisions - 1 points between each pair of frames, because
+// a runtime plays between frames too, and there the cooked clip interpolates its own keys while the
+// source is the raw frames interpolated the same way (what a lossless cook plays). Errors that
+// cancel at the frames need not cancel between them: a child fitted to undo its parent's decoded
+// error at the frames (clip_compress.cpp, error compensation) leaves a residue between them that
+// grows with how fast both move.
 //
 // The measure itself (affine_from_trs, probe_error) lives in <ossa/anim/pose_error.h>, so tools that
 // judge cooked output without the cooker (ossa-diff) measure exactly what the cooker bounded.
-// Poses are kept as per-channel, per-frame float samples (ClipSamples, the layout the compressor
-// works in); model space is built in double so the measurement reflects the data, not rounding in
-// the measurement. Decoding, on the other hand, is done in float with the runtime's own arithmetic
-// (ossa/format/clip_codec.h's decode_key and rotation_from_stored, then lerp / nlerp on the shortest arc between
+// Poses are kept as per-channel, per-position float samples (ClipSamples, the layout the
+// compressor works in); model space is built in double so the measurement reflects the data, not
+// rounding in the measurement. Decoding, on the other hand, is done in float with the runtime's own
+// arithmetic (ossa/format/clip_codec.h's decoding, then lerp / nlerp on the shortest arc between
 // keys), because the bound is a promise about what a runtime will play.
 #pragma once
 #include <cstdint>
@@ -36,8 +43,9 @@ namespace ossa::cook {
 inline constexpr uint32_t kChannelsPerJoint = 3;
 enum ChannelIndex : uint32_t { kTranslation = 0, kRotation = 1, kScale = 2 };
 
-/// Every channel of every joint sampled at every frame of a clip's grid. Translation and scale are
-/// xyz (w = 0); rotation is a unit quaternion as (x, y, z, w).
+/// Every channel of every joint sampled at every frame of a clip's grid (or, for the error measure,
+/// at every position of a finer grid: between_frames). Translation and scale are xyz (w = 0);
+/// rotation is a unit quaternion as (x, y, z, w).
 struct ClipSamples {
   uint32_t joint_count = 0;
   uint32_t frame_count = 0;
@@ -56,6 +64,11 @@ struct ClipSamples {
   }
 };
 
+/// Positions measured per frame interval (<ossa/anim/pose_error.h>): the frames and the points at
+/// 1/4, 2/4 and 3/4 of the way to the next frame. Position p of a clip is frame position p / kErrorSubdivisions; a clip of F
+/// frames has (F - 1) * kErrorSubdivisions + 1 positions.
+inline constexpr uint32_t kErrorSubdivisions = kClipErrorSubdivisions;
+
 /// A channel's bind value as a sample (translation/scale xyz with w = 0, rotation xyzw).
 glm::vec4 bind_value(const SourceJoint& joint, uint32_t channel);
 
@@ -69,10 +82,16 @@ glm::vec4 key_sample(uint32_t channel, uint32_t dropped, const float stored[3]);
 /// 1 / |q|.
 glm::vec4 interpolate_keys(uint32_t channel, const glm::vec4& a, glm::vec4 b, float alpha);
 
-/// Decodes `clip` (made for `skeleton`) at every frame of its grid: bind values for absent
-/// channels, constants, and animated keys decoded from key_values and interpolated between the
-/// key frames around each frame with alpha = (frame - f0) * (1 / (f1 - f0)).
-void decode_clip(const CompressedClip& clip, const SourceSkeleton& skeleton, ClipSamples& out);
+/// Decodes `clip` (made for `skeleton`) at every frame of its grid, or with subdivisions = n at every
+/// frame position p / n: bind values for absent channels, constants, and animated keys decoded
+/// from key_values and interpolated between the key frames f0 <= x < f1 around each position x with
+/// alpha = (x - f0) * (1 / (f1 - f0)), as runtime/anim/sample.cpp does.
+void decode_clip(const CompressedClip& clip, const SourceSkeleton& skeleton, ClipSamples& out,
+                 uint32_t subdivisions = 1);
+
+/// A clip keyed at every frame (`frames`, e.g. the source on its grid) played at every position of
+/// kErrorSubdivisions per frame, as a runtime plays it (interpolate_keys between neighbours).
+ClipSamples between_frames(const ClipSamples& frames);
 
 /// A joint's model-space transform: x -> linear * x + origin (<ossa/anim/pose_error.h>).
 using Affine = ModelAffine;
@@ -91,17 +110,20 @@ void model_at_frame(const SourceSkeleton& skeleton, const ClipSamples& samples, 
 using ossa::probe_error;
 
 struct ClipError {
-  double max = 0.0;             // over every joint at every frame
-  double mean = 0.0;            // of the per-joint, per-frame error (largest of its six points)
-  uint16_t worst_joint = 0;     // where max occurs (the first such joint, lowest frame first)
-  uint32_t worst_frame = 0;
-  std::vector<double> joint_max;  // per joint, over frames
+  double max = 0.0;             // over every joint at every position
+  double max_at_frames = 0.0;   // ... at the frames only
+  double mean = 0.0;            // of the per-joint, per-position error (largest of its six points)
+  uint16_t worst_joint = 0;     // where max occurs (the first such joint, lowest position first)
+  float worst_frame = 0.0f;     // the frame position where max occurs
+  std::vector<double> joint_max;  // per joint, over positions
 };
 
-/// Measures `test` against `reference` (same joint and frame counts, same skeleton) at every frame.
-/// `reference_models`, when given, is the reference's model space [joint * frames + frame],
-/// computed once by a caller that measures repeatedly. O(frames * joints).
+/// Measures `test` against `reference` (same joint and position counts, same skeleton) at every
+/// position; positions are frame positions p / subdivisions. `reference_models`, when given, is the
+/// reference's model space [joint * positions + position], computed once by a caller that measures
+/// repeatedly. O(positions * joints).
 ClipError measure_clip_error(const SourceSkeleton& skeleton, const ClipSamples& reference, const ClipSamples& test,
-                             double probe, const std::vector<Affine>* reference_models = nullptr);
+                             double probe, const std::vector<Affine>* reference_models = nullptr,
+                             uint32_t subdivisions = 1);
 
 }  // namespace ossa::cook

@@ -1,8 +1,7 @@
 // pose_error.cpp — the probe-point pose error (pose_error.h).
 //
-// Written joint by joint in double, in the same operations and order the cooker measured with
-// before this unit existed (cooker/clip/clip_error.cpp now calls it), so cooked bytes did not change
-// when the measure moved here and ossa-diff reproduces the cooker's figures.
+// Written joint by joint in double. The cooker (cooker/clip/clip_error.cpp), ossa-diff and
+// ossa-bench-acl all call it, so their figures are one measure.
 #include <ossa/anim/pose_error.h>
 
 #include <algorithm>
@@ -46,7 +45,9 @@ double probe_error(const ModelAffine& reference, const ModelAffine& test, double
   const glm::dvec3 d_origin = reference.origin - test.origin;
   double worst = 0.0;
   for (int axis = 0; axis < 3; ++axis) {
-    const glm::dvec3 d_axis = (reference.linear[axis] - test.linear[axis]) * probe;
+    const double length = glm::length(reference.linear[axis]);
+    const double local = length > 0.0 ? probe / length : 0.0;  // probe from the joint in model space
+    const glm::dvec3 d_axis = (reference.linear[axis] - test.linear[axis]) * local;
     worst = std::max(worst, glm::length(d_origin + d_axis));
     worst = std::max(worst, glm::length(d_origin - d_axis));
   }

@@ -88,7 +88,7 @@ TEST(Diff, IdenticalFilesAreTheSame) {
   EXPECT_TRUE(r.clips.items[0].sampled);
   EXPECT_EQ(r.clips.items[0].max_error_mm, 0.0);
   EXPECT_EQ(r.clips.items[0].joints_compared, 4u);
-  // 31 frames at 30 Hz over 1 s, and 121 times on the 120 Hz grid, 31 of which coincide.
+  // 31 frames at 30 Hz over 1 s and three points between each pair of frames: 31 + 30 * 3.
   EXPECT_EQ(r.clips.items[0].times, 121u);
   ASSERT_EQ(r.meshes.items.size(), 1u);
   EXPECT_EQ(r.meshes.items[0].max_displacement_mm, 0.0);

@@ -27,8 +27,6 @@ namespace ossa::diff {
 
 /// Probe distance of the clip and bind-pose measure, in metres (the cooker's, cooker/clip/clip_compress.h).
 inline constexpr double kProbeMetres = 0.1;
-/// Clips are sampled at their own frame times and on this grid (Hz) over their duration.
-inline constexpr double kProbeRateHz = 120.0;
 
 struct Options {
   double tolerance_mm = 0.1;  // a joint, vertex or clip differs when its error exceeds this

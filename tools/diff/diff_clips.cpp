@@ -2,9 +2,10 @@
 // sampler on both sides and measured with the cooker's probe-point measure (<ossa/anim/pose_error.h>).
 //
 // Each pair of clips is sampled (ossa::sample, no looping, so the last time is the last frame) at
-// the union of both clips' own frame times and a 120 Hz grid over the shorter duration: the frame
-// times are where the cooker measured its bound, the grid catches what happens between keys
-// (where a player sees interpolation). At every time both poses go to model space through their
+// both clips' own frame times and the points 1/4, 2/4 and 3/4 of the way between them
+// (kClipErrorSubdivisions), over the shorter duration: where the cooker measures its bound, frames
+// and what a player sees between them, so ossa-diff of a lossless cook against a compressed one
+// reports the compressed cook's own figure. At every time both poses go to model space through their
 // own rigs and every joint paired by name (diff_internal.h's joint mapping, the same one the
 // skeleton section uses) is measured; the clip's error is the largest, with the joint and time
 // where it occurs. A clip-only file's clips play on the --skeleton rig given for its side.
@@ -74,14 +75,16 @@ std::vector<SampleTime> sample_times(const ClipView& a, const ClipView& b) {
   std::vector<SampleTime> times;
   const auto add_grid = [&](double rate, uint32_t frames, bool old_frames) {
     for (uint32_t f = 0; f < frames; ++f) {
-      const double t = f / rate;
-      if (t > end + 1e-9) break;
-      times.push_back({std::min(t, end), old_frames});
+      for (uint32_t k = 0; k < kClipErrorSubdivisions; ++k) {
+        if (k > 0 && f + 1 >= frames) break;
+        const double t = (f + static_cast<double>(k) / kClipErrorSubdivisions) / rate;
+        if (t > end + 1e-9) break;
+        times.push_back({std::min(t, end), old_frames && k == 0});
+      }
     }
   };
   add_grid(a.sample_rate(), a.frame_count(), true);
   add_grid(b.sample_rate(), b.frame_count(), false);
-  add_grid(kProbeRateHz, static_cast<uint32_t>(std::floor(end * kProbeRateHz)) + 1, false);
   times.push_back({end, false});
   std::sort(times.begin(), times.end(), [](const SampleTime& x, const SampleTime& y) { return x.t < y.t; });
   std::vector<SampleTime> unique;

@@ -3,12 +3,16 @@
 // the same figure the cooker promised, without linking the cooker.
 //
 // The measure (ACL's "virtual vertices", ozz's error at a distance): around every joint sit six
-// probe points at ±probe along each of the joint's three local axes. Both poses carry them into
-// model space through the joint's whole parent chain, so an error high in the hierarchy shows up
-// at every joint below it as a skinned vertex would see it, and the joint's error is the largest
+// probe points at ±probe along each of the joint's three axes. Both poses carry them into model
+// space through the joint's whole parent chain, so an error high in the hierarchy shows up at
+// every joint below it as a skinned vertex would see it, and the joint's error is the largest
 // displacement among its six points; a pose's error is the largest over its joints. Six points,
 // not three: with a translation error d and a rotation error r a point moves by |d + r·p|, which
-// is largest on whichever side r·p points along d. A scaled joint scales its probe points with it.
+// is largest on whichever side r·p points along d. The points sit `probe` from the joint in model
+// space, placed by the reference pose: along axis k the local point is ±probe / |reference axis k|,
+// so a rig whose armature carries a ×100 scale (Blender exports) is measured 10 cm from its joints
+// like any other, not 10 m; the test pose carries the same local points, so a scale error still
+// moves them.
 // Model space is built in double from the float poses, so the measurement reflects the data and
 // not rounding in the measurement; cooker/clip/clip_error.cpp uses these same definitions. Cost: per
 // joint one quaternion-to-matrix conversion, one 3x3 product and six 3-vector lengths, all in
@@ -27,6 +31,11 @@
 
 namespace ossa {
 
+/// Where a clip's error is measured: at every frame and at the points 1/4, 2/4 and 3/4 of the way to
+/// the next frame, because a runtime plays between frames too (the cooker bounds its error there,
+/// ossa-diff and ossa-bench-acl sample there, so all three report one figure).
+inline constexpr uint32_t kClipErrorSubdivisions = 4;
+
 /// A joint's model-space transform in double: x -> linear * x + origin.
 struct ModelAffine {
   glm::dmat3 linear{1.0};
@@ -42,8 +51,10 @@ ModelAffine affine_from_trs(const glm::vec3& translation, const glm::quat& rotat
 /// parents.size(), out.size()) transforms. O(joints).
 void local_to_model_affine(std::span<const int16_t> parents, ConstPoseSpan local, std::span<ModelAffine> out);
 
-/// The largest displacement of the six probe points (±probe along each local axis) between two
-/// model-space transforms of one joint. In the transforms' units. O(1).
+/// The largest displacement of the six probe points between two model-space transforms of one
+/// joint: the local points ±(probe / |reference.linear[k]|) e_k, that is `probe` from the joint
+/// along each of its axes in the reference's model space (a zero-length reference axis puts its two
+/// points on the joint). In the transforms' units. O(1).
 double probe_error(const ModelAffine& reference, const ModelAffine& test, double probe);
 
 struct PoseError {
