@@ -408,10 +408,11 @@ ClipKeys collect_keys(const NodeGraph& graph, const aiAnimation& anim) {
   ClipKeys out;
   out.node_keys.assign(graph.nodes.size(), -1);
   out.end_ticks = std::isfinite(anim.mDuration) ? std::max(0.0, anim.mDuration) : 0.0;
+  const std::vector<int> nodes = channel_nodes(graph, anim);
   for (unsigned c = 0; c < anim.mNumChannels; ++c) {
     const aiNodeAnim* ch = anim.mChannels[c];
     if (!ch) continue;
-    const int n = graph.resolve(ch->mNodeName.C_Str());
+    const int n = nodes[c];
     if (n < 0) continue;  // warned once per file by the rig stage
     if (out.node_keys[n] >= 0) {
       ++out.twice;

@@ -25,6 +25,8 @@
 
 struct aiScene;
 struct aiNode;
+struct aiMesh;
+struct aiAnimation;
 
 namespace ossa::cook::detail {
 
@@ -80,6 +82,9 @@ struct NodeGraph {
   /// an object and a bone of the same name, e.g. Quaternius' "Torso"): prefer a non-helper node
   /// holding no mesh, then the first in depth-first order. -1 when nothing has that name.
   int resolve(const std::string& name) const;
+  /// A name that is not in the file but reads "<top>/<name>" means the node <name> under the
+  /// top-level node <top>: the cooked name of a joint whose name repeats in another armature.
+  int resolve_path(const std::string& name) const;
   /// true when a is n or one of n's raw ancestors.
   bool is_ancestor_or_self(int a, int n) const;
   /// The non-helper node an `$AssimpFbx$` helper belongs to (itself when not a helper), -1 if none.
@@ -104,6 +109,20 @@ struct Context {
 };
 
 NodeGraph build_node_graph(const Context& ctx);
+
+/// The node each of the mesh's bones means (helpers resolved to their owner, -1 when none),
+/// mesh_node being a node that holds the mesh (-1 when none). A name held by several nodes (two
+/// armatures each with a "Bone") is settled by the hierarchy, not by name alone: the candidate
+/// under the armature (top-level node) holding most of the mesh's unambiguous bones, then the
+/// one whose global transform is closest to where the skin was bound, global(mesh_node) x
+/// inverse(offset). Every stage that reads bones calls this, so they all agree.
+std::vector<int> bone_nodes(const NodeGraph& graph, const aiMesh& mesh, int mesh_node);
+
+/// The node each channel of anim means (raw, helpers not resolved; -1 when none). A clip drives the
+/// joints of its own armature: a repeated name means the candidate under the top-level node the
+/// clip's name starts with ("HatArmature|Lift", Blender's convention), else under the one holding
+/// most of the clip's unambiguous channels, else the first in node order.
+std::vector<int> channel_nodes(const NodeGraph& graph, const aiAnimation& anim);
 
 // ---------------------------------------------------------------------------------------------
 // Rig (import_rig.cpp): which nodes are joints and where each joint's local transform comes from.

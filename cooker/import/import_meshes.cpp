@@ -265,10 +265,11 @@ bool skin(const aiMesh& in, const NodeGraph& graph, const Rig& rig, int node, So
   const unsigned nv = in.mNumVertices;
   std::vector<std::vector<Influence>> per_vertex(nv);
   std::map<uint16_t, glm::mat4> bind;  // sorted by joint; a joint named twice keeps its first bone
+  const std::vector<int> nodes = bone_nodes(graph, in, node);
   for (unsigned b = 0; b < in.mNumBones; ++b) {
     const aiBone* bone = in.mBones[b];
     if (!bone) continue;
-    const int n = graph.helper_owner(graph.resolve(bone->mName.C_Str()));
+    const int n = nodes[b];
     if (n < 0 || rig.node_joint[n] < 0) continue;  // warned (or refused) by the rig stage
     const glm::dmat4 offset = to_dmat4(bone->mOffsetMatrix);
     if (!is_finite(offset)) {

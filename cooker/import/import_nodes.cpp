@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <map>
 #include <set>
 
 #include <assimp/scene.h>
@@ -164,7 +165,7 @@ NodeGraph build_node_graph(const Context& ctx) {
 
 int NodeGraph::resolve(const std::string& name) const {
   const auto it = by_name.find(name);
-  if (it == by_name.end()) return -1;
+  if (it == by_name.end()) return resolve_path(name);
   int best = -1;
   for (int n : it->second) {
     if (nodes[n].helper) continue;
@@ -172,6 +173,115 @@ int NodeGraph::resolve(const std::string& name) const {
     if (best < 0) best = n;
   }
   return best >= 0 ? best : it->second.front();
+}
+
+int NodeGraph::resolve_path(const std::string& name) const {
+  const size_t slash = name.find('/');
+  if (slash == std::string::npos) return -1;
+  const auto it = by_name.find(name.substr(slash + 1));
+  if (it == by_name.end()) return -1;
+  int best = -1;
+  for (int n : it->second) {
+    if (nodes[n].helper || nodes[nodes[n].top].name != name.substr(0, slash)) continue;
+    if (!nodes[n].has_mesh) return n;
+    if (best < 0) best = n;
+  }
+  return best;
+}
+
+namespace {
+
+/// The nodes named `name` that resolve() would choose between (neither helpers nor holding a
+/// mesh: an object named like a bone is settled by resolve()), or empty when at most one is.
+std::vector<int> ambiguous(const NodeGraph& graph, const std::string& name) {
+  const auto it = graph.by_name.find(name);
+  if (it == graph.by_name.end()) return {};
+  std::vector<int> out;
+  for (int n : it->second)
+    if (!graph.nodes[n].helper && !graph.nodes[n].has_mesh) out.push_back(n);
+  if (out.size() < 2) out.clear();
+  return out;
+}
+
+/// The top-level node most of `nodes` lie under (the first in node order on a tie), -1 if none.
+int majority_top(const NodeGraph& graph, const std::vector<int>& nodes) {
+  std::map<int, size_t> count;
+  for (int n : nodes)
+    if (n >= 0) ++count[graph.nodes[n].top];
+  int best = -1;
+  size_t most = 0;
+  for (const auto& [top, c] : count) {
+    if (c > most) {
+      best = top;
+      most = c;
+    }
+  }
+  return best;
+}
+
+/// The candidates under `top`, or all of them when none is.
+std::vector<int> under_top(const NodeGraph& graph, const std::vector<int>& candidates, int top) {
+  std::vector<int> out;
+  for (int n : candidates)
+    if (graph.nodes[n].top == top) out.push_back(n);
+  return out.empty() ? candidates : out;
+}
+
+}  // namespace
+
+std::vector<int> bone_nodes(const NodeGraph& graph, const aiMesh& mesh, int mesh_node) {
+  std::vector<int> out(mesh.mNumBones, -1);
+  std::vector<bool> settled(mesh.mNumBones, true);
+  for (unsigned b = 0; b < mesh.mNumBones; ++b) {
+    if (!mesh.mBones[b]) continue;
+    const std::string name = mesh.mBones[b]->mName.C_Str();
+    settled[b] = ambiguous(graph, name).empty();
+    if (settled[b]) out[b] = graph.helper_owner(graph.resolve(name));
+  }
+  const int top = majority_top(graph, out);
+  for (unsigned b = 0; b < mesh.mNumBones; ++b) {
+    if (settled[b]) continue;
+    const aiBone& bone = *mesh.mBones[b];
+    const std::vector<int> candidates = under_top(graph, ambiguous(graph, bone.mName.C_Str()), top);
+    glm::dmat4 bound(1.0);
+    const bool has_bind = mesh_node >= 0 && try_inverse(to_dmat4(bone.mOffsetMatrix), &bound);
+    if (has_bind) bound = graph.nodes[mesh_node].global * bound;
+    double closest = 0.0;
+    for (int n : candidates) {  // node order breaks ties: the same bytes give the same joints
+      const double d = has_bind ? relative_difference(graph.nodes[n].global, bound) : 0.0;
+      if (out[b] < 0 || d < closest) {
+        out[b] = n;
+        closest = d;
+      }
+    }
+  }
+  return out;
+}
+
+std::vector<int> channel_nodes(const NodeGraph& graph, const aiAnimation& anim) {
+  std::vector<int> out(anim.mNumChannels, -1);
+  std::vector<bool> settled(anim.mNumChannels, true);
+  for (unsigned c = 0; c < anim.mNumChannels; ++c) {
+    if (!anim.mChannels[c]) continue;
+    const std::string name = anim.mChannels[c]->mNodeName.C_Str();
+    settled[c] = ambiguous(graph, name).empty();
+    if (settled[c]) out[c] = graph.resolve(name);
+  }
+  // Blender names an action after its armature ("HatArmature|Lift"): that armature, when it is a
+  // top-level node; else the one the clip's unambiguous channels lie under.
+  int top = majority_top(graph, out);
+  const std::string clip = anim.mName.C_Str();
+  if (clip.find('|') != std::string::npos) {
+    const auto named = graph.by_name.find(clip.substr(0, clip.find('|')));
+    for (int n : named == graph.by_name.end() ? std::vector<int>{} : named->second)
+      if (graph.nodes[n].parent == 0) top = n;
+  }
+  for (unsigned c = 0; c < anim.mNumChannels; ++c) {
+    if (settled[c]) continue;
+    const std::vector<int> candidates = under_top(graph, ambiguous(graph, anim.mChannels[c]->mNodeName.C_Str()), top);
+    out[c] = candidates.front();
+  }
+  return out;
 }
 
 bool NodeGraph::is_ancestor_or_self(int a, int n) const {

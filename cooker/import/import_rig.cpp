@@ -61,13 +61,20 @@ Seeds find_seeds(const Context& ctx, const NodeGraph& graph) {
   Seeds seeds{std::vector<bool>(count, false), std::vector<bool>(count, false)};
   std::vector<std::string> missing_bones, missing_channels, cameras;
   std::set<std::string> seen_bones, seen_channels, seen_cameras;
+  std::vector<int> holder(scene.mNumMeshes, -1);  // the first node holding each mesh
+  for (size_t n = graph.nodes.size(); n-- > 0;) {
+    const aiNode& node = *graph.nodes[n].ai;
+    for (unsigned i = 0; i < node.mNumMeshes; ++i)
+      if (node.mMeshes[i] < scene.mNumMeshes) holder[node.mMeshes[i]] = static_cast<int>(n);
+  }
   for (unsigned m = 0; m < scene.mNumMeshes; ++m) {
     const aiMesh* mesh = scene.mMeshes[m];
     if (!ctx.mesh_kept[m]) continue;
+    const std::vector<int> nodes = bone_nodes(graph, *mesh, holder[m]);
     for (unsigned b = 0; b < mesh->mNumBones; ++b) {
       const aiBone* bone = mesh->mBones[b];
       if (!bone) continue;
-      const int n = graph.helper_owner(graph.resolve(bone->mName.C_Str()));
+      const int n = nodes[b];
       if (n < 0) {
         add_unique(&missing_bones, &seen_bones, bone->mName.C_Str());
       } else {
@@ -77,10 +84,11 @@ Seeds find_seeds(const Context& ctx, const NodeGraph& graph) {
   }
   for (unsigned a = 0; a < scene.mNumAnimations; ++a) {
     const aiAnimation* anim = scene.mAnimations[a];
+    const std::vector<int> nodes = anim ? channel_nodes(graph, *anim) : std::vector<int>{};
     for (unsigned c = 0; anim && c < anim->mNumChannels; ++c) {
       const aiNodeAnim* channel = anim->mChannels[c];
       if (!channel) continue;
-      const int n = graph.helper_owner(graph.resolve(channel->mNodeName.C_Str()));
+      const int n = graph.helper_owner(nodes[c]);
       if (n < 0) {
         add_unique(&missing_channels, &seen_channels, channel->mNodeName.C_Str());
       } else if (graph.nodes[n].camera_or_light) {
@@ -313,10 +321,12 @@ void adopt_mesh_bind_pose(const Context& ctx, const NodeGraph& graph, Rig* rig) 
       const unsigned m = node.mMeshes[i];
       if (m >= ctx.mesh_kept.size() || !ctx.mesh_kept[m]) continue;
       const aiMesh* mesh = ctx.scene->mMeshes[m];
-      for (unsigned b = 0; mesh && b < mesh->mNumBones; ++b) {
+      if (!mesh) continue;
+      const std::vector<int> nodes = bone_nodes(graph, *mesh, static_cast<int>(n));
+      for (unsigned b = 0; b < mesh->mNumBones; ++b) {
         const aiBone* bone = mesh->mBones[b];
         if (!bone) continue;
-        const int bn = graph.helper_owner(graph.resolve(bone->mName.C_Str()));
+        const int bn = nodes[b];
         if (bn < 0 || rig->node_joint[static_cast<size_t>(bn)] < 0) continue;
         const auto j = static_cast<size_t>(rig->node_joint[static_cast<size_t>(bn)]);
         glm::dmat4 inverse_offset;
@@ -404,6 +414,32 @@ void name_unnamed_joints(const Context& ctx, SourceSkeleton* skeleton) {
   }
 }
 
+/// Joints are nodes, and two armatures may each have a "Bone": the format binds clips, masks and
+/// retargeting by joint name, so a repeated name is made unique. The first joint keeps it; a later
+/// one becomes "<its top-level node>/<name>" (which NodeGraph::resolve understands, so clip files
+/// cooked against this rig find the joint), or "<name>.<n>" when that is taken too. Said in a warning.
+void make_names_unique(const Context& ctx, const NodeGraph& graph, Rig* rig) {
+  std::set<std::string> used;
+  std::vector<std::string> renamed;
+  for (size_t j = 0; j < rig->skeleton.joints.size(); ++j) {
+    SourceJoint& joint = rig->skeleton.joints[j];
+    if (used.insert(joint.name).second) continue;
+    const Node& node = graph.nodes[static_cast<size_t>(rig->joint_node[j])];
+    std::string name = graph.nodes[static_cast<size_t>(node.top)].name + "/" + joint.name;
+    if (node.top == 0 || used.count(name)) {
+      for (int n = 1; used.count(name = joint.name + "." + std::to_string(n)); ++n) {
+      }
+    }
+    used.insert(name);
+    renamed.push_back("'" + joint.name + "' -> '" + name + "'");
+    joint.name = name;
+  }
+  if (!renamed.empty()) {
+    ctx.warn(std::to_string(renamed.size()) + " joints share a name with another joint (several armatures) "
+             "and are renamed: " + name_list(renamed));
+  }
+}
+
 Result<Rig> own_rig(const Context& ctx, const NodeGraph& graph, const std::vector<int>& seeds) {
   Rig rig;
   rig.node_joint.assign(graph.nodes.size(), -1);
@@ -428,6 +464,7 @@ Result<Rig> own_rig(const Context& ctx, const NodeGraph& graph, const std::vecto
     rig.prefix.emplace_back(1.0);
   }
   name_unnamed_joints(ctx, &rig.skeleton);
+  make_names_unique(ctx, graph, &rig);
   for (size_t j = 0; j < order.size(); ++j) {
     if (!is_finite(chain_local(graph, rig.chain[j]))) {
       return ctx.error("joint '" + rig.skeleton.joints[j].name + "' has a non-finite transform");

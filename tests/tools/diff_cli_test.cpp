@@ -17,6 +17,7 @@
 #include <nlohmann/json.hpp>
 
 #include <ossa/loader/asset.h>
+#include "blend_shape_fbx.h"
 #include "test_files.h"
 
 namespace fs = std::filesystem;
@@ -227,6 +228,39 @@ TEST(DiffCli, ClipOnlyFileNeedsItsSkeleton) {
   r = run_command(diff_cmd() + " " + q(walk) + " " + q(walk) + " --skeleton " + q(fox));
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("Fox.ossa"), std::string::npos) << r.err;
+}
+
+TEST(DiffCli, MorphOnlyClipsCompareWithoutASkeleton) {
+  // A blend-shape face (no joints) whose take drives two morph weights: nothing to play on a rig,
+  // its weights are compared per track at the clip's frames and between.
+  const fs::path dir = ossa::test::make_temp_dir("diff-morph");
+  const std::string face = ossa::test::kBlendShapeFbx;
+  fs::create_directories(dir / "src");
+  fs::create_directories(dir / "changed");
+  ASSERT_TRUE(ossa::test::write_file(dir / "src" / "face.fbx", face));
+  std::string changed = face;
+  const size_t at = changed.find("a: 0,100,0");
+  ASSERT_NE(at, std::string::npos);
+  changed.replace(at, 10, "a: 0,80,0");  // smile peaks at 0.8 instead of 1.0
+  ASSERT_TRUE(ossa::test::write_file(dir / "changed" / "face.fbx", changed));
+  const fs::path a = cook(dir, "a", dir / "src" / "face.fbx"), b = cook(dir, "b", dir / "changed" / "face.fbx");
+  ASSERT_FALSE(a.empty());
+  ASSERT_FALSE(b.empty());
+  auto r = run_command(diff_cmd() + " " + q(a) + " " + q(a) + " -v");
+  EXPECT_EQ(r.exit_code, 0) << r.out << r.err;
+  EXPECT_NE(r.out.find("2 morph tracks, max weight difference 0"), std::string::npos) << r.out;
+  int code = 0;
+  const nlohmann::json j = diff_json(a, b, "", &code);
+  EXPECT_EQ(code, 1);
+  ASSERT_TRUE(j.contains("sections")) << j.dump();
+  ASSERT_EQ(j["sections"]["clips"]["items"].size(), 1u) << j.dump();
+  const auto& item = j["sections"]["clips"]["items"][0];
+  EXPECT_TRUE(item["sampled"].get<bool>());
+  EXPECT_EQ(item["morph_tracks_compared"].get<int>(), 2);
+  EXPECT_NEAR(item["max_morph_weight_error"].get<double>(), 0.2, 1e-3) << item.dump();
+  bool named = false;
+  for (const auto& d : j["differences"]) named = named || d.dump().find("morph weight") != std::string::npos;
+  EXPECT_TRUE(named) << j["differences"].dump();
 }
 
 TEST(DiffCli, JsonOutputMatchesItsSchema) {

@@ -27,6 +27,8 @@ namespace ossa::diff {
 
 /// Probe distance of the clip and bind-pose measure, in metres (the cooker's, cooker/clip/clip_compress.h).
 inline constexpr double kProbeMetres = 0.1;
+/// Morph weights (unitless, usually 0..1) differ when they differ by more than this.
+inline constexpr double kMorphWeightTolerance = 1e-3;
 
 struct Options {
   double tolerance_mm = 0.1;  // a joint, vertex or clip differs when its error exceeds this
@@ -129,6 +131,8 @@ struct ClipItem {
   std::optional<double> root_motion_mm;   // largest root-motion translation difference (both have it)
   std::optional<double> root_motion_deg;  // largest root-motion yaw difference
   bool events_same = true;
+  size_t morph_tracks_compared = 0;   // weight tracks in both clips, paired by name
+  double max_morph_weight_error = 0.0;  // largest |old - new| weight over those tracks and the times
   std::string note;
 };
 

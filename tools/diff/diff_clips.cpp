@@ -9,7 +9,10 @@
 // own rigs and every joint paired by name (diff_internal.h's joint mapping, the same one the
 // skeleton section uses) is measured; the clip's error is the largest, with the joint and time
 // where it occurs. A clip-only file's clips play on the --skeleton rig given for its side.
-// Duration, frame rate, events and root motion (presence, then the trajectory) are compared too.
+// Duration, frame rate, events and root motion (presence, then the trajectory) are compared too,
+// and every morph weight track both clips hold (paired by name) at the same times. A clip that
+// drives only morph weights (no joint channel: a blend-shape animal without a skeleton) needs no
+// rig: its weights are all there is to compare.
 #include <algorithm>
 #include <cmath>
 #include <numbers>
@@ -20,6 +23,7 @@
 #include <ossa/anim/pose.h>
 #include <ossa/anim/pose_error.h>
 #include <ossa/anim/root_motion.h>
+#include <ossa/anim/morph.h>
 #include <ossa/anim/sample.h>
 #include "common/message.h"
 #include "tools/diff/diff_internal.h"
@@ -38,12 +42,18 @@ std::optional<SkeletonView> rig_for(const ClipView& clip, const Asset& file, con
   return std::nullopt;
 }
 
-/// A side whose file has no skeleton cannot play its clips without a rig that binds them.
+/// A clip with no joint channel and no root motion: morph weights only, played without a rig.
+bool morph_only(const ClipView& clip) {
+  return clip.constants().empty() && clip.animated().empty() && clip.root_motion() == nullptr;
+}
+
+/// A side whose file has no skeleton cannot play its clips without a rig that binds them (clips of
+/// morph weights only aside).
 Status check_side(const Asset& file, const Asset* rig, const char* side) {
   if (!file.skeleton().empty()) return {};
   for (size_t i = 0; i < file.clip_count(); ++i) {
     const ClipView clip = file.clip(i);
-    if (rig_for(clip, file, rig)) continue;
+    if (morph_only(clip) || rig_for(clip, file, rig)) continue;
     if (rig == nullptr)
       return Error{file.name() + ": a clip-only file (no skeleton): pass --skeleton (or --" + side +
                    "-skeleton) with the cooked rig its clips were made for"};
@@ -198,6 +208,37 @@ void measure(Context& c, const std::string& label, ClipItem& item, Player& a, Pl
   if (rm_deg > limit_deg) c.add_figure(kSection, label, "root motion yaw", rm_deg, "deg", limit_deg);
 }
 
+/// Weight tracks: added and removed ones named, the paired ones sampled at `times`.
+void compare_morph_weights(Context& c, const std::string& label, ClipItem& item, const ClipView& a,
+                           const ClipView& b, const std::vector<SampleTime>& times) {
+  std::vector<std::string> old_names, new_names;
+  for (size_t i = 0; i < a.morph_track_count(); ++i)
+    old_names.emplace_back(flatbuffers::GetStringView(a.morph_track(i).name()));
+  for (size_t k = 0; k < b.morph_track_count(); ++k)
+    new_names.emplace_back(flatbuffers::GetStringView(b.morph_track(k).name()));
+  const NameMatch m = match_by_name(old_names, new_names);
+  for (size_t i : m.only_old) c.add_text(kSection, label, "morph track removed", quote_name(old_names[i]));
+  for (size_t k : m.only_new) c.add_text(kSection, label, "morph track added", quote_name(new_names[k]));
+  std::string worst;
+  double worst_time = 0.0;
+  for (const auto& [i, k] : m.pairs) {
+    for (const SampleTime& st : times) {
+      const auto t = static_cast<float>(st.t);
+      const double d = std::fabs(static_cast<double>(sample_morph_track(a, a.morph_track(i), t)) -
+                                 static_cast<double>(sample_morph_track(b, b.morph_track(k), t)));
+      if (worst.empty() || d > item.max_morph_weight_error) {
+        item.max_morph_weight_error = d;
+        worst = old_names[i];
+        worst_time = st.t;
+      }
+    }
+  }
+  item.morph_tracks_compared = m.pairs.size();
+  if (item.max_morph_weight_error > kMorphWeightTolerance)
+    c.add_figure(kSection, label, "morph weight", item.max_morph_weight_error, "", kMorphWeightTolerance,
+                 "track " + quote_name(worst) + " at " + num(worst_time) + " s");
+}
+
 ClipItem compare_clip(Context& c, const std::string& label, const ClipView& a, const ClipView& b) {
   ClipItem item;
   item.name = label;
@@ -213,6 +254,12 @@ ClipItem compare_clip(Context& c, const std::string& label, const ClipView& a, c
   if (x.root_motion != y.root_motion)
     c.add_text(kSection, label, "root motion", x.root_motion ? "removed" : "added");
   compare_events(c, label, item);
+  compare_morph_weights(c, label, item, a, b, sample_times(a, b));
+  if (morph_only(a) && morph_only(b)) {
+    item.times = sample_times(a, b).size();
+    item.sampled = true;
+    return item;
+  }
 
   const auto rig_a = rig_for(a, c.old_asset, c.old_rig), rig_b = rig_for(b, c.new_asset, c.new_rig);
   std::optional<Player> pa, pb;

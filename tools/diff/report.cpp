@@ -100,6 +100,8 @@ json clips_json(const ClipSection& s) {
                          {"root_motion_mm", optional_number(c.root_motion_mm)},
                          {"root_motion_deg", optional_number(c.root_motion_deg)},
                          {"events_same", c.events_same},
+                         {"morph_tracks_compared", c.morph_tracks_compared},
+                         {"max_morph_weight_error", round6(c.max_morph_weight_error)},
                          {"note", c.note}});
   return json{{"old_count", s.old_count}, {"new_count", s.new_count}, {"added", s.added}, {"removed", s.removed},
               {"max_error_mm", round6(s.max_error_mm)}, {"items", items}};
@@ -208,6 +210,9 @@ std::string to_text(const DiffReport& r, bool verbose) {
         text += format(", %zu times x %zu joints, max joint error %.4g mm (joint '%s' at %.4g s; at frames %.4g mm)",
                        c.times, c.joints_compared, c.max_error_mm, ossa::detail::printable(c.worst_joint).c_str(),
                        c.worst_time_s, c.max_error_at_frames_mm);
+      if (c.morph_tracks_compared > 0)
+        text += format(", %zu morph tracks, max weight difference %.4g", c.morph_tracks_compared,
+                       c.max_morph_weight_error);
       if (c.old_side.cooker_max_error_mm && c.new_side.cooker_max_error_mm)
         text += format(", cooker's error %.4g -> %.4g mm", *c.old_side.cooker_max_error_mm, *c.new_side.cooker_max_error_mm);
       line(text);
