@@ -103,6 +103,67 @@ TEST(CookerCli, OutputCollisionRefusedBeforeCooking) {
   EXPECT_TRUE(ossa::Asset::open((dir / "out" / "b" / "model.ossa").string()).ok());
 }
 
+/// A BVH of a two-joint chain with `frames` frames, each a little different.
+std::string generated_bvh(int frames) {
+  std::string s =
+      "HIERARCHY\nROOT hips\n{\n OFFSET 0 0 0\n CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation "
+      "Yrotation\n JOINT spine\n {\n  OFFSET 0 1 0\n  CHANNELS 3 Zrotation Xrotation Yrotation\n"
+      "  End Site\n  {\n   OFFSET 0 1 0\n  }\n }\n}\nMOTION\nFrames: " + std::to_string(frames) +
+      "\nFrame Time: 0.033333\n";
+  for (int f = 0; f < frames; ++f) s += "0 1 0 0 0 " + std::to_string(f * 3) + " " + std::to_string(f * 2) + " 0 0\n";
+  return s;
+}
+
+/// A one-triangle OBJ (a static mesh).
+std::string generated_obj(float size) {
+  const std::string v = std::to_string(size);
+  return "v 0 0 0\nv " + v + " 0 0\nv 0 " + v + " 0\nvn 0 0 1\nf 1//1 2//1 3//1\n";
+}
+
+// Sources of one folder that share a stem (a studio tree has skeleton.dae beside skeleton.fbx) each
+// get an output of their own, named by the input's file name; a source alone with its stem keeps
+// <stem>.ossa; everything loads and a second run finds every output up to date.
+TEST(CookerCli, SameStemSourcesOfOneFolderKeepTheirExtension) {
+  const fs::path dir = ossa::test::make_temp_dir("cli-same-stem");
+  const fs::path src = dir / "src";
+  for (const char* sub : {"rig", "clips", "other"}) fs::create_directories(src / sub);
+  ASSERT_TRUE(ossa::test::write_file(src / "rig" / "skel.bvh", generated_bvh(4)));
+  ASSERT_TRUE(ossa::test::write_file(src / "rig" / "skel.obj", generated_obj(1.0f)));
+  fs::copy_file(asset("RiggedSimple/RiggedSimple.glb"), src / "rig" / "skel.glb");
+  ASSERT_TRUE(ossa::test::write_file(src / "clips" / "walk.bvh", generated_bvh(7)));
+  fs::copy_file(asset("CesiumMan/CesiumMan.glb"), src / "clips" / "walk.glb");
+  ASSERT_TRUE(ossa::test::write_file(src / "clips" / "walk.OBJ", generated_obj(2.0f)));
+  ASSERT_TRUE(ossa::test::write_file(src / "other" / "skel.bvh", generated_bvh(5)));
+  ASSERT_TRUE(ossa::test::write_file(src / "lone.bvh", generated_bvh(3)));
+
+  const fs::path out = dir / "out";
+  const std::string cmd = cook_cmd() + " " + q(src) + " --root " + q(src) + " -o " + q(out) + " --jobs 2";
+  const auto r = run_command(cmd + " --report " + q(dir / "first.json"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::vector<std::string> expected = {"rig/skel.bvh.ossa",   "rig/skel.obj.ossa", "rig/skel.glb.ossa",
+                                             "clips/walk.bvh.ossa", "clips/walk.glb.ossa", "clips/walk.OBJ.ossa",
+                                             "other/skel.ossa",     "lone.ossa"};
+  for (const std::string& name : expected) {
+    auto a = ossa::Asset::open((out / name).string());
+    EXPECT_TRUE(a.ok()) << name << ": " << (a.ok() ? "" : a.error().message);
+  }
+  EXPECT_EQ(count_files(out), expected.size()) << "one output per input, nothing else";
+  // Distinct sources gave distinct outputs: the two BVH of one stem are not the same bytes as the GLB.
+  EXPECT_NE(ossa::test::read_file(out / "rig" / "skel.bvh.ossa"), ossa::test::read_file(out / "rig" / "skel.glb.ossa"));
+
+  const auto again = run_command(cmd + " --report " + q(dir / "second.json"));
+  ASSERT_EQ(again.exit_code, 0) << again.err;
+  const auto report = nlohmann::json::parse(ossa::test::read_text(dir / "second.json").value_or("{}"), nullptr, false);
+  ASSERT_TRUE(report.contains("records")) << report.dump();
+  ASSERT_EQ(report["records"].size(), expected.size());
+  for (const auto& rec : report["records"]) EXPECT_TRUE(rec["up_to_date"].get<bool>()) << rec.dump();
+
+  // One file of a pair cooked alone keeps the short name: the rule looks at the batch's inputs only.
+  const auto alone = run_command(cook_cmd() + " " + q(src / "rig" / "skel.bvh") + " -o " + q(dir / "alone"));
+  ASSERT_EQ(alone.exit_code, 0) << alone.err;
+  EXPECT_TRUE(fs::exists(dir / "alone" / "skel.ossa"));
+}
+
 TEST(CookerCli, InputOutsideRootIsAnError) {
   const fs::path dir = ossa::test::make_temp_dir("cli-root");
   const auto r = run_command(cook_cmd() + " " + q(asset("Fox/Fox.glb")) + " --root " + q(dir) + " -o " +
