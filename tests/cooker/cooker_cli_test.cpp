@@ -238,6 +238,36 @@ TEST(CookerCli, Gltf1DocumentsCook) {
   EXPECT_NE(r.err.find("\"skins\" is not an array"), std::string::npos) << r.err;
 }
 
+// A file that is not a model (a README, notes, an image, a file with no extension) is named as such,
+// not answered with Assimp's guess at a format it never was ("FBX-Tokenize ... unexpected
+// double-quote"); a model extension with broken content keeps Assimp's own message.
+TEST(CookerCli, NonModelFilesAreNamedAsSuch) {
+  const fs::path dir = ossa::test::make_temp_dir("cli-not-model");
+  const std::string prose = "# Notes\n\nThe \"walk\" clip loops; see {this} and [that].\n";
+  const std::vector<std::pair<std::string, std::string>> files = {
+      {"README.md", prose + ossa::test::read_text(ossa::test::source_dir() / "README.md").value_or("")},
+      {"notes.txt", prose},
+      {"picture.png", std::string(reinterpret_cast<const char*>(ossa::test::tiny_png().data()),
+                                  ossa::test::tiny_png().size())},
+      {"LICENSE", "Permission is hereby granted, \"free of charge\", to any person\n"},
+      {"data.csv", "time,x,y\n0,1,2\n"}};
+  for (const auto& [name, text] : files) {
+    ASSERT_TRUE(ossa::test::write_file(dir / name, text));
+    const auto r = run_command(cook_cmd() + " " + q(dir / name) + " -o " + q(dir / "out"));
+    EXPECT_EQ(r.exit_code, 1) << name << ": " << r.err;
+    EXPECT_NE(r.err.find(name + ": not a model file ossa-cook can read (FBX, glTF, GLB, DAE, BVH, OBJ"),
+              std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find("Tokenize"), std::string::npos) << r.err;
+  }
+  // Known model extensions with broken content: Assimp's reader says what is wrong.
+  for (const char* name : {"broken.fbx", "broken.dae", "broken.obj"}) {
+    ASSERT_TRUE(ossa::test::write_file(dir / name, prose));
+    const auto r = run_command(cook_cmd() + " " + q(dir / name) + " -o " + q(dir / "out"));
+    EXPECT_NE(r.exit_code, 0) << name;
+    EXPECT_EQ(r.err.find("not a model file"), std::string::npos) << name << ": " << r.err;
+  }
+}
+
 TEST(CookerCli, InputOutsideRootIsAnError) {
   const fs::path dir = ossa::test::make_temp_dir("cli-root");
   const auto r = run_command(cook_cmd() + " " + q(asset("Fox/Fox.glb")) + " --root " + q(dir) + " -o " +
