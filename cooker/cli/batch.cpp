@@ -53,6 +53,16 @@ Result<std::vector<BatchItem>> plan_batch(const std::vector<fs::path>& inputs, c
     }
   }
 
+  // Model sources of this batch that share a stem in one folder (skeleton.dae beside skeleton.fbx)
+  // keep their extension in the output name, so each gets its own: skeleton.dae.ossa, skeleton.fbx.ossa.
+  std::map<std::pair<fs::path, std::string>, std::set<fs::path>> by_stem;  // (folder, stem) -> file names
+  const auto folder_of = [](const fs::path& input) {
+    return fs::absolute(input).lexically_normal().parent_path();
+  };
+  for (const auto& entry : files)
+    if (!is_graph_file(entry.first))
+      by_stem[{folder_of(entry.first), output_stem(entry.first)}].insert(entry.first.filename());
+
   std::vector<BatchItem> items;
   std::map<fs::path, fs::path> claimed;  // output -> first input that maps to it
   std::error_code root_ec;
@@ -68,7 +78,10 @@ Result<std::vector<BatchItem>> plan_batch(const std::vector<fs::path>& inputs, c
         return Error{input.string() + ": is not inside --root " + root.string()};
       sub = rel.parent_path();
     }
-    fs::path output = (out_dir / sub / output_stem(input)).concat(".ossa").lexically_normal();
+    const bool shared_stem =
+        !is_graph_file(input) && by_stem[{folder_of(input), output_stem(input)}].size() > 1;
+    const std::string name = shared_stem ? input.filename().string() : output_stem(input);
+    fs::path output = (out_dir / sub / name).concat(".ossa").lexically_normal();
     auto [it, inserted] = claimed.emplace(output, input);
     if (!inserted)
       return Error{"inputs " + it->second.string() + " and " + input.string() + " would both write " +

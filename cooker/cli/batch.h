@@ -38,7 +38,9 @@ std::string output_stem(const std::filesystem::path& input);
 
 /// Expands directory inputs (recursively, sorted; source extensions and graph files `*.graph.json`
 /// only, so event sidecars and other JSON stay out) and maps each input to OUTDIR/<output_stem>.ossa,
-/// or with `root` to OUTDIR/<path relative to root>/<output_stem>.ossa. Errors: an
+/// or with `root` to OUTDIR/<path relative to root>/<output_stem>.ossa. Model sources of the batch
+/// that share a stem in one folder (walk.dae, walk.fbx) keep their file name: walk.dae.ossa,
+/// walk.fbx.ossa; a source alone with its stem keeps the short name. Errors: an
 /// input outside `root`, or two inputs mapping to one output (both named). Missing inputs are not
 /// errors here: they fail at cook time as their own record. O(inputs log inputs).
 Result<std::vector<BatchItem>> plan_batch(const std::vector<std::filesystem::path>& inputs,

@@ -182,7 +182,10 @@ int main(int argc, char** argv) {
   double clip_tolerance_mm = 0.1;
   double metres_per_unit = 0.0;
   std::string up_axis = "y";
-  app.add_option("inputs", inputs, "source files, graph files (X.graph.json -> X.ossa) or directories (searched recursively)")
+  app.add_option("inputs", inputs,
+                 "source files (X.fbx -> X.ossa; sources of one folder that share a stem keep their extension: "
+                 "X.fbx -> X.fbx.ossa beside X.dae -> X.dae.ossa), graph files (X.graph.json -> X.ossa) or "
+                 "directories (searched recursively)")
       ->required();
   app.add_option("-o,--output", out_dir, "output directory")->required();
   app.add_option("--root", root,

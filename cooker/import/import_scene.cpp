@@ -197,7 +197,15 @@ Result<SourceScene> read_and_convert(const std::string& path, const ImportOption
   importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, 0);      // drop lines ourselves, with a warning
   const aiScene* scene = importer.ReadFile(path, assimp_import_flags());
   if (!io->refused().empty()) return Error{path + ": " + io->refused()};
-  if (!scene) return Error{path + ": " + importer.GetErrorString()};
+  if (!scene) {
+    // A file whose extension no Assimp reader claims was sniffed by content; a failure there is
+    // Assimp's guess at a format the file never was ("FBX-Tokenize ... unexpected double-quote" for
+    // a README), so say what the file is not. A known extension keeps Assimp's own message.
+    const std::string ext = std::filesystem::path(path).extension().string();
+    if (ext.empty() || !importer.IsExtensionSupported(ext))
+      return Error{path + ": not a model file ossa-cook can read (FBX, glTF, GLB, DAE, BVH, OBJ, ...)"};
+    return Error{path + ": " + importer.GetErrorString()};
+  }
   if (wants_tangents(*scene)) {
     scene = importer.ApplyPostProcessing(aiProcess_CalcTangentSpace);
     if (!scene) return Error{path + ": " + importer.GetErrorString()};

@@ -343,6 +343,8 @@ Result<std::optional<std::vector<uint8_t>>> precheck_gltf(std::span<const uint8_
     if (declared > bytes.size())
       return Error{"is a GLB file that declares " + std::to_string(declared) + " bytes but has " +
                    std::to_string(bytes.size()) + ": it is truncated"};
+    // Binary glTF 1.0 (KHR_binary_glTF) has no chunks; Assimp's glTF 1.0 reader checks it itself.
+    if (u32(bytes.data() + 4) == 1) return std::optional<std::vector<uint8_t>>{};
     if (u32(bytes.data() + 16) != kChunkJson) return Error{"is a GLB file whose first chunk is not JSON"};
     json_length = u32(bytes.data() + 12);
     json_at = 20;
@@ -360,6 +362,14 @@ Result<std::optional<std::vector<uint8_t>>> precheck_gltf(std::span<const uint8_
   }
   if (!root.is_object()) return Error{"is not a glTF document (its JSON is not an object)"};
   if (const uint64_t depth = gltf_depth(root); depth > kMaxHierarchyDepth) return too_deep(depth, "node tree");
+  // glTF 1.0 keys its top-level collections ("skins", "nodes", ...) by id in objects, and its skins
+  // name joints rather than index them: the 2.0 checks and fix-ups below do not apply (Assimp's
+  // glTF 1.0 reader has its own). 1.0 is told by asset.version, or by a file with no "asset" at all.
+  const Json* version = root.contains("asset") && root["asset"].is_object() && root["asset"].contains("version")
+                            ? &root["asset"]["version"] : nullptr;
+  const bool gltf1 = !root.contains("asset") ||
+                     (version && version->is_string() && version->get<std::string>().starts_with("1"));
+  if (gltf1) return std::optional<std::vector<uint8_t>>{};
   if (auto bad = check_skins(root)) return *bad;
   if (!add_identity_inverse_binds(root)) return std::optional<std::vector<uint8_t>>{};
   std::string text = root.dump();

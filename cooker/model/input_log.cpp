@@ -103,9 +103,21 @@ std::string refuse(const fs::path& path, const std::string& why, std::string_vie
   return message;
 }
 
-std::string outside_message() {
-  return "outside the folders this cook may read (" + allowed_list() +
-         "; widen them with --root DIR or --allow-dir DIR)";
+/// Names the widening that would allow `path`: --root at the nearest folder holding both the file and
+/// an allowed folder (the input's, usually), or --allow-dir at the file's own folder.
+std::string outside_message(const fs::path& path) {
+  const fs::path file = canonical_path(path);
+  fs::path nearest;
+  for (const ReadRoots::Root& r : t_sandbox->roots.roots()) {
+    fs::path common;
+    auto a = r.canonical.begin(), b = file.begin();
+    for (; a != r.canonical.end() && b != file.end() && *a == *b; ++a, ++b) common /= *a;
+    if (common.native().size() > nearest.native().size()) nearest = common;
+  }
+  const std::string dir = detail::printable(file.parent_path().string(), 400);
+  return "outside the folders this cook may read (" + allowed_list() + "; --root " +
+         detail::printable(nearest.empty() ? std::string("/") : nearest.string(), 400) + " or --allow-dir " + dir +
+         " would allow it)";
 }
 
 std::string hard_link_message(const struct stat& st) {
@@ -133,7 +145,7 @@ Result<OpenedInput> open_input(const fs::path& path, uint64_t max_bytes, std::st
     case OpenOutcome::kAbsent:
       if (InputLog* log = current_input_log()) log->add_absent(path);
       return Error{detail::printable(path.string(), 400) + ": cannot open: " + std::strerror(f.error)};
-    case OpenOutcome::kOutside: return Error{refuse(path, outside_message(), reference)};
+    case OpenOutcome::kOutside: return Error{refuse(path, outside_message(path), reference)};
     case OpenOutcome::kNotRegular:
       return Error{refuse(path, std::string("is ") + file_kind(f.st) + ", not a regular file", reference)};
     case OpenOutcome::kHardLinked: return Error{refuse(path, hard_link_message(f.st), reference)};
@@ -214,7 +226,7 @@ bool probe_input(const fs::path& path, std::string_view reference) {
     case OpenOutcome::kAbsent:
       if (InputLog* log = current_input_log()) log->add_absent(path);
       return false;
-    case OpenOutcome::kOutside: refuse(path, outside_message(), reference); return false;
+    case OpenOutcome::kOutside: refuse(path, outside_message(path), reference); return false;
     case OpenOutcome::kNotRegular:
       // A folder is no file of that name (an importer probes folders, e.g. an empty "mtllib"); a
       // FIFO, device or socket is a file the cook cannot read, and must not pass for absent.

@@ -120,6 +120,40 @@ TEST_F(CookSandbox, GraphSourcesOutsideTheTreeAreRefused) {
   EXPECT_NE(r.err.find("g.graph.json:1:"), std::string::npos) << "names the graph entry: " << r.err;
 }
 
+// A refusal for a file outside the sandbox names the widening that allows it: --root at the nearest
+// folder holding both the input and the file, or --allow-dir at the file's folder. Each layout
+// (sibling folder, deeper nesting on both sides, a folder beside the tree) is refused, then cooks
+// with exactly what the message proposed.
+TEST_F(CookSandbox, AnOutsideRefusalNamesTheRootOrAllowDirThatAllowsIt) {
+  struct Layout {
+    fs::path input, buffer, root;
+  };
+  const fs::path base = fs::canonical(dir);
+  const std::vector<Layout> layouts = {
+      {base / "tree" / "chars" / "a.gltf", base / "tree" / "buffers" / "a.bin", base / "tree"},
+      {base / "tree" / "p" / "q" / "r" / "b.gltf", base / "tree" / "p" / "x" / "y" / "b.bin", base / "tree" / "p"},
+      {base / "tree" / "chars" / "c.gltf", base / "secret" / "deep" / "c.bin", base}};
+  for (const Layout& l : layouts) {
+    fs::create_directories(l.input.parent_path());
+    fs::create_directories(l.buffer.parent_path());
+    ASSERT_TRUE(ossa::test::write_file(l.buffer, triangle_bytes()));
+    const std::string uri = fs::relative(l.buffer, l.input.parent_path()).generic_string();
+    ASSERT_TRUE(ossa::test::write_file(l.input, triangle_gltf(uri)));
+    const auto r = cook(l.input);
+    EXPECT_EQ(r.exit_code, 1) << l.input;
+    const std::string proposal = "--root " + l.root.string() + " or --allow-dir " + l.buffer.parent_path().string() +
+                                 " would allow it";
+    EXPECT_NE(r.err.find(proposal), std::string::npos) << "expected '" << proposal << "' in: " << r.err;
+    fs::remove_all(dir / "out");
+    const auto rooted = cook(l.input, "--root " + q(l.root));
+    EXPECT_EQ(rooted.exit_code, 0) << rooted.err;
+    fs::remove_all(dir / "out");
+    const auto allowed = cook(l.input, "--allow-dir " + q(l.buffer.parent_path()));
+    EXPECT_EQ(allowed.exit_code, 0) << allowed.err;
+    fs::remove_all(dir / "out");
+  }
+}
+
 TEST_F(CookSandbox, RootWidensTheSandboxAndADirectoryArgumentIsItsOwnTree) {
   fs::create_directories(tree / "textures");
   ASSERT_TRUE(ossa::test::write_file(tree / "textures" / "tri.bin", triangle_bytes()));

@@ -103,6 +103,171 @@ TEST(CookerCli, OutputCollisionRefusedBeforeCooking) {
   EXPECT_TRUE(ossa::Asset::open((dir / "out" / "b" / "model.ossa").string()).ok());
 }
 
+/// A BVH of a two-joint chain with `frames` frames, each a little different.
+std::string generated_bvh(int frames) {
+  std::string s =
+      "HIERARCHY\nROOT hips\n{\n OFFSET 0 0 0\n CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation "
+      "Yrotation\n JOINT spine\n {\n  OFFSET 0 1 0\n  CHANNELS 3 Zrotation Xrotation Yrotation\n"
+      "  End Site\n  {\n   OFFSET 0 1 0\n  }\n }\n}\nMOTION\nFrames: " + std::to_string(frames) +
+      "\nFrame Time: 0.033333\n";
+  for (int f = 0; f < frames; ++f) s += "0 1 0 0 0 " + std::to_string(f * 3) + " " + std::to_string(f * 2) + " 0 0\n";
+  return s;
+}
+
+/// A one-triangle OBJ (a static mesh).
+std::string generated_obj(float size) {
+  const std::string v = std::to_string(size);
+  return "v 0 0 0\nv " + v + " 0 0\nv 0 " + v + " 0\nvn 0 0 1\nf 1//1 2//1 3//1\n";
+}
+
+// Sources of one folder that share a stem (a studio tree has skeleton.dae beside skeleton.fbx) each
+// get an output of their own, named by the input's file name; a source alone with its stem keeps
+// <stem>.ossa; everything loads and a second run finds every output up to date.
+TEST(CookerCli, SameStemSourcesOfOneFolderKeepTheirExtension) {
+  const fs::path dir = ossa::test::make_temp_dir("cli-same-stem");
+  const fs::path src = dir / "src";
+  for (const char* sub : {"rig", "clips", "other"}) fs::create_directories(src / sub);
+  ASSERT_TRUE(ossa::test::write_file(src / "rig" / "skel.bvh", generated_bvh(4)));
+  ASSERT_TRUE(ossa::test::write_file(src / "rig" / "skel.obj", generated_obj(1.0f)));
+  fs::copy_file(asset("RiggedSimple/RiggedSimple.glb"), src / "rig" / "skel.glb");
+  ASSERT_TRUE(ossa::test::write_file(src / "clips" / "walk.bvh", generated_bvh(7)));
+  fs::copy_file(asset("CesiumMan/CesiumMan.glb"), src / "clips" / "walk.glb");
+  ASSERT_TRUE(ossa::test::write_file(src / "clips" / "walk.OBJ", generated_obj(2.0f)));
+  ASSERT_TRUE(ossa::test::write_file(src / "other" / "skel.bvh", generated_bvh(5)));
+  ASSERT_TRUE(ossa::test::write_file(src / "lone.bvh", generated_bvh(3)));
+
+  const fs::path out = dir / "out";
+  const std::string cmd = cook_cmd() + " " + q(src) + " --root " + q(src) + " -o " + q(out) + " --jobs 2";
+  const auto r = run_command(cmd + " --report " + q(dir / "first.json"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::vector<std::string> expected = {"rig/skel.bvh.ossa",   "rig/skel.obj.ossa", "rig/skel.glb.ossa",
+                                             "clips/walk.bvh.ossa", "clips/walk.glb.ossa", "clips/walk.OBJ.ossa",
+                                             "other/skel.ossa",     "lone.ossa"};
+  for (const std::string& name : expected) {
+    auto a = ossa::Asset::open((out / name).string());
+    EXPECT_TRUE(a.ok()) << name << ": " << (a.ok() ? "" : a.error().message);
+  }
+  EXPECT_EQ(count_files(out), expected.size()) << "one output per input, nothing else";
+  // Distinct sources gave distinct outputs: the two BVH of one stem are not the same bytes as the GLB.
+  EXPECT_NE(ossa::test::read_file(out / "rig" / "skel.bvh.ossa"), ossa::test::read_file(out / "rig" / "skel.glb.ossa"));
+
+  const auto again = run_command(cmd + " --report " + q(dir / "second.json"));
+  ASSERT_EQ(again.exit_code, 0) << again.err;
+  const auto report = nlohmann::json::parse(ossa::test::read_text(dir / "second.json").value_or("{}"), nullptr, false);
+  ASSERT_TRUE(report.contains("records")) << report.dump();
+  ASSERT_EQ(report["records"].size(), expected.size());
+  for (const auto& rec : report["records"]) EXPECT_TRUE(rec["up_to_date"].get<bool>()) << rec.dump();
+
+  // One file of a pair cooked alone keeps the short name: the rule looks at the batch's inputs only.
+  const auto alone = run_command(cook_cmd() + " " + q(src / "rig" / "skel.bvh") + " -o " + q(dir / "alone"));
+  ASSERT_EQ(alone.exit_code, 0) << alone.err;
+  EXPECT_TRUE(fs::exists(dir / "alone" / "skel.ossa"));
+}
+
+/// A skinned one-triangle glTF 1.0 document: every top-level collection an object keyed by id, the
+/// skin naming its joints. `version` "" leaves the "asset" block out (Assimp then finds no reader).
+nlohmann::json gltf1_document(const std::string& version, int extra_joints) {
+  using J = nlohmann::json;
+  const std::vector<double> identity = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+  J doc;
+  if (!version.empty()) doc["asset"] = {{"version", version}};
+  doc["buffers"]["buf"] = {
+      {"byteLength", 268},
+      {"uri",
+       "data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAAAAAAAAAAAAAAAAAAAAAA"
+       "AAAAgD8AAAAAAAAAAAAAAAAAAIA/AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAAAAAAAAAAAAAAAIA/"
+       "AAAAAAAAAAAAAAAAAAABAAIAAA"
+       "AAAIA/AAAAAAAAAAAAAAAAAAAAAAAAgD8AAAAAAAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAAAAAAIA/AACAPwAAAAAAAAAAAAAAAA"
+       "AAAAAAAIA/AAAAAAAAAAAAAAAAAAAAAAAAgD8AAAAAAAAAAAAAAL8AAAAAAACAPw=="}};
+  doc["bufferViews"]["vattr"] = {{"buffer", "buf"}, {"byteOffset", 0}, {"byteLength", 132}, {"target", 34962}};
+  doc["bufferViews"]["vidx"] = {{"buffer", "buf"}, {"byteOffset", 132}, {"byteLength", 6}, {"target", 34963}};
+  doc["bufferViews"]["vibm"] = {{"buffer", "buf"}, {"byteOffset", 140}, {"byteLength", 128}};
+  const auto accessor = [](const char* view, int offset, int type, int count, const char* shape) {
+    return J{{"bufferView", view}, {"byteOffset", offset}, {"componentType", type}, {"count", count}, {"type", shape}};
+  };
+  doc["accessors"]["apos"] = accessor("vattr", 0, 5126, 3, "VEC3");
+  doc["accessors"]["apos"]["min"] = {0, 0, 0};
+  doc["accessors"]["apos"]["max"] = {1, 1, 0};
+  doc["accessors"]["ajnt"] = accessor("vattr", 36, 5126, 3, "VEC4");
+  doc["accessors"]["awgt"] = accessor("vattr", 84, 5126, 3, "VEC4");
+  doc["accessors"]["aidx"] = accessor("vidx", 0, 5123, 3, "SCALAR");
+  doc["accessors"]["aibm"] = accessor("vibm", 0, 5126, 2, "MAT4");
+  doc["materials"]["mat"] = {{"values", {{"diffuse", {0.8, 0.8, 0.8, 1}}}}};
+  doc["meshes"]["tri"]["primitives"] = J::array(
+      {{{"attributes", {{"POSITION", "apos"}, {"JOINT", "ajnt"}, {"WEIGHT", "awgt"}}}, {"indices", "aidx"},
+        {"material", "mat"}, {"mode", 4}}});
+  doc["skins"]["skin"] = {{"bindShapeMatrix", identity}, {"inverseBindMatrices", "aibm"},
+                          {"jointNames", {"j_root", "j_tip"}}};
+  doc["nodes"]["root"] = {{"children", {"j_root", "body"}}};
+  doc["nodes"]["j_root"] = {{"jointName", "j_root"}, {"children", {"j_tip"}}};
+  doc["nodes"]["j_tip"] = {{"jointName", "j_tip"}, {"translation", {0, 0.5, 0}}, {"children", J::array()}};
+  for (int i = 0; i < extra_joints; ++i) {
+    const std::string name = "j_extra" + std::to_string(i);
+    const std::string parent = i == 0 ? "j_tip" : "j_extra" + std::to_string(i - 1);
+    doc["nodes"][name] = {{"jointName", name}, {"translation", {0, 0.25, 0}}};
+    doc["nodes"][parent]["children"].push_back(name);
+  }
+  doc["nodes"]["body"] = {{"meshes", {"tri"}}, {"skin", "skin"}, {"skeletons", {"j_root"}}};
+  doc["scenes"]["s"] = {{"nodes", {"root"}}};
+  doc["scene"] = "s";
+  return doc;
+}
+
+// glTF 1.0 keys "skins", "nodes" and the rest by id in objects; the checks written for 2.0's arrays
+// must not refuse it ("its \"skins\" is not an array"): each variant cooks to a file that loads.
+TEST(CookerCli, Gltf1DocumentsCook) {
+  const fs::path dir = ossa::test::make_temp_dir("cli-gltf1");
+  const std::vector<std::pair<std::string, std::pair<std::string, int>>> variants = {
+      {"v10", {"1.0", 0}}, {"v101", {"1.0.1", 2}}, {"v10b", {"1.0", 1}}, {"v1", {"1", 3}}};
+  for (const auto& [name, spec] : variants) {
+    const fs::path file = dir / (name + ".gltf");
+    ASSERT_TRUE(ossa::test::write_file(file, gltf1_document(spec.first, spec.second).dump(1)));
+    const auto r = run_command(cook_cmd() + " " + q(file) + " -o " + q(dir / "out"));
+    EXPECT_EQ(r.exit_code, 0) << name << ": " << r.err;
+    EXPECT_EQ(r.err.find("is not an array"), std::string::npos) << r.err;
+    auto a = ossa::Asset::open((dir / "out" / (name + ".ossa")).string());
+    ASSERT_TRUE(a.ok()) << name << ": " << (a.ok() ? "" : a.error().message);
+    EXPECT_EQ(a->mesh_count(), 1u) << name;
+  }
+  // A 2.0 document whose "skins" is an object is still refused by name, before Assimp reads it.
+  auto bad = gltf1_document("2.0", 0);
+  const fs::path file = dir / "v2.gltf";
+  ASSERT_TRUE(ossa::test::write_file(file, bad.dump()));
+  const auto r = run_command(cook_cmd() + " " + q(file) + " -o " + q(dir / "out"));
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.err.find("\"skins\" is not an array"), std::string::npos) << r.err;
+}
+
+// A file that is not a model (a README, notes, an image, a file with no extension) is named as such,
+// not answered with Assimp's guess at a format it never was ("FBX-Tokenize ... unexpected
+// double-quote"); a model extension with broken content keeps Assimp's own message.
+TEST(CookerCli, NonModelFilesAreNamedAsSuch) {
+  const fs::path dir = ossa::test::make_temp_dir("cli-not-model");
+  const std::string prose = "# Notes\n\nThe \"walk\" clip loops; see {this} and [that].\n";
+  const std::vector<std::pair<std::string, std::string>> files = {
+      {"README.md", prose + ossa::test::read_text(ossa::test::source_dir() / "README.md").value_or("")},
+      {"notes.txt", prose},
+      {"picture.png", std::string(reinterpret_cast<const char*>(ossa::test::tiny_png().data()),
+                                  ossa::test::tiny_png().size())},
+      {"LICENSE", "Permission is hereby granted, \"free of charge\", to any person\n"},
+      {"data.csv", "time,x,y\n0,1,2\n"}};
+  for (const auto& [name, text] : files) {
+    ASSERT_TRUE(ossa::test::write_file(dir / name, text));
+    const auto r = run_command(cook_cmd() + " " + q(dir / name) + " -o " + q(dir / "out"));
+    EXPECT_EQ(r.exit_code, 1) << name << ": " << r.err;
+    EXPECT_NE(r.err.find(name + ": not a model file ossa-cook can read (FBX, glTF, GLB, DAE, BVH, OBJ"),
+              std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find("Tokenize"), std::string::npos) << r.err;
+  }
+  // Known model extensions with broken content: Assimp's reader says what is wrong.
+  for (const char* name : {"broken.fbx", "broken.dae", "broken.obj"}) {
+    ASSERT_TRUE(ossa::test::write_file(dir / name, prose));
+    const auto r = run_command(cook_cmd() + " " + q(dir / name) + " -o " + q(dir / "out"));
+    EXPECT_NE(r.exit_code, 0) << name;
+    EXPECT_EQ(r.err.find("not a model file"), std::string::npos) << name << ": " << r.err;
+  }
+}
+
 TEST(CookerCli, InputOutsideRootIsAnError) {
   const fs::path dir = ossa::test::make_temp_dir("cli-root");
   const auto r = run_command(cook_cmd() + " " + q(asset("Fox/Fox.glb")) + " --root " + q(dir) + " -o " +
