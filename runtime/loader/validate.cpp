@@ -27,6 +27,7 @@
 #include <string>
 #include <vector>
 
+#include <ossa/anim/cloth.h>
 #include <ossa/format/clip_codec.h>
 #include <ossa/format/hash.h>
 #include <ossa/format/vertex_format.h>
@@ -558,6 +559,18 @@ class Validator {
                    {"position_scale", m.position_scale()}};
     for (const auto& v : vectors)
       if (v.value && !finite3(*v.value)) return fail(where, format("%s is not finite", v.field));
+    if (const fb::Cloth* cloth = m.cloth()) {  // format v9: ossa/anim/cloth.h's check_cloth
+      const uint64_t bytes = 4 * (count_of(cloth->particle_vertices()) + count_of(cloth->inverse_masses()) +
+                                  count_of(cloth->max_distances()) + count_of(cloth->backstops()) +
+                                  count_of(cloth->vertices())) +
+                             2 * (count_of(cloth->vertex_particles()) + count_of(cloth->triangles())) +
+                             count_of(cloth->flipped()) +
+                             8 * (count_of(cloth->stretch()) + count_of(cloth->bend()) + count_of(cloth->tethers())) +
+                             32 * count_of(cloth->colliders());
+      if (!spend(bytes)) return over_budget(where);
+      if (Status st = check_cloth(cloth_source(MeshView{&m}), vertex_count, joint_count_); !st)
+        return fail(where, st.message());
+    }
     return check_morph_targets(m, where);
   }
 

@@ -217,8 +217,18 @@ flatbuffers::Offset<fb::Mesh> write_mesh(flatbuffers::FlatBufferBuilder& fbb, co
                                             &t.normal_step, 0, nullptr, t.default_weight, 0.0f, 0.0f));
   }
   const auto target_vector = targets.empty() ? 0 : fbb.CreateVector(targets);
+  flatbuffers::Offset<fb::Cloth> cloth;
+  if (const std::optional<SyntheticCloth>& c = m.cloth) {
+    const auto max_distances = c->max_distances.empty() ? 0 : fbb.CreateVector(c->max_distances);
+    const fb::Vec3 gravity(0, -9.81f, 0);
+    cloth = fb::CreateCloth(fbb, fbb.CreateVector(c->particle_vertices), fbb.CreateVector(c->inverse_masses),
+                            max_distances, 0, fbb.CreateVector(c->vertices), fbb.CreateVector(c->vertex_particles), 0,
+                            fbb.CreateVector(c->triangles), fbb.CreateVectorOfStructs(c->stretch), 0,
+                            fbb.CreateVectorOfStructs(c->tethers), fbb.CreateVectorOfStructs(c->colliders), 0.01f,
+                            0.0f, 1e-4f, 1.0f, c->damping, 0.5f, &gravity);
+  }
   return fb::CreateMesh(fbb, name, count, m.vertex_stride, layout, vertex_bytes, m.index_format, index_bytes,
-                        submeshes, &lo, &hi, &offset, &scale, joints, inverse_bind, target_vector);
+                        submeshes, &lo, &hi, &offset, &scale, joints, inverse_bind, target_vector, cloth);
 }
 
 flatbuffers::Offset<fb::Clip> write_clip(flatbuffers::FlatBufferBuilder& fbb, const SyntheticClip& c,

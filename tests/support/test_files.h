@@ -73,6 +73,23 @@ struct SyntheticMorphTrack {
   float range_extent = 1.0f;
 };
 
+/// A cloth region (ossa.fbs Cloth) over the default 2 x 3 grid: the bottom row (vertices 0, 1)
+/// fixed, the rest simulated and tethered to it, stretch edges along the triangles' edges. Valid as
+/// given; bad-input cases break one field.
+struct SyntheticCloth {
+  std::vector<uint32_t> particle_vertices = {0, 1, 2, 3, 4, 5};
+  std::vector<float> inverse_masses = {0, 0, 1, 1, 1, 1};
+  std::vector<float> max_distances;
+  std::vector<uint32_t> vertices = {0, 1, 2, 3, 4, 5};
+  std::vector<uint16_t> vertex_particles = {0, 1, 2, 3, 4, 5};
+  std::vector<uint16_t> triangles = {0, 1, 2, 1, 3, 2, 2, 3, 4, 3, 5, 4};
+  std::vector<fb::ClothEdge> stretch = {{0, 1, 1.0f}, {2, 3, 1.0f}, {4, 5, 1.0f}, {0, 2, 1.0f},
+                                        {1, 3, 1.0f}, {2, 4, 1.0f}, {3, 5, 1.0f}};
+  std::vector<fb::ClothTether> tethers = {{2, 0, 1.0f}, {3, 1, 1.0f}, {4, 0, 2.0f}, {5, 1, 2.0f}};
+  std::vector<fb::ClothCollider> colliders = {{1, fb::Vec3(0, 0, 0), fb::Vec3(0, 1, 0), 0.1f}};
+  float damping = 1.0f;
+};
+
 struct SyntheticMesh {
   std::string name = "body";
   /// A 2 x 3 grid of vertices up the spine: rows y = 0, 1, 2.
@@ -91,6 +108,7 @@ struct SyntheticMesh {
   /// Default: the skeleton's inverse bind of each slot's joint (identity when out of range).
   std::optional<std::vector<fb::Mat4>> inverse_bind;
   std::vector<SyntheticMorphTarget> morph_targets;  // none by default
+  std::optional<SyntheticCloth> cloth;              // none by default
 
   /// Position Unorm16x4 @0, Normal Snorm16x2 @8, TexCoord0 Float16x2 @12, Joints Uint8x4 @16,
   /// Weights Unorm8x4 @20: stride 24, the cooker's default layout.

@@ -26,7 +26,8 @@
 // counts are multiples of 3 and materials < max(1, material count); textures have a known role
 // and embedded data or a path; vertex, index and texture bytes are 16-byte aligned in memory; a
 // cooked texture has a known encoding, sides of 1..kMaxTextureSide, 1 to a full chain of mip
-// levels and exactly that chain's bytes (texture.h).
+// levels and exactly that chain's bytes (texture.h); a mesh's cloth (format v9) passes check_cloth
+// (ossa/anim/cloth.h) against the mesh's vertex count and the skeleton's joint count.
 #pragma once
 #include <cstddef>
 #include <string_view>
