@@ -27,7 +27,7 @@
 #include <string>
 #include <vector>
 
-#include <ossa/anim/cloth.h>
+#include <ossa/loader/cloth_source.h>
 #include <ossa/format/clip_codec.h>
 #include <ossa/format/hash.h>
 #include <ossa/format/vertex_format.h>
