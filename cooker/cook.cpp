@@ -273,6 +273,7 @@ void cook_into(CookRecord& record, const fs::path& input, const fs::path& output
 
   MeshOptions mesh_options;
   mesh_options.float_vertices = options.float_vertices;
+  mesh_options.cloth = options.cloth;
   MeshBuildStats stats;
   auto meshes = build_meshes(*scene, mesh_options, &stats, &record.warnings);
   if (!meshes) {

@@ -187,6 +187,7 @@ void cook_graph(CookRecord& record, const fs::path& input, const fs::path& outpu
 
   MeshOptions mesh_options;
   mesh_options.float_vertices = options.float_vertices;
+  mesh_options.cloth = options.cloth;
   MeshBuildStats stats;
   auto meshes = build_meshes(character, mesh_options, &stats, &record.warnings);
   if (!meshes) {

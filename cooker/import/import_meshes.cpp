@@ -172,6 +172,13 @@ bool copy_geometry(const aiMesh& in, SourceFormat format, SourceMesh* out, size_
     }
     if (all_white) out->colors.clear();
   }
+  if (in.mColors[1]) {  // cloth paint (docs/CLOTH.md), read by cooker/mesh/cloth_build.h
+    out->cloth_paint.reserve(nv);
+    for (unsigned v = 0; v < nv; ++v) {
+      const aiColor4D& c = in.mColors[1][v];
+      out->cloth_paint.emplace_back(c.r, c.g, c.b, c.a);
+    }
+  }
   for (unsigned f = 0; f < in.mNumFaces; ++f) {
     const aiFace& face = in.mFaces[f];
     if (face.mNumIndices != 3 || face.mIndices[0] >= nv || face.mIndices[1] >= nv ||

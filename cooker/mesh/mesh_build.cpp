@@ -180,6 +180,7 @@ Status validate_mesh(const SourceScene& scene, size_t index) {
   if (Status s = check_size(m.tangents.size(), "tangents"); !s) return s;
   if (Status s = check_size(m.uv0.size(), "texture coordinates"); !s) return s;
   if (Status s = check_size(m.colors.size(), "colours"); !s) return s;
+  if (Status s = check_size(m.cloth.size(), "cloth attributes"); !s) return s;
   if (Status s = check_size(m.joints.size(), "joint sets"); !s) return s;
   if (m.weights.size() != m.joints.size())
     return bad("has " + std::to_string(m.joints.size()) + " joint sets but " +
@@ -284,6 +285,7 @@ size_t remap_with_targets(const SourceMesh& m, std::vector<unsigned>* remap) {
     append_bytes(key, m.colors, i);
     append_bytes(key, m.joints, i);
     append_bytes(key, m.weights, i);
+    append_bytes(key, m.cloth, i);
     for (const SourceMorphTarget& t : m.morph_targets) {
       append_bytes(key, t.positions, i);
       append_bytes(key, t.normals, i);
@@ -310,6 +312,7 @@ SourceMesh weld(const SourceMesh& m, size_t* unused) {
     add_stream(streams, m.colors);
     add_stream(streams, m.joints);
     add_stream(streams, m.weights);
+    add_stream(streams, m.cloth);
     unique = meshopt_generateVertexRemapMulti(remap.data(), m.indices.data(), m.indices.size(), n, streams.data(),
                                               streams.size());
   }
@@ -324,6 +327,7 @@ SourceMesh weld(const SourceMesh& m, size_t* unused) {
   compact(out.colors, remap, unique);
   compact(out.joints, remap, unique);
   compact(out.weights, remap, unique);
+  compact(out.cloth, remap, unique);
   for (SourceMorphTarget& t : out.morph_targets) {
     compact(t.positions, remap, unique);
     compact(t.normals, remap, unique);
@@ -417,6 +421,7 @@ struct Streams {
   std::vector<glm::vec4> colors;
   std::vector<std::array<uint16_t, 4>> slots;
   std::vector<glm::vec4> weights;
+  std::vector<glm::vec4> cloth;       // cloth attributes; zeros where a member has none
   std::vector<MorphStreams> targets;  // merged by name over the members; zeros where a member lacks one
 };
 
@@ -529,7 +534,9 @@ Result<CookedMesh> build_group(const SourceScene& scene, const std::vector<Clean
 
   // Concatenate the members' streams and indices; one submesh each.
   bool colored = false;
+  bool clothed = false;
   for (const size_t member : members) colored = colored || !cleaned[member].mesh.colors.empty();
+  for (const size_t member : members) clothed = clothed || !cleaned[member].mesh.cloth.empty();
   Streams s;
   // Morph targets merge by name across members (a head split by material shares its "smile"); a
   // stream is present when any member's target of that name has it.
@@ -578,6 +585,10 @@ Result<CookedMesh> build_group(const SourceScene& scene, const std::vector<Clean
           warnings.push_back(mesh_label(m, c.source) + ": " + std::to_string(clamped) +
                              " vertex colours outside [0, 1] were clamped");
       }
+    }
+    if (clothed) {
+      if (m.cloth.empty()) s.cloth.insert(s.cloth.end(), m.positions.size(), glm::vec4(0.0f));
+      else s.cloth.insert(s.cloth.end(), m.cloth.begin(), m.cloth.end());
     }
     if (attrs.skinned) {
       for (size_t v = 0; v < m.joints.size(); ++v) {
@@ -635,6 +646,7 @@ Result<CookedMesh> build_group(const SourceScene& scene, const std::vector<Clean
       compact(s.colors, remap, unique);
       compact(s.slots, remap, unique);
       compact(s.weights, remap, unique);
+      compact(s.cloth, remap, unique);
       for (MorphStreams& t : s.targets) {
         compact(t.positions, remap, unique);
         compact(t.normals, remap, unique);
@@ -773,12 +785,13 @@ Result<CookedMesh> build_group(const SourceScene& scene, const std::vector<Clean
   if (quantized && vertex_count > 0) {
     std::vector<unsigned> remap(vertex_count);
     size_t unique = 0;
-    if (dense.empty()) {
+    if (dense.empty() && s.cloth.empty()) {
       unique = meshopt_generateVertexRemap(remap.data(), indices.data(), indices.size(), out.vertices.data(),
                                            vertex_count, layout.stride);
     } else {
       unique = remap_by_key(indices, vertex_count, &remap, [&](std::string& key, size_t i) {
         key.append(reinterpret_cast<const char*>(out.vertices.data()) + i * layout.stride, layout.stride);
+        append_bytes(key, s.cloth, i);
         for (const DenseMorph& d : dense) {
           append_bytes(key, d.positions, i);
           append_bytes(key, d.normals, i);
@@ -788,6 +801,7 @@ Result<CookedMesh> build_group(const SourceScene& scene, const std::vector<Clean
     }
     if (unique < vertex_count) {
       for (DenseMorph& d : dense) remap_morph(d, remap, unique);
+      compact(s.cloth, remap, unique);
       std::vector<uint8_t> merged(unique * layout.stride);
       meshopt_remapVertexBuffer(merged.data(), out.vertices.data(), vertex_count, layout.stride, remap.data());
       meshopt_remapIndexBuffer(indices.data(), indices.data(), indices.size(), remap.data());
@@ -809,6 +823,7 @@ Result<CookedMesh> build_group(const SourceScene& scene, const std::vector<Clean
   }
 
   for (const DenseMorph& d : dense) out.morph_targets.push_back(sparsify(d));
+  out.cloth_attributes = std::move(s.cloth);
 
   stats.cooked_vertices += out.vertex_count;
   stats.triangles += static_cast<uint32_t>(indices.size() / 3);
@@ -822,6 +837,10 @@ Result<std::vector<CookedMesh>> build_meshes(const SourceScene& scene, const Mes
   MeshBuildStats stats;
   std::vector<std::string> warnings;
 
+  // Cloth attributes from paint and settings (cloth_build.h), carried like any stream.
+  auto cloth = cloth_attributes(scene, options.cloth, &warnings);
+  if (!cloth) return cloth.error();
+
   // Validate and clean every source mesh.
   std::vector<CleanMesh> cleaned;
   for (size_t si = 0; si < scene.meshes.size(); ++si) {
@@ -830,7 +849,13 @@ Result<std::vector<CookedMesh>> build_meshes(const SourceScene& scene, const Mes
     CleanMesh c;
     c.source = si;
     size_t unused = 0;
-    c.mesh = weld(scene.meshes[si], &unused);
+    if ((*cloth)[si].empty()) {
+      c.mesh = weld(scene.meshes[si], &unused);
+    } else {
+      SourceMesh with_cloth = scene.meshes[si];
+      with_cloth.cloth = std::move((*cloth)[si]);
+      c.mesh = weld(with_cloth, &unused);
+    }
     SourceMesh& m = c.mesh;
     if (unused > 0)
       warnings.push_back(mesh_label(m, si) + ": dropped " + std::to_string(unused) + " vertices no triangle uses");
@@ -878,6 +903,11 @@ Result<std::vector<CookedMesh>> build_meshes(const SourceScene& scene, const Mes
   for (const auto& [attrs, members] : groups) {
     auto mesh = build_group(scene, cleaned, members, attrs, options, stats, warnings, misses_before, misses_after);
     if (!mesh) return mesh.error();
+    if (!mesh->cloth_attributes.empty()) {
+      auto built = build_cloth(scene, options.cloth, *mesh, mesh->cloth_attributes, &warnings);
+      if (!built) return built.error();
+      mesh->cloth = std::move(*built);
+    }
     meshes.push_back(std::move(*mesh));
   }
   if (stats.triangles > 0) {

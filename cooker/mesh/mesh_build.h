@@ -18,6 +18,7 @@
 
 #include <glm/glm.hpp>
 
+#include "cooker/mesh/cloth_build.h"
 #include "cooker/model/source_scene.h"
 #include "cooker/mesh/morph_build.h"
 #include <ossa/format/ossa_generated.h>
@@ -32,6 +33,8 @@ struct MeshOptions {
   /// metres_per_unit) and largest normal / tangent turn in radians.
   float morph_position_bound_m = 2e-5f;
   float morph_angle_bound = 0.001745f;
+  /// Cloth (cloth_build.h): paint and regions become each cooked mesh's CookedMesh::cloth.
+  ClothOptions cloth;
 };
 
 struct CookedMesh {
@@ -48,6 +51,8 @@ struct CookedMesh {
   std::vector<uint16_t> joints;           // skeleton joint per slot
   std::vector<glm::mat4> inverse_bind;    // per slot
   std::vector<CookedMorphTarget> morph_targets;  // names unique, in first-appearance order
+  std::vector<glm::vec4> cloth_attributes;  // per vertex (cloth_build.h), empty without cloth
+  CookedCloth cloth;                        // empty() without cloth
 };
 
 struct MeshBuildStats {

@@ -60,6 +60,7 @@ std::string CookOptions::canonical() const {
     s += ";map=" + retarget_map_name;
     if (retarget_map_input.present) s += "@" + hex64(retarget_map_input.hash);
   }
+  s += cloth.canonical();
   return s;
 }
 

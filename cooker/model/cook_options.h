@@ -13,6 +13,7 @@
 #include <string_view>
 #include <vector>
 
+#include "cooker/model/cloth_options.h"
 #include "cooker/model/input_log.h"
 #include "cooker/model/source_scene.h"
 
@@ -57,6 +58,7 @@ struct CookOptions {
   const SourceSkeleton* reference = nullptr;
   std::string reference_name;  // REF.ossa's file name, recorded in the options string
   InputFile reference_input;   // REF.ossa as read (absolute path, hash): its hash is in canonical()
+  ClothOptions cloth;          // the "cloth" cook setting (docs/CLOTH.md)
   /// --retarget-to TARGET.ossa: the source's clips are retargeted onto this rig
   /// (cooker/retarget/retarget_clips.h) and cooked as clip-only files of it; null otherwise.
   const SourceSkeleton* retarget_target = nullptr;

@@ -11,6 +11,7 @@
 
 #include "cooker/json/json_check.h"
 #include "cooker/json/json_source.h"
+#include "cooker/model/cloth_settings.h"
 
 namespace ossa::cook {
 namespace fs = std::filesystem;
@@ -21,7 +22,7 @@ constexpr std::string_view kFolderFile = "ossa.cook.json";
 
 const std::initializer_list<std::string_view> kSettingKeys = {
     "float_vertices", "clip_compression", "clip_tolerance_mm", "root_motion", "up_axis", "skeleton", "clip_names",
-    "metres_per_unit", "texture_format"};
+    "metres_per_unit", "texture_format", "cloth"};
 
 /// One layer of settings, checked; applied in order.
 struct Layer {
@@ -31,6 +32,7 @@ struct Layer {
   std::optional<TextureOutput> texture_format;
   std::optional<fs::path> skeleton;  // resolved against the settings file's folder
   std::map<std::string, std::string> clip_names;
+  std::optional<ClothOptions> cloth;  // the whole "cloth" object of the latest layer with one
 };
 
 bool read_bool(json::Checker& check, const json::Value& v, std::string_view what, std::optional<bool>& out) {
@@ -75,6 +77,9 @@ void read_layer(json::Checker& check, const json::Value& object, const fs::path&
     } else if (m.key == "skeleton") {
       std::string path;
       if (check.expect_name(v, what, &path)) layer.skeleton = (dir / path).lexically_normal();
+    } else if (m.key == "cloth") {
+      ClothOptions cloth;
+      if (read_cloth_settings(check, v, cloth)) layer.cloth = std::move(cloth);
     } else if (m.key == "clip_names") {
       if (check.expect(v, json::Type::Object, what))
         for (const json::Member& c : v.members) {
@@ -135,7 +140,7 @@ Result<std::vector<Layer>> read_settings(const fs::path& file, bool folder, cons
     }
   } else {
     check.expect_keys(root, {"ossa_cook", "float_vertices", "clip_compression", "clip_tolerance_mm", "root_motion", "metres_per_unit",
-                             "up_axis", "skeleton", "clip_names", "texture_format"},
+                             "up_axis", "skeleton", "clip_names", "texture_format", "cloth"},
                       "a cook settings file");
     read_layer(check, root, dir, layers.emplace_back());
   }
@@ -170,8 +175,10 @@ Status apply_cook_settings(const fs::path& input, CookOptions& options, AppliedS
       if (l.metres_per_unit) options.metres_per_unit = static_cast<float>(*l.metres_per_unit);
       if (l.skeleton) skeleton = l.skeleton;
       for (const auto& [from, to] : l.clip_names) applied.clip_names[from] = to;
+      if (l.cloth) options.cloth = *l.cloth;
     }
   }
+  options.cloth.up_axis = options.up_axis;
   if (skeleton) {
     InputFile as_read;
     auto rig = load_reference_skeleton(*skeleton, &as_read);

@@ -9,7 +9,7 @@
 // setting is one of: "float_vertices", "clip_compression" (booleans), "clip_tolerance_mm"
 // (number), "root_motion" (boolean), "up_axis" ("x" | "y" | "z"), "skeleton" (a cooked .ossa rig,
 // relative to the settings file), "clip_names" ({"source clip": "new name"}), "texture_format"
-// ("bc" | "rgba8" | "source").
+// ("bc" | "rgba8" | "source"), "cloth" (an object: docs/CLOTH.md, cooker/model/cloth_settings.h).
 //
 // Both files are read through the cook's input log (looked for on every cook, absent or not), so
 // they are inputs of the cook key and the depfile like any source: editing, adding or removing one

@@ -64,6 +64,12 @@ struct SourceMesh {
   /// covering every joint referenced by `joints`.
   std::vector<std::pair<uint16_t, glm::mat4>> bind;
   std::vector<SourceMorphTarget> morph_targets;
+  /// Empty or one per vertex: colour set 1 as the source stored it, which marks cloth
+  /// (cooker/mesh/cloth_build.h reads it; it is not drawn).
+  std::vector<glm::vec4> cloth_paint;
+  /// Empty or one per vertex: what the mesh stage carries for cloth (cloth_build.h's
+  /// cloth_attributes fill it: weight, max distance, backstop, 1).
+  std::vector<glm::vec4> cloth;
 };
 
 struct SourceTrack {

@@ -69,6 +69,30 @@ Offset<fb::Skeleton> write_skeleton(FlatBufferBuilder& fbb, const SourceSkeleton
                             skeleton_hash_of(skeleton));
 }
 
+/// Format v9: a mesh's simulated region (cloth_build.h).
+Offset<fb::Cloth> write_cloth(FlatBufferBuilder& fbb, const CookedCloth& c) {
+  const auto optional_floats = [&](const std::vector<float>& v) {
+    return v.empty() ? Offset<flatbuffers::Vector<float>>() : fbb.CreateVector(v);
+  };
+  const auto particle_vertices = fbb.CreateVector(c.particle_vertices);
+  const auto inverse_masses = fbb.CreateVector(c.inverse_masses);
+  const auto max_distances = optional_floats(c.max_distances);
+  const auto backstops = optional_floats(c.backstops);
+  const auto vertices = fbb.CreateVector(c.vertices);
+  const auto vertex_particles = fbb.CreateVector(c.vertex_particles);
+  const auto flipped = c.flipped.empty() ? Offset<flatbuffers::Vector<uint8_t>>() : fbb.CreateVector(c.flipped);
+  const auto triangles = fbb.CreateVector(c.triangles);
+  const auto stretch = fbb.CreateVectorOfStructs(c.stretch);
+  const auto bend = fbb.CreateVectorOfStructs(c.bend);
+  const auto tethers = fbb.CreateVectorOfStructs(c.tethers);
+  const auto colliders = fbb.CreateVectorOfStructs(c.colliders);
+  const fb::Vec3 gravity = vec3(c.gravity);
+  return fb::CreateCloth(fbb, particle_vertices, inverse_masses, max_distances, backstops, vertices, vertex_particles,
+                         flipped, triangles, stretch, bend, tethers, colliders, c.thickness, c.stretch_compliance,
+                         c.bend_compliance, c.tether_scale, c.damping, c.drag, &gravity, c.linear_inertia,
+                         c.angular_inertia, c.teleport_distance, c.max_speed);
+}
+
 Offset<fb::Mesh> write_mesh(FlatBufferBuilder& fbb, const CookedMesh& mesh) {
   const auto name = fbb.CreateString(mesh.name);
   const auto layout = fbb.CreateVectorOfStructs(mesh.layout);
@@ -95,8 +119,10 @@ Offset<fb::Mesh> write_mesh(FlatBufferBuilder& fbb, const CookedMesh& mesh) {
   }
   const auto targets_v =
       targets.empty() ? Offset<flatbuffers::Vector<Offset<fb::MorphTarget>>>() : fbb.CreateVector(targets);
+  const Offset<fb::Cloth> cloth = mesh.cloth.empty() ? Offset<fb::Cloth>() : write_cloth(fbb, mesh.cloth);
   return fb::CreateMesh(fbb, name, mesh.vertex_count, mesh.vertex_stride, layout, vertices, mesh.index_format,
-                        indices, submeshes, &bounds_min, &bounds_max, &offset, &scale, joints, inverse_bind_v, targets_v);
+                        indices, submeshes, &bounds_min, &bounds_max, &offset, &scale, joints, inverse_bind_v, targets_v,
+                        cloth);
 }
 
 Offset<fb::RootMotion> write_root_motion(FlatBufferBuilder& fbb, const SourceRootMotion& rm) {
