@@ -15,7 +15,7 @@ out=cooked
 rm -rf "$out"
 
 echo "== cooking characters"
-"$bin/ossa-cook" assets/Pab/skeleton.fbx assets/CesiumMan assets/Fox assets/RiggedSimple \
+"$bin/ossa-cook" assets/Pab/skeleton.fbx assets/CesiumMan assets/CapedMan assets/Fox assets/RiggedSimple \
   --root assets -o "$out" --report "$out/report-characters.json"
 echo "== cooking Pab clips and mesh against the Pab skeleton"
 "$bin/ossa-cook" assets/Pab/arnaud.fbx assets/Pab/walk.fbx assets/Pab/jog.fbx assets/Pab/run.fbx \
@@ -51,5 +51,6 @@ else
     --screenshot "$shots/fox-tail-spring.png"
   "${xvfb[@]}" "$bin/ossa-view" "$out/Fox/Fox.ossa" --clip Walk --crowd 9 --time 0.3 --size 960x540 --screenshot "$shots/fox-crowd.png"
   "${xvfb[@]}" "$bin/ossa-view" "$out/CesiumMan/CesiumMan.ossa" --time 0.5 --skeleton --size 960x540 --screenshot "$shots/cesium-man.png"
+  "${xvfb[@]}" "$bin/ossa-view" "$out/CapedMan/CapedMan.ossa" --time 1.5 --yaw 150 --size 960x540 --screenshot "$shots/caped-man-cloth.png"
   echo "demo: screenshots in $shots/ (with a display, scripts/demo.sh opens the viewer instead)"
 fi

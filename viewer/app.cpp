@@ -115,6 +115,14 @@ Status set_crowd(App& app, size_t crowd, float aspect) {
   }
   app.crowd = crowd == 0 ? 1 : crowd;
   app.animator = make_animator(app.scene, app.crowd);
+  {
+    Result<ViewerCloth> cloth = make_viewer_cloth(app.scene, app.crowd);
+    if (!cloth) return cloth.error();
+    cloth->enabled = app.cloth.enabled;
+    cloth->wind = app.cloth.wind;
+    cloth->stiffness = app.cloth.stiffness;
+    app.cloth = std::move(*cloth);
+  }
   if (held.held.size() == app.scene.morph_channels.size()) app.animator.morph_overrides = std::move(held);
 
   // Bind pose bounds of one character, then of the whole crowd.
@@ -178,6 +186,14 @@ Status open_or_add(App& app, std::span<const std::string> paths, float aspect) {
 
 Status play_clip(App& app, int clip, bool crossfade) { return select_clip(app.scene, app.animator, clip, crossfade); }
 
+Status step_cloth(App& app, float dt) {
+  if (app.cloth.empty()) return {};
+  // The cloth moves with the time played: none while paused, none for a graph banking no time.
+  const Playback& p = app.animator.playback;
+  const float played = app.animator.use_graph ? dt : (p.playing ? dt * std::fabs(p.speed) : 0.0f);
+  return step_viewer_cloth(app.cloth, app.scene, app.animator, app.renderer.bind, app.offsets, played);
+}
+
 Status step_and_render(App& app, float dt, int width, int height, FrameTimings& timings) {
   advance(app.scene, app.animator, dt);
   PoseTimings pose;
@@ -196,14 +212,16 @@ Status step_and_render(App& app, float dt, int width, int height, FrameTimings& 
     app.camera.target += moved - app.follow_applied;
     app.follow_applied = moved;
   }
+  if (Status s = step_cloth(app, dt); !s) return s;
   if (app.toggles.procedural) {
     const float size = app.bind_box.empty() ? 1.0f : 0.5f * glm::length(app.bind_box.size());
     build_procedural_overlay(app.animator, app.offsets, size, app.active_handle, app.renderer.overlay);
   } else {
     app.renderer.overlay.clear();
   }
+  if (app.show_cloth) build_cloth_overlay(app.cloth, app.animator, app.offsets, app.renderer.overlay);
   return render_frame(app.renderer, app.scene, app.animator, app.offsets, app.camera, app.toggles, width, height,
-                      timings);
+                      timings, &app.cloth);
 }
 
 }  // namespace ossa::view

@@ -16,6 +16,7 @@
 #include "viewer/animation.h"
 #include "viewer/bounds.h"
 #include "viewer/camera.h"
+#include "viewer/cloth_view.h"
 #include "viewer/renderer.h"
 #include "viewer/scene.h"
 
@@ -43,6 +44,8 @@ struct App {
   std::vector<std::string> messages;  // warnings and errors for the panel / stderr
   std::string graph_name;          // --graph: re-instantiated when the crowd or the files change
   int active_handle = -1;          // the target gizmo being dragged (ProceduralInfo::targets), or -1
+  ViewerCloth cloth;               // the character's cloth, per instance (cloth_view.h)
+  bool show_cloth = false;         // the cloth overlay: particles, edges, colliders
 };
 
 /// Replaces the scene with `paths` (scene.h load_scene), uploads it, builds the crowd and frames
@@ -73,8 +76,12 @@ Status use_graph(App& app, const std::string& name);
 /// Selects a clip by index (-1: none) with an optional cross-fade.
 Status play_clip(App& app, int clip, bool crossfade);
 
-/// Advances playback by dt (when playing), produces this frame's poses, follows the character,
-/// builds the procedural overlays (toggles.procedural, procedural_draw.h) and draws into the
+/// Steps the cloth (cloth_view.h) by the time dt plays (dt * |speed| for clips, 0 paused), from
+/// the animator's current model matrices. Errors name the file.
+Status step_cloth(App& app, float dt);
+
+/// Advances playback by dt (when playing), produces this frame's poses, steps the cloth by the
+/// time played (cloth_view.h), follows the character, builds the procedural and cloth overlays (toggles.procedural, procedural_draw.h) and draws into the
 /// bound framebuffer. Timings accumulate into `timings`.
 Status step_and_render(App& app, float dt, int width, int height, FrameTimings& timings);
 

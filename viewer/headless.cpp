@@ -2,6 +2,7 @@
 #include "viewer/headless.h"
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <string>
 
@@ -17,6 +18,7 @@ namespace ossa::view {
 namespace {
 
 constexpr float kFrameStep = 1.0f / 60.0f;
+constexpr float kClothPreroll = 2.0f;  // seconds of the clip played before the first frame when there is cloth
 
 /// The whole run, with errors as values; run_headless turns them into the exit status. A window
 /// that cannot be made (no display, no GL 3.3) sets `cannot_run`: nothing could be tried then.
@@ -54,12 +56,30 @@ Status render_headless(const ViewerOptions& o, bool& cannot_run) {
     for (float t = 0.0f; t + 0.5f * kFrameStep < o.time; t += kFrameStep) {
       advance(app.scene, app.animator, kFrameStep);
       produce_local_poses(app.scene, app.animator, ignored);
+      if (!app.cloth.empty()) {
+        compute_model_poses(app.scene, app.animator, ignored);
+        if (Status s = step_cloth(app, kFrameStep); !s) return s;
+      }
     }
   } else {
     // N frames 1/60 s apart, the last at --time: start (N - 1) steps earlier.
     const float rate = o.speed != 0.0f ? o.speed : 1.0f;
     p.time = advance_time(p.time, -kFrameStep * static_cast<float>(o.frames - 1), rate,
                           clip_duration(app.scene, app.animator), p.loop);
+    if (!app.cloth.empty() && app.cloth.enabled) {
+      // Cloth has a history: the clip plays kClothPreroll seconds (in 1/60 s frames) before the
+      // first frame, so the image shows the cloth as it is in motion, not at rest.
+      const int steps = static_cast<int>(std::lround(kClothPreroll / kFrameStep));
+      p.time = advance_time(p.time, -kFrameStep * static_cast<float>(steps), rate,
+                            clip_duration(app.scene, app.animator), p.loop);
+      PoseTimings ignored;
+      for (int k = 0; k < steps; ++k) {
+        advance(app.scene, app.animator, kFrameStep);
+        produce_local_poses(app.scene, app.animator, ignored);
+        compute_model_poses(app.scene, app.animator, ignored);
+        if (Status s = step_cloth(app, kFrameStep); !s) return s;
+      }
+    }
   }
 
   Result<Offscreen> target = create_offscreen(o.width, o.height, o.msaa);

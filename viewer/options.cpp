@@ -50,6 +50,13 @@ ParsedOptions parse_options(int argc, const char* const* argv) {
   app.add_flag("--paused", o.paused, "start paused");
   app.add_flag("--bind-pose", o.bind_pose, "show the bind pose instead of the clip");
   app.add_flag("--cpu-skinning", o.cpu_skinning, "skin on the CPU with the runtime's skin_cpu (reference path)");
+  std::string cloth = "on";
+  app.add_option("--cloth", cloth, "simulate the character's cloth (on), or draw it as skinned (off)")
+      ->check(CLI::IsMember({"on", "off"}));
+  app.add_flag("--show-cloth", o.show_cloth, "draw the cloth's particles, edges and colliders");
+  app.add_option("--wind", o.wind, "wind for the cloth, X,Y,Z metres per second (world space)")
+      ->delimiter(',')
+      ->expected(3);
   app.add_option("--crowd", o.crowd, "draw N instances with offset times, instanced")->check(CLI::Range(1u, 4096u));
   app.add_flag("--wireframe", o.wireframe, "wireframe overlay");
   app.add_flag("--skeleton", o.skeleton, "skeleton overlay");
@@ -109,6 +116,7 @@ ParsedOptions parse_options(int argc, const char* const* argv) {
     o.height = wh->second;
   }
   o.grid = !no_grid;
+  o.cloth = cloth == "on";
   for (const std::string& m : morphs) {
     const auto parsed = parse_morph(m);
     if (!parsed)

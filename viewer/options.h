@@ -61,6 +61,9 @@ struct ViewerOptions {
   bool paused = false;
   bool bind_pose = false;
   bool cpu_skinning = false;
+  bool cloth = true;            // --cloth off: cloth meshes drawn as skinned (to compare)
+  bool show_cloth = false;      // --show-cloth: the cloth overlay (particles, edges, colliders)
+  std::vector<float> wind;      // --wind X,Y,Z: metres per second, world space
   unsigned crowd = 1;
   bool wireframe = false;
   bool skeleton = false;

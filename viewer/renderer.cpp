@@ -7,6 +7,7 @@
 #include <cstdint>
 
 #include <ossa/skinning/skinning.h>
+#include "viewer/cloth_view.h"
 #include "viewer/gl_util.h"
 #include "viewer/shader_sources.h"
 
@@ -317,7 +318,7 @@ void set_grid(Renderer& r, const Box& area, float ground, float character_radius
 
 Status render_frame(Renderer& r, const Scene& scene, const Animator& animator, std::span<const glm::vec3> offsets,
                     const OrbitCamera& camera, const ViewToggles& toggles, int width, int height,
-                    FrameTimings& timings) {
+                    FrameTimings& timings, const ViewerCloth* cloth) {
   const Asset& asset = scene.character();
   const size_t instances = animator.instances.size();
 
@@ -425,22 +426,30 @@ Status render_frame(Renderer& r, const Scene& scene, const Animator& animator, s
       glPolygonMode(GL_FRONT_AND_BACK, GL_LINE);
       glUniform4f(u.flat_color, kWireColor.r, kWireColor.g, kWireColor.b, kWireColor.a);
     }
+    // Meshes with live cloth take the CPU path on both settings: their particles are written
+    // over CPU-skinned streams (cloth_view.h).
+    const auto simulated = [&](size_t i, size_t m) { return cloth != nullptr && cloth->find(i, m) != nullptr; };
+    bool any_cloth = false;
+    for (size_t m = 0; m < r.meshes.size(); ++m) any_cloth = any_cloth || simulated(0, m);
     if (!toggles.cpu_skinning) {
       glUniform1i(u.instance_texels, static_cast<GLint>(4 * r.instance_matrices));
       for (size_t m = 0; m < r.meshes.size(); ++m) {
+        if (simulated(0, m)) continue;
         set_mesh_encoding(r, r.meshes[m], false);
         bind_mesh_morphs(r, r.meshes[m], morphs ? channels : 0);
         glUniform1i(u.palette_base, static_cast<GLint>(4 * r.palette_base[m]));
         glBindVertexArray(r.meshes[m].vao);
         draw_submeshes(r, asset.mesh(m), r.meshes[m], static_cast<GLsizei>(instances), shaded);
       }
-    } else {
+    }
+    if (toggles.cpu_skinning || any_cloth) {
       // Reference path: skin_cpu per instance and mesh, drawn with the identity palette entry.
       glUniform1i(u.instance_texels, 0);
       glUniform1i(u.palette_base, static_cast<GLint>(4 * (matrices - 1)));
       glUniform1i(u.morph_channels, 0);  // morphed on the CPU
       for (size_t i = 0; i < instances; ++i) {
         for (size_t m = 0; m < r.meshes.size(); ++m) {
+          if (!toggles.cpu_skinning && !simulated(i, m)) continue;
           const GpuMesh& g = r.meshes[m];
           const MeshView view = asset.mesh(m);
           const auto t0 = Clock::now();
@@ -454,6 +463,13 @@ Status render_frame(Renderer& r, const Scene& scene, const Animator& animator, s
                                morph_and_skin_cpu(view, r.morph_base[m], scene.morph_targets[m],
                                                   animator.instances[i].morph_weights, palette, r.morph_scratch, out);
           if (!morphed) skin_cpu(view, palette, SkinningMethod::Linear, out);
+          if (const ClothInstance* c = cloth != nullptr ? cloth->find(i, m) : nullptr;
+              c != nullptr && c->positions().size() == c->particle_count()) {
+            (void)write_cloth_vertices(*c, r.skinned_positions, r.skinned_normals);  // model space
+            const glm::vec3 o = i < offsets.size() ? offsets[i] : glm::vec3(0.0f);
+            for (const uint32_t cv : c->source.vertices)
+              for (int k = 0; k < 3; ++k) r.skinned_positions[3 * cv + static_cast<size_t>(k)] += o[k];
+          }
           upload_stream(g.cpu_positions, r.skinned_positions);
           if (g.has_normals) upload_stream(g.cpu_normals, r.skinned_normals);
           if (g.has_tangents) upload_stream(g.cpu_tangents, r.skinned_tangents);

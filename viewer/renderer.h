@@ -30,6 +30,8 @@
 
 namespace ossa::view {
 
+struct ViewerCloth;
+
 struct ViewToggles {
   bool wireframe = false;
   bool skeleton = false;
@@ -121,9 +123,10 @@ void set_grid(Renderer& r, const Box& area, float ground, float character_radius
 
 /// Draws one frame into the bound framebuffer (viewport width x height). `offsets` places each
 /// instance (crowd); the animator's model matrices must be current. Adds skin/draw timings.
+/// Meshes with live cloth (`cloth`, cloth_view.h) are drawn with their simulated particles.
 /// Errors: too many instances x joints for the palette buffer (or x morph channels).
 Status render_frame(Renderer& r, const Scene& scene, const Animator& animator, std::span<const glm::vec3> offsets,
                     const OrbitCamera& camera, const ViewToggles& toggles, int width, int height,
-                    FrameTimings& timings);
+                    FrameTimings& timings, const ViewerCloth* cloth = nullptr);
 
 }  // namespace ossa::view

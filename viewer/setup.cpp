@@ -20,6 +20,9 @@ void apply_view_options(App& app, const ViewerOptions& o) {
   app.toggles.skeleton = o.skeleton;
   app.toggles.grid = o.grid;
   app.toggles.procedural = o.show_procedural || !o.headless();  // on in the window, asked for in images
+  app.cloth.enabled = o.cloth;
+  app.show_cloth = o.show_cloth;
+  if (o.wind.size() == 3) app.cloth.wind = glm::vec3(o.wind[0], o.wind[1], o.wind[2]);
 }
 
 Status setup_app(App& app, Scene scene, const ViewerOptions& o, float aspect) {

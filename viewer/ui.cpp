@@ -70,6 +70,8 @@ void morph_panel(App& app) {
   ImGui::TextDisabled("ctrl+click a slider to type a weight");
 }
 
+void cloth_panel(App& app);
+
 void view_panel(App& app, UiState& ui, float aspect) {
   ImGui::Checkbox("skeleton (K)", &app.toggles.skeleton);
   ImGui::SameLine();
@@ -77,6 +79,7 @@ void view_panel(App& app, UiState& ui, float aspect) {
   ImGui::Checkbox("grid (G)", &app.toggles.grid);
   ImGui::SameLine();
   ImGui::Checkbox("CPU skinning", &app.toggles.cpu_skinning);
+  cloth_panel(app);
   ImGui::Checkbox("follow character", &app.follow);
   ImGui::SameLine();
   if (ImGui::Button("frame (R)")) frame_camera(app, aspect);
@@ -169,6 +172,20 @@ void graph_status(const GraphDriver& g) {
   }
   ImGui::TextDisabled("events");
   for (const std::string& e : g.recent_events) ImGui::TextUnformatted(e.c_str());
+}
+
+/// The cloth's controls (cloth_view.h), when the character has cloth: on / off, the overlay,
+/// wind (metres per second along the view's x and z), stiffness and a restart from the skinned pose.
+void cloth_panel(App& app) {
+  if (app.cloth.empty()) return;
+  ImGui::Separator();
+  ImGui::TextDisabled("cloth (%zu simulated)", app.cloth.sims.size());
+  ImGui::Checkbox("simulate cloth", &app.cloth.enabled);
+  ImGui::SameLine();
+  ImGui::Checkbox("show particles", &app.show_cloth);
+  ImGui::SliderFloat3("wind m/s", &app.cloth.wind.x, -15.0f, 15.0f, "%.1f");
+  ImGui::SliderFloat("stiffness", &app.cloth.stiffness, 0.05f, 1.0f, "%.2f");
+  if (ImGui::Button("reset cloth")) reset_viewer_cloth(app.cloth);
 }
 
 /// The procedural nodes' controls: the overlay toggle, the targets (dragged in the view with
