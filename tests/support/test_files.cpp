@@ -600,6 +600,9 @@ std::vector<std::pair<std::string, SyntheticSpec>> valid_variants() {
   spec.clips[0].morph_weights = {constant_frown, SyntheticMorphTrack{}};
   out.emplace_back("morph", spec);
 
+  spec = {};
+  spec.meshes[0].cloth = SyntheticCloth{};  // format v10: the fuzz corpus mutates cloth too
+  out.emplace_back("cloth", spec);
   return out;
 }
 

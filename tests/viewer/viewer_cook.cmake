@@ -10,7 +10,7 @@ function(cook)
     message(FATAL_ERROR "ossa-cook ${ARGN} failed (${rc}): ${err}")
   endif()
 endfunction()
-cook("${ASSETS}/Pab/skeleton.fbx" "${ASSETS}/CesiumMan" "${ASSETS}/Fox" "${ASSETS}/RiggedSimple"
+cook("${ASSETS}/Pab/skeleton.fbx" "${ASSETS}/CesiumMan" "${ASSETS}/CapedMan" "${ASSETS}/Fox" "${ASSETS}/RiggedSimple"
      --root "${ASSETS}" -o "${OUT}/quantized")
 cook("${ASSETS}/Pab/arnaud.fbx" "${ASSETS}/Pab/walk.fbx" "${ASSETS}/Pab/jog.fbx" "${ASSETS}/Pab/run.fbx"
      "${ASSETS}/Pab/crossarms.fbx" --skeleton "${OUT}/quantized/Pab/skeleton.ossa" --root "${ASSETS}"

@@ -110,6 +110,15 @@ json describe_mesh(const MeshView& mesh, float metres_per_unit) {
               {"position_scale", vec3(m.position_scale())}};
   // Only when present, so files without targets describe as they did before format v5.
   if (mesh.morph_target_count() > 0) out["morph_targets"] = describe_morph_targets(mesh, metres_per_unit);
+  if (const fb::Cloth* c = m.cloth()) {  // format v10 (docs/CLOTH.md)
+    size_t fixed = 0;
+    for (const float w : *c->inverse_masses()) fixed += w == 0.0f ? 1 : 0;
+    const auto size = [](const auto* v) { return v ? static_cast<size_t>(v->size()) : size_t{0}; };
+    out["cloth"] = json{{"particles", c->particle_vertices()->size()}, {"fixed", fixed},
+                        {"vertices", c->vertices()->size()}, {"stretch", size(c->stretch())},
+                        {"bend", size(c->bend())}, {"tethers", size(c->tethers())},
+                        {"colliders", size(c->colliders())}, {"thickness_m", c->thickness() * metres_per_unit}};
+  }
   return out;
 }
 
@@ -496,6 +505,12 @@ std::string describe_text(const json& d) {
                   text(s["index_count"]).c_str(), text(s["material"]).c_str()));
     line("  joint slots    " + text(m["joint_slots"]));
     line("  bounds         " + vec_text(m["bounds"]["min"]) + " .. " + vec_text(m["bounds"]["max"]));
+    if (m.contains("cloth")) {
+      const json& c = m["cloth"];
+      line("  cloth          " + text(c["particles"]) + " particles (" + text(c["fixed"]) + " fixed) on " +
+           text(c["vertices"]) + " vertices, " + text(c["stretch"]) + " stretch + " + text(c["bend"]) +
+           " bend edges, " + text(c["tethers"]) + " tethers, " + text(c["colliders"]) + " colliders");
+    }
     if (m.contains("morph_targets")) {
       size_t t = 0;
       for (const json& mt : m["morph_targets"])
