@@ -28,7 +28,8 @@ void ring(std::vector<LineVertex>& v, const glm::vec3& c, const glm::vec3& u, co
           const glm::vec4& colour) {
   constexpr int kSegments = 16;
   for (int i = 0; i < kSegments; ++i) {
-    const float a = 6.2831853f * static_cast<float>(i) / kSegments, b = 6.2831853f * static_cast<float>(i + 1) / kSegments;
+    const float a = 6.2831853f * static_cast<float>(i) / kSegments;
+    const float b = 6.2831853f * static_cast<float>(i + 1) / kSegments;
     line(v, c + r * (std::cos(a) * u + std::sin(a) * w), c + r * (std::cos(b) * u + std::sin(b) * w), colour);
   }
 }
