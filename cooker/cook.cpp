@@ -16,6 +16,7 @@
 #include <fstream>
 #include <iterator>
 
+#include "cooker/cache/cook_cache.h"
 #include "cooker/clip/clip_events.h"
 #include "cooker/cook_internal.h"
 #include "cooker/model/cook_settings.h"
@@ -215,6 +216,22 @@ bool up_to_date(CookRecord& record, const fs::path& input, const fs::path& outpu
   return true;
 }
 
+/// A hit of the shared cook cache (cooker/cache/cook_cache.h): the verified output written
+/// atomically as a cook writes it, and the record the up-to-date check of the written file gives
+/// (so its counts and inputs are those of the file). False on a miss, or when the files changed
+/// between the lookup and the check (the cook then runs and rewrites the output).
+bool from_cache(CookRecord& record, const fs::path& input, const fs::path& output, const CookOptions& options) {
+  if (options.cache == nullptr || options.force || !options.write) return false;
+  const std::optional<std::vector<uint8_t>> bytes = cache_lookup(*options.cache, record, input, options.canonical());
+  if (!bytes) return false;
+  if (Status st = write_file_atomic(output, *bytes); !st) return false;  // the cook meets it too and says so
+  if (!up_to_date(record, input, output, options)) return false;
+  record.up_to_date = false;
+  record.cache_hit = true;
+  record.cooked_bytes = bytes->size();
+  return true;
+}
+
 void cook_into(CookRecord& record, const fs::path& input, const fs::path& output, const CookOptions& options,
                const AppliedSettings& settings) {
   std::error_code ec;
@@ -332,7 +349,11 @@ std::optional<CookRecord> cook_or_check(const fs::path& input, const fs::path& o
       record.error = input.string() + ": cook settings: " + st.message();
     } else if (options.force || !up_to_date(record, input, output, options)) {
       if (only_if_up_to_date) return std::nullopt;
-      cook_into(record, input, output, options, settings);
+      if (!from_cache(record, input, output, options)) {
+        cook_into(record, input, output, options, settings);
+        if (record.ok && options.write && options.cache != nullptr)
+          cache_store_output(*options.cache, record, output, options.canonical());
+      }
     }
   } catch (const std::exception& e) {
     if (only_if_up_to_date) return std::nullopt;
