@@ -25,17 +25,20 @@ constexpr int kManifestVersion = 1;
 
 struct Manifest {
   uint64_t cook_key = 0;
+  uint64_t output_size = 0, output_hash = 0;  // of the output at cas/<cook key>
   std::vector<InputFile> inputs;  // relative to the source's folder
 };
 
 std::vector<uint8_t> encode_manifest(const std::string& source, const std::string& canonical, uint64_t key,
-                                     const std::vector<InputFile>& inputs) {
+                                     std::span<const uint8_t> output, const std::vector<InputFile>& inputs) {
   json j;
   j["kind"] = kManifestKind;
   j["version"] = kManifestVersion;
   j["source"] = source;
   j["options"] = canonical;
   j["cook_key"] = key;
+  j["output_size"] = output.size();
+  j["output_hash"] = input_hash(output);
   json list = json::array();
   for (const InputFile& f : inputs) list.push_back({f.path, f.present, f.size, f.hash});
   j["inputs"] = std::move(list);
@@ -53,6 +56,8 @@ std::optional<Manifest> decode_manifest(const std::vector<uint8_t>& bytes, const
       return std::nullopt;
     Manifest m;
     m.cook_key = j.at("cook_key").get<uint64_t>();
+    m.output_size = j.at("output_size").get<uint64_t>();
+    m.output_hash = j.at("output_hash").get<uint64_t>();
     for (const json& f : j.at("inputs")) {
       if (!f.is_array() || f.size() != 4) return std::nullopt;
       InputFile in;
@@ -149,6 +154,13 @@ std::optional<std::vector<uint8_t>> cache_lookup(const CookCache& cache, CookRec
   if (got.trouble) note(record, *got.trouble);
   if (!got.bytes) return std::nullopt;
   record.cache_bytes_fetched += got.bytes->size();
+  // The loader's checks see structure, not every byte (a vertex flipped in a damaged entry still
+  // verifies): the manifest's hash of the output catches that.
+  if (got.bytes->size() != manifest->output_size || input_hash(*got.bytes) != manifest->output_hash) {
+    note(record, {cache.store->name() + ": cas/" + ckey + ": " + std::to_string(got.bytes->size()) +
+                      " bytes that are not the output its manifest describes (damaged or truncated)", false});
+    return std::nullopt;
+  }
   auto asset = Asset::from_bytes(*got.bytes, cache.store->name() + "/cas/" + ckey);
   if (!asset) {
     note(record, {asset.error().message, false});
@@ -163,7 +175,7 @@ std::optional<std::vector<uint8_t>> cache_lookup(const CookCache& cache, CookRec
 
 void cache_store_output(const CookCache& cache, CookRecord& record, const fs::path& output,
                         const std::string& canonical) {
-  if (cache.mode != CacheMode::ReadWrite || cache.down || !cache.store) return;
+  if (cache.mode != CacheMode::ReadWrite || cache.down || record.cache_down || !cache.store) return;
   // The output as written (not an input of the cook: read directly, outside the input log).
   std::vector<uint8_t> bytes;
   {
@@ -203,7 +215,7 @@ void cache_store_output(const CookCache& cache, CookRecord& record, const fs::pa
   // The output first: a manifest is never stored before what it leads to.
   if (std::optional<CacheTrouble> t = cache.store->put("cas", ckey, bytes)) return note(record, *t);
   record.cache_bytes_stored += bytes.size();
-  const std::vector<uint8_t> manifest = encode_manifest(source, canonical, prov->cook_key(), inputs);
+  const std::vector<uint8_t> manifest = encode_manifest(source, canonical, prov->cook_key(), bytes, inputs);
   const std::string mkey = hex64(manifest_key(source, source_size, prov->source_hash(), canonical));
   if (std::optional<CacheTrouble> t = cache.store->put("ac", mkey, manifest)) return note(record, *t);
   record.cache_bytes_stored += manifest.size();

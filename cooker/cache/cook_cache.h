@@ -13,9 +13,10 @@
 //
 // Why nothing read from the cache is trusted: an entry may be truncated (a full disk, a killed
 // writer on a network folder), corrupted, written by another cooker version, or come from a server
-// answering garbage. A manifest must name this source and these options; an output must pass the
-// runtime loader's verification and carry, in its provenance, the cook key computed here from this
-// tree's files, this input's name and these options. Anything else is a miss and is never written.
+// answering garbage. A manifest must name this source and these options; an output must have the
+// size and XXH3-64 its manifest records (the loader's checks see structure, not every byte), pass
+// the runtime loader's verification and carry, in its provenance, the cook key computed here from
+// this tree's files, this input's name and these options. Anything else is a miss, never written.
 //
 // Trouble with the store (cache_store.h) is said in the record (cache_note) and costs a miss;
 // unreachable trouble also sets cache_down, and the batch marks the cache down so that workers
