@@ -243,8 +243,9 @@ def main():
         groups = batches(tree)
         if args.only_cache:
             args.jobs = []
-        print(f"{'jobs':>4} {'inputs':>6} {'failed':>6} {'source MB':>9} {'full s':>7} {'files/s':>7} {'MB/s':>6} "
-              f"{'fresh s':>7} {'fresh %':>7} {'1 tex s':>7} {'re-cooked':>9}")
+        if args.jobs:
+            print(f"{'jobs':>4} {'inputs':>6} {'failed':>6} {'source MB':>9} {'full s':>7} {'files/s':>7} {'MB/s':>6} "
+                  f"{'fresh s':>7} {'fresh %':>7} {'1 tex s':>7} {'re-cooked':>9}")
         for jobs in args.jobs:
             out = os.path.join(work, f"out-{jobs}")
             full = []

@@ -4,9 +4,14 @@
 // Each request is bounded in time (CURLOPT_TIMEOUT over the whole transfer, a shorter connect
 // timeout) and in size (kMaxCacheEntryBytes), and runs without signals (CURLOPT_NOSIGNAL): the
 // batch's workers each make their own requests, so a slow server delays one input by at most the
-// timeout, and the batch stops asking once one worker finds it unreachable (cook_cache.h). A
-// handle is made per request: a worker makes two or three, and nothing is shared across fork().
+// timeout, and the batch stops asking once a lookup finds it unreachable (cook_cache.h). A handle
+// is made per request (nothing of libcurl's is shared across fork()), and no request starts a
+// thread (see resolve_once): the batch's own process looks entries up between forks.
+#include <arpa/inet.h>
 #include <curl/curl.h>
+#include <netdb.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
 
 #include <algorithm>
 
@@ -67,10 +72,18 @@ class HttpStore final : public CacheStore {
  public:
   HttpStore(std::string url, unsigned timeout_seconds) : url_(std::move(url)), timeout_(std::max(1u, timeout_seconds)) {
     while (!url_.empty() && url_.back() == '/') url_.pop_back();
+    resolve_once();
   }
+  ~HttpStore() override { curl_slist_free_all(resolved_); }
+  HttpStore(const HttpStore&) = delete;
+  HttpStore& operator=(const HttpStore&) = delete;
 
   CacheGet get(std::string_view kind, std::string_view key) override {
     CacheGet result;
+    if (!resolve_error_.empty()) {
+      result.trouble = CacheTrouble{url_ + ": " + resolve_error_, true};
+      return result;
+    }
     Download download;
     CURL* curl = handle(kind, key);
     if (curl == nullptr) {
@@ -95,6 +108,7 @@ class HttpStore final : public CacheStore {
   }
 
   std::optional<CacheTrouble> put(std::string_view kind, std::string_view key, std::span<const uint8_t> bytes) override {
+    if (!resolve_error_.empty()) return CacheTrouble{url_ + ": " + resolve_error_, true};
     Upload upload{bytes, 0};
     Download answer;  // the server's words, kept small and unused
     CURL* curl = handle(kind, key);
@@ -133,7 +147,48 @@ class HttpStore final : public CacheStore {
     curl_easy_setopt(curl, CURLOPT_FOLLOWLOCATION, 0L);
     curl_easy_setopt(curl, CURLOPT_PROTOCOLS_STR, "http,https");
     curl_easy_setopt(curl, CURLOPT_USERAGENT, "ossa-cook");
+    if (resolved_ != nullptr) curl_easy_setopt(curl, CURLOPT_RESOLVE, resolved_);
     return curl;
+  }
+
+  /// The server's name resolved here, once, with the blocking getaddrinfo, and handed to every
+  /// request (CURLOPT_RESOLVE): libcurl's own resolver runs in a thread, and the batch's process,
+  /// which looks entries up, must stay single-threaded because it forks its workers (worker.h).
+  void resolve_once() {
+    CURLU* u = curl_url();
+    char* host = nullptr;
+    char* port = nullptr;
+    if (u == nullptr || curl_url_set(u, CURLUPART_URL, url_.c_str(), 0) != CURLUE_OK ||
+        curl_url_get(u, CURLUPART_HOST, &host, 0) != CURLUE_OK ||
+        curl_url_get(u, CURLUPART_PORT, &port, CURLU_DEFAULT_PORT) != CURLUE_OK) {
+      resolve_error_ = "not a URL libcurl reads";
+    } else {
+      std::string name = host;
+      if (name.size() > 2 && name.front() == '[') name = name.substr(1, name.size() - 2);  // [::1]
+      addrinfo hints{};
+      hints.ai_socktype = SOCK_STREAM;
+      addrinfo* found = nullptr;
+      if (const int rc = ::getaddrinfo(name.c_str(), port, &hints, &found); rc != 0) {
+        resolve_error_ = "cannot resolve '" + name + "': " + ::gai_strerror(rc);
+      } else {
+        std::string addresses;
+        for (const addrinfo* a = found; a != nullptr; a = a->ai_next) {
+          char text[INET6_ADDRSTRLEN] = {};
+          const void* where = a->ai_family == AF_INET6
+                                  ? static_cast<const void*>(&reinterpret_cast<const sockaddr_in6*>(a->ai_addr)->sin6_addr)
+                                  : static_cast<const void*>(&reinterpret_cast<const sockaddr_in*>(a->ai_addr)->sin_addr);
+          if (::inet_ntop(a->ai_family, where, text, sizeof text) == nullptr) continue;
+          const std::string one = a->ai_family == AF_INET6 ? "[" + std::string(text) + "]" : std::string(text);
+          if (addresses.find(one) == std::string::npos) addresses += (addresses.empty() ? "" : ",") + one;
+        }
+        ::freeaddrinfo(found);
+        if (!addresses.empty())
+          resolved_ = curl_slist_append(nullptr, (std::string(host) + ":" + port + ":" + addresses).c_str());
+      }
+    }
+    curl_free(host);
+    curl_free(port);
+    curl_url_cleanup(u);
   }
   CacheTrouble trouble(std::string_view kind, std::string_view key, const std::string& why, bool down) const {
     return CacheTrouble{url_ + ": " + std::string(kind) + "/" + std::string(key) + ": " + why, down};
@@ -141,6 +196,8 @@ class HttpStore final : public CacheStore {
 
   std::string url_;
   unsigned timeout_;
+  curl_slist* resolved_ = nullptr;  // "host:port:address[,address...]"
+  std::string resolve_error_;       // set when the name does not resolve: every request is trouble
 };
 
 }  // namespace

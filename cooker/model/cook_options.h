@@ -82,6 +82,8 @@ struct CookOptions {
   /// --cache: the shared cook cache to look outputs up in and store them into; null: none. Not
   /// const: the batch marks it down when a worker finds it unreachable.
   CookCache* cache = nullptr;
+  /// The batch looked this input up in the cache already (a miss): the worker only stores.
+  bool cache_looked_up = false;
   bool write = true;   // false (--list-inputs): cook in memory, write nothing
 };
 
