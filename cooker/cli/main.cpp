@@ -5,11 +5,15 @@
 //             [--report FILE.json] [--skeleton REF.ossa] [--retarget-to TARGET.ossa [--map MAP.json]]
 //             [--float-vertices] [--clip-tolerance MM]
 //             [--no-clip-compression] [--root-motion] [--up-axis x|y|z] [--metres-per-unit M] [--force] [--depfile FILE]
-//             [--list-inputs] [-q | -v] [--version] [--help]
+//             [--list-inputs] [--cache DIR|URL [--cache-mode read|readwrite|off] [--cache-timeout S]]
+//             [-q | -v] [--version] [--help]
 //
 // As a build step (docs/SCALE.md): an output whose cook key matches its inputs as they are now is
 // up to date and left alone (--force cooks anyway); --depfile writes a Make-syntax file naming
 // every file each output's cook read; --list-inputs prints those files without writing anything.
+// --cache (or OSSA_COOK_CACHE) shares outputs through a folder or an HTTP cache: the batch looks
+// each input up before starting its worker, and a worker stores what it cooked
+// (cooker/cache/cook_cache.h).
 //
 // Each input is cooked in a worker process of its own, up to --jobs at once (cooker/cli/worker.h):
 // an input that crashes or aborts the importer, runs past --timeout (default 600 s) or past
