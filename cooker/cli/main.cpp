@@ -382,7 +382,7 @@ int main(int argc, char** argv) {
     if (!r.ok) {
       std::fprintf(stderr, "%s%s FAILED %s\n", tty ? "\r\033[K" : "", head.c_str(), shown(r.error).c_str());
     } else if (!quiet && !list_inputs) {
-      const char* what = r.up_to_date ? " (up to date)" : "";
+      const char* what = r.up_to_date ? " (up to date)" : r.cache_hit ? " (cache hit)" : "";
       if (tty)  // one line rewritten in place: it must not wrap, so a long path keeps its tail
         std::fprintf(stderr, "\r\033[K%s %s%s", head.c_str(),
                      fit(shown(r.input), terminal_columns() - head.size() - std::strlen(what) - 2).c_str(), what);
