@@ -204,8 +204,8 @@ def cache_rows(cook, work, label, source, jobs, caches, report):
                      and not r.get("up_to_date"))
         same = "yes" if snapshot(out_b) == reference else "NO"
         print(f"{label:>8} {name:>6} {full_doc['inputs']:>6} {full_s:>7.2f} {a_s:>7.2f} {stored:>9.1f} {b_s:>7.2f} "
-              f"{100 * b_s / full_s:>6.1f}% {cooked:>5} {hits:>5} {fetched:>10.1f} {1e3 * b_s / full_doc['inputs']:>8.2f} "
-              f"{same:>9}")
+              f"{100 * b_s / full_s:>6.1f}% {cooked:>5} {hits:>5} {fetched:>10.1f} "
+              f"{1e3 * b_s / full_doc['inputs']:>8.2f} {same:>9}")
 
 
 def pick_texture(doc, tree):

@@ -61,10 +61,8 @@ bool unreachable(CURLcode code) {
     case CURLE_RECV_ERROR:
     case CURLE_SEND_ERROR:
     case CURLE_WEIRD_SERVER_REPLY:
-    case CURLE_SSL_CONNECT_ERROR:
-      return true;
-    default:
-      return false;
+    case CURLE_SSL_CONNECT_ERROR: return true;
+    default: return false;
   }
 }
 
@@ -107,7 +105,8 @@ class HttpStore final : public CacheStore {
     return result;
   }
 
-  std::optional<CacheTrouble> put(std::string_view kind, std::string_view key, std::span<const uint8_t> bytes) override {
+  std::optional<CacheTrouble> put(std::string_view kind, std::string_view key,
+                                  std::span<const uint8_t> bytes) override {
     if (!resolve_error_.empty()) return CacheTrouble{url_ + ": " + resolve_error_, true};
     Upload upload{bytes, 0};
     Download answer;  // the server's words, kept small and unused
@@ -127,7 +126,8 @@ class HttpStore final : public CacheStore {
     curl_easy_getinfo(curl, CURLINFO_RESPONSE_CODE, &status);
     curl_easy_cleanup(curl);
     curl_slist_free_all(headers);
-    if (code != CURLE_OK) return trouble(kind, key, std::string("storing: ") + curl_easy_strerror(code), unreachable(code));
+    if (code != CURLE_OK)
+      return trouble(kind, key, std::string("storing: ") + curl_easy_strerror(code), unreachable(code));
     if (status != 200 && status != 201 && status != 204)
       return trouble(kind, key, "storing: HTTP status " + std::to_string(status), false);
     return std::nullopt;
@@ -174,9 +174,10 @@ class HttpStore final : public CacheStore {
         std::string addresses;
         for (const addrinfo* a = found; a != nullptr; a = a->ai_next) {
           char text[INET6_ADDRSTRLEN] = {};
-          const void* where = a->ai_family == AF_INET6
-                                  ? static_cast<const void*>(&reinterpret_cast<const sockaddr_in6*>(a->ai_addr)->sin6_addr)
-                                  : static_cast<const void*>(&reinterpret_cast<const sockaddr_in*>(a->ai_addr)->sin_addr);
+          const void* where =
+              a->ai_family == AF_INET6
+                  ? static_cast<const void*>(&reinterpret_cast<const sockaddr_in6*>(a->ai_addr)->sin6_addr)
+                  : static_cast<const void*>(&reinterpret_cast<const sockaddr_in*>(a->ai_addr)->sin_addr);
           if (::inet_ntop(a->ai_family, where, text, sizeof text) == nullptr) continue;
           const std::string one = a->ai_family == AF_INET6 ? "[" + std::string(text) + "]" : std::string(text);
           if (addresses.find(one) == std::string::npos) addresses += (addresses.empty() ? "" : ",") + one;

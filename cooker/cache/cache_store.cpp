@@ -49,9 +49,11 @@ class FolderStore final : public CacheStore {
     return result;
   }
 
-  std::optional<CacheTrouble> put(std::string_view kind, std::string_view key, std::span<const uint8_t> bytes) override {
+  std::optional<CacheTrouble> put(std::string_view kind, std::string_view key,
+                                  std::span<const uint8_t> bytes) override {
     if (Status st = write_file_atomic(entry(kind, key), bytes); !st)
-      return CacheTrouble{dir_ + ": storing " + std::string(kind) + "/" + std::string(key) + ": " + st.message(), false};
+      return CacheTrouble{dir_ + ": storing " + std::string(kind) + "/" + std::string(key) + ": " + st.message(),
+                          false};
     return std::nullopt;
   }
 
@@ -76,7 +78,8 @@ std::unique_ptr<CacheStore> folder_cache_store(const std::string& dir) { return 
 bool http_cache_available() { return false; }
 
 Result<std::unique_ptr<CacheStore>> http_cache_store(const std::string& url, unsigned) {
-  return Error{"--cache " + url + ": this ossa-cook was built without the HTTP cache (libcurl was not found); "
+  return Error{"--cache " + url +
+               ": this ossa-cook was built without the HTTP cache (libcurl was not found); "
                "use a folder, or build with libcurl4-openssl-dev installed"};
 }
 #endif

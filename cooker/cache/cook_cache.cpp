@@ -26,7 +26,7 @@ constexpr int kManifestVersion = 1;
 struct Manifest {
   uint64_t cook_key = 0;
   uint64_t output_size = 0, output_hash = 0;  // of the output at cas/<cook key>
-  std::vector<InputFile> inputs;  // relative to the source's folder
+  std::vector<InputFile> inputs;              // relative to the source's folder
 };
 
 std::vector<uint8_t> encode_manifest(const std::string& source, const std::string& canonical, uint64_t key,
@@ -133,7 +133,8 @@ std::optional<std::vector<uint8_t>> cache_lookup(const CookCache& cache, CookRec
   record.cache_bytes_fetched += got.bytes->size();
   const std::optional<Manifest> manifest = decode_manifest(*got.bytes, source, canonical);
   if (!manifest) {
-    note(record, {cache.store->name() + ": ac/" + mkey + ": not a manifest of " + source + " with these options", false});
+    note(record,
+         {cache.store->name() + ": ac/" + mkey + ": not a manifest of " + source + " with these options", false});
     return std::nullopt;
   }
   for (const InputFile& f : manifest->inputs) {
@@ -142,8 +143,9 @@ std::optional<std::vector<uint8_t>> cache_lookup(const CookCache& cache, CookRec
     else if (!hash_input(path)) return std::nullopt;  // unreadable here: the cook will say why
   }
   if (!log.refusals().empty()) {
-    note(record, {cache.store->name() + ": ac/" + mkey + ": names a file this cook may not read: " +
-                      log.refusals().front(), false});
+    note(record,
+         {cache.store->name() + ": ac/" + mkey + ": names a file this cook may not read: " + log.refusals().front(),
+          false});
     return std::nullopt;
   }
   const uint64_t key = cook_key(relative_inputs(log.files(), base), canonical);
@@ -158,7 +160,8 @@ std::optional<std::vector<uint8_t>> cache_lookup(const CookCache& cache, CookRec
   // verifies): the manifest's hash of the output catches that.
   if (got.bytes->size() != manifest->output_size || input_hash(*got.bytes) != manifest->output_hash) {
     note(record, {cache.store->name() + ": cas/" + ckey + ": " + std::to_string(got.bytes->size()) +
-                      " bytes that are not the output its manifest describes (damaged or truncated)", false});
+                      " bytes that are not the output its manifest describes (damaged or truncated)",
+                  false});
     return std::nullopt;
   }
   auto asset = Asset::from_bytes(*got.bytes, cache.store->name() + "/cas/" + ckey);
@@ -199,7 +202,8 @@ void cache_store_output(const CookCache& cache, CookRecord& record, const fs::pa
   auto asset = Asset::from_bytes(bytes, output.string());
   if (!asset) return;
   const fb::Provenance* prov = asset->file().provenance();
-  if (prov == nullptr || prov->inputs() == nullptr || prov->cook_key() != record.cook_key) return;  // rewritten meanwhile
+  if (prov == nullptr || prov->inputs() == nullptr || prov->cook_key() != record.cook_key)
+    return;  // rewritten meanwhile
   const std::string source = flatbuffers::GetString(prov->source_name());
   if (flatbuffers::GetStringView(prov->options()) != canonical) return;
   std::vector<InputFile> inputs;

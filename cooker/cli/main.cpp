@@ -297,7 +297,8 @@ int main(int argc, char** argv) {
   CookCache cache;
   if (!cache_mode_text.empty()) {
     const std::optional<CacheMode> mode = parse_cache_mode(cache_mode_text);
-    if (!mode) return command.usage_error("OSSA_COOK_CACHE_MODE: '" + cache_mode_text + "' is not read, readwrite or off");
+    if (!mode)
+      return command.usage_error("OSSA_COOK_CACHE_MODE: '" + cache_mode_text + "' is not read, readwrite or off");
     cache.mode = *mode;
   }
   if (!cache_location.empty() && cache.mode != CacheMode::Off && !list_inputs) {

@@ -27,8 +27,8 @@
 #include "test_files.h"
 
 namespace fs = std::filesystem;
-using ossa::test::run_command;
 using nlohmann::json;
+using ossa::test::run_command;
 
 namespace {
 
@@ -75,8 +75,9 @@ struct Cook {
 Cook cook(const fs::path& tree, const fs::path& out, const std::string& extra, unsigned jobs = 2) {
   const fs::path report = out.string() + ".report.json";
   Cook c;
-  c.run = run_command("env -u OSSA_COOK_CACHE -u OSSA_COOK_CACHE_MODE " + (ossa::test::bin_dir() / "ossa-cook").string() +
-                      " " + q(tree) + " -o " + q(out) + " --root " + q(tree) + " -j" + std::to_string(jobs) + " --report " + q(report) + " " + extra);
+  c.run = run_command("env -u OSSA_COOK_CACHE -u OSSA_COOK_CACHE_MODE " +
+                      (ossa::test::bin_dir() / "ossa-cook").string() + " " + q(tree) + " -o " + q(out) + " --root " +
+                      q(tree) + " -j" + std::to_string(jobs) + " --report " + q(report) + " " + extra);
   if (auto text = ossa::test::read_text(report)) c.report = json::parse(*text, nullptr, false);
   fs::remove(report);
   return c;
@@ -205,15 +206,20 @@ struct Nginx {
     }
     for (int attempt = 0; attempt < 3 && port == 0; ++attempt) {
       const uint16_t p = free_port();
-      const std::string conf = user + "worker_processes 1;\npid " + (dir / "nginx.pid").string() +
-                               ";\nerror_log " + (dir / "error.log").string() +
-                               ";\nevents { worker_connections 256; }\nhttp {\n access_log off;\n"
-                               " client_body_temp_path " + (dir / "body").string() + ";\n"
-                               " server {\n  listen 127.0.0.1:" + std::to_string(p) + ";\n  root " +
-                               (dir / "data").string() + ";\n  client_max_body_size 0;\n"
-                               "  location / { dav_methods PUT; create_full_put_path on; dav_access user:rw; }\n }\n}\n";
+      const std::string conf =
+          user + "worker_processes 1;\npid " + (dir / "nginx.pid").string() + ";\nerror_log " +
+          (dir / "error.log").string() +
+          ";\nevents { worker_connections 256; }\nhttp {\n access_log off;\n"
+          " client_body_temp_path " +
+          (dir / "body").string() +
+          ";\n"
+          " server {\n  listen 127.0.0.1:" +
+          std::to_string(p) + ";\n  root " + (dir / "data").string() +
+          ";\n  client_max_body_size 0;\n"
+          "  location / { dav_methods PUT; create_full_put_path on; dav_access user:rw; }\n }\n}\n";
       ossa::test::write_file(dir / "nginx.conf", conf);
-      const auto r = run_command(exe + " -p " + q(dir) + " -e " + q(dir / "error.log") + " -c " + q(dir / "nginx.conf"));
+      const auto r =
+          run_command(exe + " -p " + q(dir) + " -e " + q(dir / "error.log") + " -c " + q(dir / "nginx.conf"));
       if (r.exit_code != 0) {
         why_not = "nginx did not start: " + r.err;
         continue;
@@ -277,8 +283,9 @@ TEST_F(CookCache, FolderSecondCloneCooksNothingAndEditedInputsMiss) {
     EXPECT_EQ(r.at("cache_hit").get<bool>(), r.at("input").get<std::string>().find("walk.fbx") == std::string::npos);
   EXPECT_TRUE(snapshot(dir_ / "out3") == snapshot(dir_ / "ref3"));
   // The environment sets it for a team; off turns it off.
-  const auto env = run_command("OSSA_COOK_CACHE=" + cache + " " + (ossa::test::bin_dir() / "ossa-cook").string() + " " +
-                               q(dir_ / "clone2") + " -o " + q(dir_ / "outEnv") + " --root " + q(dir_ / "clone2") + " 2>&1");
+  const auto env =
+      run_command("OSSA_COOK_CACHE=" + cache + " " + (ossa::test::bin_dir() / "ossa-cook").string() + " " +
+                  q(dir_ / "clone2") + " -o " + q(dir_ / "outEnv") + " --root " + q(dir_ / "clone2") + " 2>&1");
   EXPECT_EQ(env.exit_code, 0);
   EXPECT_NE(env.out.find(std::to_string(inputs_) + " hits, 0 misses"), std::string::npos) << env.out;
   expect_local_bytes(dir_ / "outEnv");
@@ -406,9 +413,10 @@ TEST_F(CookCache, TwoWritersAtOnce) {
     const std::string exe = (ossa::test::bin_dir() / "ossa-cook").string();
     fs::remove_all(dir_ / "w1");
     fs::remove_all(dir_ / "w2");
-    const auto both = run_command(exe + " " + q(dir_ / "clone1") + " -o " + q(dir_ / "w1") + " --root " + q(dir_ / "clone1") + " --cache " + cache +
-                                  " -q -j2 & " + exe + " " + q(dir_ / "clone3") + " -o " + q(dir_ / "w2") +
-                                  " --root " + q(dir_ / "clone3") + " --cache " + cache + " -q -j2 & wait %1; a=$?; wait %2; b=$?; echo $a $b");
+    const auto both = run_command(exe + " " + q(dir_ / "clone1") + " -o " + q(dir_ / "w1") + " --root " +
+                                  q(dir_ / "clone1") + " --cache " + cache + " -q -j2 & " + exe + " " +
+                                  q(dir_ / "clone3") + " -o " + q(dir_ / "w2") + " --root " + q(dir_ / "clone3") +
+                                  " --cache " + cache + " -q -j2 & wait %1; a=$?; wait %2; b=$?; echo $a $b");
     EXPECT_EQ(both.out, "0 0\n") << both.err;
     expect_local_bytes(dir_ / "w1");
     expect_local_bytes(dir_ / "w2");
