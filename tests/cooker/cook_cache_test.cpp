@@ -315,8 +315,9 @@ TEST_F(CookCache, DamagedTruncatedForeignAndGarbageEntriesAreMisses) {
   std::sort(cas.begin(), cas.end());
   std::sort(ac.begin(), ac.end());
   ASSERT_GE(cas.size(), 4u);
+  ASSERT_GE(ac.size(), 3u);
   // One of each: a byte flipped deep inside (still verifies as a FlatBuffer), cut in half, another
-  // output under this key, and a manifest that is not one.
+  // output under this key, a manifest that is not one and another source's manifest under this key.
   auto flipped = *ossa::test::read_file(cas[0]);
   flipped[flipped.size() * 3 / 4] ^= 0x20;
   ossa::test::write_file(cas[0], flipped);
@@ -325,9 +326,10 @@ TEST_F(CookCache, DamagedTruncatedForeignAndGarbageEntriesAreMisses) {
   ossa::test::write_file(cas[1], cut);
   fs::copy_file(cas[3], cas[2], fs::copy_options::overwrite_existing);
   ossa::test::write_file(ac[0], std::string_view("not a manifest"));
+  fs::copy_file(ac[2], ac[1], fs::copy_options::overwrite_existing);  // another source's manifest
 
   const Cook c = survive(q(cache), dir_ / "outB");
-  // Three outputs of three inputs damaged, and one manifest (of any input).
+  // Three outputs of three inputs damaged, and two manifests (of any inputs).
   EXPECT_LE(c.hits(), inputs_ - 3);
   EXPECT_GE(c.misses(), 3u);
   EXPECT_GE(c.cache().at("inputs_with_trouble").get<size_t>(), 3u);
