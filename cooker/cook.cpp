@@ -16,6 +16,7 @@
 #include <fstream>
 #include <iterator>
 
+#include "cooker/cache/cook_cache.h"
 #include "cooker/clip/clip_events.h"
 #include "cooker/cook_internal.h"
 #include "cooker/model/cook_settings.h"
@@ -215,6 +216,22 @@ bool up_to_date(CookRecord& record, const fs::path& input, const fs::path& outpu
   return true;
 }
 
+/// A hit of the shared cook cache (cooker/cache/cook_cache.h): the verified output written
+/// atomically as a cook writes it, and the record the up-to-date check of the written file gives
+/// (so its counts and inputs are those of the file). False on a miss, or when the files changed
+/// between the lookup and the check (the cook then runs and rewrites the output).
+bool from_cache(CookRecord& record, const fs::path& input, const fs::path& output, const CookOptions& options) {
+  if (options.cache == nullptr || options.cache_looked_up || options.force || !options.write) return false;
+  const std::optional<std::vector<uint8_t>> bytes = cache_lookup(*options.cache, record, input, options.canonical());
+  if (!bytes) return false;
+  if (Status st = write_file_atomic(output, *bytes); !st) return false;  // the cook meets it too and says so
+  if (!up_to_date(record, input, output, options)) return false;
+  record.up_to_date = false;
+  record.cache_hit = true;
+  record.cooked_bytes = bytes->size();
+  return true;
+}
+
 void cook_into(CookRecord& record, const fs::path& input, const fs::path& output, const CookOptions& options,
                const AppliedSettings& settings) {
   std::error_code ec;
@@ -310,10 +327,11 @@ void cook_into(CookRecord& record, const fs::path& input, const fs::path& output
 
 namespace {
 
-/// cook_file's body. With only_if_up_to_date, stops after the up-to-date check: the record of an
-/// up-to-date output, or nullopt for anything else (settings that fail, --force, a stale output).
+/// cook_file's body. With only_if_up_to_date, stops after the up-to-date check and the cache
+/// lookup: the record of an up-to-date output or a cache hit, or nullopt for anything else
+/// (settings that fail, --force, a stale output and a miss: the miss's cache fields go to `miss`).
 std::optional<CookRecord> cook_or_check(const fs::path& input, const fs::path& output, const CookOptions& batch_options,
-                                        bool only_if_up_to_date) {
+                                        bool only_if_up_to_date, CookRecord* miss = nullptr) {
   CookRecord record;
   record.input = input.string();
   record.output = output.string();
@@ -332,8 +350,20 @@ std::optional<CookRecord> cook_or_check(const fs::path& input, const fs::path& o
       if (only_if_up_to_date) return std::nullopt;
       record.error = input.string() + ": cook settings: " + st.message();
     } else if (options.force || !up_to_date(record, input, output, options)) {
-      if (only_if_up_to_date) return std::nullopt;
-      cook_into(record, input, output, options, settings);
+      if (only_if_up_to_date) {
+        if (!from_cache(record, input, output, options)) {
+          if (miss != nullptr) {
+            miss->cache_note = record.cache_note;
+            miss->cache_down = record.cache_down;
+            miss->cache_bytes_fetched = record.cache_bytes_fetched;
+          }
+          return std::nullopt;
+        }
+      } else if (!from_cache(record, input, output, options)) {
+        cook_into(record, input, output, options, settings);
+        if (record.ok && options.write && options.cache != nullptr)
+          cache_store_output(*options.cache, record, output, options.canonical());
+      }
     }
   } catch (const std::exception& e) {
     if (only_if_up_to_date) return std::nullopt;
@@ -372,8 +402,8 @@ CookRecord cook_file(const fs::path& input, const fs::path& output, const CookOp
 }
 
 std::optional<CookRecord> up_to_date_record(const fs::path& input, const fs::path& output,
-                                            const CookOptions& batch_options) {
-  return cook_or_check(input, output, batch_options, true);
+                                            const CookOptions& batch_options, CookRecord* cache_miss) {
+  return cook_or_check(input, output, batch_options, true, cache_miss);
 }
 
 Result<tools::HumanoidMapFile> load_humanoid_map_file(const fs::path& path, InputFile* as_read) {

@@ -46,8 +46,12 @@ CookRecord cook_file(const std::filesystem::path& input, const std::filesystem::
 /// the output (through the verifying loader) and settings files (ossa's own JSON reader): no
 /// importer runs, so the batch calls it in its own process before starting a worker for an input,
 /// and an all-up-to-date run costs no process per input. O(bytes of the listed inputs).
+///
+/// With a cache (options.cache), an output that is not up to date is looked up there too, and a
+/// hit is written and returned (cache_hit): a warm cache costs no process per input either. On a
+/// miss, `cache_miss` (when given) receives the lookup's cache_note, cache_down and bytes fetched.
 std::optional<CookRecord> up_to_date_record(const std::filesystem::path& input, const std::filesystem::path& output,
-                                            const CookOptions& options);
+                                            const CookOptions& options, CookRecord* cache_miss = nullptr);
 
 /// Reads and parses a humanoid map file (for --map; tools/retarget/map_file.h). Errors name the
 /// file. `as_read`, when given, receives its input record (absolute path, hash, size).

@@ -46,7 +46,11 @@ def allowed_table():
         a[stage] = {"format", "common", "cooker/json", "cooker/model"} | set(COOKER_STAGES[:i]) | runtime_public
     # Humanoid map files (--map) are read by the retarget stage, the orchestrator and the tools.
     a["cooker/retarget"] |= {"tools/retarget"}
-    a["cooker/cook"] = {"format", "common", "cooker/json", "cooker/model", "tools/retarget"} | set(COOKER_STAGES) | runtime_public
+    # The shared cook cache: keys from the model's input log, entries verified by the runtime's
+    # loader, written with the writer's atomic files; the orchestrator looks up and stores.
+    a["cooker/cache"] = {"format", "common", "cooker/model", "cooker/write"} | runtime_public
+    a["cooker/cook"] = ({"format", "common", "cooker/json", "cooker/model", "tools/retarget", "cooker/cache"} |
+                        set(COOKER_STAGES) | runtime_public)
     a["cooker/cli"] = a["cooker/cook"] | {"cooker/cook", "tools/cli"}
     # Programs over cooked files: the runtime's public headers, the shared command line.
     a["tools/cli"] = {"format", "common"}

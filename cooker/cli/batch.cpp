@@ -15,6 +15,7 @@
 #include <string_view>
 #include <type_traits>
 
+#include "cooker/cache/cook_cache.h"
 #include "cooker/cli/worker.h"
 #include "common/message.h"
 
@@ -139,6 +140,12 @@ std::vector<CookRecord> run_batch(const std::vector<BatchItem>& items, const Coo
   }
   size_t done = 0;
   cook_in_workers(items, options, limits, jobs, [&](size_t index, CookRecord record) {
+    // A worker that found the cache unreachable: those started from now on do not ask (they are
+    // forked from this process and see the mark; cook_cache.h).
+    if (record.cache_down && options.cache != nullptr && !options.cache->down) {
+      options.cache->down = true;
+      options.cache->down_reason = record.cache_note;
+    }
     records[index] = std::move(record);
     ++done;
     if (progress) progress(done, items.size(), records[index]);
@@ -399,8 +406,13 @@ nlohmann::ordered_json report_record(const CookRecord& r) {
           if (!r.ok) j[key] = value;
         } else if (k == "cook_key") {
           if (r.ok) j[key] = hex64(r.cook_key);
-        } else if (k == "output" || k == "cooked_bytes" || k == "up_to_date") {
+        } else if (k == "output" || k == "cooked_bytes" || k == "up_to_date" || k == "cache_hit") {
           if (r.ok) j[key] = value;
+        } else if (k == "cache_down") {
+          // said by cache_note; the batch's own business (it stops asking)
+        } else if (k == "cache_note" || k == "cache_bytes_fetched" || k == "cache_bytes_stored") {
+          if constexpr (std::is_same_v<T, std::string> || std::is_same_v<T, uint64_t>)
+            if (value != T{}) j[key] = value;
         } else {
           j[key] = value;
         }
@@ -410,6 +422,21 @@ nlohmann::ordered_json report_record(const CookRecord& r) {
 }
 
 }  // namespace
+
+CacheTotals cache_totals(const std::vector<CookRecord>& records) {
+  CacheTotals t;
+  for (const CookRecord& r : records) {
+    if (r.cache_hit) ++t.hits;
+    else if (!r.up_to_date) ++t.misses;
+    t.bytes_fetched += r.cache_bytes_fetched;
+    t.bytes_stored += r.cache_bytes_stored;
+    if (!r.cache_note.empty()) {
+      ++t.troubled;
+      if (t.first_trouble.empty()) t.first_trouble = r.cache_note;
+    }
+  }
+  return t;
+}
 
 nlohmann::ordered_json report_json(const std::vector<CookRecord>& records, const CookOptions& options,
                                    const BatchLimits& limits) {
@@ -428,6 +455,19 @@ nlohmann::ordered_json report_json(const std::vector<CookRecord>& records, const
   }
   doc["inputs"] = records.size();
   doc["failed"] = failed;
+  if (options.cache != nullptr) {
+    const CacheTotals t = cache_totals(records);
+    nlohmann::ordered_json c;
+    c["location"] = options.cache->store ? options.cache->store->name() : std::string();
+    c["mode"] = cache_mode_name(options.cache->mode);
+    c["hits"] = t.hits;
+    c["misses"] = t.misses;
+    c["bytes_fetched"] = t.bytes_fetched;
+    c["bytes_stored"] = t.bytes_stored;
+    c["inputs_with_trouble"] = t.troubled;
+    if (!t.first_trouble.empty()) c["trouble"] = t.first_trouble;
+    doc["cache"] = std::move(c);
+  }
   doc["records"] = std::move(list);
   make_utf8(doc);  // keys are ours (ASCII); values may carry any bytes
   return doc;

@@ -93,6 +93,17 @@ std::optional<std::string> depfile_spelling(const std::string& path, bool target
 inline constexpr const char* kReportSchema = "ossa-cook-report";
 inline constexpr int kReportSchemaVersion = 1;
 
+/// What the shared cook cache did for a batch (--cache): hits, misses (inputs neither up to date
+/// nor hits: cooked, or failed), bytes moved, and its trouble, said once (the first, and how many
+/// inputs met any).
+struct CacheTotals {
+  size_t hits = 0, misses = 0;
+  uint64_t bytes_fetched = 0, bytes_stored = 0;
+  size_t troubled = 0;
+  std::string first_trouble;
+};
+CacheTotals cache_totals(const std::vector<CookRecord>& records);
+
 /// The --report document (every string made valid UTF-8: invalid bytes read as Latin-1): schema name and version, cooker version, options, the limits each input
 /// ran under, totals and one record per input. A failed record carries its error and the counts
 /// known before the failure, and no "output" or "cooked_bytes": nothing was written for it.

@@ -5,11 +5,15 @@
 //             [--report FILE.json] [--skeleton REF.ossa] [--retarget-to TARGET.ossa [--map MAP.json]]
 //             [--float-vertices] [--clip-tolerance MM]
 //             [--no-clip-compression] [--root-motion] [--up-axis x|y|z] [--metres-per-unit M] [--force] [--depfile FILE]
-//             [--list-inputs] [-q | -v] [--version] [--help]
+//             [--list-inputs] [--cache DIR|URL [--cache-mode read|readwrite|off] [--cache-timeout S]]
+//             [-q | -v] [--version] [--help]
 //
 // As a build step (docs/SCALE.md): an output whose cook key matches its inputs as they are now is
 // up to date and left alone (--force cooks anyway); --depfile writes a Make-syntax file naming
 // every file each output's cook read; --list-inputs prints those files without writing anything.
+// --cache (or OSSA_COOK_CACHE) shares outputs through a folder or an HTTP cache: the batch looks
+// each input up before starting its worker, and a worker stores what it cooked
+// (cooker/cache/cook_cache.h).
 //
 // Each input is cooked in a worker process of its own, up to --jobs at once (cooker/cli/worker.h):
 // an input that crashes or aborts the importer, runs past --timeout (default 600 s) or past
@@ -32,6 +36,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <optional>
@@ -40,6 +45,7 @@
 #include <thread>
 #include <vector>
 
+#include "cooker/cache/cook_cache.h"
 #include "cooker/cli/batch.h"
 #include "cooker/cli/worker.h"
 #include "cooker/cook.h"
@@ -115,7 +121,8 @@ void print_summary(const std::vector<CookRecord>& records) {
     if (!r.ok) continue;
     std::printf("%-*s %7u %7u %9u %6u %12s %12s  %s\n", width, shown(r.output).c_str(), r.joints.value_or(0),
                 r.meshes.value_or(0), r.vertices.value_or(0), r.clips.value_or(0), human_bytes(r.source_bytes).c_str(),
-                human_bytes(r.cooked_bytes).c_str(), r.up_to_date ? "up to date" : "cooked");
+                human_bytes(r.cooked_bytes).c_str(),
+                r.up_to_date ? "up to date" : r.cache_hit ? "cache_hit" : "cooked");
   }
 }
 
@@ -240,6 +247,19 @@ int main(int argc, char** argv) {
   app.add_flag("--list-inputs", list_inputs,
                "print every file the cooks read (one per line, sorted) and write no output; up-to-date outputs "
                "answer from their provenance");
+  std::string cache_location, cache_mode_text;
+  unsigned cache_timeout = 10;
+  app.add_option("--cache", cache_location,
+                 "a shared cook cache: a folder, or the URL of an HTTP cache speaking Bazel's remote-cache protocol "
+                 "(nginx with WebDAV, bazel-remote); outputs found there are not cooked, outputs cooked are stored "
+                 "(default: $OSSA_COOK_CACHE; docs/SCALE.md)");
+  app.add_option("--cache-mode", cache_mode_text,
+                 "read: look up only (developers' machines); readwrite: also store (CI); off (default: "
+                 "$OSSA_COOK_CACHE_MODE, else readwrite)")
+      ->check(CLI::IsMember({"read", "readwrite", "off"}));
+  app.add_option("--cache-timeout", cache_timeout,
+                 "seconds one request to an HTTP cache may take before it counts as a miss (default 10)")
+      ->check(CLI::Range(1u, 3600u));
   if (const auto exit_now = command.parse(argc, argv)) return *exit_now;
   const bool quiet = command.quiet(), verbose = command.verbose();
   std::optional<uint64_t> max_memory;
@@ -269,6 +289,27 @@ int main(int argc, char** argv) {
     options.allow_dirs.emplace_back(d);
   }
   options.write = !list_inputs;
+  // The cache: set once for a team through the environment, or per run on the command line.
+  if (cache_location.empty())
+    if (const char* env = std::getenv("OSSA_COOK_CACHE"); env != nullptr) cache_location = env;
+  if (cache_mode_text.empty())
+    if (const char* env = std::getenv("OSSA_COOK_CACHE_MODE"); env != nullptr && *env != '\0') cache_mode_text = env;
+  CookCache cache;
+  if (!cache_mode_text.empty()) {
+    const std::optional<CacheMode> mode = parse_cache_mode(cache_mode_text);
+    if (!mode)
+      return command.usage_error("OSSA_COOK_CACHE_MODE: '" + cache_mode_text + "' is not read, readwrite or off");
+    cache.mode = *mode;
+  }
+  if (!cache_location.empty() && cache.mode != CacheMode::Off && !list_inputs) {
+    auto store = open_cache_store(cache_location, cache_timeout);
+    if (!store) {
+      std::fprintf(stderr, "ossa-cook: %s\n", store.error().message.c_str());
+      return ossa::cli::kExitUsage;
+    }
+    cache.store = std::move(*store);
+    options.cache = &cache;
+  }
   options.allow_hard_links = allow_hard_links;
   SourceSkeleton reference;
   if (!skeleton_path.empty()) {
@@ -342,7 +383,7 @@ int main(int argc, char** argv) {
     if (!r.ok) {
       std::fprintf(stderr, "%s%s FAILED %s\n", tty ? "\r\033[K" : "", head.c_str(), shown(r.error).c_str());
     } else if (!quiet && !list_inputs) {
-      const char* what = r.up_to_date ? " (up to date)" : "";
+      const char* what = r.up_to_date ? " (up to date)" : r.cache_hit ? " (cache hit)" : "";
       if (tty)  // one line rewritten in place: it must not wrap, so a long path keeps its tail
         std::fprintf(stderr, "\r\033[K%s %s%s", head.c_str(),
                      fit(shown(r.input), terminal_columns() - head.size() - std::strlen(what) - 2).c_str(), what);
@@ -391,6 +432,17 @@ int main(int argc, char** argv) {
     }
   }
   if (!quiet && !list_inputs) print_summary(records);
+  if (options.cache != nullptr) {
+    // Said once: the totals, and the cache's first trouble (each such input cooked as a miss).
+    const CacheTotals t = cache_totals(records);
+    if (!quiet)
+      std::fprintf(stderr, "ossa-cook: cache %s (%s): %zu hits, %zu misses, %s fetched, %s stored\n",
+                   shown(cache.store->name()).c_str(), cache_mode_name(cache.mode), t.hits, t.misses,
+                   human_bytes(t.bytes_fetched).c_str(), human_bytes(t.bytes_stored).c_str());
+    if (t.troubled > 0)
+      std::fprintf(stderr, "ossa-cook: cache trouble (%zu input%s cooked without it): %s\n", t.troubled,
+                   t.troubled == 1 ? "" : "s", shown(t.first_trouble).c_str());
+  }
   if (!quiet && !verbose && warnings > 0)
     std::fprintf(stderr, "ossa-cook: %zu warning%s (-v prints them; --report records them)\n", warnings,
                  warnings == 1 ? "" : "s");

@@ -2,6 +2,8 @@
 // hook, and the parent's scheduler (see worker.h for why it is shaped so).
 #include "cooker/cli/worker.h"
 
+#include "cooker/cache/cook_cache.h"
+
 #include <fcntl.h>
 #include <poll.h>
 #include <signal.h>
@@ -273,6 +275,9 @@ struct Worker {
   bool had_output = false;
   dev_t output_dev = 0;
   ino_t output_ino = 0;
+  // The batch's own cache lookup for this input, a miss (cook_cache.h): its fields join the record.
+  bool looked_up = false;
+  CookRecord cache_miss;
 };
 
 std::string signal_name(int sig) {
@@ -337,17 +342,23 @@ void cook_in_workers(const std::vector<BatchItem>& items, const CookOptions& opt
     const BatchItem& item = items[next];
     // An up-to-date output needs no worker: the check runs no importer (cook.h), and a process per
     // input was most of an all-up-to-date run's time. Inputs a test fault names still go to a worker.
+    // So does a cache hit (cooker/cache/cook_cache.h); a miss's trouble is kept for the worker's record.
+    Worker w;
+    w.index = next;
     if (!options.force && test_fault(item.input.string()).empty()) {
       CookOptions item_options = options;
       if (item_options.root.empty()) item_options.root = item.tree;
-      if (std::optional<CookRecord> fresh = up_to_date_record(item.input, item.output, item_options)) {
+      if (std::optional<CookRecord> fresh = up_to_date_record(item.input, item.output, item_options, &w.cache_miss)) {
         finished(next, std::move(*fresh));
         ++next;
         return true;
       }
+      w.looked_up = options.cache != nullptr;
+      if (w.cache_miss.cache_down && options.cache != nullptr && !options.cache->down) {
+        options.cache->down = true;  // this worker and those after it do not ask again
+        options.cache->down_reason = w.cache_miss.cache_note;
+      }
     }
-    Worker w;
-    w.index = next;
     struct stat st {};
     if (::stat(item.output.c_str(), &st) == 0) {
       w.had_output = true;
@@ -371,6 +382,11 @@ void cook_in_workers(const std::vector<BatchItem>& items, const CookOptions& opt
     if (pid == 0) {
       ::close(fds[0]);
       for (const Worker& other : running) ::close(other.fd);  // other workers' read ends (may be -1)
+      if (w.looked_up) {
+        CookOptions stores_only = options;
+        stores_only.cache_looked_up = true;
+        run_worker(item, stores_only, limits, fds[1], self);
+      }
       run_worker(item, options, limits, fds[1], self);
     }
     ::close(fds[1]);
@@ -413,6 +429,9 @@ void cook_in_workers(const std::vector<BatchItem>& items, const CookOptions& opt
       remove_leftovers(item.output, w);
       record = failed_record(w.index, why, seconds);
     }
+    if (record->cache_note.empty()) record->cache_note = w.cache_miss.cache_note;
+    record->cache_down = record->cache_down || w.cache_miss.cache_down;
+    record->cache_bytes_fetched += w.cache_miss.cache_bytes_fetched;
     finished(w.index, std::move(*record));
   };
 

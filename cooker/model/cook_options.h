@@ -23,6 +23,8 @@ struct HumanoidMapFile;  // tools/retarget/map_file.h (--map)
 
 namespace ossa::cook {
 
+struct CookCache;  // cooker/cache/cook_cache.h (--cache)
+
 /// What the cooker makes of a texture (--texture-format; cooker/texture/texture_cook.h).
 enum class TextureOutput : uint8_t {
   Compressed,  // "bc": mip chains in BC1 / BC3 / BC4 / BC5 by role (the default)
@@ -78,7 +80,12 @@ struct CookOptions {
   /// --allow-hard-links: read regular files that have other links (refused by default: a hard
   /// link is another name for bytes that may lie outside the allowed folders).
   bool allow_hard_links = false;
-  bool force = false;  // --force: cook even when the output is up to date
+  bool force = false;  // --force: cook even when the output is up to date (and do not look in the cache)
+  /// --cache: the shared cook cache to look outputs up in and store them into; null: none. Not
+  /// const: the batch marks it down when a worker finds it unreachable.
+  CookCache* cache = nullptr;
+  /// The batch looked this input up in the cache already (a miss): the worker only stores.
+  bool cache_looked_up = false;
   bool write = true;   // false (--list-inputs): cook in memory, write nothing
 };
 

@@ -107,6 +107,12 @@ struct CookRecord {
   std::vector<InputFile> inputs_read;
   uint64_t cook_key = 0;   // of the written (or up-to-date) output
   bool up_to_date = false; // ok without cooking: the output's cook key matched (nothing written)
+  // The shared cook cache (cooker/cache/cook_cache.h), when the batch has one:
+  bool cache_hit = false;            // ok without cooking: the output came from the cache, verified
+  std::string cache_note;            // the first trouble the cache gave this input (a miss, never a failure)
+  bool cache_down = false;           // that trouble was the cache being unreachable: the batch stops asking
+  uint64_t cache_bytes_fetched = 0;  // manifest and output bytes read from the cache
+  uint64_t cache_bytes_stored = 0;   // manifest and output bytes written to it
 };
 
 // The field lists. Each calls f(key, r.member...) once per field, in report order, for one record
@@ -211,6 +217,11 @@ constexpr void cook_record_fields(F&& f, R&... r) {
   f("cooked_bytes", r.cooked_bytes...);
   f("up_to_date", r.up_to_date...);
   f("cook_key", r.cook_key...);
+  f("cache_hit", r.cache_hit...);
+  f("cache_note", r.cache_note...);
+  f("cache_down", r.cache_down...);
+  f("cache_bytes_fetched", r.cache_bytes_fetched...);
+  f("cache_bytes_stored", r.cache_bytes_stored...);
   f("inputs_read", r.inputs_read...);
   f("seconds", r.seconds...);
   f("warnings", r.warnings...);

@@ -408,6 +408,11 @@ TEST(CookIsolation, RecordRoundTripsEveryField) {
                    {"/src/walk.events.json", 0, 0, false}};
   r.cook_key = 0x8000000000000001ull;
   r.up_to_date = true;
+  r.cache_hit = true;
+  r.cache_note = "http://cache: ac/0123: Timeout was reached";
+  r.cache_down = true;
+  r.cache_bytes_fetched = 0x100000001ull;
+  r.cache_bytes_stored = 0x200000002ull;
 
   // The test means nothing for a field it leaves at its default: every listed field is set (the
   // one optional left empty checks that null crosses too), and each record list holds a record with
