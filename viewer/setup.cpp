@@ -20,6 +20,7 @@ void apply_view_options(App& app, const ViewerOptions& o) {
   app.toggles.skeleton = o.skeleton;
   app.toggles.grid = o.grid;
   app.toggles.procedural = o.show_procedural || !o.headless();  // on in the window, asked for in images
+  app.toggles.mapping = o.show_mapping || !o.headless();
 }
 
 Status setup_app(App& app, Scene scene, const ViewerOptions& o, float aspect) {
@@ -64,6 +65,10 @@ Status setup_app(App& app, Scene scene, const ViewerOptions& o, float aspect) {
       return Error{name + ": no morph target named '" + morph + "' (morph targets: " + (names.empty() ? "none" : names) + ")"};
     }
     hold_morph(app.animator, static_cast<size_t>(c), true, weight);
+  }
+  if (!o.retarget_from.empty()) {
+    if (Status s = set_retarget(app, o.retarget_from, o.retarget_map, o.retarget_clip, aspect); !s) return s;
+    set_time(app.retarget->source, app.retarget->animator, o.time);
   }
   Playback& p = app.animator.playback;
   p.bind_pose = o.bind_pose;
