@@ -41,7 +41,9 @@ void frame_camera(App& app, float aspect) {
     compute_model_poses(app.scene, a, ignored);
     const auto& model = a.instances.front().model;
     Box shown = posed_bounds(app.scene.character(), model);
-    if (app.retarget && app.retarget->show_source) shown.add(source_bounds(*app.retarget));
+    // The source as first shown (the same box at any clip time, so --time moves only the figures).
+    if (app.retarget && app.retarget->framing.empty()) app.retarget->framing = source_bounds(*app.retarget);
+    if (app.retarget && app.retarget->show_source) shown.add(app.retarget->framing);
     if (!shown.empty()) app.framing = shown;
     if (!model.empty()) {
       moved = glm::vec3(model[0][3]) - app.root_bind;

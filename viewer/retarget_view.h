@@ -49,6 +49,7 @@ struct RetargetView {
   std::vector<std::string> files;  // what it was opened from (the panel lists them)
   std::string map_file;
   bool show_source = true;  // the panel's toggle: draw the source character
+  Box framing;              // the source as first shown, which the camera frames with the character
 };
 
 /// Opens the source files, maps both rigs (by name, or the map file's sections: tools/retarget
