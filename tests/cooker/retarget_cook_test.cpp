@@ -9,8 +9,9 @@
 // mid-plane where the source's is not, every planted foot within 1 cm of where it is held. Then a
 // rig onto itself equals the source within 0.1 mm, missing bones are named, map file mistakes are
 // named, and the live job (ossa::retarget on the cooked source clip) equals the cooked clip within
-// 0.1 mm. Cooks go to one cache folder under the test tree; a second test process finds them up to
-// date (their cook keys match) instead of cooking again.
+// 0.1 mm; a graph's retarget node (format v10) equals the live job, allocates nothing per update
+// and its compile mistakes are named. Cooks go to one cache folder under the test tree; a second
+// test process finds them up to date (their cook keys match) instead of cooking again.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -30,6 +31,7 @@
 #include <ossa/retarget/foot_contacts.h>
 #include <ossa/retarget/retarget.h>
 #include "tools/retarget/map_file.h"
+#include "allocation_counter.h"
 #include "test_files.h"
 
 namespace fs = std::filesystem;
@@ -392,9 +394,10 @@ std::string graph_json(const std::string& name, const fs::path& skeleton, const 
 std::string path_json(const fs::path& p) { return nlohmann::json(p.string()).dump(); }
 
 /// Plays graph `name` of `character` with `files` and compares every frame but the last (where a
-/// looping node wraps) with `expected`; the worst joint distance in mm.
+/// looping node wraps) with `expected`; the worst joint distance in mm. `allocations`, when given,
+/// receives how many times the updates after the first allocated.
 double graph_against(const ossa::Asset& character, const std::string& name, std::span<const ossa::Asset* const> files,
-                     const std::vector<ossa::Pose>& expected, float rate) {
+                     const std::vector<ossa::Pose>& expected, float rate, size_t* allocations = nullptr) {
   auto def = ossa::GraphDefinition::create(character, name, files);
   EXPECT_TRUE(def.ok()) << def.error().message;
   if (!def.ok()) return 1e9;
@@ -407,7 +410,9 @@ double graph_against(const ossa::Asset& character, const std::string& name, std:
   instance->update(0.0f);
   for (size_t f = 0; f + 1 < expected.size(); ++f) {
     worst = std::max(worst, pose_distance_mm(sk, character.file().metres_per_unit(), instance->pose(), expected[f]));
+    const size_t before = ossa::test::allocation_count();
     instance->update(1.0f / rate);
+    if (allocations != nullptr) *allocations += ossa::test::allocation_count() - before;
   }
   return worst;
 }
@@ -439,7 +444,9 @@ TEST(RetargetGraph, NodeEqualsTheLiveJob) {
     times.push_back(ossa::advance_time(times.back(), 1.0f / clip.sample_rate(), 1.0f, clip.duration(), true));
   const std::vector<ossa::Pose> live = live_frames(*rig, clip, *character, times);
   const ossa::Asset* files[] = {&*library, &*rig};
-  const double mm = graph_against(*character, "cowboy_walks_like_pab", files, live, clip.sample_rate());
+  size_t allocations = 0;
+  const double mm = graph_against(*character, "cowboy_walks_like_pab", files, live, clip.sample_rate(), &allocations);
+  EXPECT_EQ(allocations, 0u) << "the retarget node's updates allocated";
   std::printf("graph retarget node against the live job (Pab walk on the Cowboy): %.6f mm\n", mm);
   EXPECT_LT(mm, 1e-4);
 
