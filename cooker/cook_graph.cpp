@@ -9,8 +9,11 @@
 // once. Every file it reads (the graph file, sources and their event sidecars) goes into the
 // cook's input log, so the cook key changes when any of them does.
 // Messages about a source start with the graph file's position of the entry naming it and then
-// carry the source's own message (which names the source).
+// carry the source's own message (which names the source). A retarget node's source rig and map
+// file (docs/RETARGET.md) are read here too, and its rigs mapped, for the compiler.
+#include <functional>
 #include <map>
+#include <optional>
 #include <span>
 
 #include "cooker/clip/clip_events.h"
@@ -21,12 +24,140 @@
 #include "cooker/mesh/mesh_build.h"
 #include "cooker/write/write_ossa.h"
 #include "cooker/texture/texture_cook.h"
+#include "tools/retarget/map_file.h"
 #include <ossa/format/hash.h>
+#include <ossa/loader/asset.h>
+#include <ossa/retarget/humanoid.h>
+#include <ossa/retarget/retarget.h>
 
 namespace ossa::cook::detail {
 namespace fs = std::filesystem;
 
 namespace {
+
+/// One rig as the retarget job reads it (retarget_clips.cpp makes the same from a SourceSkeleton).
+struct MappedRig {
+  std::vector<std::string_view> names;
+  std::vector<int16_t> parents;
+  std::vector<Transform> bind;
+  tools::AppliedRigMap applied;
+  RetargetRig rig;
+};
+
+Result<MappedRig> map_rig(const SourceSkeleton& skeleton, const tools::HumanoidMapFile* map,
+                          const std::string& map_name, const char* role, const std::string& name) {
+  MappedRig r;
+  for (const SourceJoint& j : skeleton.joints) {
+    r.names.emplace_back(j.name);
+    r.parents.push_back(static_cast<int16_t>(j.parent));
+    r.bind.push_back(Transform{j.translation, j.rotation, j.scale});
+  }
+  const tools::RigMapSpec* spec = map != nullptr ? tools::section_for(*map, role, r.names) : nullptr;
+  auto applied = tools::apply_rig_map(spec, r.names, r.parents, spec != nullptr ? map_name + " (" + role + ")" : name);
+  if (!applied) return applied.error();
+  r.applied = std::move(*applied);
+  return r;
+}
+
+void finish_rig(MappedRig& r, std::string_view name) {
+  r.rig.name = name;
+  r.rig.parents = r.parents;
+  r.rig.bind = r.bind;
+  r.rig.names = r.names;
+  r.rig.humanoid = r.applied.humanoid;
+  r.rig.rest = r.applied.rest;
+  r.rig.rest_rotations = r.applied.rest_rotations;
+}
+
+std::vector<RetargetRestRotationDef> rest_rotations_of(const tools::AppliedRigMap& applied) {
+  std::vector<RetargetRestRotationDef> out;
+  for (const RestRotation& r : applied.rest_rotations) {
+    RetargetRestRotationDef d;
+    d.joint = static_cast<uint16_t>(r.joint);
+    d.rotation[0] = r.rotation.x;
+    d.rotation[1] = r.rotation.y;
+    d.rotation[2] = r.rotation.z;
+    d.rotation[3] = r.rotation.w;
+    out.push_back(d);
+  }
+  return out;
+}
+
+/// A retarget node's rigs (graph_compile.h): the source rig (a cooked .ossa, or a source file
+/// imported as ossa-cook imports it: the same names and parents, so the same skeleton hash as its
+/// cook) and the map file, both read through the cook's input log (keyed inputs), both rigs
+/// mapped and the retarget map built once, so a rig the retarget cannot use fails the cook with
+/// the bones it lacks named.
+Result<GraphRetargetRigs> retarget_rigs(const fs::path& rig_path, const fs::path& map_path,
+                                        const SourceSkeleton& target,
+                                        const std::function<void(const std::vector<uint8_t>&)>& add) {
+  std::error_code ec;
+  if (!fs::is_regular_file(rig_path, ec)) return Error{rig_path.string() + ": no such rig file"};
+  auto bytes = read_bytes(rig_path);
+  if (!bytes) return bytes.error();
+  add(*bytes);
+  SourceSkeleton source;
+  uint64_t hash = 0;
+  if (rig_path.extension() == ".ossa") {
+    auto asset = Asset::from_bytes(*bytes, rig_path.string());
+    if (!asset) return asset.error();
+    const SkeletonView sk = asset->skeleton();
+    if (sk.empty() || sk.joint_count() == 0) return Error{rig_path.string() + ": holds no skeleton to retarget from"};
+    for (size_t i = 0; i < sk.joint_count(); ++i) {
+      SourceJoint j;
+      j.name = std::string(sk.joint_name(i));
+      j.parent = sk.parents()[i];
+      const fb::Vec3& t = sk.bind_translations()[i];
+      const fb::Quat& q = sk.bind_rotations()[i];
+      const fb::Vec3& sc = sk.bind_scales()[i];
+      j.translation = {t.x(), t.y(), t.z()};
+      j.rotation = glm::quat(q.w(), q.x(), q.y(), q.z());
+      j.scale = {sc.x(), sc.y(), sc.z()};
+      source.joints.push_back(std::move(j));
+    }
+    hash = sk.hash();
+  } else {
+    auto scene = import_scene(rig_path.string());
+    if (!scene) return scene.error();
+    if (scene->skeleton.joints.empty()) return Error{rig_path.string() + ": has no skeleton to retarget from"};
+    source = std::move(scene->skeleton);
+    hash = skeleton_hash_of(source);
+  }
+  if (source.joints.size() > 65535) return Error{rig_path.string() + ": more than 65535 joints"};
+  std::optional<tools::HumanoidMapFile> map;
+  if (!map_path.empty()) {
+    std::error_code map_ec;
+    if (!fs::is_regular_file(map_path, map_ec)) return Error{map_path.string() + ": no such map file"};
+    auto text = read_bytes(map_path);
+    if (!text) return text.error();
+    add(*text);
+    auto parsed = tools::parse_humanoid_map_file(
+        std::string_view(reinterpret_cast<const char*>(text->data()), text->size()), map_path.string());
+    if (!parsed) return parsed.error();
+    map = std::move(*parsed);
+  }
+  const tools::HumanoidMapFile* map_file = map ? &*map : nullptr;
+  const std::string source_name = rig_path.filename().string() + " (the retarget node's source rig)";
+  auto from = map_rig(source, map_file, map_path.string(), "source", source_name);
+  if (!from) return from.error();
+  auto to = map_rig(target, map_file, map_path.string(), "target", "the graph's rig");
+  if (!to) return to.error();
+  finish_rig(*from, source_name);
+  finish_rig(*to, "the graph's rig");
+  if (Status st = check_humanoid(from->rig.humanoid, from->parents, source_name); !st) return st.error();
+  if (Status st = check_humanoid(to->rig.humanoid, to->parents, "the graph's rig"); !st) return st.error();
+  if (auto built = make_retarget_map(from->rig, to->rig); !built) return built.error();
+  GraphRetargetRigs out;
+  out.source_skeleton_hash = hash;
+  out.source_joint_count = static_cast<uint16_t>(source.joints.size());
+  out.source_bones.assign(from->applied.humanoid.joints.begin(), from->applied.humanoid.joints.end());
+  out.target_bones.assign(to->applied.humanoid.joints.begin(), to->applied.humanoid.joints.end());
+  out.source_rest = from->applied.rest == RestPose::Bind ? 1 : 0;
+  out.target_rest = to->applied.rest == RestPose::Bind ? 1 : 0;
+  out.source_rest_rotations = rest_rotations_of(from->applied);
+  out.target_rest_rotations = rest_rotations_of(to->applied);
+  return out;
+}
 
 /// The bytes the graph reads besides itself (each file it reads is in the cook's input log).
 struct SourceTally {
@@ -140,6 +271,10 @@ void cook_graph(CookRecord& record, const fs::path& input, const fs::path& outpu
   // Clips: each from its source (imported once, with its event sidecar), renamed.
   GraphContext context;
   context.skeleton = &rig;
+  context.retarget_rigs = [&](const std::string& rig_file, const std::string& map_file) {
+    return retarget_rigs(cook.resolve(rig_file), map_file.empty() ? fs::path() : cook.resolve(map_file), rig,
+                         [&](const std::vector<uint8_t>& bytes) { cook.add(bytes); });
+  };
   for (const GraphClipSource& entry : manifest->clips) {
     const fs::path path = cook.resolve(entry.source);
     auto it = cook.clip_sources.find(path);

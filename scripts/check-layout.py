@@ -26,7 +26,7 @@ from collections import defaultdict
 # The cooker's stages in the order data flows through them. A stage may include the model, the
 # JSON reader and the stages before it (whose products it reads), never one after it.
 COOKER_STAGES = ["cooker/import", "cooker/retarget", "cooker/mesh", "cooker/clip", "cooker/graph", "cooker/texture", "cooker/write"]
-RUNTIME_ROOMS = ["runtime/loader", "runtime/anim", "runtime/skinning", "runtime/graph", "runtime/retarget"]
+RUNTIME_ROOMS = ["runtime/loader", "runtime/anim", "runtime/skinning", "runtime/retarget", "runtime/graph"]
 
 
 def allowed_table():
@@ -57,7 +57,7 @@ def allowed_table():
     a["tools/retarget"] = {"format", "common"} | runtime_public
     a["tools/inspect"] = {"format", "common", "tools/cli", "tools/retarget"} | runtime_public
     a["tools/diff"] = {"format", "common", "tools/cli", "tools/inspect"} | runtime_public
-    a["viewer"] = {"format", "common", "tools/cli"} | runtime_public
+    a["viewer"] = {"format", "common", "tools/cli", "tools/retarget"} | runtime_public
     # Runtime suites build in the runtime-only build: the runtime, the format and test support, plus
     # ossa_cook_base (COOK_BASE below), the part of the cooker that needs only FlatBuffers and GLM.
     a["tests/runtime"] = {"format", "common", "tests/support", "cooker/model"} | runtime_all

@@ -6,6 +6,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "viewer/procedural_draw.h"
+#include "viewer/retarget_view.h"
 #include <utility>
 
 namespace ossa::view {
@@ -36,9 +37,13 @@ void frame_camera(App& app, float aspect) {
     Animator& a = app.animator;
     PoseTimings ignored;
     produce_local_poses(app.scene, a, ignored);
+    if (app.retarget) retarget_poses(*app.retarget, a, app.bind_box, 0.0f);
     compute_model_poses(app.scene, a, ignored);
     const auto& model = a.instances.front().model;
-    const Box shown = posed_bounds(app.scene.character(), model);
+    Box shown = posed_bounds(app.scene.character(), model);
+    // The source as first shown (the same box at any clip time, so --time moves only the figures).
+    if (app.retarget && app.retarget->framing.empty()) app.retarget->framing = source_bounds(*app.retarget);
+    if (app.retarget && app.retarget->show_source) shown.add(app.retarget->framing);
     if (!shown.empty()) app.framing = shown;
     if (!model.empty()) {
       moved = glm::vec3(model[0][3]) - app.root_bind;
@@ -73,6 +78,15 @@ Status open_loaded_scene(App& app, Scene scene, size_t crowd, float aspect) {
   }
   app.scene = std::move(scene);
   app.messages = std::move(warnings);
+  // A retarget source is mapped onto the new character, or dropped when it cannot be.
+  if (app.retarget) {
+    const std::vector<std::string> files = app.retarget->files;
+    const std::string map = app.retarget->map_file;
+    release_retarget_view(*app.retarget);
+    app.retarget.reset();
+    if (auto view = make_retarget_view(app.scene, files, map, {}); view) app.retarget = std::move(*view);
+    else app.messages.push_back(view.error().message);
+  }
   app.animator = Animator{};
   // Keep playing the graph by name if the new files have it; otherwise back to clips.
   bool has_graph = false;
@@ -184,6 +198,27 @@ Status open_or_add(App& app, std::span<const std::string> paths, float aspect) {
   return play_clip(app, static_cast<int>(before), true);
 }
 
+Status set_retarget(App& app, std::span<const std::string> files, const std::string& map_file, const std::string& clip,
+                    float aspect) {
+  std::unique_ptr<RetargetView> view;
+  if (!files.empty()) {
+    if (app.scene.assets.empty()) return Error{"--retarget-from: no character opened to retarget onto"};
+    auto made = make_retarget_view(app.scene, files, map_file, clip);
+    if (!made) return made.error();
+    view = std::move(*made);
+  }
+  if (app.retarget) release_retarget_view(*app.retarget);
+  app.retarget = std::move(view);
+  frame_camera(app, aspect);
+  return {};
+}
+
+void release_app_gpu(App& app) {
+  if (app.retarget) release_retarget_view(*app.retarget);
+  app.retarget.reset();
+  destroy_renderer(app.renderer);
+}
+
 Status play_clip(App& app, int clip, bool crossfade) { return select_clip(app.scene, app.animator, clip, crossfade); }
 
 Status step_cloth(App& app, float dt) {
@@ -198,6 +233,10 @@ Status step_and_render(App& app, float dt, int width, int height, FrameTimings& 
   advance(app.scene, app.animator, dt);
   PoseTimings pose;
   produce_local_poses(app.scene, app.animator, pose);
+  if (app.retarget) {
+    const Playback& p = app.animator.playback;
+    retarget_poses(*app.retarget, app.animator, app.bind_box, p.playing && !p.bind_pose ? dt * p.speed : 0.0f);
+  }
   compute_model_poses(app.scene, app.animator, pose);
   produce_morph_weights(app.scene, app.animator);
   timings.sample_ms += pose.sample_ms;
@@ -220,8 +259,26 @@ Status step_and_render(App& app, float dt, int width, int height, FrameTimings& 
     app.renderer.overlay.clear();
   }
   if (app.show_cloth) build_cloth_overlay(app.cloth, app.animator, app.offsets, app.renderer.overlay);
-  return render_frame(app.renderer, app.scene, app.animator, app.offsets, app.camera, app.toggles, width, height,
-                      timings, &app.cloth);
+  ViewToggles toggles = app.toggles;
+  if (app.retarget && app.retarget->show_source) {
+    // The source first, then the character over the same frame (its grid and overlays last).
+    RetargetView& v = *app.retarget;
+    if (app.toggles.mapping && !app.offsets.empty())
+      build_mapping_lines(v, app.animator, app.offsets.front(), app.renderer.overlay);
+    v.renderer.viewport_x = app.renderer.viewport_x;
+    v.renderer.viewport_y = app.renderer.viewport_y;
+    v.renderer.overlay.clear();
+    ViewToggles source = app.toggles;
+    source.grid = false;
+    const glm::vec3 here(0.0f);
+    if (Status s = render_frame(v.renderer, v.source, v.animator, std::span<const glm::vec3>(&here, 1), app.camera,
+                                source, width, height, timings);
+        !s)
+      return s;
+    toggles.keep_frame = true;
+  }
+  return render_frame(app.renderer, app.scene, app.animator, app.offsets, app.camera, toggles, width, height, timings,
+                      &app.cloth);
 }
 
 }  // namespace ossa::view

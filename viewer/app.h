@@ -6,6 +6,7 @@
 // pixels go (a window, or an offscreen framebuffer written to a PNG).
 #pragma once
 #include <cstddef>
+#include <memory>
 #include <span>
 #include <string>
 #include <vector>
@@ -18,6 +19,7 @@
 #include "viewer/camera.h"
 #include "viewer/cloth_view.h"
 #include "viewer/renderer.h"
+#include "viewer/retarget_view.h"
 #include "viewer/scene.h"
 
 namespace ossa::view {
@@ -46,6 +48,7 @@ struct App {
   int active_handle = -1;          // the target gizmo being dragged (ProceduralInfo::targets), or -1
   ViewerCloth cloth;               // the character's cloth, per instance (cloth_view.h)
   bool show_cloth = false;         // the cloth overlay: particles, edges, colliders
+  std::unique_ptr<RetargetView> retarget;  // --retarget-from: a clip of another rig drives the character
 };
 
 /// Replaces the scene with `paths` (scene.h load_scene), uploads it, builds the crowd and frames
@@ -72,6 +75,15 @@ void frame_camera(App& app, float aspect);
 /// told where its character stands (GraphInstance::set_transform: its crowd placement), so
 /// world-space targets, foot locks and springs act where it is drawn.
 Status use_graph(App& app, const std::string& name);
+
+/// Retarget mode (retarget_view.h): the clip `clip` (empty: the first) of the source `files`
+/// drives the character, the source drawn beside it. Replaces any previous source; errors leave
+/// the App as it was. Empty `files`: back to the character's own clips.
+Status set_retarget(App& app, std::span<const std::string> files, const std::string& map_file, const std::string& clip,
+                    float aspect);
+
+/// Frees the GPU objects the App holds (the renderer, a retarget source's); the context must be current.
+void release_app_gpu(App& app);
 
 /// Selects a clip by index (-1: none) with an optional cross-fade.
 Status play_clip(App& app, int clip, bool crossfade);

@@ -81,6 +81,11 @@ Status render_headless(const ViewerOptions& o, bool& cannot_run) {
       }
     }
   }
+  if (app.retarget) {  // the source clip likewise ends at --time
+    RetargetView& v = *app.retarget;
+    const float rate = o.speed != 0.0f ? o.speed : 1.0f;
+    set_time(v.source, v.animator, o.time - rate * kFrameStep * static_cast<float>(o.frames - 1));
+  }
 
   Result<Offscreen> target = create_offscreen(o.width, o.height, o.msaa);
   if (!target) return Error{name + ": " + target.error().message};
@@ -92,6 +97,7 @@ Status render_headless(const ViewerOptions& o, bool& cannot_run) {
     float dt = f == 0 ? 0.0f : kFrameStep;
     if (!graph && f == o.frames - 1) {
       set_time(app.scene, app.animator, o.time);  // exactly --time, no drift
+      if (app.retarget) set_time(app.retarget->source, app.retarget->animator, o.time);
       dt = 0.0f;
     }
     if (Status s = step_and_render(app, dt, o.width, o.height, total); !s) return s;
@@ -120,7 +126,7 @@ Status render_headless(const ViewerOptions& o, bool& cannot_run) {
   }
   destroy_offscreen(*target);
   release_scene(app.renderer);
-  destroy_renderer(app.renderer);
+  release_app_gpu(app);
   return {};
 }
 

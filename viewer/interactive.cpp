@@ -342,7 +342,7 @@ int run_interactive(const ViewerOptions& o) {
   ImGui_ImplOpenGL3_Shutdown();
   ImGui_ImplGlfw_Shutdown();
   ImGui::DestroyContext();
-  destroy_renderer(app.renderer);
+  release_app_gpu(app);
   return status;
 }
 

@@ -89,6 +89,16 @@ ParsedOptions parse_options(int argc, const char* const* argv) {
       ->type_name("SECTION[@T]")
       ->needs("--montage")
       ->allow_extra_args(false);
+  app.add_option("--retarget-from", o.retarget_from,
+                 "play a clip of this humanoid character on the opened one, drawn beside it (repeatable: the source "
+                 "character, then clip files cooked for it)")
+      ->allow_extra_args(false);
+  app.add_option("--retarget-map", o.retarget_map, "a humanoid map file for --retarget-from (docs/RETARGET.md)")
+      ->needs("--retarget-from");
+  app.add_option("--retarget-clip", o.retarget_clip, "the source clip --retarget-from plays (default: its first)")
+      ->needs("--retarget-from");
+  app.add_flag("--show-mapping", o.show_mapping, "draw the retarget's joint mapping in headless images too")
+      ->needs("--retarget-from");
   std::vector<std::string> morphs;
   app.add_option("--morph", morphs, "hold the morph targets named NAME at WEIGHT (clips no longer drive them); repeatable")
       ->type_name("NAME=WEIGHT")

@@ -7,6 +7,7 @@
 //             [--window-frames N] [--graph NAME [--set|--param PARAM=VALUE ...] [--show-procedural]
 //              [--montage NAME[@T] [--montage-next SECTION=NEXT[@T]] [--montage-jump SECTION[@T]]]]
 //             [--morph NAME=WEIGHT ...]
+//             [--retarget-from SOURCE.ossa ... [--retarget-map MAP.json] [--retarget-clip NAME] [--show-mapping]]
 //             [--panel open|collapsed] [--ui-scale S] [--browse DIR] [--cook-and-open SOURCE ...]
 //             [-q | -v] [--version] [--help]
 //   ossa-view [--browse DIR] [--cook-and-open SOURCE ...] [...]     (the window, no file yet)
@@ -24,6 +25,12 @@
 // --montage NAME@T plays the graph's montage NAME (format v9) once the graph has played T seconds
 // (default 0); --montage-next SECTION=NEXT@T and --montage-jump SECTION@T change its section links
 // or jump at their times (montage_control.h), so a headless image can show a montage at any point.
+// --retarget-from SOURCE.ossa (repeatable: the source character, then clip files cooked for it)
+// plays a clip of another humanoid rig on the character through the live retarget job, the
+// source drawn beside it (retarget_view.h); --retarget-map names a humanoid map file for rigs whose
+// joint names do not say, --retarget-clip the source clip, and --show-mapping draws the lines
+// between mapped joints in headless images too (the window shows them by default; the panel's
+// Retarget section toggles them). --time, --speed and --paused apply to the source clip too.
 // --morph NAME=WEIGHT holds a morph target channel (every target of that name) at WEIGHT, as the
 // panel's slider does: clips no longer drive it; repeatable; a name the character lacks is an
 // error listing the names it has.
@@ -81,6 +88,10 @@ struct ViewerOptions {
   std::string graph;            // drive the character with this graph
   std::vector<std::string> set; // graph parameter start values, "name=value" (or "trigger"; a vector "name=x,y,z")
   bool show_procedural = false; // headless: draw the procedural overlays (the window shows them by default)
+  std::vector<std::string> retarget_from;  // --retarget-from: the source character and its clip files
+  std::string retarget_map;     // --retarget-map: a humanoid map file (tools/retarget/map_file.h)
+  std::string retarget_clip;    // --retarget-clip: the source clip (empty: its first)
+  bool show_mapping = false;    // headless: draw the retarget mapping (the window shows it by default)
   std::vector<std::string> montage;       // --montage NAME[@T]: montages played at graph times
   std::vector<std::string> montage_next;  // --montage-next SECTION=NEXT[@T]
   std::vector<std::string> montage_jump;  // --montage-jump SECTION[@T]

@@ -377,10 +377,12 @@ Status render_frame(Renderer& r, const Scene& scene, const Animator& animator, s
 
   glViewport(r.viewport_x, r.viewport_y, width, height);
   glScissor(r.viewport_x, r.viewport_y, width, height);
-  glEnable(GL_SCISSOR_TEST);
-  glClearColor(kBackground.r, kBackground.g, kBackground.b, kBackground.a);
-  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-  glDisable(GL_SCISSOR_TEST);
+  if (!toggles.keep_frame) {
+    glEnable(GL_SCISSOR_TEST);
+    glClearColor(kBackground.r, kBackground.g, kBackground.b, kBackground.a);
+    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    glDisable(GL_SCISSOR_TEST);
+  }
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_LESS);
   glDisable(GL_CULL_FACE);

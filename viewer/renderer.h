@@ -38,6 +38,8 @@ struct ViewToggles {
   bool grid = true;
   bool cpu_skinning = false;
   bool procedural = false;  // the procedural nodes' overlays (procedural_draw.h)
+  bool mapping = false;     // the retarget mode's joint mapping (retarget_view.h)
+  bool keep_frame = false;  // draw over what the viewport holds (no clear): a second character's pass
 };
 
 /// Milliseconds spent in each stage of a frame (CPU time; gpu_ms from a timer query, a frame

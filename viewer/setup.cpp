@@ -23,6 +23,7 @@ void apply_view_options(App& app, const ViewerOptions& o) {
   app.cloth.enabled = o.cloth;
   app.show_cloth = o.show_cloth;
   if (o.wind.size() == 3) app.cloth.wind = glm::vec3(o.wind[0], o.wind[1], o.wind[2]);
+  app.toggles.mapping = o.show_mapping || !o.headless();
 }
 
 Status setup_app(App& app, Scene scene, const ViewerOptions& o, float aspect) {
@@ -67,6 +68,10 @@ Status setup_app(App& app, Scene scene, const ViewerOptions& o, float aspect) {
       return Error{name + ": no morph target named '" + morph + "' (morph targets: " + (names.empty() ? "none" : names) + ")"};
     }
     hold_morph(app.animator, static_cast<size_t>(c), true, weight);
+  }
+  if (!o.retarget_from.empty()) {
+    if (Status s = set_retarget(app, o.retarget_from, o.retarget_map, o.retarget_clip, aspect); !s) return s;
+    set_time(app.retarget->source, app.retarget->animator, o.time);
   }
   Playback& p = app.animator.playback;
   p.bind_pose = o.bind_pose;

@@ -45,6 +45,34 @@ void clips_panel(App& app, UiState& ui) {
   ImGui::SliderFloat("cross-fade", &p.fade_seconds, 0.0f, 1.0f, "%.2f s");
 }
 
+/// The retarget mode (retarget_view.h): the source's clips (the one picked drives the character),
+/// the source and mapping toggles, and a way back to the character's own clips.
+void retarget_panel(App& app, UiState& ui, float aspect) {
+  RetargetView& v = *app.retarget;
+  ImGui::TextWrapped("source: %s", std::filesystem::path(v.files.front()).filename().string().c_str());
+  if (!v.map_file.empty()) ImGui::TextWrapped("map: %s", std::filesystem::path(v.map_file).filename().string().c_str());
+  const Playback& p = v.animator.playback;
+  if (ImGui::BeginListBox("##retarget-clips",
+                          ImVec2(-1.0f, std::min(6.0f, static_cast<float>(v.source.clips.size()) + 0.5f) *
+                                            ImGui::GetTextLineHeightWithSpacing()))) {
+    for (size_t i = 0; i < v.source.clips.size(); ++i) {
+      ImGui::PushID(static_cast<int>(i));
+      if (ImGui::Selectable(v.source.clips[i].label.c_str(), p.clip == static_cast<int>(i))) {
+        if (Status s = select_clip(v.source, v.animator, static_cast<int>(i), true); !s) ui.status = s.message();
+      }
+      ImGui::PopID();
+    }
+    ImGui::EndListBox();
+  }
+  ImGui::Text("source clip %.2f s, hips scale %.3f", v.animator.playback.time, v.map.scale);
+  ImGui::Checkbox("show source", &v.show_source);
+  ImGui::SameLine();
+  ImGui::Checkbox("show mapping", &app.toggles.mapping);
+  if (ImGui::Button("stop retargeting")) {
+    if (Status s = set_retarget(app, {}, {}, {}, aspect); !s) ui.status = s.message();
+  }
+}
+
 /// One slider per morph channel. A channel left to the clip shows instance 0's live weight (the
 /// slider moves as the clip plays); moving the slider, or ticking its box, holds the channel at
 /// the slider's value; unticking gives it back to the clip.
@@ -352,6 +380,8 @@ void draw_panels(App& app, UiState& ui, const SceneLayout& layout) {
     if (scene) {
       if (ImGui::CollapsingHeader("Graph", app.animator.graph ? ImGuiTreeNodeFlags_DefaultOpen : 0)) graph_panel(app, ui);
       if (ImGui::CollapsingHeader("Clips", app.animator.graph ? 0 : ImGuiTreeNodeFlags_DefaultOpen)) clips_panel(app, ui);
+      if (app.retarget && ImGui::CollapsingHeader("Retarget", ImGuiTreeNodeFlags_DefaultOpen))
+        retarget_panel(app, ui, aspect);
       if (!app.scene.morph_channels.empty() && ImGui::CollapsingHeader("Morph targets", ImGuiTreeNodeFlags_DefaultOpen))
         morph_panel(app);
       if (ImGui::CollapsingHeader("View", ImGuiTreeNodeFlags_DefaultOpen)) view_panel(app, ui, aspect);

@@ -168,6 +168,9 @@ int GraphCompiler::clip(const Value& v, const std::string& role) {
     clip_used_[static_cast<size_t>(found->second)] = true;
     return found->second;
   }
+  if (retarget_clip_index_.count(v.string) != 0)
+    return check_.error(v.pos, "clip '" + v.string + "' is a retarget node's clip of another rig; only retarget nodes "
+                               "play it"), -1;
   if (check_.full()) return check_.error(v.pos, "unknown clip '" + v.string + "'"), -1;
   const std::string hint = json::closest_name(v.string, g_.clips);
   check_.error(v.pos, "unknown clip '" + v.string + "'" + (hint.empty() ? "" : " (did you mean '" + hint + "'?)") +

@@ -16,6 +16,7 @@
 // stably sorted by priority.
 #pragma once
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -63,9 +64,23 @@ struct GraphClipInfo {
   std::vector<SourceEvent> events;  // events it already has (its source's sidecar)
 };
 
+/// A retarget node's rigs as the cooker loaded them (format v10): the source rig's identity and
+/// both rigs' humanoid bones (kHumanoidBoneCount entries each, -1: none) and rest settings.
+struct GraphRetargetRigs {
+  uint64_t source_skeleton_hash = 0;
+  uint16_t source_joint_count = 0;
+  std::vector<int16_t> source_bones, target_bones;
+  uint8_t source_rest = 0, target_rest = 0;  // RestPose
+  std::vector<RetargetRestRotationDef> source_rest_rotations, target_rest_rotations;
+};
+
 struct GraphContext {
   const SourceSkeleton* skeleton = nullptr;  // the rig: joint names for masks, hash, joint count
   std::vector<GraphClipInfo> clips;          // found by graph clip name
+  /// Loads a retarget node's source rig (a cooked .ossa, relative to the graph file) and optional
+  /// map file and maps both rigs (cook_graph.cpp); its error message is reported at the node.
+  /// Unset: retarget nodes are an error.
+  std::function<Result<GraphRetargetRigs>(const std::string& rig, const std::string& map)> retarget_rigs;
 };
 
 struct CompiledGraph {

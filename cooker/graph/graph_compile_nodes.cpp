@@ -35,11 +35,11 @@ int GraphCompiler::node(const Value& v, const std::string& default_name) {
   if (!kind) {
     if (check_.expect_keys(
             v, {"clip", "blend", "select", "layered", "blend_space", "additive", "state_machine", "morph", "use",
-                "two_bone_ik", "aim", "foot_placement", "foot_lock", "spring", "slot", "name"},
+                "two_bone_ik", "aim", "foot_placement", "foot_lock", "spring", "slot", "retarget", "name"},
             "a node"))
       check_.error(v.pos,
                    "a node needs one of the keys clip, blend, select, layered, blend_space, additive, "
-                   "state_machine, morph, two_bone_ik, aim, foot_placement, foot_lock, spring, slot, use");
+                   "state_machine, morph, two_bone_ik, aim, foot_placement, foot_lock, spring, slot, retarget, use");
     return -1;
   }
   // Every node but a use (which stands for the node it copies) becomes one output node.
@@ -86,10 +86,73 @@ int GraphCompiler::node(const Value& v, const std::string& default_name) {
   else if (k == "foot_lock") index = foot_node(v, name, true);
   else if (k == "spring") index = spring_node(v, name);
   else if (k == "slot") index = montage_.slot_node(v, name);
+  else if (k == "retarget") index = retarget_node(v, name);
   else index = use_node(v, name, v.find("name") != nullptr);
   --depth_;
   output_depth_ -= output ? 1 : 0;
   return index;
+}
+
+int GraphCompiler::retarget_node(const Value& v, const std::string& name) {
+  check_.expect_keys(v, {"retarget", "rig", "map", "rate", "rate_parameter", "loop", "start", "contacts", "name"},
+                     "a retarget node");
+  RetargetNodeDef r;
+  bool ok = true;
+  const Value& clip_name = *v.find("retarget");
+  if (!check_.expect(clip_name, Type::String, "\"retarget\" (the name of a clip of the source rig)")) ok = false;
+  else if (clip_name.string.empty()) ok = check_.error(clip_name.pos, "\"retarget\" names no clip");
+  else if (clip_index_.count(clip_name.string) != 0)
+    ok = check_.error(clip_name.pos, "clip '" + clip_name.string +
+                                         "' is one of the graph's own clips (\"clips\"), made for its rig; a retarget "
+                                         "node plays a clip of another rig, by a name of its own");
+  const Value* rig = required(v, "rig", "a retarget node");
+  std::string map;
+  if (const Value* m = v.find("map")) {
+    if (check_.expect(*m, Type::String, "\"map\" (a humanoid map file)")) map = m->string;
+    else ok = false;
+  }
+  if (const Value* x = v.find("rate")) ok &= read_float(*x, "\"rate\"", &r.rate, -kMaxRate, kMaxRate);
+  if (const Value* p = v.find("rate_parameter")) {
+    const int param = parameter(*p, {ParamType::Float, ParamType::Int}, "\"rate_parameter\"");
+    ok &= param >= 0;
+    r.rate_parameter = static_cast<int16_t>(param);
+  }
+  if (const Value* l = v.find("loop")) ok &= read_bool(*l, "\"loop\"", &r.loop);
+  if (const Value* c = v.find("contacts")) ok &= read_bool(*c, "\"contacts\"", &r.contacts);
+  if (const Value* s = v.find("start")) ok &= read_float(*s, "\"start\" (seconds)", &r.start_offset, 0.0, kMaxSeconds);
+  if (!rig || !check_.expect(*rig, Type::String, "\"rig\" (the source rig: its cooked .ossa or a source file)"))
+    return -1;
+  if (!ctx_.retarget_rigs) return check_.error(v.pos, "retarget nodes need the cooker to load their rigs"), -1;
+  // Each rig and map pair is loaded once (a named node is compiled again when checked unused).
+  auto key = std::make_pair(rig->string, map);
+  auto cached = retarget_rigs_.find(key);
+  if (cached == retarget_rigs_.end()) cached = retarget_rigs_.emplace(key, ctx_.retarget_rigs(rig->string, map)).first;
+  const Result<GraphRetargetRigs>& rigs = cached->second;
+  if (!rigs) return check_.error(rig->pos, "retarget node: " + rigs.error().message), -1;
+  if (!ok) return -1;
+  r.source_skeleton_hash = rigs->source_skeleton_hash;
+  r.source_joint_count = rigs->source_joint_count;
+  r.source_bones = rigs->source_bones;
+  r.target_bones = rigs->target_bones;
+  r.source_rest = rigs->source_rest;
+  r.target_rest = rigs->target_rest;
+  r.source_rest_rotations = rigs->source_rest_rotations;
+  r.target_rest_rotations = rigs->target_rest_rotations;
+  // The clip: a graph clip of its own, after the graph's own clips, resolved at run time among the
+  // clip files given. An unused node's check (thrown away) adds none.
+  if (checking_unused_) return emit(name, std::move(r));
+  auto found = retarget_clip_index_.find(clip_name.string);
+  if (found == retarget_clip_index_.end()) {
+    if (g_.clips.size() >= kMaxGraphClips) return check_.error(clip_name.pos, "too many clips"), -1;
+    found = retarget_clip_index_.emplace(clip_name.string, static_cast<int>(g_.clips.size())).first;
+    g_.clips.push_back(clip_name.string);
+    clip_events_.emplace_back();
+    clip_duration_.push_back(0.0f);
+    clip_used_.push_back(true);
+    clip_pos_.push_back(clip_name.pos);
+  }
+  r.clip = static_cast<uint16_t>(found->second);
+  return emit(name, std::move(r));
 }
 
 int GraphCompiler::use_node(const Value& v, const std::string& name, bool named_here) {

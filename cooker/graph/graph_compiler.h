@@ -9,6 +9,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <initializer_list>
+#include <map>
 #include <string>
 #include <string_view>
 #include <unordered_map>
@@ -32,7 +33,8 @@ constexpr double kFloatMax = 3.4e38;      // Parameter.min_value / max_value def
 constexpr double kIntLimit = 16777216.0;  // ints are held as floats: exact up to 2^24
 inline const std::vector<std::string_view> kNodeKinds = {
     "clip",  "blend",      "select",         "layered",   "blend_space", "additive", "state_machine", "morph",
-    "use",   "two_bone_ik", "aim",           "foot_placement", "foot_lock", "spring", "slot"};
+    "use",   "two_bone_ik", "aim",           "foot_placement", "foot_lock", "spring", "slot",
+    "retarget"};
 constexpr double kDegrees = 3.14159265358979323846 / 180.0;
 // The loader's bounds (runtime/loader/validate_graph.cpp). A value past one compiled into a file
 // that failed verification ("internal error, cooked bytes fail verification"): each is refused
@@ -99,6 +101,8 @@ class GraphCompiler {
   // looked up by a scan made the checks quadratic in the file's size.
   std::unordered_map<std::string_view, size_t> named_index_;
   std::unordered_map<std::string_view, int> param_index_, clip_index_, joint_index_;
+  std::unordered_map<std::string_view, int> retarget_clip_index_;  // clips of other rigs, by name
+  std::map<std::pair<std::string, std::string>, Result<GraphRetargetRigs>> retarget_rigs_;  // by rig and map file
   std::vector<std::string> use_stack_;
   size_t visits_ = 0;
   bool too_many_ = false;
@@ -211,6 +215,13 @@ class GraphCompiler {
   ///  "radius": metres, "tail_length": metres}], "colliders": [{"joint": J, "offset": [..] m, "tail": [..] m,
   ///  "radius": m}], "step": seconds, "teleport_distance": metres, "weight", "weight_parameter"}
   int spring_node(const Value& v, const std::string& name);
+
+  // ---- retarget (format v10) -------------------------------------------------------------------
+
+  /// {"retarget": CLIP, "rig": "source rig (.ossa or a source file)", "map": "map.json", "rate",
+  ///  "rate_parameter", "loop", "start", "contacts"}: a clip of another humanoid rig, not imported: the
+  /// runtime finds it by name among the clip files it is given, bound to that rig (docs/RETARGET.md).
+  int retarget_node(const Value& v, const std::string& name);
 
   // ---- state machines ------------------------------------------------------------------------
 

@@ -169,9 +169,28 @@ struct SlotDef {
   bool mesh_space_rotation = false;
 };
 
+/// Format v10 (fb::RetargetNode): a clip of another humanoid rig, retargeted live.
+struct RetargetRestRotationDef {
+  uint16_t joint = 0;
+  float rotation[4] = {0.0f, 0.0f, 0.0f, 1.0f};  // x y z w
+};
+struct RetargetNodeDef {
+  uint16_t clip = 0;
+  uint64_t source_skeleton_hash = 0;
+  uint16_t source_joint_count = 0;
+  std::vector<int16_t> source_bones, target_bones;  // one per humanoid profile bone, -1: none
+  float rate = 1.0f;
+  int16_t rate_parameter = -1;
+  bool loop = true;
+  float start_offset = 0.0f;
+  bool contacts = true;
+  uint8_t source_rest = 0, target_rest = 0;  // RestPose
+  std::vector<RetargetRestRotationDef> source_rest_rotations, target_rest_rotations;
+};
+
 using NodeKind = std::variant<ClipNodeDef, BlendAlphaDef, SelectDef, LayeredDef, BlendSpaceDef, AdditiveDef,
                               StateMachineRefDef, MorphWeightsDef, TwoBoneIkDef, AimDef, FootPlacementDef,
-                              FootLockDef, SpringDef, SlotDef>;
+                              FootLockDef, SpringDef, SlotDef, RetargetNodeDef>;
 
 struct NodeDef {
   std::string name;

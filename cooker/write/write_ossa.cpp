@@ -271,6 +271,22 @@ Offset<fb::Node> write_node(FlatBufferBuilder& fbb, const NodeDef& node) {
     data = fb::CreateFootLockNode(fbb, lock->input, legs_v, lock->release_radius, lock->blend_time, lock->weight,
                                   lock->weight_parameter)
                .Union();
+  } else if (const auto* rt = std::get_if<RetargetNodeDef>(&node.kind)) {
+    type = fb::NodeData::RetargetNode;
+    const auto source_v = fbb.CreateVector(rt->source_bones);
+    const auto target_v = fbb.CreateVector(rt->target_bones);
+    const auto rests = [&](const std::vector<RetargetRestRotationDef>& list) {
+      std::vector<fb::RetargetRestRotation> out;
+      for (const RetargetRestRotationDef& r : list)
+        out.emplace_back(r.joint, fb::Quat(r.rotation[0], r.rotation[1], r.rotation[2], r.rotation[3]));
+      return fbb.CreateVectorOfStructs(out);
+    };
+    const auto source_rest_v = rests(rt->source_rest_rotations);
+    const auto target_rest_v = rests(rt->target_rest_rotations);
+    data = fb::CreateRetargetNode(fbb, rt->clip, rt->source_skeleton_hash, rt->source_joint_count, source_v, target_v,
+                                  rt->rate, rt->rate_parameter, rt->loop, rt->start_offset, rt->contacts,
+                                  rt->source_rest, rt->target_rest, source_rest_v, target_rest_v)
+               .Union();
   } else if (const auto* sp = std::get_if<SpringDef>(&node.kind)) {
     type = fb::NodeData::SpringNode;
     std::vector<Offset<fb::SpringChainSettings>> chains;

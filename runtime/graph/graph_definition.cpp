@@ -67,7 +67,7 @@ uint32_t scratch_needed(const GraphDefinition::Impl& def, uint16_t n) {
   const NodeInfo& info = def.nodes[n];
   switch (info.kind) {
     case Kind::Clip:
-      return 0;
+    case Kind::Retarget: return 0;
     case Kind::BlendAlpha: {
       const auto* t = static_cast<const fb::BlendAlphaNode*>(info.table);
       return std::max(scratch_needed(def, t->a()), 1 + scratch_needed(def, t->b()));
@@ -133,6 +133,7 @@ void mark_driven_channels(const GraphDefinition::Impl& d, uint16_t n, std::vecto
   switch (info.kind) {
     case Kind::Clip:
       return mark_clip(static_cast<const fb::ClipNode*>(info.table)->clip());
+    case Kind::Retarget: return;  // its clip's weight tracks are not played (graph_retarget.cpp)
     case Kind::BlendSpace:
       for (const fb::BlendSample* smp : *static_cast<const fb::BlendSpaceNode*>(info.table)->samples()) mark_clip(smp->clip());
       return;
@@ -212,10 +213,13 @@ Result<GraphDefinition> GraphDefinition::create(const Asset& asset, std::string_
     }
     if (!found) return Error{where + ": clip '" + std::string(clip_name) + "' not found in the file or the clip files given"};
     ClipView view{found};
-    if (Status st = check_clip_binding(view, d.skeleton, owner->name() + ": clip '" + std::string(clip_name) + "'"); !st)
+    // A retarget node's clip plays on its source rig (graph_retarget.cpp), any other on the graph's.
+    auto rig = graph_detail::retarget_clip_rig(d, static_cast<uint16_t>(d.clips.size()), asset, more_clips, where);
+    if (!rig) return rig.error();
+    if (Status st = check_clip_binding(view, *rig, owner->name() + ": clip '" + std::string(clip_name) + "'"); !st)
       return Error{where + ": " + st.message()};
     d.clips.push_back(view);
-    auto prototype = make_sampling_cache(view, d.skeleton);
+    auto prototype = make_sampling_cache(view, *rig);
     if (!prototype) return Error{where + ": " + prototype.error().message};
     d.prototypes.push_back(std::move(*prototype));
   }
@@ -261,6 +265,18 @@ Result<GraphDefinition> GraphDefinition::create(const Asset& asset, std::string_
           info.held = static_cast<int32_t>(d.held.size());
           d.held.push_back(std::move(pose));
         }
+        break;
+      }
+      case fb::NodeData::RetargetNode: {
+        info.kind = Kind::Retarget;
+        const auto* r = node.data_as_RetargetNode();
+        info.table = r;
+        d.float_count += 1;  // time
+        d.cache_count += 1;  // the clip on its source rig
+        if (Status st =
+                graph_detail::bind_retarget_node(d, info, *r, asset, more_clips, where + ": node " + std::to_string(i));
+            !st)
+          return st.error();
         break;
       }
       case fb::NodeData::BlendAlphaNode:

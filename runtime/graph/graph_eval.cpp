@@ -384,6 +384,8 @@ void evaluate(State& s, uint16_t n, const Advance& advance, float weight, bool d
   switch (info.kind) {
     case Kind::Clip:
       return evaluate_clip(s, n, info, advance, dominant, out, ow);
+    case Kind::Retarget:
+      return evaluate_retarget(s, n, advance, out, ow);
     case Kind::BlendSpace:
       return evaluate_blend_space(s, n, info, advance, dominant, out, ow, depth);
     case Kind::Select:
@@ -452,6 +454,8 @@ void restart(State& s, uint16_t n) {
       restart(s, a.additive());
       return;
     }
+    case Kind::Retarget:
+      return restart_retarget(s, info);
     case Kind::Machine:
       return restart_machine(s, info.machine);
     case Kind::Morph:
@@ -500,6 +504,8 @@ Cycle cycle(const State& s, uint16_t n) {
     }
     case Kind::Additive:
       return cycle(s, static_cast<const fb::AdditiveNode*>(info.table)->base());
+    case Kind::Retarget:
+      return retarget_cycle(s, info);
     case Kind::Machine:
       return machine_cycle(s, info.machine);
     case Kind::Morph:
@@ -550,6 +556,8 @@ void set_phase(State& s, uint16_t n, float p) {
       set_phase(s, a.additive(), p);
       return;
     }
+    case Kind::Retarget:
+      return set_retarget_phase(s, info, p);
     case Kind::Machine:
       return set_machine_phase(s, info.machine, p);
     case Kind::Morph:

@@ -94,6 +94,15 @@ Result<GraphInstance> GraphInstance::create(const GraphDefinition& definition, s
       auto cache = make_sampling_cache(d.clips[c->clip()], d.skeleton, &d.prototypes[c->clip()]);
       if (!cache) return cache.error();
       s->caches.push_back(std::move(*cache));
+    } else if (info.kind == Kind::Retarget) {
+      const auto* r = static_cast<const fb::RetargetNode*>(info.table);
+      const RetargetNodeData& data = d.retargets[info.aux];
+      auto cache = make_sampling_cache(d.clips[r->clip()], data.source, &d.prototypes[r->clip()]);
+      if (!cache) return cache.error();
+      s->caches.push_back(std::move(*cache));
+      auto buffers = make_retarget_instance(d, info);
+      if (!buffers) return buffers.error();
+      s->retargets.push_back(std::move(*buffers));
     } else if (info.kind == Kind::BlendSpace) {
       for (const fb::BlendSample* smp : *static_cast<const fb::BlendSpaceNode*>(info.table)->samples()) {
         auto cache = make_sampling_cache(d.clips[smp->clip()], d.skeleton, &d.prototypes[smp->clip()]);

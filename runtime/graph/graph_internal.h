@@ -19,6 +19,8 @@
 #include <ossa/loader/validate.h>
 #include <ossa/graph/graph.h>
 #include <ossa/anim/sample.h>
+#include <ossa/retarget/foot_contacts.h>
+#include <ossa/retarget/retarget.h>
 
 namespace ossa::graph_detail {
 
@@ -26,6 +28,7 @@ enum class Kind : uint8_t {
   Clip, BlendAlpha, Select, Layered, BlendSpace, Additive, Machine, Morph,
   TwoBoneIk, Aim, FootPlacement, FootLock, Spring,  // procedural: graph_procedural.cpp
   Slot,                                             // montages: graph_slot.cpp
+  Retarget,                                         // graph_retarget.cpp (format v10)
 };
 
 struct NodeInfo {
@@ -37,7 +40,7 @@ struct NodeInfo {
                                 // slot: its SlotInfo (Impl::slots);
                                 // morph: first drive channel (Impl::drive_channels);
                                 // spring: first chain (State::springs), foot lock: first leg's
-                                // events (Impl::leg_events)
+                                // events (Impl::leg_events); retarget: index into Impl::retargets
   uint32_t samples = 0;         // blend space: first entry in Impl::sample_x / sample_duration
   uint16_t machine = 0;         // Machine: index into Impl::machines
   int32_t held = -1;            // Clip with rate 0 and no rate parameter: index into Impl::held
@@ -58,6 +61,22 @@ struct MachineInfo {
   const fb::StateMachine* fb = nullptr;
   uint16_t node = 0;                          // the StateMachineNode that plays it
   std::vector<TransitionInfo> transitions;    // priority order
+};
+
+/// A retarget node's data made with the definition (graph_retarget.cpp): the source rig (another
+/// file's skeleton), the retarget map, and the clip's foot contacts.
+struct RetargetNodeData {
+  SkeletonView source;
+  RetargetMap map;
+  std::vector<ContactSpan> contacts;
+  float floor = 0.0f;
+  float sample_rate = 30.0f;
+};
+
+/// A retarget node's per-instance buffers.
+struct RetargetInstance {
+  Pose source;
+  RetargetScratch scratch;
 };
 
 /// A slot node, decoded (graph_slot.cpp).
@@ -148,6 +167,7 @@ struct GraphDefinition::Impl {
   std::vector<std::vector<SpringCollider>> colliders; // per spring node, indexed by NodeInfo::samples
   std::vector<std::string_view> leg_events;           // per foot lock leg: plant, lift ("" none)
   bool procedural = false;                            // any procedural node: model matrices needed
+  std::vector<graph_detail::RetargetNodeData> retargets;  // one per retarget node, in node order
   // Montages and slots (format v9).
   std::vector<graph_detail::SlotInfo> slots;          // per slot node, indexed by NodeInfo::aux
   std::vector<std::vector<float>> slot_masks;
@@ -264,6 +284,7 @@ struct GraphInstance::State {
   glm::mat4 transform{1.0f};        // model to world, set by the host (set_transform)
   glm::mat4 inverse_transform{1.0f};
   std::vector<SpringChain> springs; // every spring node's chains' state
+  std::vector<graph_detail::RetargetInstance> retargets;  // one per retarget node
   // Montages (graph_montage.cpp), last for the same reason: a graph without them reads none of it.
   std::vector<graph_detail::MontagePlay> plays;   // kMaxMontagePlays when the graph has montages
   std::vector<int16_t> montage_links;             // plays * max_sections
@@ -314,6 +335,21 @@ void evaluate_procedural(GraphInstance::State& s, uint16_t n, const Advance& adv
 uint16_t procedural_input(const NodeInfo& info);
 /// Back to the animated pose: foot locks released, spring chains restarted at the next update.
 void restart_procedural(GraphInstance::State& s, uint16_t n);
+
+/// Retarget node (graph_retarget.cpp). The rig a graph clip binds to: the graph's, or the source
+/// rig of the first retarget node playing it, found by hash in `asset` or `more` (an error names
+/// the clip when none holds it).
+Result<SkeletonView> retarget_clip_rig(const GraphDefinition::Impl& d, uint16_t clip, const Asset& asset,
+                                       std::span<const Asset* const> more, const std::string& where);
+/// Builds the node's RetargetNodeData (its rig checked against the clip, the map, the contacts)
+/// and points info.aux at it.
+Status bind_retarget_node(GraphDefinition::Impl& d, NodeInfo& info, const fb::RetargetNode& node, const Asset& asset,
+                          std::span<const Asset* const> more, const std::string& where);
+Result<RetargetInstance> make_retarget_instance(const GraphDefinition::Impl& d, const NodeInfo& info);
+void evaluate_retarget(GraphInstance::State& s, uint16_t n, const Advance& advance, PoseSpan out, std::span<float> ow);
+void restart_retarget(GraphInstance::State& s, const NodeInfo& info);
+Cycle retarget_cycle(const GraphInstance::State& s, const NodeInfo& info);
+void set_retarget_phase(GraphInstance::State& s, const NodeInfo& info, float p);
 
 /// Slot node (graph_slot.cpp) and montage playback (graph_montage.cpp).
 void evaluate_slot(GraphInstance::State& s, uint16_t n, const Advance& advance, float weight, bool dominant,

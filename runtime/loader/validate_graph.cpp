@@ -15,6 +15,7 @@
 
 #include "common/message.h"
 #include "internal/validate_montage.h"
+#include "internal/retarget_bones.h"
 #include <ossa/loader/validate.h>
 
 namespace ossa {
@@ -48,6 +49,12 @@ class GraphChecker {
       if (flatbuffers::GetStringView(g_.clips()->Get(static_cast<flatbuffers::uoffset_t>(i))).empty())
         return fail(format("clip %zu has an empty name", i));
     referrers_.assign(node_count_, 0);
+    // Clips played by retarget nodes are bound to another rig: no other node or montage may play
+    // them on the graph's (their indices are checked with each node).
+    retarget_clip_.assign(clip_count_, 0);
+    for (const fb::Node* node : *g_.nodes())
+      if (const fb::RetargetNode* r = node->data_as_RetargetNode(); r != nullptr && r->clip() < clip_count_)
+        retarget_clip_[r->clip()] = 1;
     depth_.assign(node_count_, 1);
     machine_player_.assign(machine_count_, -1);
     for (size_t i = 0; i < node_count_; ++i)
@@ -60,6 +67,13 @@ class GraphChecker {
     bool over = false;
     if (const std::string e = detail::check_montages(g_, budget_, &over); over) return over_budget();
     else if (!e.empty()) return fail(e);
+    if (const auto* montages = g_.montages())
+      for (flatbuffers::uoffset_t m = 0; m < montages->size(); ++m)
+        for (const fb::MontageTrack* track : *montages->Get(m)->tracks())
+          for (const fb::MontageSegment* seg : *track->segments())
+            if (retarget_clip_[seg->clip()])
+              return fail(
+                  format("montage %u: clip %u is played by a retarget node (bound to another rig)", m, seg->clip()));
     return {};
   }
 
@@ -180,6 +194,55 @@ class GraphChecker {
     }
     return {};
   }
+  /// Format v10: the source rig is another file's; its bones are checked against its joint count
+  /// here and the skeleton itself when a definition binds the clip (graph_retarget.cpp).
+  Status check_retarget(const std::string& at, const fb::RetargetNode& r) {
+    if (r.clip() >= clip_count_)
+      return fail(at + format(": retarget clip %u is out of range (%zu clips)", r.clip(), clip_count_));
+    if (!rate_ok(r.rate()))
+      return fail(at + format(": retarget rate %g must be finite and within +-%g", r.rate(), kMaxRate));
+    if (!time_ok(r.start_offset())) return fail(at + ": retarget start offset must be finite and in [0, 1e6] s");
+    if (r.source_joint_count() == 0) return fail(at + ": retarget source rig has no joints");
+    struct Side {
+      const flatbuffers::Vector<int16_t>* bones;
+      const flatbuffers::Vector<const fb::RetargetRestRotation*>* rotations;
+      uint8_t rest;
+      uint32_t joints;
+      const char* which;
+    };
+    const Side sides[] = {
+        {r.source_bones(), r.source_rest_rotations(), r.source_rest(), r.source_joint_count(), "source"},
+        {r.target_bones(), r.target_rest_rotations(), r.target_rest(), g_.joint_count(), "target"}};
+    for (const Side& side : sides) {
+      if (side.bones->size() != detail::kRetargetBoneCount)
+        return fail(at + format(": retarget %s bones: %u entries, not one per humanoid bone (%zu)", side.which,
+                                side.bones->size(), detail::kRetargetBoneCount));
+      for (flatbuffers::uoffset_t b = 0; b < side.bones->size(); ++b) {
+        const int16_t j = side.bones->Get(b);
+        if (j < -1 || (j >= 0 && uint32_t(j) >= side.joints))
+          return fail(at + format(": retarget %s bone %u names joint %d, out of range (%u joints)", side.which, b, j,
+                                  side.joints));
+      }
+      if (side.rest > 1)
+        return fail(at + format(": retarget %s rest mode %u is unknown (0 straighten, 1 bind)", side.which, side.rest));
+      if (side.rotations == nullptr) continue;
+      if (!spend(uint64_t(side.rotations->size()) * 20)) return over_budget();
+      if (side.rotations->size() > side.joints)
+        return fail(at + format(": retarget %s rest rotations: %u, more than the rig's %u joints", side.which,
+                                side.rotations->size(), side.joints));
+      for (const fb::RetargetRestRotation* x : *side.rotations) {
+        const fb::Quat& q = x->rotation();
+        const float len = std::sqrt(q.x() * q.x() + q.y() * q.y() + q.z() * q.z() + q.w() * q.w());
+        if (x->joint() >= side.joints)
+          return fail(at + format(": retarget %s rest rotation joint %u is out of range (%u joints)", side.which,
+                                  x->joint(), side.joints));
+        if (!std::isfinite(len) || std::fabs(len - 1.0f) > 1e-3f)
+          return fail(
+              at + format(": retarget %s rest rotation of joint %u is not a unit quaternion", side.which, x->joint()));
+      }
+    }
+    return check_param_ref(at + " rate", r.rate_parameter(), true, {fb::ParameterType::Float, fb::ParameterType::Int});
+  }
   static constexpr float kMaxRate = 1000.0f, kMaxWeight = 100.0f, kMaxSeconds = 1e6f, kMaxCoordinate = 1e6f;
 
   Status check_node(size_t n) {
@@ -189,10 +252,13 @@ class GraphChecker {
       case fb::NodeData::ClipNode: {
         const auto& c = *node.data_as_ClipNode();
         if (c.clip() >= clip_count_) return fail(at + format(": clip %u is out of range (%zu clips)", c.clip(), clip_count_));
+        if (retarget_clip_[c.clip()])
+          return fail(at + format(": clip %u is played by a retarget node (bound to another rig)", c.clip()));
         if (!rate_ok(c.rate())) return fail(at + format(": rate %g must be finite and within +-%g", c.rate(), kMaxRate));
         if (!time_ok(c.start_offset())) return fail(at + ": start offset must be finite and in [0, 1e6] s");
         return check_param_ref(at + " rate", c.rate_parameter(), true, {fb::ParameterType::Float, fb::ParameterType::Int});
       }
+      case fb::NodeData::RetargetNode: return check_retarget(at, *node.data_as_RetargetNode());
       case fb::NodeData::BlendAlphaNode: {
         const auto& a = *node.data_as_BlendAlphaNode();
         if (Status st = child(n, a.a(), "input a"); !st) return st;
@@ -260,6 +326,9 @@ class GraphChecker {
         for (flatbuffers::uoffset_t k = 0; k < samples.size(); ++k) {
           const fb::BlendSample& smp = *samples.Get(k);
           if (smp.clip() >= clip_count_) return fail(at + format(": sample %u clip %u is out of range", k, smp.clip()));
+          if (retarget_clip_[smp.clip()])
+            return fail(
+                at + format(": sample %u clip %u is played by a retarget node (bound to another rig)", k, smp.clip()));
           if (!coordinate_ok(smp.x()) || !coordinate_ok(smp.y()))
             return fail(at + format(": sample %u position must be finite and within +-%g", k, kMaxCoordinate));
           if (!two_d && k > 0 && !(smp.x() > samples.Get(k - 1)->x()))
@@ -486,6 +555,7 @@ class GraphChecker {
   std::string where_;
   size_t param_count_ = 0, clip_count_ = 0, node_count_ = 0, machine_count_ = 0;
   std::vector<uint8_t> referrers_;
+  std::vector<uint8_t> retarget_clip_;  // per clip: 1 when a retarget node plays it
   std::vector<uint32_t> depth_;
   std::vector<int> machine_player_;
 };

@@ -2,8 +2,13 @@
 // required, and the structural check of a map against a rig's hierarchy.
 #include <ossa/retarget/humanoid.h>
 
+#include "internal/retarget_bones.h"
+
 #include <algorithm>
 #include <cctype>
+
+static_assert(ossa::kHumanoidBoneCount == ossa::detail::kRetargetBoneCount,
+              "the loader checks retarget nodes against internal/retarget_bones.h: keep it in step");
 
 namespace ossa {
 namespace {

@@ -376,6 +376,63 @@ TEST(Montage, HostileFieldsRejectedByName) {
 }
 
 // ---------------------------------------------------------------------------------------------
+// Retarget nodes (format v10): every stored field refused by name when hostile.
+
+TEST(RetargetNode, HostileFieldsRejectedByName) {
+  const Keywords kNode = {{"graph 0 'g'"}, {"node 16"}};
+  struct Case {
+    const char* what;
+    std::function<void(SyntheticRetarget&)> spoil;
+    std::vector<std::string> words;
+  };
+  const float nan = kNaN, inf = kInf;
+  const std::vector<Case> cases = {
+      {"clip", [](SyntheticRetarget& r) { r.clip = 9; }, {"retarget clip 9 is out of range"}},
+      {"rate", [=](SyntheticRetarget& r) { r.rate = inf; }, {"retarget rate inf"}},
+      {"rate NaN", [=](SyntheticRetarget& r) { r.rate = nan; }, {"retarget rate nan"}},
+      {"start", [](SyntheticRetarget& r) { r.start = -1.0f; }, {"retarget start offset"}},
+      {"rate parameter", [](SyntheticRetarget& r) { r.rate_parameter = 2; }, {"rate", "'go'"}},
+      {"no source joints", [](SyntheticRetarget& r) { r.source_joints = 0; }, {"source rig has no joints"}},
+      {"source bone count",
+       [](SyntheticRetarget& r) { r.source_bones.resize(51, -1); },
+       {"retarget source bones: 51 entries"}},
+      {"target bone count",
+       [](SyntheticRetarget& r) { r.target_bones.resize(53, -1); },
+       {"retarget target bones: 53 entries"}},
+      {"source bone joint", [](SyntheticRetarget& r) { r.source_bones[3] = 30; }, {"source bone 3 names joint 30"}},
+      {"source bone negative", [](SyntheticRetarget& r) { r.source_bones[0] = -7; }, {"source bone 0 names joint -7"}},
+      {"target bone joint", [](SyntheticRetarget& r) { r.target_bones[5] = 900; }, {"target bone 5 names joint 900"}},
+      {"rest mode", [](SyntheticRetarget& r) { r.source_rest = 7; }, {"source rest mode 7 is unknown"}},
+      {"rest rotation joint", [](SyntheticRetarget& r) { r.rest_joint = 400; }, {"target rest rotation joint 400"}},
+      {"rest rotation NaN",
+       [=](SyntheticRetarget& r) { r.rest_rotation = fb::Quat(nan, 0, 0, 1); },
+       {"not a unit quaternion"}},
+      {"rest rotation length",
+       [](SyntheticRetarget& r) { r.rest_rotation = fb::Quat(0, 0, 0, 2); },
+       {"not a unit quaternion"}},
+      {"clip also on a clip node",
+       [](SyntheticRetarget& r) { r.clip_node_plays_it = true; },
+       {"node 0: clip 1 is played by a retarget node"}},
+  };
+  SyntheticSpec spec;
+  spec.graph = true;
+  spec.retarget = SyntheticRetarget{};
+  ASSERT_TRUE(accepts(make_valid_file(spec)));
+  for (const Case& c : cases) {
+    SyntheticSpec bad = spec;
+    c.spoil(*bad.retarget);
+    const Keywords words =
+        c.what == std::string("clip also on a clip node") ? Keywords{{"graph 0 'g'"}, c.words} : with(kNode, c.words);
+    EXPECT_TRUE(rejects(bad, words)) << c.what;
+  }
+  // A montage playing the retarget clip is refused too.
+  SyntheticSpec montage = spec;
+  montage.montage = SyntheticMontage{};
+  montage.montage->clip = 1;
+  EXPECT_TRUE(rejects(montage, {{"graph 0 'g'"}, {"montage 0: clip 1 is played by a retarget node"}}));
+}
+
+// ---------------------------------------------------------------------------------------------
 // Messages quote untrusted names: they must come out printable and bounded.
 
 TEST(Messages, HostileNamesAreQuotedSafely) {

@@ -329,7 +329,8 @@ flatbuffers::Offset<flatbuffers::Vector<flatbuffers::Offset<fb::Montage>>> write
 
 flatbuffers::Offset<fb::Graph> write_graph(flatbuffers::FlatBufferBuilder& fbb, const std::string& clip,
                                            uint64_t skeleton_hash, uint16_t joint_count,
-                                           const std::optional<SyntheticMontage>& montage) {
+                                           const std::optional<SyntheticMontage>& montage,
+                                           const std::optional<SyntheticRetarget>& retarget) {
   using PT = fb::ParameterType;
   std::vector<flatbuffers::Offset<fb::Parameter>> params;
   params.push_back(fb::CreateParameterDirect(fbb, "speed", PT::Float, 1.0f, 0.0f, 4.0f));
@@ -346,7 +347,8 @@ flatbuffers::Offset<fb::Graph> write_graph(flatbuffers::FlatBufferBuilder& fbb, 
     return fb::CreateNode(fbb, fbb.CreateString(""), type, data);
   };
   std::vector<flatbuffers::Offset<fb::Node>> nodes;
-  nodes.push_back(node(fb::NodeData::ClipNode, fb::CreateClipNode(fbb, 0, 1.0f, 0).Union()));              // 0
+  const uint16_t first_clip = retarget && retarget->clip_node_plays_it ? retarget->clip : 0;
+  nodes.push_back(node(fb::NodeData::ClipNode, fb::CreateClipNode(fbb, first_clip, 1.0f, 0).Union()));     // 0
   nodes.push_back(node(fb::NodeData::ClipNode, fb::CreateClipNode(fbb, 0, -1.0f, -1, false).Union()));     // 1
   nodes.push_back(node(fb::NodeData::BlendAlphaNode, fb::CreateBlendAlphaNode(fbb, 0, 1, 0).Union()));    // 2
   const std::vector<fb::BlendSample> samples = {{0, 0.0f, 0.0f}, {0, 2.0f, 0.0f}};
@@ -413,6 +415,18 @@ flatbuffers::Offset<fb::Graph> write_graph(flatbuffers::FlatBufferBuilder& fbb, 
     montages_v = write_montages(fbb, *montage);
   }
   std::vector<flatbuffers::Offset<flatbuffers::String>> clips = {fbb.CreateString(clip)};
+  if (retarget) {  // format v10: beside the root, read by no node
+    const SyntheticRetarget& r = *retarget;
+    const std::vector<fb::RetargetRestRotation> rests = {{r.rest_joint, r.rest_rotation}};
+    const auto source_bones = fbb.CreateVector(r.source_bones);
+    const auto target_bones = fbb.CreateVector(r.target_bones);
+    const auto rest_v = fbb.CreateVectorOfStructs(rests);
+    nodes.push_back(node(fb::NodeData::RetargetNode,
+                         fb::CreateRetargetNode(fbb, r.clip, r.source_hash, r.source_joints, source_bones, target_bones,
+                                                r.rate, r.rate_parameter, true, r.start, true, r.source_rest,
+                                                r.target_rest, 0, rest_v).Union()));
+    clips.push_back(fbb.CreateString("other_walk"));
+  }
   return fb::CreateGraph(fbb, fbb.CreateString("g"), skeleton_hash, joint_count, fbb.CreateVector(params),
                          fbb.CreateVector(clips), fbb.CreateVector(nodes), fbb.CreateVector(machines), root, montages_v);
 }
@@ -644,7 +658,7 @@ std::vector<uint8_t> make_valid_file(const SyntheticSpec& spec) {
   }
   std::vector<flatbuffers::Offset<fb::Graph>> graphs;
   if (spec.graph && !spec.clips.empty())
-    graphs.push_back(write_graph(fbb, spec.clips[0].name, hash, joint_count, spec.montage));
+    graphs.push_back(write_graph(fbb, spec.clips[0].name, hash, joint_count, spec.montage, spec.retarget));
   const auto root = fb::CreateFileDirect(fbb, spec.version, spec.metres_per_unit, skeleton,
                                          spec.meshes.empty() ? nullptr : &meshes, spec.clips.empty() ? nullptr : &clips,
                                          spec.materials.empty() ? nullptr : &materials, provenance,

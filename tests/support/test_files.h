@@ -232,6 +232,22 @@ struct SyntheticMontage {
   bool root_motion = false;
 };
 
+/// A retarget node (format v10), written with the synthetic graph beside its root (no node reads
+/// it), playing a second graph clip "other_walk" made for another rig. One field per stored value,
+/// so a bad-input case spoils exactly one.
+struct SyntheticRetarget {
+  uint16_t clip = 1;  // index into the graph's clips: 1 is the one added for it
+  uint64_t source_hash = 0x5eed;
+  uint16_t source_joints = 30;
+  std::vector<int16_t> source_bones = std::vector<int16_t>(52, -1), target_bones = std::vector<int16_t>(52, -1);
+  float rate = 1.0f, start = 0.0f;
+  int16_t rate_parameter = 0;  // "speed"
+  uint8_t source_rest = 0, target_rest = 1;
+  uint16_t rest_joint = 2;     // one target rest rotation
+  fb::Quat rest_rotation{0.0f, 0.0f, 0.0f, 1.0f};
+  bool clip_node_plays_it = false;  // the graph's first clip node plays the retarget clip too
+};
+
 struct SyntheticSpec {
   std::string identifier = "OSSA";  // exactly 4 characters
   uint32_t version = default_version();
@@ -246,6 +262,8 @@ struct SyntheticSpec {
   bool graph = false;
   /// With `graph`: a slot node over its root and this montage (format v9).
   std::optional<SyntheticMontage> montage;
+  /// With `graph`: a retarget node (format v10).
+  std::optional<SyntheticRetarget> retarget;
 
   static uint32_t default_version();  // kFormatVersion
 };
