@@ -10,7 +10,7 @@
 namespace ossa::view {
 namespace {
 constexpr float kMaxSeconds = 3600.0f;
-constexpr float kMaxMorphWeight = 1000.0f;  // runtime/loader/validate.cpp kMaxMorphWeight
+constexpr float kMaxMorphWeight = 1000.0f;  // runtime/internal/validator.h kMaxMorphWeight
 }
 
 std::optional<std::pair<int, int>> parse_size(const std::string& text) {

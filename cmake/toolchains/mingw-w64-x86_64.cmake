@@ -47,7 +47,8 @@ endif()
 # target("avx2") code can land on a 16-byte boundary, and an aligned vmovaps/vmovdqa to it faults.
 # The assembler rewrites aligned vector moves as unaligned ones (same speed on aligned data since
 # Nehalem). A safety net: today's skinning kernels compile to unaligned moves even without it
-# (objdump of skinning.cpp.obj: no vmovaps/vmovdqa), but a future kernel or compiler might not.
+# (objdump of skin_palette/skin_x86/skin_x86_batch.cpp.obj: no vmovaps/vmovdqa), but a future kernel
+# or compiler might not.
 set(CMAKE_C_FLAGS_INIT "-Wa,-muse-unaligned-vector-move")
 set(CMAKE_CXX_FLAGS_INIT "-Wa,-muse-unaligned-vector-move")
 

@@ -13,7 +13,7 @@
 
 namespace ossa::cook {
 
-/// The loader's bound on translations and scales (validate.cpp's kMaxPoseValue), source units.
+/// The loader's bound on translations and scales (runtime/internal/validator.h's kMaxPoseValue), source units.
 inline constexpr float kMaxSourceValue = 1e7f;
 
 /// Checks bind poses, inverse binds, mesh attributes and bind matrices (finite), clip keys and

@@ -149,7 +149,7 @@ OSSA_IVDEP
   }
 }
 
-/// The loader's bound on every translation and scale it accepts (validate.cpp's kMaxPoseValue):
+/// The loader's bound on every translation and scale it accepts (internal/validator.h's kMaxPoseValue):
 /// ratios and products of bounded values are clamped back into it, so they stay finite.
 constexpr float kMaxPoseValue = 1e7f;
 OSSA_INLINE float clamp_pose_value(float v) { return std::min(std::max(v, -kMaxPoseValue), kMaxPoseValue); }

@@ -26,7 +26,7 @@
 // frame. A position within 1e-5 frames of a whole frame snaps to it, so sampling at a frame's
 // time returns that frame's decoded keys exactly instead of a blend one ulp away.
 //
-// Trust. Everything read here was proven by validate.cpp (key ranges, bit ranges, sorted frames
+// Trust. Everything read here was proven by validate_clip.cpp (key ranges, bit ranges, sorted frames
 // from 0 to frame_count - 1, finite ranges, bounded rotation components, dropped component 0..3)
 // and the cache was made for this clip and a skeleton with its hash and joint count
 // (check_clip_binding), so no check is repeated per sample.

@@ -1,6 +1,6 @@
 // soa_kernel.h — skin_cpu's structure-of-arrays kernel: eight vertices of one influence class at a
 // time, for positions with normals, or normals alone (the cooker's quantized layout, class-ordered
-// ranges, no tangents). Internal to runtime/skinning (skinning.cpp includes it after <immintrin.h>).
+// ranges, no tangents). Internal to runtime/skinning (skin_x86*.cpp include it after <immintrin.h>).
 //
 // Why it is shaped so:
 // - Blending stays array-of-structures, one vertex at a time (two 8-wide FMAs per influence,
@@ -8,7 +8,7 @@
 //   gathers are slow on Zen. What goes structure-of-arrays is everything after it: the eight
 //   blended matrices are transposed once (an 8x8 transpose of each column pair, the w row
 //   dropped), and each output component of eight vertices is then a few FMAs.
-// - The per-vertex kernel (skinning.cpp) spreads (x, y, z, 1) over the columns and adds the
+// - The per-vertex kernel (skin_x86.cpp) spreads (x, y, z, 1) over the columns and adds the
 //   halves, per vertex and stream; it also decodes the normals to memory first and renormalizes
 //   in a second pass over the output. Here the normals are decoded eight at a time in registers
 //   (from the same 16-byte load as the position when the normal follows it, the cooker's layout),
@@ -108,7 +108,7 @@ OSSA_SOA_TARGET OSSA_SOA_INLINE __m256 rounded(__m256 v) {
   return v;
 }
 
-/// One component of a point: c0 * x + c1 * y + c2 * z + c3, rounded as skinning.cpp's per-vertex
+/// One component of a point: c0 * x + c1 * y + c2 * z + c3, rounded as skin_x86.cpp's per-vertex
 /// kernel rounds it (fma(c2, z, c0 * x) + (c1 * y + c3)), so that every path of skin_cpu gives
 /// bit-identical outputs whichever streams are asked for.
 OSSA_SOA_TARGET OSSA_SOA_INLINE __m256 transform_point(__m256 c0, __m256 c1, __m256 c2, __m256 c3, __m256 x, __m256 y, __m256 z) {

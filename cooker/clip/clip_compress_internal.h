@@ -1,0 +1,70 @@
+// clip_compress_internal.h — what the three files of the clip compressor share (internal to
+// cooker/clip/): the channel plan, the error metric and levers, and the stage functions that
+// clip_compress.cpp (classification order, compensation, packing, verification) calls in
+// clip_compress_levers.cpp (step 2: levers) and clip_compress_channel.cpp (steps 4-5 for one
+// channel: classification, keys and bits). The design is in clip_compress.cpp's header; the stages
+// are files of their own so each stays readable on its own.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "cooker/clip/clip_compress.h"
+#include "cooker/clip/clip_error.h"
+
+namespace ossa::cook::compress_detail {
+
+enum class Kind : uint8_t { Bind, Constant, Animated };
+
+// ---------------------------------------------------------------------------------------------
+// Step 2 (clip_compress_levers.cpp)
+
+/// Per joint: which of its channels are fitted to compensate their parent's decoded error.
+constexpr uint8_t kCompensatesRotation = 1, kCompensatesTranslation = 2;
+
+struct Lever {
+  double translation = 0.0;  // model displacement per unit of local translation error
+  double rotation = 0.0;     // ... per unit of 2 sin(angle / 2), or of relative scale error
+  double compensated = 0.0;  // rotation, when the joints in `compensates` absorb it (step 4)
+};
+
+/// Levers from the reference poses, maximised over frames (`compensated`: under the assumption
+/// that the joints in `compensates` absorb a rotation error). O(frames * joints * depth).
+std::vector<Lever> compute_levers(const SourceSkeleton& skeleton, const ClipSamples& ref, double probe,
+                                  const std::vector<uint8_t>& compensates);
+
+// ---------------------------------------------------------------------------------------------
+// Steps 4-5 for one channel (clip_compress_channel.cpp)
+
+struct Metric {
+  uint32_t channel = kTranslation;
+  double lever = 1.0;
+};
+
+/// One key as stored: three quantized components, or three raw float bit patterns (bits == 32).
+using Code = std::array<uint32_t, 3>;
+
+struct ChannelPlan {
+  Kind kind = Kind::Bind;
+  glm::vec4 constant{0.0f};
+  uint32_t bits = 0;                 // animated: 1..kMaxQuantBits or 32
+  uint32_t dropped = 0;              // animated rotation: the component not stored (0..3)
+  std::vector<uint16_t> frames;      // animated: kept key frames
+  std::vector<Code> codes;           // animated: every frame's key as it would be stored
+  float range_min[3] = {0, 0, 0}, range_extent[3] = {0, 0, 0};
+};
+
+bool all_equal(const glm::vec4* v, uint32_t n, const glm::vec4& value);
+/// A channel cooked losslessly: bind, constant, or raw floats at every frame.
+ChannelPlan plan_lossless(uint32_t channel, const glm::vec4* ref, uint32_t n, const glm::vec4& bind);
+/// Step 4: bind or constant when the source (`ref`) allows it within `tolerance`; otherwise a plan
+/// of kind Animated, still to be encoded.
+ChannelPlan classify_channel(const Metric& m, const glm::vec4* ref, uint32_t n, const glm::vec4& bind,
+                             double tolerance);
+/// Step 5: keys and bits of an animated channel fitted to `target` (per frame) within tolerance.
+ChannelPlan encode_animated(const Metric& m, const glm::vec4* target, uint32_t n, double tolerance);
+/// Every frame of a planned channel, decoded exactly as decode_clip decodes the packed bytes.
+void decode_plan(const ChannelPlan& plan, uint32_t channel, uint32_t n, const glm::vec4& bind, glm::vec4* out);
+
+}  // namespace ossa::cook::compress_detail

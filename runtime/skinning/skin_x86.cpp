@@ -1,0 +1,419 @@
+// skin_x86.cpp — skin_cpu's x86 fast paths for the cooker's quantized layout (Position Unorm16x4,
+// Normal Snorm16x2, Tangent Snorm16x4, Joints Uint8x4 / Uint16x4, Weights Unorm8x4): the per-class
+// loops and the drivers that run them over a class-ordered mesh or a classified batch.
+//
+// Why it is shaped so: intrinsics rather than target_clones, picked at run time with internal/cpu.h's
+// queries (the default build runs on any x86-64) through target attributes on each function, so no
+// per-file flags. Every vertex has its own matrices, so the work is array-of-structures per vertex
+// (a structure-of-arrays form needs 12 gathers per influence, and gathers measured ~1.4 cycles per
+// element on Zen 4), and what makes it fast is in-register shuffles and rsqrt, which
+// auto-vectorized clones do not produce. Influence counts vary from vertex to vertex with no
+// pattern, so each influence class runs a loop specialized for it (skin_internal.h's Batch).
+// The batch-level steps (classification, direction decoding, renormalization) are in
+// skin_x86_batch.cpp; the eight-vertex structure-of-arrays kernel is soa_kernel.h.
+//
+// A call runs batch by batch (kBatch vertices, a contiguous range):
+//   1. classify: load each vertex's four weight bytes as one word, derive the classes of 8 (AVX2)
+//      or 16 (AVX-512) vertices with vector compares, and left-pack the vertex indices of each
+//      class into its list (a permute table on AVX2, vpcompressd on AVX-512);
+//   2. with normals or tangents: decode the batch's octahedral words structure-of-arrays, 8 at a
+//      time, into float4 temporaries already multiplied by the direction prescale;
+//   3. one loop per class over its list: blend the palette matrices (two 8-wide FMAs per
+//      influence, columns 0-1 and 2-3), transform the position by spreading (x, y, z, 1) over the
+//      column layout and adding the halves, likewise the normal and tangent; store (directions
+//      unnormalized);
+//   4. renormalize the batch's output normals (8 at a time, structure-of-arrays) and tangents
+//      (rsqrt + one Newton step).
+// A class-ordered mesh skinned for normals without tangents takes soa_kernel.h instead of steps
+// 2-4: eight vertices at a time, structure-of-arrays after the blend (see "meshes ordered by
+// influence class" below).
+// The per-vertex loops use 256-bit registers on both paths: on Zen 4, which executes a 512-bit
+// operation as two 256-bit halves, a 16-wide per-vertex kernel measured ~25% slower (more
+// cross-lane shuffles for the same arithmetic). The classification is where AVX-512 pays.
+// Scalar word loads rather than gathers in steps 1 and 2: measured faster on Zen 4.
+
+#include <algorithm>
+#include <cstdint>
+#include <cstring>
+#include <type_traits>
+
+#include <ossa/format/vertex_codec.h>
+
+#include "skinning/skin_internal.h"
+
+#if OSSA_SKIN_X86
+#include "skinning/soa_kernel.h"
+
+namespace ossa::skin_detail {
+namespace {
+
+template <Slots kSlots>
+inline uint32_t slot_of(uint64_t slot_bits, int k) {
+  return kSlots == Slots::Wide ? static_cast<uint32_t>(slot_bits >> (16 * k)) & 0xffffu
+                               : static_cast<uint32_t>(slot_bits >> (8 * k)) & 0xffu;
+}
+
+// ---- the per-class loops ----
+
+/// Blended matrix of the first K influences (K = 0: the first slot's matrix as it is), as
+/// columns 0-1 and 2-3. `wb` receives the vertex's four weight bytes (loaded for K = 0 only when
+/// kNeedWeights).
+template <int K, Slots kSlots, bool kNeedWeights>
+OSSA_TARGET_AVX2 inline void blend_matrix(const float* palette, const uint8_t* vx, uint32_t off_joints,
+                                          uint32_t off_weights, __m256& a01, __m256& a23, uint32_t& wb) {
+  uint64_t sb;
+  wb = 0;
+  if constexpr (kSlots == Slots::Packed) {
+    const uint64_t both = load_u64(vx + off_joints);
+    sb = both & 0xffffffffu;
+    wb = static_cast<uint32_t>(both >> 32);
+  } else {
+    sb = kSlots == Slots::Wide ? load_u64(vx + off_joints) : load_u32(vx + off_joints);
+    if constexpr (K > 0 || kNeedWeights) wb = load_u32(vx + off_weights);
+  }
+  const float* p0 = palette + 16 * slot_of<kSlots>(sb, 0);
+  if constexpr (K == 0) {
+    a01 = _mm256_loadu_ps(p0);
+    a23 = _mm256_loadu_ps(p0 + 8);
+  } else {
+    __m256 w = _mm256_broadcast_ss(&kWeight[wb & 0xffu]);
+    a01 = _mm256_mul_ps(w, _mm256_loadu_ps(p0));
+    a23 = _mm256_mul_ps(w, _mm256_loadu_ps(p0 + 8));
+    if constexpr (K > 1) {
+      const float* p = palette + 16 * slot_of<kSlots>(sb, 1);
+      w = _mm256_broadcast_ss(&kWeight[(wb >> 8) & 0xffu]);
+      a01 = _mm256_fmadd_ps(w, _mm256_loadu_ps(p), a01);
+      a23 = _mm256_fmadd_ps(w, _mm256_loadu_ps(p + 8), a23);
+    }
+    if constexpr (K > 2) {
+      const float* p = palette + 16 * slot_of<kSlots>(sb, 2);
+      w = _mm256_broadcast_ss(&kWeight[(wb >> 16) & 0xffu]);
+      a01 = _mm256_fmadd_ps(w, _mm256_loadu_ps(p), a01);
+      a23 = _mm256_fmadd_ps(w, _mm256_loadu_ps(p + 8), a23);
+    }
+    if constexpr (K > 3) {
+      const float* p = palette + 16 * slot_of<kSlots>(sb, 3);
+      w = _mm256_broadcast_ss(&kWeight[wb >> 24]);
+      a01 = _mm256_fmadd_ps(w, _mm256_loadu_ps(p), a01);
+      a23 = _mm256_fmadd_ps(w, _mm256_loadu_ps(p + 8), a23);
+    }
+  }
+}
+
+/// c0 * v.x + c1 * v.y + c2 * v.z + c3 * v.w for the blended columns a01 = (c0, c1), a23 = (c2, c3)
+/// and v given in both 128-bit lanes (x, y, z, w, x, y, z, w): in-lane permutes only (vpermilps),
+/// which a broadcast or duplicating load sets up for free. (Lane-crossing vpermps from one xmm
+/// measured ~10% slower per vertex on Zen 5.)
+OSSA_TARGET_AVX2 inline __m128 transform_dup(__m256 a01, __m256 a23, __m256 v) {
+  const __m256 xy = _mm256_permutevar_ps(v, _mm256_setr_epi32(0, 0, 0, 0, 1, 1, 1, 1));
+  const __m256 zw = _mm256_permutevar_ps(v, _mm256_setr_epi32(2, 2, 2, 2, 3, 3, 3, 3));
+  const __m256 t = _mm256_fmadd_ps(a23, zw, _mm256_mul_ps(a01, xy));
+  return _mm_add_ps(_mm256_castps256_ps128(t), _mm256_extractf128_ps(t, 1));
+}
+
+OSSA_TARGET_AVX2 inline void store3(float* out, __m128 r) {
+  _mm_storel_pi(reinterpret_cast<__m64*>(out), r);
+  _mm_store_ss(out + 2, _mm_movehl_ps(r, r));
+}
+
+/// Stores xyz of r at out. A range loop writes vertices in increasing order, so when another
+/// vertex follows it may store all 16 bytes (kWide: one store, no shuffle): the stray w lands on
+/// the next vertex's x, which that vertex overwrites later. The buffer's last vertex stores 12.
+template <bool kWide>
+OSSA_TARGET_AVX2 inline void store_xyz(float* out, __m128 r) {
+  if constexpr (kWide) _mm_storeu_ps(out, r);
+  else store3(out, r);
+}
+
+/// Whether a vertex with weight bytes wb may be skinned by class K's loop: K = 0 needs the single
+/// weight 255; K = 1..3 needs every weight past influence K - 1 zero (a lower class blends its zero
+/// weights harmlessly); K = 4 takes anything. Accumulated as bits that must stay zero.
+template <int K>
+inline uint32_t outside_class(uint32_t wb) {
+  if constexpr (K == 0) return wb ^ 255u;
+  else if constexpr (K < 4) return wb >> (8 * K);
+  else return 0;
+}
+
+/// What one vertex's loop body reads and writes: the vertex's bytes, its decoded directions (in
+/// the batch) and its outputs.
+struct VertexPointers {
+  const uint8_t* vx;
+  const float* normal;   // b.normal row
+  const float* tangent;  // b.tangent row
+  float* position_out;
+  float* normal_out;
+  float* tangent_out;
+};
+
+/// Skins one vertex of class K. kWide: the xyz outputs may be stored as 16 bytes (another vertex
+/// follows in memory order and is written later). Returns outside_class<K> of its weights (only
+/// computed when kCheck).
+template <int K, bool kCheck, bool kWide, Slots kSlots, bool kPositions, bool kNormals, bool kTangents>
+[[gnu::always_inline]] OSSA_TARGET_AVX2 inline uint32_t skin_vertex(const float* palette, const VertexPointers& at,
+                                                                    uint32_t off_position, uint32_t off_joints,
+                                                                    uint32_t off_weights) {
+  __m256 a01, a23;
+  uint32_t wb;
+  blend_matrix<K, kSlots, kCheck>(palette, at.vx, off_joints, off_weights, a01, a23, wb);
+  if constexpr (kPositions) {
+    // The four unorm16 words twice (one duplicating load), widened: (x, y, z, 1) in both lanes.
+    const __m256 scale = _mm256_setr_ps(1.0f / 65535.0f, 1.0f / 65535.0f, 1.0f / 65535.0f, 0.0f, 1.0f / 65535.0f,
+                                        1.0f / 65535.0f, 1.0f / 65535.0f, 0.0f);
+    const __m256 w_one = _mm256_setr_ps(0.0f, 0.0f, 0.0f, 1.0f, 0.0f, 0.0f, 0.0f, 1.0f);
+    const __m128i q2 = _mm_castpd_si128(_mm_loaddup_pd(reinterpret_cast<const double*>(at.vx + off_position)));
+    const __m256 p = _mm256_fmadd_ps(_mm256_cvtepi32_ps(_mm256_cvtepu16_epi32(q2)), scale, w_one);
+    store_xyz<kWide>(at.position_out, transform_dup(a01, a23, p));
+  }
+  if constexpr (kNormals)
+    store_xyz<kWide>(at.normal_out, transform_dup(a01, a23, _mm256_broadcast_ps(reinterpret_cast<const __m128*>(at.normal))));
+  if constexpr (kTangents) {
+    const __m128 t = _mm_load_ps(at.tangent);
+    // w of t is the sign: transform xyz only, then put the sign back.
+    const __m128 r = transform_dup(a01, a23, _mm256_blend_ps(_mm256_broadcast_ps(reinterpret_cast<const __m128*>(at.tangent)), _mm256_setzero_ps(), 0x88));
+    _mm_storeu_ps(at.tangent_out, _mm_blend_ps(r, t, 0x8));
+  }
+  return kCheck ? outside_class<K>(wb) : 0u;
+}
+
+/// Class K's loop over a batch's list of n vertices (any order).
+template <int K, Slots kSlots, bool kPositions, bool kNormals, bool kTangents>
+OSSA_TARGET_AVX2 void skin_class(const uint32_t* list, uint32_t n, const float* palette, const FastMesh& mesh,
+                                 const Batch& b, Outputs out) {
+  const uint8_t* const base = mesh.base;
+  const size_t stride = mesh.stride;
+  const uint32_t off_position = mesh.off_position, off_joints = mesh.off_joints, off_weights = mesh.off_weights;
+  for (uint32_t i = 0; i < n; ++i) {
+    const size_t v = list[i];
+    const VertexPointers at{base + v * stride,
+                            b.normal[v - b.first],
+                            b.tangent[v - b.first],
+                            kPositions ? out.positions + 3 * v : nullptr,
+                            kNormals ? out.normals + 3 * v : nullptr,
+                            kTangents ? out.tangents + 4 * v : nullptr};
+    skin_vertex<K, false, false, kSlots, kPositions, kNormals, kTangents>(palette, at, off_position, off_joints, off_weights);
+  }
+}
+
+/// Class K's loop over the contiguous vertices [b.first, b.first + b.n) of a class-ordered mesh,
+/// walking every pointer forward (no index arithmetic per vertex). Returns the OR of
+/// outside_class<K> over them: non-zero means some vertex did not belong to the range (and its
+/// outputs are wrong).
+template <int K, Slots kSlots, bool kPositions, bool kNormals, bool kTangents>
+OSSA_TARGET_AVX2 uint32_t skin_range(const float* palette, const FastMesh& mesh, const Batch& b, Outputs out) {
+  const size_t stride = mesh.stride;
+  const uint32_t off_position = mesh.off_position, off_joints = mesh.off_joints, off_weights = mesh.off_weights;
+  const size_t first = b.first;
+  VertexPointers at{mesh.base + first * stride,
+                    b.normal[0],
+                    b.tangent[0],
+                    kPositions ? out.positions + 3 * first : nullptr,
+                    kNormals ? out.normals + 3 * first : nullptr,
+                    kTangents ? out.tangents + 4 * first : nullptr};
+  // The mesh's very last vertex stores 12 bytes per stream; every other one may store 16.
+  const uint32_t wide = b.first + b.n == mesh.count ? b.n - 1 : b.n;
+  uint32_t outside = 0;
+#pragma GCC unroll 2
+  for (uint32_t i = 0; i < wide; ++i) {
+    outside |= skin_vertex<K, true, true, kSlots, kPositions, kNormals, kTangents>(palette, at, off_position, off_joints, off_weights);
+    at.vx += stride;
+    at.normal += 4;
+    at.tangent += 4;
+    if constexpr (kPositions) at.position_out += 3;
+    if constexpr (kNormals) at.normal_out += 3;
+    if constexpr (kTangents) at.tangent_out += 4;
+  }
+  if (wide < b.n)
+    outside |= skin_vertex<K, true, false, kSlots, kPositions, kNormals, kTangents>(palette, at, off_position, off_joints, off_weights);
+  return outside;
+}
+
+/// Class K's loop over the contiguous vertices [first, first + n) of a class-ordered mesh, eight at
+/// a time (soa_kernel.h), positions and normals (renormalized as out asks) written directly.
+/// Returns n, or the index (from first) of the block where a vertex did not belong to the class:
+/// outputs from there on are not written, or wrong.
+template <int K, Slots kSlots, bool kPositions, bool kNormals>
+OSSA_TARGET_AVX2 uint32_t skin_range_soa(const float* palette, const FastMesh& m, uint32_t first, uint32_t n, Outputs out,
+                                          bool avx512) {
+  constexpr bool kWide = kSlots == Slots::Wide, kPacked = kSlots == Slots::Packed;
+  const soa::Layout l{palette, kWeight.data(), m.stride, m.off_position, m.off_normal, m.off_joints, m.off_weights,
+                      {m.prescale[0], m.prescale[1], m.prescale[2]}, out.renormalize};
+  const uint8_t* vx = m.base + static_cast<size_t>(first) * m.stride;
+  const soa::Cursor<kPacked> at{vx + m.off_joints, vx + m.off_weights, vx + m.off_position, vx + m.off_normal};
+  float* const p = kPositions ? out.positions + 3 * static_cast<size_t>(first) : nullptr;
+  float* const q = kNormals ? out.normals + 3 * static_cast<size_t>(first) : nullptr;
+  // The cooker's layout: 16 bytes from the position stay inside the vertex, and hold the normal.
+  if (m.off_position + 16 <= m.stride && (!kNormals || m.off_normal == m.off_position + 8))
+    return avx512 ? soa::range_avx512<K, kWide, kPacked, kPositions, kNormals, true>(at, n, l, p, q)
+                  : soa::range_avx2<K, kWide, kPacked, kPositions, kNormals, true>(at, n, l, p, q);
+  return avx512 ? soa::range_avx512<K, kWide, kPacked, kPositions, kNormals, false>(at, n, l, p, q)
+                : soa::range_avx2<K, kWide, kPacked, kPositions, kNormals, false>(at, n, l, p, q);
+}
+
+template <bool kNormals, bool kTangents>
+OSSA_TARGET_AVX2 void normalize_batch(const Batch& b, Outputs out) {
+  if (!out.renormalize) return;
+  if constexpr (kNormals) normalize_xyz(out.normals + 3 * static_cast<size_t>(b.first), b.n);
+  if constexpr (kTangents) normalize_xyz_w(out.tangents + 4 * static_cast<size_t>(b.first), b.n);
+}
+
+template <Slots kSlots, bool kPositions, bool kNormals, bool kTangents>
+OSSA_TARGET_AVX2 void skin_batch(const float* palette, const FastMesh& m, const Batch& b, Outputs out) {
+  skin_class<0, kSlots, kPositions, kNormals, kTangents>(b.lists[0], b.count[0], palette, m, b, out);
+  skin_class<1, kSlots, kPositions, kNormals, kTangents>(b.lists[1], b.count[1], palette, m, b, out);
+  skin_class<2, kSlots, kPositions, kNormals, kTangents>(b.lists[2], b.count[2], palette, m, b, out);
+  skin_class<3, kSlots, kPositions, kNormals, kTangents>(b.lists[3], b.count[3], palette, m, b, out);
+  skin_class<4, kSlots, kPositions, kNormals, kTangents>(b.lists[4], b.count[4], palette, m, b, out);
+  normalize_batch<kNormals, kTangents>(b, out);
+}
+
+/// Vertices [first, count) batch by batch, each classified first (any vertex order).
+template <Slots kSlots, bool kPositions, bool kNormals, bool kTangents>
+OSSA_TARGET_AVX2 void skin_classified(const float* palette, const FastMesh& m, Outputs out, bool avx512, uint32_t first) {
+  Batch b;
+  for (; first < m.count; first += kBatch) {
+    b.first = first;
+    b.n = std::min(kBatch, m.count - first);
+    if (avx512) classify_avx512(m, b);
+    else classify_avx2(m, b);
+    if constexpr (kNormals || kTangents) decode_directions<kTangents>(m, b);
+    skin_batch<kSlots, kPositions, kNormals, kTangents>(palette, m, b, out);
+  }
+}
+
+// ---- meshes ordered by influence class ----
+//
+// The cooker orders a skinned mesh's vertices by class (cooker/mesh/mesh_build.cpp,
+// influence_class_order), so the classes are five contiguous ranges and each runs its loop straight
+// through: no classification pass, no lists, outputs written in order. Nothing is trusted: the
+// range ends come from a binary search that assumes the order, and every range loop checks each
+// vertex it skins against its class (outside_class, one shift and OR on bytes it loads anyway).
+// A range that fails is redone, with everything after it, by the classified path; a mesh whose
+// first kOrderProbe vertices are out of order (an older cook, another tool's file) goes there
+// from the start, so it pays a 64-vertex probe and nothing else. With normals and no tangents a
+// range runs soa_kernel.h's eight-vertex blocks (skin_range_soa), which check their vertices the
+// same way and report the first failing block; positions alone, or with tangents, run skin_range.
+
+constexpr uint32_t kOrderProbe = 64;
+
+inline uint32_t weight_word(const FastMesh& m, uint32_t v) {
+  return load_u32(m.base + static_cast<size_t>(v) * m.stride + m.off_weights);
+}
+
+/// Whether the first kOrderProbe vertices' classes never decrease.
+inline bool ordered_start(const FastMesh& m) {
+  const uint32_t n = std::min(m.count, kOrderProbe);
+  int last = 0;
+  for (uint32_t v = 0; v < n; ++v) {
+    const int c = influence_class(weight_word(m, v));
+    if (c < last) return false;
+    last = c;
+  }
+  return true;
+}
+
+/// First vertex in [lo, count) whose class exceeds c, assuming classes never decrease.
+inline uint32_t class_end(const FastMesh& m, uint32_t lo, int c) {
+  uint32_t hi = m.count;
+  while (lo < hi) {
+    const uint32_t mid = lo + (hi - lo) / 2;
+    if (influence_class(weight_word(m, mid)) > c) hi = mid;
+    else lo = mid + 1;
+  }
+  return lo;
+}
+
+template <Slots kSlots, bool kPositions, bool kNormals, bool kTangents>
+OSSA_TARGET_AVX2 void skin_fast(const float* palette, const FastMesh& m, Outputs out, bool avx512) {
+  if (!ordered_start(m)) {
+    skin_classified<kSlots, kPositions, kNormals, kTangents>(palette, m, out, avx512, 0);
+    return;
+  }
+  Batch b;
+  uint32_t begin = 0;
+  const auto run = [&](auto k) -> bool {
+    constexpr int K = decltype(k)::value;
+    const uint32_t end = K == kClasses - 1 ? m.count : class_end(m, begin, K);
+    if constexpr (kNormals && !kTangents) {
+      const uint32_t done = skin_range_soa<K, kSlots, kPositions, kNormals>(palette, m, begin, end - begin, out, avx512);
+      if (done != end - begin) {
+        skin_classified<kSlots, kPositions, kNormals, kTangents>(palette, m, out, avx512, begin + done);
+        return false;
+      }
+      begin = end;
+      return true;
+    }
+    for (b.first = begin; b.first < end; b.first += kBatch) {
+      b.n = std::min(kBatch, end - b.first);
+      if constexpr (kNormals || kTangents) decode_directions<kTangents>(m, b);
+      if (skin_range<K, kSlots, kPositions, kNormals, kTangents>(palette, m, b, out) != 0) {
+        skin_classified<kSlots, kPositions, kNormals, kTangents>(palette, m, out, avx512, b.first);
+        return false;
+      }
+      normalize_batch<kNormals, kTangents>(b, out);
+    }
+    begin = end;
+    return true;
+  };
+  run(std::integral_constant<int, 0>{}) && run(std::integral_constant<int, 1>{}) &&
+      run(std::integral_constant<int, 2>{}) && run(std::integral_constant<int, 3>{}) &&
+      run(std::integral_constant<int, 4>{});
+}
+
+template <Slots kSlots, bool kPositions>
+void skin_fast_directions(const float* palette, const FastMesh& m, Outputs out, bool avx512) {
+  if (out.tangents != nullptr) {
+    if (out.normals != nullptr) skin_fast<kSlots, kPositions, true, true>(palette, m, out, avx512);
+    else skin_fast<kSlots, kPositions, false, true>(palette, m, out, avx512);
+  } else if (out.normals != nullptr) {
+    skin_fast<kSlots, kPositions, true, false>(palette, m, out, avx512);
+  } else if constexpr (kPositions) {
+    skin_fast<kSlots, true, false, false>(palette, m, out, avx512);
+  }
+}
+
+template <Slots kSlots>
+void skin_fast_streams(const float* palette, const FastMesh& m, Outputs out, bool avx512) {
+  if (out.positions != nullptr) skin_fast_directions<kSlots, true>(palette, m, out, avx512);
+  else skin_fast_directions<kSlots, false>(palette, m, out, avx512);
+}
+
+/// The fast paths read the cooker's quantized layout (8- or 16-bit slots), nothing else.
+bool fast_layout(const MeshFacts& m, Outputs out, FastMesh* f) {
+  if (m.joints == nullptr || m.position == nullptr || m.position->format() != VertexFormat::Unorm16x4) return false;
+  if (m.weights->format() != VertexFormat::Unorm8x4) return false;
+  if ((out.normals != nullptr || out.tangents != nullptr) &&
+      (m.normal == nullptr || m.normal->format() != VertexFormat::Snorm16x2))
+    return false;
+  if (out.tangents != nullptr && m.tangent->format() != VertexFormat::Snorm16x4) return false;
+  *f = FastMesh{m.base,
+                m.count,
+                m.stride,
+                m.position->offset(),
+                m.normal != nullptr ? m.normal->offset() : 0u,
+                m.tangent != nullptr ? m.tangent->offset() : 0u,
+                m.joints->offset(),
+                m.weights->offset(),
+                m.joints->format() == VertexFormat::Uint16x4                   ? Slots::Wide
+                : m.weights->offset() == static_cast<uint32_t>(m.joints->offset()) + 4u ? Slots::Packed
+                                                                                         : Slots::Narrow,
+                {m.direction_prescale.x, m.direction_prescale.y, m.direction_prescale.z}};
+  return true;
+}
+
+}  // namespace
+
+bool skin_quantized(const MeshFacts& m, const float* palette, Outputs out, bool avx512) {
+  FastMesh f;
+  if (!fast_layout(m, out, &f)) return false;
+  switch (f.slots) {
+    case Slots::Narrow: skin_fast_streams<Slots::Narrow>(palette, f, out, avx512); break;
+    case Slots::Wide: skin_fast_streams<Slots::Wide>(palette, f, out, avx512); break;
+    case Slots::Packed: skin_fast_streams<Slots::Packed>(palette, f, out, avx512); break;
+  }
+  return true;
+}
+
+}  // namespace ossa::skin_detail
+
+#endif  // OSSA_SKIN_X86
