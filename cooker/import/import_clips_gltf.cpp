@@ -194,7 +194,10 @@ GltfClip plan_gltf_clip(const gltf::Animations& file, const gltf::Animation& ani
     if (ch.path == gltf::TargetPath::Weights) {
       const int mesh = file.nodes[static_cast<size_t>(ch.node)].mesh;
       if (!s.error.empty()) {
-        out.kept.push_back("'" + gltf::assimp_node_name(file, ch.node) + "' weights dropped (" + s.error + ")");
+        std::string note = "'";  // appended: "'" + std::string&& trips GCC 12's false -Wrestrict at -O3
+        note += gltf::assimp_node_name(file, ch.node);
+        note += "' weights dropped (" + s.error + ")";
+        out.kept.push_back(std::move(note));
       } else if (mesh >= 0 && !s.times.empty()) {
         out.weights.emplace_back(&s, &file.meshes[static_cast<size_t>(mesh)].names);
       }

@@ -50,15 +50,24 @@ std::string CookOptions::canonical() const {
   // input's directory, so it enters the key through its hash here rather than as a relative path.
   if (reference != nullptr) {
     s += ";skeleton=" + reference_name;
-    if (reference_input.present) s += "@" + hex64(reference_input.hash);
+    if (reference_input.present) {
+      s += '@';  // not "@" + hex64(...): GCC 12's false -Wrestrict at -O3 (GCC bug 105329)
+      s += hex64(reference_input.hash);
+    }
   }
   if (retarget_target != nullptr) {
     s += ";retarget=" + retarget_name;
-    if (retarget_input.present) s += "@" + hex64(retarget_input.hash);
+    if (retarget_input.present) {
+      s += '@';
+      s += hex64(retarget_input.hash);
+    }
   }
   if (retarget_map != nullptr) {
     s += ";map=" + retarget_map_name;
-    if (retarget_map_input.present) s += "@" + hex64(retarget_map_input.hash);
+    if (retarget_map_input.present) {
+      s += '@';
+      s += hex64(retarget_map_input.hash);
+    }
   }
   s += cloth.canonical();
   return s;

@@ -33,7 +33,11 @@ std::string temporary_prefix(const std::string& output_name) {
   char hash[12];
   std::snprintf(hash, sizeof hash, "~%08x",
                 static_cast<unsigned>(XXH3_64bits(output_name.data(), output_name.size()) & 0xFFFFFFFFu));
-  return "." + output_name.substr(0, kCutName) + hash + ".tmp-";
+  std::string prefix = ".";  // appended: "." + std::string&& trips GCC 12's false -Wrestrict at -O3
+  prefix += output_name.substr(0, kCutName);
+  prefix += hash;
+  prefix += ".tmp-";
+  return prefix;
 }
 
 std::string temporary_name(const std::string& output_name, long pid, unsigned n) {
