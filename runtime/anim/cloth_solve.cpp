@@ -21,8 +21,10 @@
 
 #include <glm/gtc/quaternion.hpp>
 
+#include "anim/cloth_kernels.h"
 #include "common/message.h"
 #include "internal/rotation.h"
+#include "internal/vector_clones.h"
 
 namespace ossa {
 namespace {
@@ -133,7 +135,14 @@ void apply_carry(ClothInstance& c, const Carry& k) {
   if (k.identity) return;
   const glm::mat3 r = glm::mat3_cast(k.rotation);
   const size_t n = c.current.size();
-  for (size_t i = 0; i < n; ++i) {
+  size_t i = 0;
+#if OSSA_HAVE_VECTOR_CLONES
+  if (detail::cloth_kernels_selected()) {
+    i = n & ~size_t{7};
+    detail::carry_particles8(c.current.data(), c.previous.data(), i, r, k.translation);
+  }
+#endif
+  for (; i < n; ++i) {
     glm::vec4& x = c.current[i];
     glm::vec4& p = c.previous[i];
     const glm::vec3 xn = r * xyz(x) + k.translation, pn = r * xyz(p) + k.translation;
@@ -142,81 +151,133 @@ void apply_carry(ClothInstance& c, const Carry& k) {
   }
 }
 
+/// Particle i's prediction (see predict).
+OSSA_INLINE void predict_one(ClothInstance& c, size_t i, std::span<const glm::vec3> skinned, const Step& st) {
+  glm::vec4& x = c.current[i];
+  glm::vec4& p = c.previous[i];
+  if (x.w == 0.0f) {
+    p = x;
+    x = glm::vec4(st.w.of(c.skinned_older[i], c.skinned_before[i], skinned[i]), 0.0f);
+    return;
+  }
+  const glm::vec3 at = xyz(x);
+  glm::vec3 v = (at - xyz(p)) * st.keep;
+  if (st.drag > 0.0f) {
+    // The wind's drag along the normal of a triangle the particle is a corner of, from the
+    // current positions (the particles before i already predicted, as the loop goes).
+    const uint16_t* f = &c.facing[3 * i];
+    const glm::vec3 a = xyz(c.current[f[0]]);
+    glm::vec3 nrm = glm::cross(xyz(c.current[f[1]]) - a, xyz(c.current[f[2]]) - a);
+    const float len2 = glm::dot(nrm, nrm);
+    nrm = len2 > 1e-30f ? nrm * (1.0f / std::sqrt(len2)) : glm::vec3(0.0f);
+    v += nrm * (glm::dot(nrm, st.wind_h - v) * st.drag);
+  }
+  v += st.gravity_h2;
+  const float max2 = st.max_step * st.max_step;
+  if (max2 > 0.0f) {
+    const float l2 = glm::dot(v, v);
+    if (l2 > max2) v *= st.max_step / std::sqrt(l2);
+  }
+  p = glm::vec4(at, p.w);
+  x = glm::vec4(at + v, x.w);
+}
+
+/// Damped velocity, the wind's drag, gravity and the speed limit for free particles; fixed ones
+/// step to their skinned position. Without drag the particles do not read each other, and the
+/// kernel takes eight at a time.
 void predict(ClothInstance& c, std::span<const glm::vec3> skinned, const Step& st) {
   const size_t n = c.current.size();
-  const bool drag = st.drag > 0.0f;
-  const float max2 = st.max_step * st.max_step;
-  for (size_t i = 0; i < n; ++i) {
-    glm::vec4& x = c.current[i];
-    glm::vec4& p = c.previous[i];
-    if (x.w == 0.0f) {
-      p = x;
-      x = glm::vec4(st.w.of(c.skinned_older[i], c.skinned_before[i], skinned[i]), 0.0f);
-      continue;
-    }
-    const glm::vec3 at = xyz(x);
-    glm::vec3 v = (at - xyz(p)) * st.keep;
-    if (drag) {
-      const uint16_t* f = &c.facing[3 * i];
-      const glm::vec3 a = xyz(c.current[f[0]]);
-      glm::vec3 nrm = glm::cross(xyz(c.current[f[1]]) - a, xyz(c.current[f[2]]) - a);
-      const float len2 = glm::dot(nrm, nrm);
-      nrm = len2 > 1e-30f ? nrm * (1.0f / std::sqrt(len2)) : glm::vec3(0.0f);
-      v += nrm * (glm::dot(nrm, st.wind_h - v) * st.drag);
-    }
-    v += st.gravity_h2;
-    if (max2 > 0.0f) {
-      const float l2 = glm::dot(v, v);
-      if (l2 > max2) v *= st.max_step / std::sqrt(l2);
-    }
-    p = glm::vec4(at, p.w);
-    x = glm::vec4(at + v, x.w);
+  size_t i = 0;
+#if OSSA_HAVE_VECTOR_CLONES
+  if (detail::cloth_kernels_selected() && !(st.drag > 0.0f)) {
+    for (; i + 8 <= n; i += 8)
+      for (uint32_t fixed = detail::predict_particles8(c.current.data(), c.previous.data(), i, st.keep,
+                                                       st.gravity_h2, st.max_step);
+           fixed != 0; fixed &= fixed - 1)
+        predict_one(c, i + static_cast<size_t>(__builtin_ctz(fixed)), skinned, st);
   }
+#endif
+  for (; i < n; ++i) predict_one(c, i, skinned, st);
 }
 
-/// XPBD distance constraints. kLambda: keep multipliers across iterations (iterations > 1).
+/// One XPBD distance constraint. kLambda: keep its multiplier across iterations (iterations > 1).
 template <bool kLambda>
-void project_edges(glm::vec4* x, std::span<const fb::ClothEdge> edges, float alpha, float* lambda) {
-  const size_t count = edges.size();
-  for (size_t k = 0; k < count; ++k) {
-    const fb::ClothEdge& e = edges[k];
-    glm::vec4& a = x[e.a()];
-    glm::vec4& b = x[e.b()];
-    const float wsum = a.w + b.w;
-    const glm::vec3 d(b.x - a.x, b.y - a.y, b.z - a.z);
-    const float len2 = glm::dot(d, d);
-    if (!(len2 > 1e-24f) || wsum == 0.0f) continue;
-    const float len = std::sqrt(len2);
-    const float violation = len - e.rest();
-    float dl;
-    if constexpr (kLambda) {
-      dl = (-violation - alpha * lambda[k]) / (wsum + alpha);
-      lambda[k] += dl;
-    } else {
-      dl = -violation / (wsum + alpha);
-    }
-    const glm::vec3 corr = d * (dl / len);
-    a.x -= a.w * corr.x;
-    a.y -= a.w * corr.y;
-    a.z -= a.w * corr.z;
-    b.x += b.w * corr.x;
-    b.y += b.w * corr.y;
-    b.z += b.w * corr.z;
+OSSA_INLINE void project_edge(glm::vec4* x, const fb::ClothEdge& e, float alpha, float* lambda) {
+  glm::vec4& a = x[e.a()];
+  glm::vec4& b = x[e.b()];
+  const float wsum = a.w + b.w;
+  const glm::vec3 d(b.x - a.x, b.y - a.y, b.z - a.z);
+  const float len2 = glm::dot(d, d);
+  if (!(len2 > 1e-24f) || wsum == 0.0f) return;
+  const float len = std::sqrt(len2);
+  const float violation = len - e.rest();
+  float dl;
+  if constexpr (kLambda) {
+    dl = (-violation - alpha * *lambda) / (wsum + alpha);
+    *lambda += dl;
+  } else {
+    dl = -violation / (wsum + alpha);
   }
+  const glm::vec3 corr = d * (dl / len);
+  a.x -= a.w * corr.x;
+  a.y -= a.w * corr.y;
+  a.z -= a.w * corr.z;
+  b.x += b.w * corr.x;
+  b.y += b.w * corr.y;
+  b.z += b.w * corr.z;
 }
 
-void project_tethers(glm::vec4* x, std::span<const fb::ClothTether> tethers, float scale) {
-  for (const fb::ClothTether& t : tethers) {
-    glm::vec4& p = x[t.particle()];
-    if (p.w == 0.0f) continue;
-    const glm::vec4& a = x[t.anchor()];
-    const glm::vec3 d(p.x - a.x, p.y - a.y, p.z - a.z);
-    const float limit = t.length() * scale;
-    const float len2 = glm::dot(d, d);
-    if (len2 <= limit * limit) continue;
-    const glm::vec3 at = xyz(a) + d * (limit / std::sqrt(len2));
-    p = glm::vec4(at, p.w);
+/// The edges in their stored order; with the eight-wide kernel, each run of edges that share no
+/// particle (`runs`: where each ends) goes eight at a time and its last few one by one, which
+/// gives the same bits as the stored order (no edge of a run reads what another writes).
+template <bool kLambda>
+void project_edges(glm::vec4* x, std::span<const fb::ClothEdge> edges, std::span<const uint32_t> runs, float alpha,
+                   float* lambda, bool wide) {
+  size_t k = 0;
+#if OSSA_HAVE_VECTOR_CLONES
+  if (wide) {
+    for (const uint32_t end : runs) {
+      const size_t eight = (end - k) & ~size_t{7};
+      if (eight > 0) detail::project_edges8(x, edges.data() + k, eight, alpha, kLambda ? lambda + k : nullptr);
+      for (k += eight; k < end; ++k) project_edge<kLambda>(x, edges[k], alpha, kLambda ? lambda + k : nullptr);
+    }
   }
+#else
+  (void)runs;
+  (void)wide;
+#endif
+  for (; k < edges.size(); ++k) project_edge<kLambda>(x, edges[k], alpha, kLambda ? lambda + k : nullptr);
+}
+
+OSSA_INLINE void project_tether(glm::vec4* x, const fb::ClothTether& t, float scale) {
+  glm::vec4& p = x[t.particle()];
+  if (p.w == 0.0f) return;
+  const glm::vec4& a = x[t.anchor()];
+  const glm::vec3 d(p.x - a.x, p.y - a.y, p.z - a.z);
+  const float limit = t.length() * scale;
+  const float len2 = glm::dot(d, d);
+  if (len2 <= limit * limit) return;
+  const glm::vec3 at = xyz(a) + d * (limit / std::sqrt(len2));
+  p = glm::vec4(at, p.w);
+}
+
+/// The tethers in their stored order, runs of them that share no particle eight at a time.
+void project_tethers(glm::vec4* x, std::span<const fb::ClothTether> tethers, std::span<const uint32_t> runs,
+                     float scale, bool wide) {
+  size_t k = 0;
+#if OSSA_HAVE_VECTOR_CLONES
+  if (wide) {
+    for (const uint32_t end : runs) {
+      const size_t eight = (end - k) & ~size_t{7};
+      if (eight > 0) detail::project_tethers8(x, tethers.data() + k, eight, scale);
+      for (k += eight; k < end; ++k) project_tether(x, tethers[k], scale);
+    }
+  }
+#else
+  (void)runs;
+  (void)wide;
+#endif
+  for (; k < tethers.size(); ++k) project_tether(x, tethers[k], scale);
 }
 
 /// Max distance and backstop against the skinned pose `f` of the way through this update.
@@ -246,36 +307,68 @@ void project_limits(ClothInstance& c, std::span<const glm::vec3> skinned, std::s
   }
 }
 
-/// Pushes free particles out of every collider, its ends `f` of the way from the last update's to
-/// this one's.
-void project_colliders(ClothInstance& c, const Weights& w) {
+/// Each collider's ends and bounding sphere at weights w of the last three updates' (or, with
+/// `now`, at this update's pose) into collider_step.
+void set_collider_step(ClothInstance& c, const Weights& w, bool now = false) {
   const ClothSource& s = c.source;
-  const size_t n = c.current.size();
   for (size_t k = 0; k < s.colliders.size(); ++k) {
-    const glm::vec3 a = w.of(c.colliders_older[2 * k], c.colliders_before[2 * k], c.colliders_now[2 * k]);
-    const glm::vec3 b = w.of(c.colliders_older[2 * k + 1], c.colliders_before[2 * k + 1], c.colliders_now[2 * k + 1]);
+    const auto end = [&](size_t e) {
+      return now ? c.colliders_now[e] : w.of(c.colliders_older[e], c.colliders_before[e], c.colliders_now[e]);
+    };
+    const glm::vec3 a = end(2 * k), b = end(2 * k + 1);
     const float reach = s.colliders[k].radius() + c.settings.thickness;
-    const glm::vec3 centre = 0.5f * (a + b);
     const float bound = 0.5f * glm::length(b - a) + reach;
-    const float bound2 = bound * bound;
-    for (size_t i = 0; i < n; ++i) {
-      glm::vec4& x = c.current[i];
-      const glm::vec3 at = xyz(x);
-      const glm::vec3 dc = at - centre;
-      if (glm::dot(dc, dc) >= bound2 || x.w == 0.0f) continue;
-      const glm::vec3 q = closest_on_segment(at, a, b);
-      const glm::vec3 away = at - q;
-      const float dist2 = glm::dot(away, away);
-      if (dist2 >= reach * reach) continue;
-      const float dist = std::sqrt(dist2);
-      // Out along the shortest way; a particle exactly on the axis goes out along the previous
-      // substep's side of it.
-      glm::vec3 dir = dist > 1e-12f ? away / dist : xyz(c.previous[i]) - q;
-      const float dl = glm::length(dir);
-      dir = dl > 1e-12f ? dir / dl : glm::vec3(0.0f, 1.0f, 0.0f);
-      x = glm::vec4(q + dir * reach, x.w);
-    }
+    c.collider_step[3 * k] = glm::vec4(a, reach);
+    c.collider_step[3 * k + 1] = glm::vec4(b, 0.0f);
+    c.collider_step[3 * k + 2] = glm::vec4(0.5f * (a + b), bound * bound);
   }
+}
+
+/// Pushes the point `at` out of every collider of collider_step in turn; a point exactly on a
+/// collider's axis goes out along `side - q` (the previous position's side of it).
+OSSA_INLINE void push_out(const ClothInstance& c, glm::vec3& at, const glm::vec3& side) {
+  const size_t count = c.source.colliders.size();
+  for (size_t k = 0; k < count; ++k) {
+    const glm::vec4& ea = c.collider_step[3 * k];
+    const glm::vec4& bound = c.collider_step[3 * k + 2];
+    const glm::vec3 dc = at - xyz(bound);
+    if (glm::dot(dc, dc) >= bound.w) continue;
+    const float reach = ea.w;
+    const glm::vec3 q = closest_on_segment(at, xyz(ea), xyz(c.collider_step[3 * k + 1]));
+    const glm::vec3 away = at - q;
+    const float dist2 = glm::dot(away, away);
+    if (dist2 >= reach * reach) continue;
+    const float dist = std::sqrt(dist2);
+    glm::vec3 dir = dist > 1e-12f ? away / dist : side - q;
+    const float dl = glm::length(dir);
+    dir = dl > 1e-12f ? dir / dl : glm::vec3(0.0f, 1.0f, 0.0f);
+    at = q + dir * reach;
+  }
+}
+
+/// Pushes free particles out of every collider (collider_step: this substep's), each particle
+/// through the colliders in order, eight at a time with the kernels.
+void project_colliders(ClothInstance& c, bool wide) {
+  const size_t count = c.source.colliders.size();
+  if (count == 0) return;
+  const size_t n = c.current.size();
+  const auto push = [&](size_t i) {
+    glm::vec4& x = c.current[i];
+    if (x.w == 0.0f) return;
+    glm::vec3 at = xyz(x);
+    push_out(c, at, xyz(c.previous[i]));
+    x = glm::vec4(at, x.w);
+  };
+  size_t next = 0;
+#if OSSA_HAVE_VECTOR_CLONES
+  if (wide) {
+    for (; next + 8 <= n; next += 8)
+      detail::push_out_colliders8(c.current.data(), c.previous.data(), next, c.collider_step.data(), count);
+  }
+#else
+  (void)wide;
+#endif
+  for (; next < n; ++next) push(next);
 }
 
 void substep(ClothInstance& c, const ClothInput& in, const Step& st) {
@@ -286,17 +379,19 @@ void substep(ClothInstance& c, const ClothInput& in, const Step& st) {
   glm::vec4* x = c.current.data();
   const ClothSource& src = c.source;
   if (s.iterations > 1) std::fill(c.lambda.begin(), c.lambda.end(), 0.0f);
+  const bool wide = detail::cloth_kernels_selected();
+  set_collider_step(c, st.w);
   for (uint32_t it = 0; it < s.iterations; ++it) {
     if (s.iterations > 1) {
-      project_edges<true>(x, src.stretch, stretch_alpha, c.lambda.data());
-      project_edges<true>(x, src.bend, bend_alpha, c.lambda.data() + src.stretch.size());
+      project_edges<true>(x, src.stretch, c.stretch_runs, stretch_alpha, c.lambda.data(), wide);
+      project_edges<true>(x, src.bend, c.bend_runs, bend_alpha, c.lambda.data() + src.stretch.size(), wide);
     } else {
-      project_edges<false>(x, src.stretch, stretch_alpha, nullptr);
-      project_edges<false>(x, src.bend, bend_alpha, nullptr);
+      project_edges<false>(x, src.stretch, c.stretch_runs, stretch_alpha, nullptr, wide);
+      project_edges<false>(x, src.bend, c.bend_runs, bend_alpha, nullptr, wide);
     }
-    project_tethers(x, src.tethers, s.tether_scale);
+    project_tethers(x, src.tethers, c.tether_runs, s.tether_scale, wide);
     project_limits(c, in.skinned_positions, in.skinned_normals, st);
-    project_colliders(c, st.w);
+    project_colliders(c, wide);
   }
 }
 
@@ -377,26 +472,20 @@ void write_output(ClothInstance& c, const ClothInput& in, float ahead, const Car
       if (depth < -s.backstops[i]) at -= nrm * (depth + s.backstops[i]);
     }
   }
-  for (size_t k = 0; k < s.colliders.size(); ++k) {
-    const glm::vec3 a = c.colliders_now[2 * k], b = c.colliders_now[2 * k + 1];
-    const float reach = s.colliders[k].radius() + c.settings.thickness;
-    const glm::vec3 centre = 0.5f * (a + b);
-    const float bound = 0.5f * glm::length(b - a) + reach;
-    for (size_t i = 0; i < n; ++i) {
-      glm::vec3& at = c.out_positions[i];
-      const glm::vec3 dc = at - centre;
-      if (glm::dot(dc, dc) >= bound * bound || c.current[i].w == 0.0f) continue;
-      const glm::vec3 q = closest_on_segment(at, a, b);
-      const glm::vec3 away = at - q;
-      const float dist2 = glm::dot(away, away);
-      if (dist2 >= reach * reach) continue;
-      const float dist = std::sqrt(dist2);
-      glm::vec3 dir = dist > 1e-12f ? away / dist : xyz(c.current[i]) - q;
-      const float dl = glm::length(dir);
-      dir = dl > 1e-12f ? dir / dl : glm::vec3(0.0f, 1.0f, 0.0f);
-      at = q + dir * reach;
-    }
+  set_collider_step(c, Weights{}, true);
+  const auto push = [&](size_t i) {
+    if (c.current[i].w != 0.0f) push_out(c, c.out_positions[i], xyz(c.current[i]));
+  };
+  size_t next = 0;
+#if OSSA_HAVE_VECTOR_CLONES
+  if (detail::cloth_kernels_selected() && !s.colliders.empty()) {
+    for (; next + 8 <= n; next += 8)
+      detail::push_out_colliders8(c.out_positions.data(), c.current.data(), next, c.collider_step.data(),
+                                  s.colliders.size());
   }
+#endif
+  if (!s.colliders.empty())
+    for (; next < n; ++next) push(next);
   // Normals: area-weighted sums over the triangles, then unit length.
   std::fill(c.out_normals.begin(), c.out_normals.end(), glm::vec3(0.0f));
   const auto& tri = s.triangles;

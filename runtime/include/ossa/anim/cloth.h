@@ -63,6 +63,8 @@ struct ClothInstance {
   std::vector<glm::vec3> colliders_older, colliders_now;
   std::vector<float> lambda;           // XPBD multipliers (stretch then bend) when iterations > 1
   std::vector<uint16_t> facing;        // 3 per particle: a triangle it is a corner of (the wind's normal)
+  std::vector<uint32_t> stretch_runs, bend_runs, tether_runs;  // ends of runs that share no particle
+  std::vector<glm::vec4> collider_step;  // 3 per collider, this substep's: ends (w: reach), bounding sphere
   glm::mat4 world_before{1.0f};        // model_to_world at the last update
   glm::mat4 world_state{1.0f};         // model_to_world at the last substep: current's frame
   glm::mat4 world_older{1.0f};         // model_to_world at the update before the last
