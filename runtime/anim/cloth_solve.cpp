@@ -454,8 +454,20 @@ void write_output(ClothInstance& c, const ClothInput& in, float ahead, const Car
     if (!rest_of_frame.identity) o = r * o + rest_of_frame.translation;
     c.out_positions[i] = o;
   }
-  // Limits and colliders at this update's pose, on the output positions.
+  // Tethers, limits and colliders at this update's pose, on the output positions: the fixed
+  // particles are at this update's skinned pose while the free ones were carried forward from the
+  // last substep, so a fast (or discontinuous) pose would otherwise stretch the output.
   const ClothSource& s = c.source;
+  const float scale = c.settings.tether_scale;
+  for (const fb::ClothTether& t : s.tethers) {
+    if (c.current[t.particle()].w == 0.0f) continue;
+    glm::vec3& p = c.out_positions[t.particle()];
+    const glm::vec3& a = c.out_positions[t.anchor()];
+    const glm::vec3 d = p - a;
+    const float limit = t.length() * scale;
+    const float len2 = glm::dot(d, d);
+    if (len2 > limit * limit) p = a + d * (limit / std::sqrt(len2));
+  }
   for (size_t i = 0; i < n; ++i) {
     if (c.current[i].w == 0.0f) continue;
     glm::vec3& at = c.out_positions[i];
@@ -538,6 +550,13 @@ Status update_cloth(ClothInstance& c, const ClothInput& in) {
   const float total = banked_before + in.dt;
   int steps = static_cast<int>(std::floor(total / h));
   c.banked = total - static_cast<float>(steps) * h;
+  // Rounding can leave a whole substep banked (three 1/144 s frames are five 1/240 s substeps, and
+  // the float sum falls a hair short): take it now, or the output trails its input by a substep
+  // and a jump in the skinned pose shows in it for a frame.
+  if (c.banked >= h * (1.0f - 1e-4f)) {
+    ++steps;
+    c.banked = 0.0f;
+  }
   if (steps > kMaxSubsteps) {
     steps = kMaxSubsteps;
     c.banked = 0.0f;

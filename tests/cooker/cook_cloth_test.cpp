@@ -4,12 +4,14 @@
 // the region named in `<stem>.cook.json` instead; and bad cloth settings refused naming the file.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <string>
 #include <vector>
 
 #include <glm/glm.hpp>
+#include <glm/gtc/matrix_transform.hpp>
 #include <nlohmann/json.hpp>
 
 #include <ossa/anim/cloth.h>
@@ -218,11 +220,37 @@ struct SampleRun {
   float largest_swing = 0.0f;        // furthest any particle got from its skinned position
   float deepest_penetration = 0.0f;  // deepest any particle was inside a collider after an update
   bool finite = true;
+  float worst_tether = 0.0f;  // largest distance to a tether's anchor over its length
 };
 
-/// Plays the cooked CapedMan's walk for `seconds` at `hz` (the cloth updated every frame, the
-/// character walking forward with its root motion) and measures the cloth against the colliders.
-SampleRun play_caped_walk(const ossa::Asset& asset, float hz, float seconds) {
+/// No world motion: the character stays where its clip puts it.
+glm::mat4 standing(double) { return glm::mat4(1.0f); }
+
+/// Running along +z, up to 3.5 m/s in 0.5 s, then a quarter turn left between 1.0 and 1.3 s,
+/// running on.
+glm::mat4 run_and_turn(double t) {
+  const double start = 1.0, end = 1.3, speed = 3.5;
+  const auto yaw_at = [&](double s) {
+    const double u = std::clamp((s - start) / (end - start), 0.0, 1.0);
+    return 0.5 * 3.14159265358979 * (u * u * (3.0 - 2.0 * u));
+  };
+  glm::dvec3 p(0.0);
+  const int steps = 1000;
+  for (int k = 0; k < steps; ++k) {
+    const double s = t * (k + 0.5) / steps, yaw = yaw_at(s);
+    const double v = speed * std::min(1.0, s / 0.5);  // up to speed in 0.5 s
+    p += glm::dvec3(std::sin(yaw), 0.0, std::cos(yaw)) * (v * t / steps);
+  }
+  glm::mat4 m = glm::rotate(glm::mat4(1.0f), static_cast<float>(yaw_at(t)), glm::vec3(0, 1, 0));
+  m[3] = glm::vec4(glm::vec3(p), 1.0f);
+  return m;
+}
+
+/// Plays `clip` (the cooked CapedMan's own walk, or a clip cooked onto its rig) for `seconds` at
+/// `hz`, the cloth updated every frame and the character moved by `world`, and measures the cloth
+/// against the colliders.
+SampleRun play_caped(const ossa::Asset& asset, const ossa::ClipView& clip, float hz, float seconds,
+                     glm::mat4 (*world)(double) = standing) {
   SampleRun run;
   const ossa::SkeletonView skeleton = asset.skeleton();
   const size_t joints = skeleton.joint_count();
@@ -236,7 +264,6 @@ SampleRun play_caped_walk(const ossa::Asset& asset, float hz, float seconds) {
   auto cloth = ossa::make_cloth_instance(source, mesh.vertex_count(), joints);
   EXPECT_TRUE(cloth.ok());
   if (!cloth.ok()) return run;
-  const ossa::ClipView clip = asset.clip(0);
   auto cache = ossa::make_sampling_cache(clip, skeleton);
   EXPECT_TRUE(cache.ok());
   if (!cache.ok()) return run;
@@ -255,8 +282,12 @@ SampleRun play_caped_walk(const ossa::Asset& asset, float hz, float seconds) {
     in.skinned_positions = pos;
     in.skinned_normals = nrm;
     in.model = model;
+    in.model_to_world = world(static_cast<double>(f) / hz);
     in.dt = f == 0 ? 0.0f : 1.0f / hz;
     EXPECT_TRUE(ossa::update_cloth(*cloth, in).ok());
+    for (const ossa::fb::ClothTether& th : source.tethers)
+      run.worst_tether = std::max(run.worst_tether, glm::distance(cloth->positions()[th.particle()],
+                                                                  cloth->positions()[th.anchor()]) / th.length());
     for (size_t i = 0; i < pos.size(); ++i) {
       const glm::vec3 p = cloth->positions()[i];
       run.finite = run.finite && std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
@@ -292,13 +323,13 @@ TEST(CookCloth, CapedManSampleWalks) {
   ASSERT_TRUE(asset.ok()) << asset.error().message;
   ASSERT_GE(asset->clip_count(), 1u);
 
-  const SampleRun at60 = play_caped_walk(*asset, 60.0f, 2.0f);
+  const SampleRun at60 = play_caped(*asset, asset->clip(0), 60.0f, 2.0f);
   ASSERT_FALSE(at60.final_positions.empty());
   EXPECT_TRUE(at60.finite);
   EXPECT_GT(at60.largest_swing, 0.05f) << "the cape never left its skinned pose: nothing was simulated";
   EXPECT_LE(at60.deepest_penetration, 0.001f);
   for (const float hz : {30.0f, 144.0f, 240.0f}) {
-    const SampleRun other = play_caped_walk(*asset, hz, 2.0f);
+    const SampleRun other = play_caped(*asset, asset->clip(0), hz, 2.0f);
     ASSERT_EQ(other.final_positions.size(), at60.final_positions.size());
     EXPECT_LE(other.deepest_penetration, 0.001f) << hz;
     float worst = 0.0f;
@@ -308,6 +339,47 @@ TEST(CookCloth, CapedManSampleWalks) {
     // holds 1 cm across rates on exactly the same motion: cloth_test's SameMotionAtAnyFrameRate).
     EXPECT_LT(worst, hz < 60.0f ? 0.02f : 0.01f) << hz << " Hz against 60 Hz after 2 s of the walk";
     std::printf("%g Hz worst %g m swing %g pen %g\n", hz, worst, other.largest_swing, other.deepest_penetration);
+  }
+}
+
+/// The issue's run and sudden turn on the sample: Pab's run cooked onto CapedMan's rig
+/// (--retarget-to; --root-motion takes the hips' travel out of the clip, as a game moving the
+/// character itself would, so the loop does not snap the body back a metre), played while the character runs at 3.5 m/s and turns a quarter left in 0.3 s;
+/// at 30, 60, 144 and 240 Hz the cape swings, never enters a collider, and its tethers hold.
+TEST(CookCloth, CapedManSampleRunsAndTurns) {
+  const fs::path root = ossa::test::source_dir();
+  const fs::path dir = ossa::test::make_temp_dir("cloth-run");
+  const std::string cook = (ossa::test::bin_dir() / "ossa-cook").string();
+  const auto caped = run_command(cook + " " + q(root / "assets" / "CapedMan" / "CapedMan.glb") + " -o " + q(dir));
+  ASSERT_EQ(caped.exit_code, 0) << caped.err;
+  const auto run = run_command(cook + " " + q(root / "assets" / "Pab" / "run.fbx") + " --retarget-to " +
+                               q(dir / "CapedMan.ossa") + " --map " +
+                               q(root / "assets" / "CesiumMan" / "CesiumMan.humanoid.json") + " --root-motion -o " + q(dir));
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  auto asset = ossa::Asset::open((dir / "CapedMan.ossa").string());
+  ASSERT_TRUE(asset.ok()) << asset.error().message;
+  auto clips = ossa::Asset::open((dir / "run.ossa").string());
+  ASSERT_TRUE(clips.ok()) << clips.error().message;
+  ASSERT_GE(clips->clip_count(), 1u);
+
+  // A cape in a 3.5 m/s stream of air flutters, and flutter is chaotic: runs whose inputs differ
+  // by the clip's sampling at another frame rate part ways within a second (the same motion at
+  // any rate is asserted on the walk above and on cloth_test's walk and turn, where the cape trails
+  // without fluttering). What must hold at every rate here is what the issue asks of a run.
+  std::vector<SampleRun> runs;
+  for (const float hz : {30.0f, 60.0f, 144.0f, 240.0f}) {
+    runs.push_back(play_caped(*asset, clips->clip(0), hz, 2.0f, run_and_turn));
+    const SampleRun& r = runs.back();
+    ASSERT_FALSE(r.final_positions.empty());
+    EXPECT_TRUE(r.finite) << hz;
+    EXPECT_GT(r.largest_swing, 0.05f) << hz << " Hz: the cape never left its skinned pose";
+    EXPECT_LE(r.deepest_penetration, 0.001f) << hz << " Hz: a particle inside a collider";
+    EXPECT_LE(r.worst_tether, 1.10f) << hz << " Hz: a tether stretched past 10 %";
+    float spread = 0.0f;
+    for (size_t i = 0; i < r.final_positions.size(); ++i)
+      spread = std::max(spread, glm::distance(r.final_positions[i], runs.front().final_positions[i]));
+    std::printf("run+turn: %g Hz swing %.3f m, penetration %.4f m, tether %.3f, %.3f m from 30 Hz at 2 s\n", hz,
+                r.largest_swing, r.deepest_penetration, r.worst_tether, spread);
   }
 }
 
