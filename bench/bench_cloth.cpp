@@ -20,7 +20,6 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include <ossa/anim/cloth.h>
-#include "bench/machine.h"
 #include "cloth_grid.h"
 
 namespace {
@@ -103,17 +102,3 @@ void BM_ClothCrowd(benchmark::State& state) {
 BENCHMARK(BM_ClothCrowd)->Arg(64)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
-
-int main(int argc, char** argv) {
-  std::string error;
-  if (!ossa::bench::apply_clone(argc, argv, &error)) {
-    std::fprintf(stderr, "ossa-bench-cloth: %s\n", error.c_str());
-    return 2;
-  }
-  benchmark::AddCustomContext("machine", ossa::bench::machine_line());
-  benchmark::Initialize(&argc, argv);
-  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
-  benchmark::RunSpecifiedBenchmarks();
-  benchmark::Shutdown();
-  return 0;
-}

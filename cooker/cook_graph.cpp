@@ -35,38 +35,18 @@ namespace fs = std::filesystem;
 
 namespace {
 
-/// One rig as the retarget job reads it (retarget_clips.cpp makes the same from a SourceSkeleton).
-struct MappedRig {
+/// A source skeleton's joints as map_rig takes them (names view the skeleton's strings).
+Result<tools::MappedRig> map_rig(const SourceSkeleton& skeleton, const tools::HumanoidMapFile* map,
+                                 const std::string& map_name, const char* role, const std::string& name) {
   std::vector<std::string_view> names;
   std::vector<int16_t> parents;
   std::vector<Transform> bind;
-  tools::AppliedRigMap applied;
-  RetargetRig rig;
-};
-
-Result<MappedRig> map_rig(const SourceSkeleton& skeleton, const tools::HumanoidMapFile* map,
-                          const std::string& map_name, const char* role, const std::string& name) {
-  MappedRig r;
   for (const SourceJoint& j : skeleton.joints) {
-    r.names.emplace_back(j.name);
-    r.parents.push_back(static_cast<int16_t>(j.parent));
-    r.bind.push_back(Transform{j.translation, j.rotation, j.scale});
+    names.emplace_back(j.name);
+    parents.push_back(static_cast<int16_t>(j.parent));
+    bind.push_back(Transform{j.translation, j.rotation, j.scale});
   }
-  const tools::RigMapSpec* spec = map != nullptr ? tools::section_for(*map, role, r.names) : nullptr;
-  auto applied = tools::apply_rig_map(spec, r.names, r.parents, spec != nullptr ? map_name + " (" + role + ")" : name);
-  if (!applied) return applied.error();
-  r.applied = std::move(*applied);
-  return r;
-}
-
-void finish_rig(MappedRig& r, std::string_view name) {
-  r.rig.name = name;
-  r.rig.parents = r.parents;
-  r.rig.bind = r.bind;
-  r.rig.names = r.names;
-  r.rig.humanoid = r.applied.humanoid;
-  r.rig.rest = r.applied.rest;
-  r.rig.rest_rotations = r.applied.rest_rotations;
+  return tools::map_rig(std::move(names), std::move(parents), std::move(bind), map, map_name, role, name);
 }
 
 std::vector<RetargetRestRotationDef> rest_rotations_of(const tools::AppliedRigMap& applied) {
@@ -142,8 +122,8 @@ Result<GraphRetargetRigs> retarget_rigs(const fs::path& rig_path, const fs::path
   if (!from) return from.error();
   auto to = map_rig(target, map_file, map_path.string(), "target", "the graph's rig");
   if (!to) return to.error();
-  finish_rig(*from, source_name);
-  finish_rig(*to, "the graph's rig");
+  tools::finish_mapped_rig(*from, source_name);
+  tools::finish_mapped_rig(*to, "the graph's rig");
   if (Status st = check_humanoid(from->rig.humanoid, from->parents, source_name); !st) return st.error();
   if (Status st = check_humanoid(to->rig.humanoid, to->parents, "the graph's rig"); !st) return st.error();
   if (auto built = make_retarget_map(from->rig, to->rig); !built) return built.error();

@@ -21,42 +21,23 @@ constexpr glm::vec4 kLeftColor{0.2f, 0.85f, 1.0f, 1.0f};
 constexpr glm::vec4 kRightColor{1.0f, 0.3f, 0.85f, 1.0f};
 constexpr glm::vec4 kCentreColor{1.0f, 0.9f, 0.2f, 1.0f};
 
-/// One rig as the retarget job reads it, its names and bind pose kept alive.
-struct Rig {
+using Rig = tools::MappedRig;
+
+/// A cooked skeleton's joints as tools::map_rig takes them (names view the file's strings).
+Result<Rig> make_rig(const SkeletonView& sk, const tools::HumanoidMapFile* map, const std::string& map_file,
+                     const char* role, std::string_view name) {
   std::vector<std::string_view> names;
   std::vector<int16_t> parents;
   std::vector<Transform> bind;
-  tools::AppliedRigMap applied;
-  RetargetRig rig;
-};
-
-Result<Rig> make_rig(const SkeletonView& sk, const tools::HumanoidMapFile* map, const std::string& map_file,
-                     const char* role, std::string_view name) {
-  Rig r;
   for (size_t j = 0; j < sk.joint_count(); ++j) {
-    r.names.push_back(sk.joint_name(j));
-    r.parents.push_back(sk.parents()[j]);
+    names.push_back(sk.joint_name(j));
+    parents.push_back(sk.parents()[j]);
     const fb::Vec3& t = sk.bind_translations()[j];
     const fb::Quat& q = sk.bind_rotations()[j];
     const fb::Vec3& s = sk.bind_scales()[j];
-    r.bind.push_back(Transform{{t.x(), t.y(), t.z()}, glm::quat(q.w(), q.x(), q.y(), q.z()), {s.x(), s.y(), s.z()}});
+    bind.push_back(Transform{{t.x(), t.y(), t.z()}, glm::quat(q.w(), q.x(), q.y(), q.z()), {s.x(), s.y(), s.z()}});
   }
-  const tools::RigMapSpec* spec = map != nullptr ? tools::section_for(*map, role, r.names) : nullptr;
-  auto applied = tools::apply_rig_map(spec, r.names, r.parents,
-                                      spec != nullptr ? map_file + " (" + role + ")" : std::string(name));
-  if (!applied) return applied.error();
-  r.applied = std::move(*applied);
-  return r;
-}
-
-void finish(Rig& r, std::string_view name) {
-  r.rig.name = name;
-  r.rig.parents = r.parents;
-  r.rig.bind = r.bind;
-  r.rig.names = r.names;
-  r.rig.humanoid = r.applied.humanoid;
-  r.rig.rest = r.applied.rest;
-  r.rig.rest_rotations = r.applied.rest_rotations;
+  return tools::map_rig(std::move(names), std::move(parents), std::move(bind), map, map_file, role, name);
 }
 
 Result<std::optional<tools::HumanoidMapFile>> read_map(const std::string& path) {
@@ -96,8 +77,8 @@ Result<std::unique_ptr<RetargetView>> make_retarget_view(const Scene& target, st
   if (!source) return source.error();
   auto dest = make_rig(target.skeleton(), spec, map_file, "target", target_name);
   if (!dest) return dest.error();
-  finish(*source, source_name);
-  finish(*dest, target_name);
+  tools::finish_mapped_rig(*source, source_name);
+  tools::finish_mapped_rig(*dest, target_name);
   if (Status st = check_humanoid(source->rig.humanoid, source->parents, source_name); !st) return st.error();
   if (Status st = check_humanoid(dest->rig.humanoid, dest->parents, target_name); !st) return st.error();
   auto built = make_retarget_map(source->rig, dest->rig);

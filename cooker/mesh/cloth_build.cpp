@@ -16,6 +16,7 @@
 
 #include "cooker/mesh/cloth_internal.h"
 #include "cooker/mesh/mesh_build.h"
+#include <ossa/anim/cloth.h>
 #include <ossa/format/vertex_codec.h>
 #include <ossa/format/vertex_format.h>
 #include <ossa/skinning/vertex_fetch.h>
@@ -96,27 +97,6 @@ glm::vec3 bind_position(const SourceMesh& m, size_t v, const std::vector<glm::ma
     const glm::mat4 inverse_bind = it != m.bind.end() && it->first == j ? it->second : glm::mat4(1.0f);
     const glm::mat4 joint_model = j < bind_model.size() ? bind_model[j] : glm::mat4(1.0f);
     out += w * glm::vec3(joint_model * inverse_bind * glm::vec4(m.positions[v], 1.0f));
-  }
-  return out;
-}
-
-std::vector<fb::ClothEdge> colour_edges(std::vector<fb::ClothEdge> edges, size_t particles) {
-  std::vector<fb::ClothEdge> out;
-  out.reserve(edges.size());
-  std::vector<uint32_t> used(particles, 0);
-  uint32_t colour = 0;
-  while (!edges.empty()) {
-    ++colour;
-    std::vector<fb::ClothEdge> rest;
-    for (const fb::ClothEdge& e : edges) {
-      if (used[e.a()] == colour || used[e.b()] == colour) {
-        rest.push_back(e);
-        continue;
-      }
-      used[e.a()] = used[e.b()] = colour;
-      out.push_back(e);
-    }
-    edges = std::move(rest);
   }
   return out;
 }
@@ -315,8 +295,8 @@ Result<CookedCloth> build_cloth(const SourceScene& scene, const ClothOptions& op
     if (!bends.insert({c, d}).second) continue;
     bend.emplace_back(static_cast<uint16_t>(c), static_cast<uint16_t>(d), glm::distance(rest[c], rest[d]));
   }
-  out.stretch = detail::colour_edges(std::move(stretch), count);
-  out.bend = detail::colour_edges(std::move(bend), count);
+  out.stretch = colour_cloth_edges(stretch, count);
+  out.bend = colour_cloth_edges(bend, count);
 
   // Tethers: each free particle to its nearest fixed one along the edges.
   std::vector<float> distance(count, INFINITY);

@@ -22,9 +22,6 @@ std::vector<glm::mat4> bind_model_matrices(const SourceSkeleton& skeleton);
 /// A source vertex skinned at the bind pose (model space); the mesh's own position when static.
 glm::vec3 bind_position(const SourceMesh& m, size_t v, const std::vector<glm::mat4>& bind_model);
 
-/// Edges reordered greedily by colour: each run that shares no particle comes together.
-std::vector<fb::ClothEdge> colour_edges(std::vector<fb::ClothEdge> edges, size_t particles);
-
 /// A cooked mesh's vertices skinned at the bind pose, decoded from its cooked bytes.
 struct DecodedMesh {
   std::vector<glm::vec3> positions, normals;  // model space; normals unit length

@@ -80,6 +80,25 @@ Result<ClothInstance> make_cloth_instance(const ClothSource& source, uint32_t ve
 
 void reset_cloth(ClothInstance& cloth) { cloth.started = false; }
 
+std::vector<fb::ClothEdge> colour_cloth_edges(std::span<const fb::ClothEdge> edges, size_t particle_count) {
+  std::vector<fb::ClothEdge> out, left(edges.begin(), edges.end()), rest;
+  out.reserve(edges.size());
+  std::vector<uint32_t> used(particle_count, 0);
+  for (uint32_t colour = 1; !left.empty(); ++colour) {
+    rest.clear();
+    for (const fb::ClothEdge& e : left) {
+      if (used[e.a()] == colour || used[e.b()] == colour) {
+        rest.push_back(e);
+        continue;
+      }
+      used[e.a()] = used[e.b()] = colour;
+      out.push_back(e);
+    }
+    left.swap(rest);
+  }
+  return out;
+}
+
 Status gather_cloth_particles(const ClothSource& source, std::span<const float> skinned_positions,
                               std::span<const float> skinned_normals, std::span<glm::vec3> positions,
                               std::span<glm::vec3> normals) {

@@ -48,28 +48,6 @@ struct GridCloth {
   }
 };
 
-/// Greedy colouring: edges reordered so that each run of edges sharing no particle comes together
-/// (what the cooker stores).
-inline std::vector<fb::ClothEdge> colour_edges(std::vector<fb::ClothEdge> edges, size_t particles) {
-  std::vector<fb::ClothEdge> out;
-  std::vector<uint32_t> used(particles, 0);
-  uint32_t colour = 0;
-  while (!edges.empty()) {
-    ++colour;
-    std::vector<fb::ClothEdge> rest;
-    for (const fb::ClothEdge& e : edges) {
-      if (used[e.a()] == colour || used[e.b()] == colour) {
-        rest.push_back(e);
-        continue;
-      }
-      used[e.a()] = used[e.b()] = colour;
-      out.push_back(e);
-    }
-    edges = std::move(rest);
-  }
-  return out;
-}
-
 inline GridCloth make_grid_cloth(uint32_t columns, uint32_t rows, float spacing, float top = 1.5f, float z = -0.15f) {
   GridCloth g;
   g.columns = columns;
@@ -103,8 +81,8 @@ inline GridCloth make_grid_cloth(uint32_t columns, uint32_t rows, float spacing,
       if (c + 2 < columns) bend.push_back(edge(id(c, r), id(c + 2, r)));
       if (r + 2 < rows) bend.push_back(edge(id(c, r), id(c, r + 2)));
     }
-  g.stretch = colour_edges(stretch, n);
-  g.bend = colour_edges(bend, n);
+  g.stretch = colour_cloth_edges(stretch, n);
+  g.bend = colour_cloth_edges(bend, n);
   for (uint32_t r = 1; r < rows; ++r)
     for (uint32_t c = 0; c < columns; ++c)
       g.tethers.emplace_back(id(c, r), id(c, 0), spacing * static_cast<float>(r));

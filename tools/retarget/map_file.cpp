@@ -7,6 +7,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "common/edit_distance.h"
+
 namespace ossa::tools {
 namespace {
 
@@ -14,25 +16,11 @@ using json = nlohmann::json;
 
 /// The profile bone name closest to `name` by edit distance (for "did you mean").
 std::string closest_bone(std::string_view name) {
-  auto distance = [](std::string_view a, std::string_view b) {
-    std::vector<size_t> row(b.size() + 1);
-    for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
-    for (size_t i = 1; i <= a.size(); ++i) {
-      size_t diagonal = row[0];
-      row[0] = i;
-      for (size_t j = 1; j <= b.size(); ++j) {
-        const size_t up = row[j];
-        row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
-        diagonal = up;
-      }
-    }
-    return row[b.size()];
-  };
   std::string best;
   size_t best_distance = SIZE_MAX;
   for (size_t b = 0; b < kHumanoidBoneCount; ++b) {
     const std::string_view bone = humanoid_bone_name(static_cast<HumanoidBone>(b));
-    const size_t d = distance(name, bone);
+    const size_t d = edit_distance(name, bone);
     if (d < best_distance) best_distance = d, best = std::string(bone);
   }
   return best_distance <= std::max<size_t>(2, name.size() / 3) ? best : std::string();
@@ -164,6 +152,31 @@ Result<AppliedRigMap> apply_rig_map(const RigMapSpec* spec, std::span<const std:
     out.rest_rotations.push_back(RestRotation{static_cast<int16_t>(j), q});
   }
   return out;
+}
+
+Result<MappedRig> map_rig(std::vector<std::string_view> names, std::vector<int16_t> parents,
+                          std::vector<Transform> bind, const HumanoidMapFile* map, const std::string& map_name,
+                          const char* role, std::string_view name) {
+  MappedRig r;
+  r.names = std::move(names);
+  r.parents = std::move(parents);
+  r.bind = std::move(bind);
+  const RigMapSpec* spec = map != nullptr ? section_for(*map, role, r.names) : nullptr;
+  auto applied =
+      apply_rig_map(spec, r.names, r.parents, spec != nullptr ? map_name + " (" + role + ")" : std::string(name));
+  if (!applied) return applied.error();
+  r.applied = std::move(*applied);
+  return r;
+}
+
+void finish_mapped_rig(MappedRig& r, std::string_view name) {
+  r.rig.name = name;
+  r.rig.parents = r.parents;
+  r.rig.bind = r.bind;
+  r.rig.names = r.names;
+  r.rig.humanoid = r.applied.humanoid;
+  r.rig.rest = r.applied.rest;
+  r.rig.rest_rotations = r.applied.rest_rotations;
 }
 
 }  // namespace ossa::tools

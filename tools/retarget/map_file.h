@@ -69,4 +69,25 @@ Result<AppliedRigMap> apply_rig_map(const RigMapSpec* spec, std::span<const std:
 const RigMapSpec* section_for(const HumanoidMapFile& file, std::string_view role,
                               std::span<const std::string_view> names);
 
+/// One rig as the retarget job reads it: its joint names, parents and bind pose, its map applied,
+/// and `rig`, the RetargetRig over them (set by finish_mapped_rig, whose spans point into this
+/// struct: call it once the struct is where it stays).
+struct MappedRig {
+  std::vector<std::string_view> names;  // views of the caller's strings, which must outlive this
+  std::vector<int16_t> parents;
+  std::vector<Transform> bind;
+  AppliedRigMap applied;
+  RetargetRig rig;
+};
+
+/// A rig in `role` ("source" or "target") mapped with `map`'s section for it (section_for), or by
+/// the humanoid profile's names when there is none; errors name the file and section, or `name`.
+/// The cooker (a source skeleton) and the viewer (a cooked one) map rigs through this one path.
+Result<MappedRig> map_rig(std::vector<std::string_view> names, std::vector<int16_t> parents,
+                          std::vector<Transform> bind, const HumanoidMapFile* map, const std::string& map_name,
+                          const char* role, std::string_view name);
+
+/// Points r.rig at r's names, parents, bind pose and mapping, under `name`.
+void finish_mapped_rig(MappedRig& r, std::string_view name);
+
 }  // namespace ossa::tools

@@ -107,6 +107,12 @@ Status update_cloth(ClothInstance& cloth, const ClothInput& input);
 /// The next update restarts from the skinned pose at rest (after a cut or a respawn). O(1).
 void reset_cloth(ClothInstance& cloth);
 
+/// `edges` reordered for the solver: greedily coloured, each colour (edges that share no
+/// particle, in their given order) stored together, so that make_cloth_instance finds long runs
+/// the solver projects eight at a time. Any order is correct; this one is fast. What the cooker
+/// stores; for hosts that build cloth themselves. Allocates. O(edges * colours).
+std::vector<fb::ClothEdge> colour_cloth_edges(std::span<const fb::ClothEdge> edges, size_t particle_count);
+
 /// The particles' skinned positions and normals (model space): the driving vertices of `mesh`
 /// skinned with `palette` (ossa/skinning/skinning.h's skinning_matrices, linear blend), as skin_cpu
 /// would skin them. For hosts that skin the rest on the GPU. Allocation-free. O(particles).
