@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include <ossa/version.h>
 
 #include "tools/cli/cli.h"
@@ -168,6 +170,47 @@ TEST(ToolsCli, InspectQuietOnlyAnswersByStatusVerboseListsChannels) {
   const CommandResult missing = run_tool("ossa-inspect", q(dir / "missing.ossa"));
   EXPECT_EQ(missing.exit_code, 2);
   EXPECT_NE(missing.err.find("missing.ossa"), std::string::npos) << missing.err;
+}
+
+/// Several files in one call: each described in turn, a bad one named without stopping the
+/// others, the status the worst of them; --json gives an array for several files and the object
+/// alone for one.
+TEST(ToolsCli, InspectTakesSeveralFiles) {
+  const fs::path dir = ossa::test::make_temp_dir("tools-inspect-many");
+  ASSERT_EQ(run_tool("ossa-cook", q(asset("Fox/Fox.glb")) + " " + q(asset("CesiumMan/CesiumMan.glb")) + " -q -o " +
+                                      q(dir))
+                .exit_code,
+            0);
+  ASSERT_TRUE(ossa::test::write_file(dir / "junk.ossa", std::string_view("junk junk junk junk")));
+  const std::string fox = q(dir / "Fox.ossa"), cesium = q(dir / "CesiumMan.ossa");
+
+  const CommandResult both = run_tool("ossa-inspect", fox + " " + cesium);
+  ASSERT_EQ(both.exit_code, 0) << both.err;
+  const size_t first = both.out.find("Fox.ossa"), second = both.out.find("CesiumMan.ossa");
+  EXPECT_NE(first, std::string::npos) << both.out;
+  EXPECT_NE(second, std::string::npos) << both.out;
+  EXPECT_LT(first, second) << "in the order given";
+
+  const CommandResult mixed =
+      run_tool("ossa-inspect", fox + " " + q(dir / "junk.ossa") + " " + q(dir / "missing.ossa") + " " + cesium);
+  EXPECT_EQ(mixed.exit_code, 2) << "the worst: a file that is not there";
+  EXPECT_NE(mixed.err.find("junk.ossa"), std::string::npos) << mixed.err;
+  EXPECT_NE(mixed.err.find("missing.ossa"), std::string::npos) << mixed.err;
+  EXPECT_NE(mixed.out.find("CesiumMan.ossa"), std::string::npos) << "a bad file stopped the rest:\n" << mixed.out;
+  EXPECT_EQ(run_tool("ossa-inspect", "-q " + fox + " " + q(dir / "junk.ossa")).exit_code, 1);
+
+  const CommandResult array = run_tool("ossa-inspect", "--json " + fox + " " + cesium);
+  ASSERT_EQ(array.exit_code, 0) << array.err;
+  const auto many = nlohmann::json::parse(array.out, nullptr, false);
+  ASSERT_TRUE(many.is_array()) << array.out.substr(0, 200);
+  ASSERT_EQ(many.size(), 2u);
+  EXPECT_EQ(many[0]["file"], "Fox.ossa");
+  EXPECT_EQ(many[1]["file"], "CesiumMan.ossa");
+  const CommandResult single = run_tool("ossa-inspect", "--json " + fox);
+  ASSERT_EQ(single.exit_code, 0) << single.err;
+  const auto one = nlohmann::json::parse(single.out, nullptr, false);
+  ASSERT_TRUE(one.is_object());
+  EXPECT_EQ(one, many[0]);
 }
 
 TEST(CliHelper, EditDistance) {
