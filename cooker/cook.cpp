@@ -36,12 +36,22 @@ namespace detail {
 
 Result<std::vector<uint8_t>> read_bytes(const fs::path& path) { return read_input(path); }
 
+/// What a cook read, every file counted: the source and what it references (a glTF's buffers and
+/// images, an OBJ's materials), its sidecar and settings files, a graph's sources.
+uint64_t bytes_read(const std::vector<InputFile>& files) {
+  uint64_t total = 0;
+  for (const InputFile& f : files)
+    if (f.present) total += f.size;
+  return total;
+}
+
 bool finish_provenance(WriteProvenance& provenance, CookRecord& record, const fs::path& input,
                        const CookOptions& options) {
   provenance.source_name = input.filename().string();
   provenance.options = options.canonical();
   const InputLog* log = current_input_log();
   record.inputs_read = log != nullptr ? log->files() : std::vector<InputFile>{};
+  record.source_bytes = bytes_read(record.inputs_read);
   provenance.inputs = relative_inputs(record.inputs_read, input.parent_path());
   provenance.cook_key = cook_key(provenance.inputs, provenance.options);
   record.cook_key = provenance.cook_key;
@@ -199,9 +209,7 @@ bool up_to_date(CookRecord& record, const fs::path& input, const fs::path& outpu
   record.inputs_read = files;
   record.cook_key = prov->cook_key();
   record.cooked_bytes = fs::file_size(output, ec);
-  const std::string main_input = fs::absolute(input, ec).lexically_normal().string();
-  for (const InputFile& f : files)
-    if (f.present && f.path == main_input) record.source_bytes = f.size;
+  record.source_bytes = detail::bytes_read(files);
   const SkeletonView sk = asset->skeleton();
   record.joints = static_cast<uint32_t>(sk.empty() ? 0 : sk.joint_count());
   record.meshes = static_cast<uint32_t>(asset->mesh_count());

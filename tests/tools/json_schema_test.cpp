@@ -61,6 +61,41 @@ const json* find_record(const json& report, const std::string& input_suffix) {
   return nullptr;
 }
 
+/// A record's source_bytes counts every file the cook read: a source and its events sidecar; a
+/// glTF with its buffer and every texture image (the shared AnimeBoy, when ../shared is there).
+TEST(CookReportSchema, SourceBytesCountEveryFileRead) {
+  const fs::path dir = ossa::test::make_temp_dir("schema-report-bytes");
+  const CommandResult r = tool("ossa-cook", q(asset("Pab/walk.fbx")) + " -q -o " + q(dir / "out") + " --report " +
+                                                q(dir / "report.json"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const json report = read_json(dir / "report.json");
+  ASSERT_EQ(report["records"].size(), 1u);
+  EXPECT_EQ(report["records"][0]["source_bytes"].get<uint64_t>(),
+            fs::file_size(asset("Pab/walk.fbx")) + fs::file_size(asset("Pab/walk.events.json")));
+  // An up-to-date output's record counts the same files.
+  const CommandResult again = tool("ossa-cook", q(asset("Pab/walk.fbx")) + " -q -o " + q(dir / "out") +
+                                                    " --report " + q(dir / "again.json"));
+  ASSERT_EQ(again.exit_code, 0) << again.err;
+  const json second = read_json(dir / "again.json");
+  EXPECT_EQ(second["records"][0]["up_to_date"], true);
+  EXPECT_EQ(second["records"][0]["source_bytes"], report["records"][0]["source_bytes"]);
+
+  const fs::path boy = ossa::test::shared_assets() / "AnimeBoy";
+  if (!fs::exists(boy / "scene.gltf")) GTEST_SKIP() << "no " << boy << ": the glTF half is not checked";
+  uint64_t everything = 0;
+  for (const auto& e : fs::recursive_directory_iterator(boy))
+    if (e.is_regular_file() && (e.path().extension() == ".gltf" || e.path().extension() == ".bin" ||
+                                e.path().extension() == ".png" || e.path().extension() == ".jpg"))
+      everything += e.file_size();
+  const CommandResult g = tool("ossa-cook", q(boy / "scene.gltf") + " -q -o " + q(dir / "boy") + " --report " +
+                                                q(dir / "boy.json"));
+  ASSERT_EQ(g.exit_code, 0) << g.err;
+  const json boy_report = read_json(dir / "boy.json");
+  const uint64_t counted = boy_report["records"][0]["source_bytes"].get<uint64_t>();
+  EXPECT_GT(counted, fs::file_size(boy / "scene.gltf") + fs::file_size(boy / "scene.bin")) << "the images count";
+  EXPECT_LE(counted, everything) << "only files that are there";
+}
+
 // ---------------------------------------------------------------------------------------------
 // ossa-cook --report
 
