@@ -35,7 +35,10 @@ function(ossa_cook target)
     message(FATAL_ERROR "ossa_cook(${target}): SOURCES and OUTPUT_DIR are required")
   endif()
   if(NOT OSSA_COOK_EXECUTABLE)
-    message(FATAL_ERROR "ossa_cook(${target}): OSSA_COOK_EXECUTABLE is not set (find_package(ossa) sets it)")
+    message(FATAL_ERROR "ossa_cook(${target}): no cooker: OSSA_COOK_EXECUTABLE is not set and no ossa-cook was "
+                        "found. A runtime-only package (-DOSSA_RUNTIME_ONLY=ON) installs no cooker: point "
+                        "-DOSSA_COOK_EXECUTABLE=/path/to/ossa-cook at one from a full build or install, or put it "
+                        "on PATH (docs/BUILD.md)")
   endif()
   get_filename_component(out_dir "${ARG_OUTPUT_DIR}" ABSOLUTE BASE_DIR "${CMAKE_CURRENT_BINARY_DIR}")
   set(common -o "${out_dir}" -q)
