@@ -34,7 +34,8 @@ cp -r /usr/share/X11/xkb "$stage/xkb"
 
 # Shared libraries: everything ldd resolves, less glibc, libglvnd (the .debs), the stubbed two,
 # and libstdc++/libgcc_s, which go to lib/fallback (used only where the image's are older).
-skip='^(libc|libm|libdl|libpthread|librt|libresolv|ld-linux-x86-64|linux-vdso|libGL|libGLX|libGLdispatch|libEGL|libOpenGL|libGLESv2|libz3|libxml2|libicuuc|libicudata)\.so'
+skip='^(libc|libm|libdl|libpthread|librt|libresolv|ld-linux-x86-64|linux-vdso|'
+skip+='libGL|libGLX|libGLdispatch|libEGL|libOpenGL|libGLESv2|libz3|libxml2|libicuuc|libicudata)\.so'
 for f in "$stage"/bin/* "$stage"/dri/swrast_dri.so "$stage"/lib/libGLX_mesa.so.0; do
   ldd "$f" | awk '/=> \//{print $1, $3}'
 done | sort -u | while read -r name path; do
@@ -66,14 +67,15 @@ nm -D --undefined-only "$llvm" | awk '$2 ~ /@LIBXML2_/ {print $2}' | sort -u >"$
     prev=$v
   done
 } >"$stage/xml.map"
-cc -shared -fPIC -o "$stage/lib/libxml2.so.2" -Wl,-soname,libxml2.so.2 -Wl,--version-script="$stage/xml.map" "$stage/xml.c"
+cc -shared -fPIC -o "$stage/lib/libxml2.so.2" -Wl,-soname,libxml2.so.2 -Wl,--version-script="$stage/xml.map" \
+  "$stage/xml.c"
 rm "$stage"/z3.c "$stage"/xml.c "$stage"/xml.map "$stage"/xml.syms
 
 # The samples, cooked as scripts/demo.sh cooks them.
 cook=$build/bin/ossa-cook
 (cd "$repo" && "$cook" assets/Pab/skeleton.fbx assets/CesiumMan assets/CapedMan --root assets -o "$stage/cooked")
-(cd "$repo" && "$cook" assets/Pab/arnaud.fbx assets/Pab/walk.fbx --skeleton "$stage/cooked/Pab/skeleton.ossa" --root assets \
-  -o "$stage/cooked")
+(cd "$repo" && "$cook" assets/Pab/arnaud.fbx assets/Pab/walk.fbx --skeleton "$stage/cooked/Pab/skeleton.ossa" \
+  --root assets -o "$stage/cooked")
 # A textured character for the first-frame bench, when the shared assets are beside the checkout.
 if [ -d "$repo/../shared/assets/AnimeBoy" ]; then cp -r "$repo/../shared/assets/AnimeBoy" "$stage/shared/"; fi
 

@@ -12,7 +12,8 @@
 # OSSA_BIG_FRAMES (frames of GPU-skinned crowds of 1000 and more, default OSSA_FRAMES),
 # OSSA_CPU_BIG_FRAMES (frames of CPU-skinned crowds of 1000 and more, default 60), OSSA_VIEW_TIMEOUT
 # (seconds per viewer run, 90), OSSA_EXTRA=1 (the 4096-crowd runs without MSAA and at 320x180),
-# OSSA_FF_RUNS (first-frame runs, 5), OSSA_TAG (screenshot name suffix, the vendor by default).
+# OSSA_FF_RUNS (first-frame runs, 5), OSSA_FF_TIMEOUT (its seconds, 120), OSSA_TAG (screenshot name
+# suffix, the vendor by default).
 set -u
 export PATH=$PATH:/usr/sbin:/sbin
 here=$(cd "$(dirname "$0")" && pwd)
@@ -59,7 +60,8 @@ libs=$b/lib
 sys_cxx=$(ldconfig -p | awk '/libstdc\+\+\.so\.6 .*x86-64/{print $NF; exit}')
 if [ -z "$sys_cxx" ] || ! grep -qa GLIBCXX_3.4.30 "$sys_cxx"; then libs=$libs:$b/lib/fallback; fi
 if [ "$vendor" = nvidia ] && ! ldconfig -p | grep -q libGLX_nvidia.so.0; then
-  glx=$(find /usr/local/nvidia /usr/lib /usr/lib64 /usr/lib/x86_64-linux-gnu -name 'libGLX_nvidia.so.0' 2>/dev/null | head -1)
+  glx=$(find /usr/local/nvidia /usr/lib /usr/lib64 /usr/lib/x86_64-linux-gnu -name 'libGLX_nvidia.so.0' 2>/dev/null |
+    head -1)
   [ -n "$glx" ] && libs=$libs:$(dirname "$glx")
 fi
 export LD_LIBRARY_PATH=$libs LIBGL_DRIVERS_PATH=$b/dri
@@ -83,14 +85,16 @@ step renderer 30 "$view" "$c/CesiumMan/CesiumMan.ossa" --frames 1 -v
 # another renderer's) unless OSSA_ANY_RENDERER=1.
 if [ "$vendor" = nvidia ] && ! grep -q 'ossa-view: OpenGL .*NVIDIA' "$log"; then
   step diag 30 sh -c 'cat /etc/os-release | head -2; ldconfig -p | grep -iE "nvidia|libGLX|libstdc"; \
-    ls -la /usr/local/nvidia/lib64 /usr/local/nvidia/lib 2>&1 | head -40; ls /usr/share/glvnd/egl_vendor.d /usr/local/nvidia/share/glvnd 2>&1'
+    ls -la /usr/local/nvidia/lib64 /usr/local/nvidia/lib 2>&1 | head -40; \
+    ls /usr/share/glvnd/egl_vendor.d /usr/local/nvidia/share/glvnd 2>&1'
   LIBGL_DEBUG=verbose step glxinfo-debug 20 "$b/bin/glxinfo" -B
   cat "$OUT/xvfb.txt" >>"$log"
   if [ "${OSSA_ANY_RENDERER:-0}" != 1 ]; then say "# not NVIDIA: stopping"; kill "$xvfb"; exit 1; fi
 fi
 
 # 1. First frame, cooked against Assimp (the repository's samples plus the shared AnimeBoy).
-step first-frame 120 "$b/bin/ossa-bench-first-frame" --runs "${OSSA_FF_RUNS:-5}" --assets "$repo/assets" --shared "$b/shared"
+step first-frame "${OSSA_FF_TIMEOUT:-120}" "$b/bin/ossa-bench-first-frame" --runs "${OSSA_FF_RUNS:-5}" \
+  --assets "$repo/assets" --shared "$b/shared"
 
 # view LABEL FRAMES ARGS...: one headless run with --stats and --first-frame-time; prints a RESULT
 # line: per-frame wall time over frames 2..N (process wall minus first-frame-ms, over N-1: so it
@@ -116,7 +120,8 @@ view() {
 # 2. GPU skinning against CPU skinning, crowds.
 for n in ${OSSA_SKIN_NS:-1 100 1000 4096}; do
   for who in cesium pab; do
-    if [ $who = cesium ]; then files=("$c/CesiumMan/CesiumMan.ossa"); else files=("$c/Pab/arnaud.ossa" "$c/Pab/walk.ossa"); fi
+    files=("$c/CesiumMan/CesiumMan.ossa")
+    [ $who = pab ] && files=("$c/Pab/arnaud.ossa" "$c/Pab/walk.ossa")
     gf=$frames cf=$frames
     [ "$n" -ge 1000 ] && gf=$big_frames cf=$big_cpu_frames
     view "$who crowd $n gpu-skin" "$gf" "${files[@]}" --crowd "$n"
@@ -126,23 +131,28 @@ done
 
 # 3. Cloth (CapedMan's cape: simulated on the CPU, or drawn skinned).
 for n in 1 100; do
-  for cl in on off; do view "caped crowd $n cloth $cl" "$frames" "$c/CapedMan/CapedMan.ossa" --crowd "$n" --cloth "$cl"; done
+  for cl in on off; do
+    view "caped crowd $n cloth $cl" "$frames" "$c/CapedMan/CapedMan.ossa" --crowd "$n" --cloth "$cl"
+  done
 done
 
 # 3b. Where a large GPU-skinned crowd's frame goes: the same crowd with no multisampling, then at a
 # small size (fewer fragments), with OSSA_EXTRA=1.
 if [ "${OSSA_EXTRA:-0}" = 1 ]; then
   for who in cesium pab; do
-    if [ $who = cesium ]; then files=("$c/CesiumMan/CesiumMan.ossa"); else files=("$c/Pab/arnaud.ossa" "$c/Pab/walk.ossa"); fi
+    files=("$c/CesiumMan/CesiumMan.ossa")
+    [ $who = pab ] && files=("$c/Pab/arnaud.ossa" "$c/Pab/walk.ossa")
     view "$who crowd 4096 gpu-skin msaa1" "$big_frames" "${files[@]}" --crowd 4096 --msaa 1
     view "$who crowd 4096 gpu-skin 320x180 msaa1" "$big_frames" "${files[@]}" --crowd 4096 --msaa 1 --size 320x180
-    view "$who crowd 4096 cpu-skin 320x180 msaa1" "$big_cpu_frames" "${files[@]}" --crowd 4096 --msaa 1 --size 320x180 --cpu-skinning
+    view "$who crowd 4096 cpu-skin 320x180 msaa1" "$big_cpu_frames" "${files[@]}" --crowd 4096 --msaa 1 --size 320x180 \
+      --cpu-skinning
   done
 fi
 
 # 4. Screenshots, to compare with another vendor's (scripts/png-diff.py).
 step shot-cesium 30 "$view" "$c/CesiumMan/CesiumMan.ossa" --time 0.5 --size 960x540 --screenshot "$OUT/cesium-$tag.png"
-step shot-caped 30 "$view" "$c/CapedMan/CapedMan.ossa" --time 1.5 --yaw 150 --size 960x540 --screenshot "$OUT/caped-$tag.png"
+step shot-caped 30 "$view" "$c/CapedMan/CapedMan.ossa" --time 1.5 --yaw 150 --size 960x540 \
+  --screenshot "$OUT/caped-$tag.png"
 step shot-crowd 30 "$view" "$c/Pab/arnaud.ossa" "$c/Pab/walk.ossa" --crowd 100 --time 0.6 --size 960x540 \
   --screenshot "$OUT/pab-crowd-$tag.png"
 
