@@ -6,12 +6,13 @@
 // constants their value in both keys with a zero 1/length, so their blend weight is always 0;
 // those entries are written once, when the cache is made. Animated channels overwrite their
 // joint's entries whenever playback crosses one of their keys. A sample is then two passes:
-//   1. per key run (the animated channels sharing one key-frame list: the cooker shares a run
-//      between channels with equal frames, and then one test and one cursor serve them all), one
-//      compare of the frame position against the range its cached key pair covers; only a run
-//      that left its range moves its cursor (forward by one: keep k1 as the new k0 and decode one
-//      key per channel; otherwise a short walk or a binary search on key_frames) and decodes
-//      (ossa/format/clip_codec.h);
+//   1. unless the frame lies where every run's cached pair still holds (one compare against the
+//      intersection of their ranges, kept with the cursors), per key run (the animated channels
+//      sharing one key-frame list: the cooker shares a run between channels with equal frames,
+//      and then one test and one cursor serve them all), one compare of the frame position
+//      against the range its cached key pair covers; only a run that left its range moves its
+//      cursor (forward by one: keep k1 as the new k0 and decode one key per channel; otherwise a
+//      short walk or a binary search on key_frames) and decodes (ossa/format/clip_codec.h);
 //   2. one loop over all joints (SoA, 8-lane blocks): lerp T and S, nlerp R with the shortest-arc
 //      sign fix, write the pose. It is written with vector extensions, and on x86-64 compiled
 //      twice (AVX2 and the SSE2 baseline, picked per call: internal/vector_clones.h), so the
@@ -57,7 +58,6 @@
 #include "internal/vector_clones.h"
 
 namespace ossa {
-
 namespace {
 
 constexpr uint32_t kNoCursor = std::numeric_limits<uint32_t>::max();
@@ -137,6 +137,9 @@ struct SamplingCache::State {
   // sample touches per instance, so a crowd pays one cache miss per clip instead of three.
   Run* runs = nullptr;
   uint32_t run_count = 0;
+  // The intersection of every run's range (largest enter, smallest leave): a frame inside moves no
+  // run, so pass 1 is one compare (a slow clip, updates faster than keys). Empty when forgotten.
+  float all_enter = kInf, all_leave = -kInf;
   std::vector<Track> tracks;  // grouped by run
   // What move_run reads: tracks, or a prototype's (identical: they depend on the clip and rig only).
   const Track* track_data = nullptr;
@@ -159,6 +162,8 @@ void forget_cursors(State& s) {
     r.enter = kInf;
     r.leave = -kInf;
   }
+  s.all_enter = kInf;
+  s.all_leave = -kInf;
 }
 
 /// Writes a fixed value (bind or constant) into both keys of one joint's channel.
@@ -602,9 +607,17 @@ void sample(const ClipView& clip, float time, const SampleOptions& options, Samp
   const auto nearest = static_cast<float>(static_cast<int32_t>(frame + 0.5f));
   if (std::fabs(frame - nearest) <= 1e-5f * (1.0f + nearest)) frame = nearest;
 
-  // Pass 1: runs whose cached pair no longer covers the frame.
-  for (Run& r : std::span<Run>(s.runs, s.run_count))
-    if (!(frame >= r.enter && frame < r.leave)) move_run(s, r, frame);
+  // Pass 1: runs whose cached pair no longer covers the frame (none while inside every run's range).
+  if (!(frame >= s.all_enter && frame < s.all_leave)) {
+    float all_enter = -kInf, all_leave = kInf;
+    for (Run& r : std::span<Run>(s.runs, s.run_count)) {
+      if (!(frame >= r.enter && frame < r.leave)) move_run(s, r, frame);
+      all_enter = std::max(all_enter, r.enter);
+      all_leave = std::min(all_leave, r.leave);
+    }
+    s.all_enter = all_enter;
+    s.all_leave = all_leave;
+  }
 
   // Pass 2: every joint.
   const Lanes lanes{s.k0, s.fixed, s.k1, s.start, s.inv_length, s.kinds, out.base, s.stride};

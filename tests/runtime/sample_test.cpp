@@ -530,9 +530,29 @@ TEST(SamplePab, CacheIsInvisible) {
   expect_cache_invisible(clip, skeleton, playback(clip, 1.0f, 400, true), loop, "forward 60 Hz");
   expect_cache_invisible(clip, skeleton, playback(clip, -1.0f, 400, true, 0.3f), loop, "reverse");
   expect_cache_invisible(clip, skeleton, playback(clip, 0.37f, 400, false), SampleOptions{.loop = false}, "slow, clamped");
+  // Many updates between keys (a montage's held section): pass 1 skips every run until one's pair ends.
+  expect_cache_invisible(clip, skeleton, playback(clip, 0.05f, 400, true, 0.4f), loop, "very slow");
+  expect_cache_invisible(clip, skeleton, playback(clip, -0.05f, 400, true, 0.4f), loop, "very slow, reverse");
   expect_cache_invisible(clip, skeleton, random_times(clip, 400, 5), loop, "random seeks");
   expect_cache_invisible(clip, skeleton, random_times(clip, 100, 6),
                          SampleOptions{.loop = true, .rotation = RotationInterpolation::Slerp}, "slerp seeks");
+}
+
+TEST(SamplePab, CacheIsInvisibleOnEveryClipAtEveryRate) {
+  // Every cooked Pab clip (their key runs differ: walk, jog, run, the mostly still crossarms) at
+  // rates from a montage's hold (0.05: dozens of updates between keys, where pass 1 skips every
+  // run) to fast, forward and reverse.
+  REQUIRE_PAB();
+  (void)clip;  // the walk is one of them
+  for (const char* name : {"walk", "jog", "run", "crossarms"}) {
+    auto a = Asset::open((test::fixtures_dir() / "Pab" / (std::string(name) + ".ossa")).string());
+    ASSERT_TRUE(a.ok()) << a.error().message;
+    for (size_t c = 0; c < a->clip_count(); ++c)
+      for (float rate : {0.05f, -0.05f, 0.5f, 1.0f, 2.5f})
+        for (bool looping : {true, false})
+          expect_cache_invisible(a->clip(c), skeleton, playback(a->clip(c), rate, 300, looping, 0.2f),
+                                 SampleOptions{.loop = looping}, name);
+  }
 }
 
 TEST(SamplePab, RefusedByAnotherRig) {
