@@ -456,9 +456,11 @@ void write_output(ClothInstance& c, const ClothInput& in, float ahead, const Car
   }
   // Tethers, limits and colliders at this update's pose, on the output positions: the fixed
   // particles are at this update's skinned pose while the free ones were carried forward from the
-  // last substep, so a fast (or discontinuous) pose would otherwise stretch the output.
+  // last substep, so a fast (or discontinuous) pose would otherwise stretch the output. The
+  // carrying itself stretches tethers by a hair, so the output holds them at 1 % over their
+  // length (most need no square root then).
   const ClothSource& s = c.source;
-  const float scale = c.settings.tether_scale;
+  const float scale = c.settings.tether_scale * 1.01f;
   for (const fb::ClothTether& t : s.tethers) {
     if (c.current[t.particle()].w == 0.0f) continue;
     glm::vec3& p = c.out_positions[t.particle()];
