@@ -27,12 +27,14 @@ bool cloth_kernels_selected() { return vector_avx2_selected(); }
 namespace {
 
 #define OSSA_CLOTH_TARGET OSSA_TARGET("avx2")
+// The GNU spelling: it follows OSSA_CLOTH_TARGET's __attribute__, after which Clang takes no [[...]].
+#define OSSA_CLOTH_INLINE __attribute__((always_inline)) inline
 
 struct Rows8 {
   __m256 x, y, z, w;
 };
 
-OSSA_CLOTH_TARGET OSSA_INLINE Rows8 transpose_in(__m128 r0, __m128 r1, __m128 r2, __m128 r3, __m128 r4, __m128 r5,
+OSSA_CLOTH_TARGET OSSA_CLOTH_INLINE Rows8 transpose_in(__m128 r0, __m128 r1, __m128 r2, __m128 r3, __m128 r4, __m128 r5,
                                                  __m128 r6, __m128 r7) {
   const __m256 t0 = _mm256_insertf128_ps(_mm256_castps128_ps256(r0), r4, 1);
   const __m256 t1 = _mm256_insertf128_ps(_mm256_castps128_ps256(r1), r5, 1);
@@ -44,28 +46,28 @@ OSSA_CLOTH_TARGET OSSA_INLINE Rows8 transpose_in(__m128 r0, __m128 r1, __m128 r2
           _mm256_shuffle_ps(u1, u3, _MM_SHUFFLE(1, 0, 1, 0)), _mm256_shuffle_ps(u1, u3, _MM_SHUFFLE(3, 2, 3, 2))};
 }
 
-OSSA_CLOTH_TARGET OSSA_INLINE float* row(glm::vec4* x, uint32_t i) { return &x[i].x; }
+OSSA_CLOTH_TARGET OSSA_CLOTH_INLINE float* row(glm::vec4* x, uint32_t i) { return &x[i].x; }
 
 /// The eight edges' lanes run in the order 0, 1, 4, 5, 2, 3, 6, 7: the order in which one shuffle
 /// of two 256-bit loads of the edges (8 bytes each: a, b, rest) lines their rest lengths up.
 constexpr int kLane[8] = {0, 1, 4, 5, 2, 3, 6, 7};
 
 /// Eight floats in edge order into kLane order, and back.
-OSSA_CLOTH_TARGET OSSA_INLINE __m256 lane_order(__m256 v) {
+OSSA_CLOTH_TARGET OSSA_CLOTH_INLINE __m256 lane_order(__m256 v) {
   return _mm256_castpd_ps(_mm256_permute4x64_pd(_mm256_castps_pd(v), _MM_SHUFFLE(3, 1, 2, 0)));
 }
 
 template <bool kB>
-OSSA_CLOTH_TARGET OSSA_INLINE uint32_t end_of(const fb::ClothEdge* e, int lane) {
+OSSA_CLOTH_TARGET OSSA_CLOTH_INLINE uint32_t end_of(const fb::ClothEdge* e, int lane) {
   return kB ? e[kLane[lane]].b() : e[kLane[lane]].a();
 }
 template <bool kB>
-OSSA_CLOTH_TARGET OSSA_INLINE uint32_t end_of(const fb::ClothTether* t, int lane) {
+OSSA_CLOTH_TARGET OSSA_CLOTH_INLINE uint32_t end_of(const fb::ClothTether* t, int lane) {
   return kB ? t[kLane[lane]].anchor() : t[kLane[lane]].particle();
 }
 
 template <bool kB, typename Pair>
-OSSA_CLOTH_TARGET OSSA_INLINE Rows8 load_ends(glm::vec4* x, const Pair* e) {
+OSSA_CLOTH_TARGET OSSA_CLOTH_INLINE Rows8 load_ends(glm::vec4* x, const Pair* e) {
   return transpose_in(_mm_loadu_ps(row(x, end_of<kB>(e, 0))), _mm_loadu_ps(row(x, end_of<kB>(e, 1))),
                       _mm_loadu_ps(row(x, end_of<kB>(e, 2))), _mm_loadu_ps(row(x, end_of<kB>(e, 3))),
                       _mm_loadu_ps(row(x, end_of<kB>(e, 4))), _mm_loadu_ps(row(x, end_of<kB>(e, 5))),
@@ -73,7 +75,7 @@ OSSA_CLOTH_TARGET OSSA_INLINE Rows8 load_ends(glm::vec4* x, const Pair* e) {
 }
 
 /// Eight rows back where they came from; the pairs of a run share no particle, so no store overlaps.
-OSSA_CLOTH_TARGET OSSA_INLINE void transpose_out(const Rows8& r, __m128* rows) {
+OSSA_CLOTH_TARGET OSSA_CLOTH_INLINE void transpose_out(const Rows8& r, __m128* rows) {
   const __m256 u0 = _mm256_unpacklo_ps(r.x, r.y), u1 = _mm256_unpackhi_ps(r.x, r.y);
   const __m256 u2 = _mm256_unpacklo_ps(r.z, r.w), u3 = _mm256_unpackhi_ps(r.z, r.w);
   const __m256 t0 = _mm256_shuffle_ps(u0, u2, _MM_SHUFFLE(1, 0, 1, 0));  // rows 0 | 4
@@ -90,28 +92,28 @@ OSSA_CLOTH_TARGET OSSA_INLINE void transpose_out(const Rows8& r, __m128* rows) {
   rows[7] = _mm256_extractf128_ps(t3, 1);
 }
 
-OSSA_CLOTH_TARGET OSSA_INLINE Rows8 load_block(const glm::vec4* x) {
+OSSA_CLOTH_TARGET OSSA_CLOTH_INLINE Rows8 load_block(const glm::vec4* x) {
   const float* p = &x->x;
   return transpose_in(_mm_loadu_ps(p), _mm_loadu_ps(p + 4), _mm_loadu_ps(p + 8), _mm_loadu_ps(p + 12),
                       _mm_loadu_ps(p + 16), _mm_loadu_ps(p + 20), _mm_loadu_ps(p + 24), _mm_loadu_ps(p + 28));
 }
 
-OSSA_CLOTH_TARGET OSSA_INLINE void store_block(glm::vec4* x, const Rows8& r) {
+OSSA_CLOTH_TARGET OSSA_CLOTH_INLINE void store_block(glm::vec4* x, const Rows8& r) {
   __m128 rows[8];
   transpose_out(r, rows);
   for (size_t l = 0; l < 8; ++l) _mm_storeu_ps(&x[l].x, rows[l]);
 }
 
 template <bool kB, typename Pair>
-OSSA_CLOTH_TARGET OSSA_INLINE void store_ends(glm::vec4* x, const Pair* e, const Rows8& r) {
+OSSA_CLOTH_TARGET OSSA_CLOTH_INLINE void store_ends(glm::vec4* x, const Pair* e, const Rows8& r) {
   __m128 rows[8];
   transpose_out(r, rows);
   for (int l = 0; l < 8; ++l) _mm_storeu_ps(row(x, end_of<kB>(e, l)), rows[l]);
 }
 
-OSSA_CLOTH_TARGET OSSA_INLINE __m256 splat(float v) { return _mm256_set1_ps(v); }
+OSSA_CLOTH_TARGET OSSA_CLOTH_INLINE __m256 splat(float v) { return _mm256_set1_ps(v); }
 /// x0 * x1 + y0 * y1 + z0 * z1 in glm::dot's order.
-OSSA_CLOTH_TARGET OSSA_INLINE __m256 dot3(__m256 x0, __m256 y0, __m256 z0, __m256 x1, __m256 y1, __m256 z1) {
+OSSA_CLOTH_TARGET OSSA_CLOTH_INLINE __m256 dot3(__m256 x0, __m256 y0, __m256 z0, __m256 x1, __m256 y1, __m256 z1) {
   return _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(x0, x1), _mm256_mul_ps(y0, y1)), _mm256_mul_ps(z0, z1));
 }
 
@@ -179,14 +181,14 @@ OSSA_CLOTH_TARGET void tethers8(glm::vec4* x, const fb::ClothTether* t, size_t c
 
 /// Row `row` of r * p + t for eight points (glm's mat3 * vec3 order: column 0's term, plus column
 /// 1's, plus column 2's; then t).
-OSSA_CLOTH_TARGET OSSA_INLINE __m256 transformed(const Rows8& p, const glm::mat3& r, const glm::vec3& t, int row) {
+OSSA_CLOTH_TARGET OSSA_CLOTH_INLINE __m256 transformed(const Rows8& p, const glm::mat3& r, const glm::vec3& t, int row) {
   return _mm256_add_ps(_mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(_mm256_set1_ps(r[0][row]), p.x),
                                                    _mm256_mul_ps(_mm256_set1_ps(r[1][row]), p.y)),
                                      _mm256_mul_ps(_mm256_set1_ps(r[2][row]), p.z)),
                        _mm256_set1_ps(t[row]));
 }
 
-OSSA_CLOTH_TARGET OSSA_INLINE void transform(Rows8& p, const glm::mat3& r, const glm::vec3& t) {
+OSSA_CLOTH_TARGET OSSA_CLOTH_INLINE void transform(Rows8& p, const glm::mat3& r, const glm::vec3& t) {
   const __m256 x = transformed(p, r, t, 0), y = transformed(p, r, t, 1), z = transformed(p, r, t, 2);
   p.x = x;
   p.y = y;
@@ -238,7 +240,7 @@ OSSA_CLOTH_TARGET uint32_t predict8(glm::vec4* x, glm::vec4* previous, size_t fi
 /// lanes that move) pushed out of each collider of `step` in turn, as cloth_solve.cpp's push_out
 /// pushes one: a collider whose bounding sphere and capsule hold none of the lanes costs a few
 /// operations. Returns the lanes moved.
-OSSA_CLOTH_TARGET OSSA_INLINE __m256 push_out8(__m256& px, __m256& py, __m256& pz, __m256 sx, __m256 sy, __m256 sz,
+OSSA_CLOTH_TARGET OSSA_CLOTH_INLINE __m256 push_out8(__m256& px, __m256& py, __m256& pz, __m256 sx, __m256 sy, __m256 sz,
                                                __m256 free, const glm::vec4* step, size_t count) {
   const __m256 zero = _mm256_setzero_ps(), one = splat(1.0f), tiny = splat(1e-12f);
   __m256 moved = zero;
