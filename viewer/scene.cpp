@@ -6,6 +6,8 @@
 
 #include <ossa/anim/morph.h>
 
+#include "viewer/cook_job.h"
+
 namespace ossa::view {
 namespace {
 
@@ -60,6 +62,10 @@ Result<Scene> load_scene(std::span<const std::string> paths) {
   size_t character = paths.size();
   for (size_t i = 0; i < paths.size(); ++i) {
     Result<Asset> a = Asset::open(paths[i], OpenMode::kRead);
+    if (!a && is_cook_source(paths[i]) && std::filesystem::is_regular_file(paths[i]))
+      return Error{a.error().message + "; it is a source model, which the viewer shows once cooked: ossa-cook '" +
+                   paths[i] + "' -o cooked, then ossa-view cooked/" + std::filesystem::path(paths[i]).stem().string() +
+                   ".ossa (or, in the window, --cook-and-open '" + paths[i] + "' cooks and opens it)"};
     if (!a) return a.error();
     if (character == paths.size() && a->mesh_count() > 0) character = i;
     opened.push_back(std::move(*a));

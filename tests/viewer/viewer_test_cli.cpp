@@ -48,6 +48,24 @@ TEST_F(Viewer, TruncatedFileIsRefusedByName) {
   EXPECT_NE(r.err.find(bad.string()), std::string::npos) << r.err;
 }
 
+/// A source model given where a cooked file is expected: the message names it and says how to cook
+/// it (ossa-cook, or --cook-and-open in the window).
+TEST_F(Viewer, SourceModelGivenSaysHowToCookIt) {
+  for (const char* name : {"Fox/Fox.glb", "Pab/walk.fbx"}) {
+    const fs::path source = ossa::test::source_dir() / "assets" / name;
+    const CommandResult r = run_viewer(quote(source.string()) + " --screenshot " + quote((dir_ / "x.png").string()));
+    EXPECT_EQ(r.exit_code, 1) << name;
+    EXPECT_NE(r.err.find(source.string()), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("ossa-cook '" + source.string() + "' -o cooked"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("--cook-and-open"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(dir_ / "x.png"));
+  }
+  // A corrupt .ossa is not taken for a source.
+  const fs::path bad = dir_ / "garbage.ossa";
+  ASSERT_TRUE(write_file(bad, std::string(4096, 'x')));
+  EXPECT_EQ(run_viewer(quote(bad.string()) + " --frames 1").err.find("ossa-cook"), std::string::npos);
+}
+
 TEST_F(Viewer, MissingFileIsNamed) {
   const fs::path missing = dir_ / "no-such-file.ossa";
   const CommandResult r = run_viewer(quote(missing.string()) + " --frames 1");
