@@ -227,57 +227,68 @@ OSSA_INLINE void project_edge(glm::vec4* x, const fb::ClothEdge& e, float alpha,
   b.z += b.w * corr.z;
 }
 
-/// The edges in their stored order; with the eight-wide kernel, each run of edges that share no
-/// particle (`runs`: where each ends) goes eight at a time and its last few one by one, which
-/// gives the same bits as the stored order (no edge of a run reads what another writes).
-template <bool kLambda>
-void project_edges(glm::vec4* x, std::span<const fb::ClothEdge> edges, std::span<const uint32_t> runs, float alpha,
-                   float* lambda, bool wide) {
+/// Visits [0, count) in order: `one(k)` for a single constraint; with the eight-wide kernels,
+/// `eight(k, n)` for the first multiple of 8 of each run of constraints that share no particle
+/// (`runs`: where each ends) and `one` for the run's last few, which gives the same bits as the
+/// stored order (no constraint of a run reads what another writes).
+template <typename Eight, typename One>
+OSSA_INLINE void by_runs(size_t count, std::span<const uint32_t> runs, bool wide, Eight eight, One one) {
   size_t k = 0;
 #if OSSA_HAVE_VECTOR_CLONES
   if (wide) {
     for (const uint32_t end : runs) {
-      const size_t eight = (end - k) & ~size_t{7};
-      if (eight > 0) detail::project_edges8(x, edges.data() + k, eight, alpha, kLambda ? lambda + k : nullptr);
-      for (k += eight; k < end; ++k) project_edge<kLambda>(x, edges[k], alpha, kLambda ? lambda + k : nullptr);
+      const size_t n = (end - k) & ~size_t{7};
+      if (n > 0) eight(k, n);
+      for (k += n; k < end; ++k) one(k);
     }
   }
 #else
   (void)runs;
   (void)wide;
+  (void)eight;
 #endif
-  for (; k < edges.size(); ++k) project_edge<kLambda>(x, edges[k], alpha, kLambda ? lambda + k : nullptr);
+  for (; k < count; ++k) one(k);
+}
+
+template <bool kLambda>
+void project_edges(glm::vec4* x, std::span<const fb::ClothEdge> edges, std::span<const uint32_t> runs, float alpha,
+                   float* lambda, bool wide) {
+  by_runs(
+      edges.size(), runs, wide,
+      [&]([[maybe_unused]] size_t k, [[maybe_unused]] size_t n) {
+#if OSSA_HAVE_VECTOR_CLONES
+        detail::project_edges8(x, edges.data() + k, n, alpha, kLambda ? lambda + k : nullptr);
+#endif
+      },
+      [&](size_t k) { project_edge<kLambda>(x, edges[k], alpha, kLambda ? lambda + k : nullptr); });
+}
+
+/// Moves `p` onto the sphere of radius `limit` around `anchor` when it is outside it (a tether).
+OSSA_INLINE bool hold_within(glm::vec3& p, const glm::vec3& anchor, float limit) {
+  const glm::vec3 d = p - anchor;
+  const float len2 = glm::dot(d, d);
+  if (len2 <= limit * limit) return false;
+  p = anchor + d * (limit / std::sqrt(len2));
+  return true;
 }
 
 OSSA_INLINE void project_tether(glm::vec4* x, const fb::ClothTether& t, float scale) {
   glm::vec4& p = x[t.particle()];
   if (p.w == 0.0f) return;
-  const glm::vec4& a = x[t.anchor()];
-  const glm::vec3 d(p.x - a.x, p.y - a.y, p.z - a.z);
-  const float limit = t.length() * scale;
-  const float len2 = glm::dot(d, d);
-  if (len2 <= limit * limit) return;
-  const glm::vec3 at = xyz(a) + d * (limit / std::sqrt(len2));
-  p = glm::vec4(at, p.w);
+  glm::vec3 at = xyz(p);
+  if (hold_within(at, xyz(x[t.anchor()]), t.length() * scale)) p = glm::vec4(at, p.w);
 }
 
-/// The tethers in their stored order, runs of them that share no particle eight at a time.
 void project_tethers(glm::vec4* x, std::span<const fb::ClothTether> tethers, std::span<const uint32_t> runs,
                      float scale, bool wide) {
-  size_t k = 0;
+  by_runs(
+      tethers.size(), runs, wide,
+      [&]([[maybe_unused]] size_t k, [[maybe_unused]] size_t n) {
 #if OSSA_HAVE_VECTOR_CLONES
-  if (wide) {
-    for (const uint32_t end : runs) {
-      const size_t eight = (end - k) & ~size_t{7};
-      if (eight > 0) detail::project_tethers8(x, tethers.data() + k, eight, scale);
-      for (k += eight; k < end; ++k) project_tether(x, tethers[k], scale);
-    }
-  }
-#else
-  (void)runs;
-  (void)wide;
+        detail::project_tethers8(x, tethers.data() + k, n, scale);
 #endif
-  for (; k < tethers.size(); ++k) project_tether(x, tethers[k], scale);
+      },
+      [&](size_t k) { project_tether(x, tethers[k], scale); });
 }
 
 /// Max distance and backstop against the skinned pose `f` of the way through this update.
@@ -463,12 +474,7 @@ void write_output(ClothInstance& c, const ClothInput& in, float ahead, const Car
   const float scale = c.settings.tether_scale * 1.01f;
   for (const fb::ClothTether& t : s.tethers) {
     if (c.current[t.particle()].w == 0.0f) continue;
-    glm::vec3& p = c.out_positions[t.particle()];
-    const glm::vec3& a = c.out_positions[t.anchor()];
-    const glm::vec3 d = p - a;
-    const float limit = t.length() * scale;
-    const float len2 = glm::dot(d, d);
-    if (len2 > limit * limit) p = a + d * (limit / std::sqrt(len2));
+    hold_within(c.out_positions[t.particle()], c.out_positions[t.anchor()], t.length() * scale);
   }
   for (size_t i = 0; i < n; ++i) {
     if (c.current[i].w == 0.0f) continue;
