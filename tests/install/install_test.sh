@@ -22,12 +22,18 @@ libdir=lib
 for f in include/ossa/version.h include/ossa/format/ossa_generated.h include/ossa/loader/asset.h \
          include/ossa/graph/graph.h $libdir/libossa_runtime.a $libdir/libossa_format.a \
          $libdir/cmake/ossa/ossaConfig.cmake $libdir/cmake/ossa/ossaConfigVersion.cmake \
-         $libdir/pkgconfig/ossa.pc share/doc/ossa/LICENSE share/ossa/ossa.fbs bin/ossa-cook bin/ossa-inspect bin/ossa-diff bin/ossa-view; do
+         $libdir/pkgconfig/ossa.pc share/doc/ossa/LICENSE share/ossa/ossa.fbs share/ossa/schema/mesh.fbs bin/ossa-cook bin/ossa-inspect bin/ossa-diff bin/ossa-view; do
   [ -e "$prefix/$f" ] || fail "missing $f"
 done
 if grep -q FLATBUFFERS_VERSION_REVISION "$prefix/include/ossa/format/ossa_generated.h"; then
   fail "the installed ossa_generated.h pins a FlatBuffers patch version"
 fi
+echo "== the installed schema (ossa.fbs and its parts) compiles to the installed header"
+flatc --cpp --scoped-enums --gen-all -o "$work/schema" "$prefix/share/ossa/ossa.fbs" >"$work/flatc.log" 2>&1 \
+  || { cat "$work/flatc.log" >&2; fail "flatc cannot compile the installed share/ossa/ossa.fbs"; }
+strip_version() { grep -v -e 'FLATBUFFERS_VERSION_' -e 'flatbuffers version included' -e "needs FlatBuffers" "$1"; }
+cmp -s <(strip_version "$work/schema/ossa_generated.h") <(strip_version "$prefix/include/ossa/format/ossa_generated.h") \
+  || fail "the installed schema does not generate the installed ossa_generated.h"
 if grep -rqF "$build" "$prefix/$libdir/cmake" "$prefix/$libdir/pkgconfig"; then
   fail "the installed package refers to the build tree $build"
 fi
