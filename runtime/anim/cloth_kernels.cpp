@@ -135,16 +135,16 @@ OSSA_CLOTH_TARGET void edges8(glm::vec4* x, const fb::ClothEdge* e, size_t count
     if (_mm256_testz_ps(ok, ok)) continue;
     const __m256 len = _mm256_sqrt_ps(len2);
     const __m256 neg_violation = _mm256_xor_ps(_mm256_sub_ps(len, rest), sign);
-    __m256 dl;
+    __m256 s;
     if constexpr (kLambda) {
       // Pairs of multipliers into kLane order and back (the swap of the middle pairs undoes itself).
       const __m256 lam = lane_order(_mm256_loadu_ps(lambda + k));
-      dl = _mm256_div_ps(_mm256_sub_ps(neg_violation, _mm256_mul_ps(va, lam)), _mm256_add_ps(wsum, va));
+      const __m256 dl = _mm256_div_ps(_mm256_sub_ps(neg_violation, _mm256_mul_ps(va, lam)), _mm256_add_ps(wsum, va));
       _mm256_storeu_ps(lambda + k, lane_order(_mm256_blendv_ps(lam, _mm256_add_ps(lam, dl), ok)));
+      s = _mm256_div_ps(dl, len);
     } else {
-      dl = _mm256_div_ps(neg_violation, _mm256_add_ps(wsum, va));
+      s = _mm256_div_ps(neg_violation, _mm256_mul_ps(_mm256_add_ps(wsum, va), len));
     }
-    const __m256 s = _mm256_div_ps(dl, len);
     const __m256 cx = _mm256_mul_ps(dx, s), cy = _mm256_mul_ps(dy, s), cz = _mm256_mul_ps(dz, s);
     a.x = _mm256_blendv_ps(a.x, _mm256_sub_ps(a.x, _mm256_mul_ps(a.w, cx)), ok);
     a.y = _mm256_blendv_ps(a.y, _mm256_sub_ps(a.y, _mm256_mul_ps(a.w, cy)), ok);

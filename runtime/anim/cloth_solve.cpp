@@ -211,14 +211,15 @@ OSSA_INLINE void project_edge(glm::vec4* x, const fb::ClothEdge& e, float alpha,
   if (!(len2 > 1e-24f) || wsum == 0.0f) return;
   const float len = std::sqrt(len2);
   const float violation = len - e.rest();
-  float dl;
+  float s;  // the correction per unit of d: dl / len, in one division where no multiplier is kept
   if constexpr (kLambda) {
-    dl = (-violation - alpha * *lambda) / (wsum + alpha);
+    const float dl = (-violation - alpha * *lambda) / (wsum + alpha);
     *lambda += dl;
+    s = dl / len;
   } else {
-    dl = -violation / (wsum + alpha);
+    s = -violation / ((wsum + alpha) * len);
   }
-  const glm::vec3 corr = d * (dl / len);
+  const glm::vec3 corr = d * s;
   a.x -= a.w * corr.x;
   a.y -= a.w * corr.y;
   a.z -= a.w * corr.z;
