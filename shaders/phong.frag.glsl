@@ -1,7 +1,8 @@
 // phong.frag.glsl — Phong shading with the seed thesis's terms: ambient 0.1, diffuse, specular
 // strength 0.5 and shininess 32, all times the surface colour (material diffuse x vertex colour x
 // diffuse map). A normal map (tangent space, needs tangents) bends the normal; a specular map
-// scales the specular term. Surfaces are lit on the side that faces the eye: the normal is
+// scales the specular term; an occlusion map (a PBR source's) scales the ambient term, and the
+// emissive colour (times an emissive map) is added. Surfaces are lit on the side that faces the eye: the normal is
 // flipped when it points away from the viewer, not by gl_FrontFacing, because sources may be
 // open, inconsistently wound, or placed by a mirroring bind matrix (which flips the winding but
 // not the transformed normal). A non-zero u_flat_color.a replaces shading
@@ -30,6 +31,11 @@ uniform sampler2D u_specular_map;
 uniform bool u_has_diffuse_map;
 uniform bool u_has_normal_map;
 uniform bool u_has_specular_map;
+uniform sampler2D u_occlusion_map;
+uniform sampler2D u_emissive_map;
+uniform bool u_has_occlusion_map;
+uniform bool u_has_emissive_map;
+uniform vec3 u_emissive_color;
 uniform vec4 u_flat_color;
 
 out vec4 o_color;
@@ -67,6 +73,11 @@ void main() {
   float specular = kSpecularStrength * pow(max(dot(v, reflect(-l, n)), 0.0), kShininess);
   if (u_has_specular_map) specular *= texture(u_specular_map, v_uv).r;
 
-  vec3 linear = (kAmbient + diffuse + specular) * colour;
+  float ambient = kAmbient;
+  if (u_has_occlusion_map) ambient *= texture(u_occlusion_map, v_uv).r;
+  vec3 emission = u_emissive_color;
+  if (u_has_emissive_map) emission *= texture(u_emissive_map, v_uv).rgb;
+
+  vec3 linear = (ambient + diffuse + specular) * colour + emission;
   o_color = vec4(linear_to_srgb(linear), u_opacity);
 }

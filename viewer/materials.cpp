@@ -191,7 +191,7 @@ GLuint load_texture(const fb::Texture& texture, const std::string& asset_path, u
   GLuint t = 0;
   const TextureView view{&texture};
   // Colour maps are sRGB: sampled through an sRGB format, they come back linear for lighting.
-  const bool colour = texture.role() == fb::TextureRole::Diffuse;
+  const bool colour = texture.role() == fb::TextureRole::Diffuse || texture.role() == fb::TextureRole::Emissive;
   if (view.gpu_ready()) {
     what = "embedded texture";
     t = upload_cooked(view, gpu_bytes, why);
@@ -217,17 +217,23 @@ std::vector<GpuMaterial> create_materials(const Asset& asset, const std::string&
                                           std::vector<std::string>& warnings) {
   std::vector<GpuMaterial> out;
   std::map<const fb::Texture*, GLuint> shared;
+  std::vector<std::string> pbr_only;  // materials whose metallic-roughness the Phong shader does not use
   for (size_t i = 0; i < asset.material_count(); ++i) {
     const fb::Material& m = asset.material(i);
     GpuMaterial g;
     if (const fb::Vec3* d = m.diffuse()) g.diffuse = glm::vec3(d->x(), d->y(), d->z());
+    if (const fb::Vec3* e = m.emissive()) g.emissive = glm::vec3(e->x(), e->y(), e->z());
     g.opacity = m.opacity();
+    bool metallic_roughness_map = false;
     if (m.textures() != nullptr) {
       for (const fb::Texture* t : *m.textures()) {
-        GLuint* slot = t->role() == fb::TextureRole::Diffuse   ? &g.diffuse_map
-                       : t->role() == fb::TextureRole::Normal  ? &g.normal_map
-                       : t->role() == fb::TextureRole::Specular ? &g.specular_map
-                                                                : nullptr;
+        metallic_roughness_map |= t->role() == fb::TextureRole::MetallicRoughness;
+        GLuint* slot = t->role() == fb::TextureRole::Diffuse     ? &g.diffuse_map
+                       : t->role() == fb::TextureRole::Normal    ? &g.normal_map
+                       : t->role() == fb::TextureRole::Specular  ? &g.specular_map
+                       : t->role() == fb::TextureRole::Occlusion ? &g.occlusion_map
+                       : t->role() == fb::TextureRole::Emissive  ? &g.emissive_map
+                                                                 : nullptr;
         if (slot == nullptr || *slot != 0) continue;
         // Materials sharing a texture table share its GL texture (format v7 writes one table per
         // distinct image and role).
@@ -241,7 +247,16 @@ std::vector<GpuMaterial> create_materials(const Asset& asset, const std::string&
     }
     // A material whose colour is black but which has a diffuse map means "the map is the colour".
     if (g.diffuse_map != 0 && g.diffuse == glm::vec3(0.0f)) g.diffuse = glm::vec3(1.0f);
+    if (metallic_roughness_map || (m.pbr() != nullptr && m.pbr()->metallic() > 0.0f))
+      pbr_only.push_back("'" + detail::printable(flatbuffers::GetString(m.name()), 80) + "'");
     out.push_back(g);
+  }
+  if (!pbr_only.empty()) {
+    std::string names;
+    for (size_t i = 0; i < pbr_only.size() && i < 4; ++i) names += (i ? ", " : "") + pbr_only[i];
+    if (pbr_only.size() > 4) names += " and " + std::to_string(pbr_only.size() - 4) + " more";
+    warnings.push_back(asset_path + ": metallic-roughness of material" + (pbr_only.size() > 1 ? "s " : " ") + names +
+                       " not shown (the viewer shades Phong: base colour, normal, occlusion and emissive maps are used)");
   }
   if (out.empty()) out.push_back(GpuMaterial{});
   return out;
@@ -250,7 +265,7 @@ std::vector<GpuMaterial> create_materials(const Asset& asset, const std::string&
 void destroy_materials(std::vector<GpuMaterial>& materials) {
   std::set<GLuint> deleted;  // shared textures are deleted once
   for (GpuMaterial& m : materials) {
-    const GLuint textures[] = {m.diffuse_map, m.normal_map, m.specular_map};
+    const GLuint textures[] = {m.diffuse_map, m.normal_map, m.specular_map, m.occlusion_map, m.emissive_map};
     for (GLuint t : textures) {
       if (t != 0 && deleted.insert(t).second) glDeleteTextures(1, &t);
     }

@@ -1,4 +1,7 @@
-// materials.h — a file's materials on the GPU: colours and the diffuse / normal / specular maps.
+// materials.h — a file's materials on the GPU: colours and the diffuse / normal / specular maps,
+// and of a PBR source what Phong shading can use: occlusion (scales the ambient term) and the
+// emissive colour and map (added). Metallic-roughness maps and factors are not shown: a warning
+// names the materials that have them.
 //
 // A cooked texture (ossa/loader/texture.h) is uploaded level by level from the file's bytes with
 // glCompressedTexImage2D (BC1 / BC3 / BC4 / BC5) or glTexImage2D (RGBA8): no decode and no mipmap
@@ -22,7 +25,8 @@ namespace ossa::view {
 struct GpuMaterial {
   glm::vec3 diffuse{0.8f};
   float opacity = 1.0f;
-  GLuint diffuse_map = 0, normal_map = 0, specular_map = 0;  // 0: none
+  glm::vec3 emissive{0.0f};
+  GLuint diffuse_map = 0, normal_map = 0, specular_map = 0, occlusion_map = 0, emissive_map = 0;  // 0: none
   uint64_t texture_bytes = 0;  // GPU memory of the textures this material uploaded (shared ones count once)
 };
 

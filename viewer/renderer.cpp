@@ -55,12 +55,18 @@ void bind_material(const Renderer& r, const GpuMaterial& m) {
   const auto& u = r.mesh_uniforms;
   glUniform3f(u.diffuse_color, m.diffuse.x, m.diffuse.y, m.diffuse.z);
   glUniform1f(u.opacity, m.opacity);
-  const GLuint maps[] = {m.diffuse_map, m.normal_map, m.specular_map};
-  const GLint flags[] = {u.has_diffuse_map, u.has_normal_map, u.has_specular_map};
-  for (int i = 0; i < 3; ++i) {
-    glActiveTexture(GL_TEXTURE1 + static_cast<GLenum>(i));
-    glBindTexture(GL_TEXTURE_2D, maps[i]);
-    glUniform1i(flags[i], maps[i] != 0 ? 1 : 0);
+  glUniform3f(u.emissive_color, m.emissive.x, m.emissive.y, m.emissive.z);
+  const struct {
+    GLenum unit;
+    GLuint map;
+    GLint flag;
+  } maps[] = {{GL_TEXTURE1, m.diffuse_map, u.has_diffuse_map},     {GL_TEXTURE2, m.normal_map, u.has_normal_map},
+              {GL_TEXTURE3, m.specular_map, u.has_specular_map},   {GL_TEXTURE7, m.occlusion_map, u.has_occlusion_map},
+              {GL_TEXTURE8, m.emissive_map, u.has_emissive_map}};
+  for (const auto& map : maps) {
+    glActiveTexture(map.unit);
+    glBindTexture(GL_TEXTURE_2D, map.map);
+    glUniform1i(map.flag, map.map != 0 ? 1 : 0);
   }
   glActiveTexture(GL_TEXTURE0);
 }
@@ -183,6 +189,11 @@ Result<Renderer> create_renderer() {
   u.has_normal_map = glGetUniformLocation(p, "u_has_normal_map");
   u.has_specular_map = glGetUniformLocation(p, "u_has_specular_map");
   u.flat_color = glGetUniformLocation(p, "u_flat_color");
+  u.occlusion_map = glGetUniformLocation(p, "u_occlusion_map");
+  u.emissive_map = glGetUniformLocation(p, "u_emissive_map");
+  u.has_occlusion_map = glGetUniformLocation(p, "u_has_occlusion_map");
+  u.has_emissive_map = glGetUniformLocation(p, "u_has_emissive_map");
+  u.emissive_color = glGetUniformLocation(p, "u_emissive_color");
   u.morph_ranges = glGetUniformLocation(p, "u_morph_ranges");
   u.morph_entries = glGetUniformLocation(p, "u_morph_entries");
   u.morph_weights = glGetUniformLocation(p, "u_morph_weights");
@@ -192,7 +203,7 @@ Result<Renderer> create_renderer() {
   r.line_uniforms.point_size = glGetUniformLocation(r.line_program, "u_point_size");
 
   // Texture units: 0 palette, 1 diffuse, 2 normal, 3 specular, 4 morph ranges, 5 morph entries,
-  // 6 morph weights (each sampler type on its own unit, as GL requires).
+  // 6 morph weights, 7 occlusion, 8 emissive (each sampler type on its own unit, as GL requires).
   glUseProgram(p);
   glUniform1i(u.palette, 0);
   glUniform1i(u.diffuse_map, 1);
@@ -201,6 +212,8 @@ Result<Renderer> create_renderer() {
   glUniform1i(u.morph_ranges, 4);
   glUniform1i(u.morph_entries, 5);
   glUniform1i(u.morph_weights, 6);
+  glUniform1i(u.occlusion_map, 7);
+  glUniform1i(u.emissive_map, 8);
   glUniform1i(u.morph_channels, 0);
   glUniform1i(u.morph_texels, 1);
   glUseProgram(0);

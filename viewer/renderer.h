@@ -73,7 +73,8 @@ struct Renderer {
     GLint palette, palette_base, instance_texels, normal_encoding, tangent_encoding, direction_prescale,
         view_projection, camera_position, light_direction, diffuse_color, opacity, diffuse_map, normal_map,
         specular_map, has_diffuse_map, has_normal_map, has_specular_map, flat_color, morph_ranges, morph_entries,
-        morph_weights, morph_channels, morph_texels;
+        morph_weights, morph_channels, morph_texels, occlusion_map, emissive_map, has_occlusion_map, has_emissive_map,
+        emissive_color;
   } mesh_uniforms{};
   struct {
     GLint view_projection, point_size;

@@ -154,6 +154,47 @@ bool find_texture(const Context& ctx, const aiMaterial& mat, std::initializer_li
   return accept_image(ctx, std::move(bytes), ends_with_tga(path), label, "texture '" + path + "'", out);
 }
 
+/// The emissive colour and map, and a PBR source's factors and maps: occlusion (glTF's occlusion
+/// texture arrives as Assimp's LIGHTMAP), metallic-roughness (glTF's one texture, G roughness and B
+/// metallic, which Assimp reports as both METALNESS and DIFFUSE_ROUGHNESS). Separate metalness and
+/// roughness images (other formats' PBR) have no cooked form: said in a warning, not dropped silently.
+void import_pbr(const Context& ctx, const aiMaterial& mat, const std::string& label, SourceMaterial& out) {
+  get_color(mat, AI_MATKEY_COLOR_EMISSIVE, &out.emissive);
+  SourceTexture tex;
+  if (find_texture(ctx, mat, {aiTextureType_EMISSIVE}, TextureRole::Emissive, label, &tex)) {
+    out.textures.push_back(std::move(tex));
+  }
+  tex = {};
+  if (find_texture(ctx, mat, {aiTextureType_AMBIENT_OCCLUSION, aiTextureType_LIGHTMAP}, TextureRole::Occlusion,
+                   label, &tex)) {
+    out.textures.push_back(std::move(tex));
+  }
+  float metallic = 1.0f, roughness = 1.0f;
+  const bool has_metallic = mat.Get(AI_MATKEY_METALLIC_FACTOR, metallic) == AI_SUCCESS;
+  const bool has_roughness = mat.Get(AI_MATKEY_ROUGHNESS_FACTOR, roughness) == AI_SUCCESS;
+  if (has_metallic || has_roughness) {
+    out.pbr = true;
+    out.metallic = std::isfinite(metallic) ? std::clamp(metallic, 0.0f, 1.0f) : 1.0f;
+    out.roughness = std::isfinite(roughness) ? std::clamp(roughness, 0.0f, 1.0f) : 1.0f;
+  }
+  aiString metalness, rough;
+  const bool has_metalness_map = mat.GetTextureCount(aiTextureType_METALNESS) > 0 &&
+                                 mat.GetTexture(aiTextureType_METALNESS, 0, &metalness) == AI_SUCCESS;
+  const bool has_roughness_map = mat.GetTextureCount(aiTextureType_DIFFUSE_ROUGHNESS) > 0 &&
+                                 mat.GetTexture(aiTextureType_DIFFUSE_ROUGHNESS, 0, &rough) == AI_SUCCESS;
+  if (!has_metalness_map && !has_roughness_map) return;
+  if (ctx.format != SourceFormat::Gltf || !has_metalness_map || !has_roughness_map ||
+      std::string(metalness.C_Str()) != rough.C_Str()) {
+    ctx.warn(label + ": separate metalness / roughness maps are not cooked (only glTF's combined metallic-roughness "
+             "texture is)");
+    return;
+  }
+  tex = {};
+  if (find_texture(ctx, mat, {aiTextureType_METALNESS}, TextureRole::MetallicRoughness, label, &tex)) {
+    out.textures.push_back(std::move(tex));
+  }
+}
+
 SourceMaterial import_material(const Context& ctx, const aiMaterial& mat, unsigned index) {
   SourceMaterial out;
   aiString name;
@@ -189,6 +230,7 @@ SourceMaterial import_material(const Context& ctx, const aiMaterial& mat, unsign
   if (find_texture(ctx, mat, {aiTextureType_SPECULAR}, TextureRole::Specular, label, &tex)) {
     out.textures.push_back(std::move(tex));
   }
+  import_pbr(ctx, mat, label, out);
   return out;
 }
 

@@ -124,7 +124,7 @@ inline bool clip_named(const SourceClip& clip, const std::string& name) {
   return clip.name == name || (!clip.source_name.empty() && clip.source_name == name);
 }
 
-enum class TextureRole : uint8_t { Diffuse = 0, Normal = 1, Specular = 2 };
+enum class TextureRole : uint8_t { Diffuse = 0, Normal = 1, Specular = 2, Occlusion = 3, MetallicRoughness = 4, Emissive = 5 };
 
 struct SourceTexture {
   TextureRole role = TextureRole::Diffuse;
@@ -152,6 +152,9 @@ struct SourceMaterial {
   float shininess = 32.0f;
   float opacity = 1.0f;
   std::vector<SourceTexture> textures;
+  glm::vec3 emissive{0.0f};
+  bool pbr = false;                      // a PBR source (glTF): metallic and roughness below hold
+  float metallic = 1.0f, roughness = 1.0f;
 };
 
 struct SourceScene {

@@ -18,6 +18,9 @@ const char* role_name(TextureRole role) {
   switch (role) {
     case TextureRole::Normal: return "normal";
     case TextureRole::Specular: return "specular";
+    case TextureRole::Occlusion: return "occlusion";
+    case TextureRole::MetallicRoughness: return "metallic-roughness";
+    case TextureRole::Emissive: return "emissive";
     default: return "diffuse";
   }
 }
@@ -84,6 +87,10 @@ Choice choose(const Image& image, TextureRole role, TextureOutput output) {
   switch (role) {
     case TextureRole::Normal:
       return {raw ? fb::TextureEncoding::Rgba8 : fb::TextureEncoding::Bc5, false, TexelKind::Normal, 0x3};
+    case TextureRole::Occlusion:  // glTF's occlusion is the R channel
+      return {raw ? fb::TextureEncoding::Rgba8 : fb::TextureEncoding::Bc4, false, TexelKind::Data, 0x1};
+    case TextureRole::MetallicRoughness:  // after metallic_roughness_channels(): R roughness, G metallic
+      return {raw ? fb::TextureEncoding::Rgba8 : fb::TextureEncoding::Bc5, false, TexelKind::Data, 0x3};
     case TextureRole::Specular:
       if (raw) return {fb::TextureEncoding::Rgba8, false, TexelKind::Data, 0xF};
       return greyscale(image) ? Choice{fb::TextureEncoding::Bc4, false, TexelKind::Data, 0x1}
@@ -95,6 +102,17 @@ Choice choose(const Image& image, TextureRole role, TextureOutput output) {
   }
 }
 
+/// glTF's metallic-roughness texels (G roughness, B metallic) as the format stores them in every
+/// encoding: R roughness, G metallic, B 0, A 255, so the two channels fit BC5.
+void metallic_roughness_channels(Image& image) {
+  for (size_t i = 0; i + 3 < image.rgba.size(); i += 4) {
+    image.rgba[i] = image.rgba[i + 1];
+    image.rgba[i + 1] = image.rgba[i + 2];
+    image.rgba[i + 2] = 0;
+    image.rgba[i + 3] = 255;
+  }
+}
+
 Result<TextureRecord> cook_one(SourceTexture& t, TextureOutput output) {
   TextureRecord r;
   r.name = t.name.empty() ? t.path : t.name;
@@ -102,6 +120,7 @@ Result<TextureRecord> cook_one(SourceTexture& t, TextureOutput output) {
   r.source_bytes = t.data.size();
   auto decoded = decode_rgba(t.data);
   if (!decoded) return decoded.error();
+  if (t.role == TextureRole::MetallicRoughness && output != TextureOutput::Source) metallic_roughness_channels(*decoded);
   const Image& level0 = *decoded;
   r.width = level0.width;
   r.height = level0.height;

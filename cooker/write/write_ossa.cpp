@@ -384,7 +384,10 @@ Offset<fb::Material> write_material(FlatBufferBuilder& fbb, const SourceMaterial
   }
   const auto textures_v = fbb.CreateVector(textures);
   const fb::Vec3 ambient = vec3(material.ambient), diffuse = vec3(material.diffuse), specular = vec3(material.specular);
-  return fb::CreateMaterial(fbb, name, &ambient, &diffuse, &specular, material.shininess, material.opacity, textures_v);
+  const fb::Vec3 emissive = vec3(material.emissive);
+  const fb::PbrFactors pbr(material.metallic, material.roughness);
+  return fb::CreateMaterial(fbb, name, &ambient, &diffuse, &specular, material.shininess, material.opacity, textures_v,
+                            material.emissive == glm::vec3(0.0f) ? nullptr : &emissive, material.pbr ? &pbr : nullptr);
 }
 
 }  // namespace

@@ -158,6 +158,12 @@ Status Validator::check_material(const fb::Material& m, size_t material_index) {
     if (c.value && !finite3(*c.value)) return fail(where, format("%s colour %s is not finite", c.field, vec3_text(*c.value).c_str()));
   if (!std::isfinite(m.shininess())) return fail(where, "shininess is not finite");
   if (!std::isfinite(m.opacity())) return fail(where, "opacity is not finite");
+  if (m.emissive() && !finite3(*m.emissive()))
+    return fail(where, format("emissive colour %s is not finite", vec3_text(*m.emissive()).c_str()));
+  if (const fb::PbrFactors* p = m.pbr(); p && !(p->metallic() >= 0.0f && p->metallic() <= 1.0f &&
+                                                p->roughness() >= 0.0f && p->roughness() <= 1.0f))
+    return fail(where, format("metallic %g / roughness %g outside [0, 1]", static_cast<double>(p->metallic()),
+                              static_cast<double>(p->roughness())));
   const auto* textures = m.textures();
   if (!textures) return {};
   if (!spend(static_cast<uint64_t>(textures->size()) * 4)) return over_budget(where);

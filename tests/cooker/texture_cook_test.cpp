@@ -252,6 +252,48 @@ TEST(TextureCook, FormatPerRoleAndContent) {
   EXPECT_EQ(records[0].encoding, "source");
 }
 
+// A PBR source's maps (format v11) by role: occlusion keeps R in BC4; metallic-roughness moves
+// glTF's G (roughness) and B (metallic) into BC5's R and G; emissive is colour (BC1 sRGB, BC3 with
+// alpha). Gradients per channel, so a channel taken from the wrong source channel cannot match.
+TEST(TextureCook, PbrMapsCookByRoleWithTheirChannels) {
+  const Image orm = make_image(16, 16, [](uint32_t x, uint32_t y) {
+    return std::array<uint8_t, 4>{uint8_t(x * 16), uint8_t(y * 16), uint8_t(255 - x * 16), 255};
+  });
+  const Image glow = make_image(16, 8, [](uint32_t x, uint32_t) { return std::array<uint8_t, 4>{uint8_t(x * 16), 40, 0, 255}; });
+  SourceScene scene;
+  scene.materials.resize(1);
+  scene.materials[0].textures = {texture_of(orm, TextureRole::Occlusion, "orm"),
+                                 texture_of(orm, TextureRole::MetallicRoughness, "orm"),
+                                 texture_of(glow, TextureRole::Emissive, "glow")};
+  std::vector<TextureRecord> records;
+  ASSERT_TRUE(cook_textures(scene, TextureOutput::Compressed, "test", records).ok());
+  ASSERT_EQ(records.size(), 3u) << "one image in two roles is cooked once per role";
+  const SourceTexture &occlusion = scene.materials[0].textures[0], &mr = scene.materials[0].textures[1],
+                      &emissive = scene.materials[0].textures[2];
+  EXPECT_EQ(static_cast<fb::TextureEncoding>(occlusion.encoding), fb::TextureEncoding::Bc4);
+  EXPECT_FALSE(occlusion.srgb);
+  EXPECT_EQ(static_cast<fb::TextureEncoding>(mr.encoding), fb::TextureEncoding::Bc5);
+  EXPECT_FALSE(mr.srgb);
+  EXPECT_EQ(static_cast<fb::TextureEncoding>(emissive.encoding), fb::TextureEncoding::Bc1);
+  EXPECT_TRUE(emissive.srgb);
+  EXPECT_EQ(records[0].role, "occlusion");
+  EXPECT_EQ(records[1].role, "metallic-roughness");
+  EXPECT_EQ(records[2].role, "emissive");
+  const Image occlusion0 = decode_level(occlusion.data, fb::TextureEncoding::Bc4, 16, 16);
+  const Image mr0 = decode_level(mr.data, fb::TextureEncoding::Bc5, 16, 16);
+  const Image source = *decode_rgba(png_of(orm));  // rows bottom to top, as the cooked levels
+  int worst_occlusion = 0, worst_roughness = 0, worst_metallic = 0;
+  for (size_t i = 0; i < source.rgba.size(); i += 4) {
+    worst_occlusion = std::max(worst_occlusion, std::abs(occlusion0.rgba[i] - source.rgba[i]));
+    worst_roughness = std::max(worst_roughness, std::abs(mr0.rgba[i] - source.rgba[i + 1]));
+    worst_metallic = std::max(worst_metallic, std::abs(mr0.rgba[i + 1] - source.rgba[i + 2]));
+  }
+  EXPECT_LE(worst_occlusion, 4) << "occlusion is the source's R";
+  EXPECT_LE(worst_roughness, 4) << "the cooked R is the source's G (roughness)";
+  EXPECT_LE(worst_metallic, 4) << "the cooked G is the source's B (metallic)";
+  EXPECT_GT(records[1].psnr_db, 40.0f);
+}
+
 TEST(TextureCook, OneCookedTexturePerImageAndRole) {
   const Image img = make_image(8, 8, [](uint32_t x, uint32_t y) { return std::array<uint8_t, 4>{uint8_t(x * 30), uint8_t(y * 30), 9, 255}; });
   SourceScene scene;

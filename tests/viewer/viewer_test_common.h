@@ -8,9 +8,13 @@
 #pragma once
 #include <gtest/gtest.h>
 
+#include <cstdint>
 #include <cstdlib>
 #include <filesystem>
 #include <string>
+#include <vector>
+
+#include <stb_image_write.h>
 
 #include "test_files.h"
 #include "viewer_harness.h"
@@ -47,6 +51,44 @@ inline Image screenshot(const std::string& args, const std::filesystem::path& pn
 inline bool foreground(const Image& image, int x, int y) {
   const uint8_t *p = image.at(x, y), *bg = image.at(0, 0);
   return std::abs(p[0] - bg[0]) > 6 || std::abs(p[1] - bg[1]) > 6 || std::abs(p[2] - bg[2]) > 6;
+}
+
+/// A flat 8 x 8 RGB PNG of one colour (the generated maps of the texture suites).
+inline std::vector<uint8_t> solid_png(uint8_t r, uint8_t g, uint8_t b) {
+  std::vector<uint8_t> texels;
+  for (int i = 0; i < 64; ++i) texels.insert(texels.end(), {r, g, b});
+  std::vector<uint8_t> out;
+  stbi_write_png_to_func([](void* ctx, void* data, int size) {
+    auto* o = static_cast<std::vector<uint8_t>*>(ctx);
+    o->insert(o->end(), static_cast<uint8_t*>(data), static_cast<uint8_t*>(data) + size);
+  }, &out, 8, 8, 3, texels.data(), 24);
+  return out;
+}
+
+/// Writes `dir`/quad.bin, which quad_gltf's documents read: a 2 x 2 unit quad facing +Z
+/// (positions, normals, texture coordinates, 6 indices; 140 bytes).
+inline bool write_quad_bin(const std::filesystem::path& dir) {
+  const float geometry[] = {-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0,  // positions
+                            0,  0,  1, 0, 0,  1, 0, 0, 1, 0,  0, 1,  // normals
+                            0,  1,  1, 1, 1,  0, 0, 0};              // texture coordinates
+  const uint16_t indices[] = {0, 1, 2, 0, 2, 3};
+  std::vector<uint8_t> bin(reinterpret_cast<const uint8_t*>(geometry), reinterpret_cast<const uint8_t*>(geometry) + sizeof geometry);
+  bin.insert(bin.end(), reinterpret_cast<const uint8_t*>(indices), reinterpret_cast<const uint8_t*>(indices) + sizeof indices);
+  return bin.size() == 140 && write_file(dir / "quad.bin", bin);
+}
+
+/// A glTF document of that quad (its one primitive uses material 0); `tail` holds its
+/// "materials" member (and "images", "textures" when it has maps), without the closing brace.
+inline std::string quad_gltf(const std::string& tail) {
+  return R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+    "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "NORMAL": 1, "TEXCOORD_0": 2}, "indices": 3, "material": 0}]}],
+    "buffers": [{"uri": "quad.bin", "byteLength": 140}],
+    "bufferViews": [{"buffer": 0, "byteLength": 48}, {"buffer": 0, "byteOffset": 48, "byteLength": 48},
+                    {"buffer": 0, "byteOffset": 96, "byteLength": 32}, {"buffer": 0, "byteOffset": 128, "byteLength": 12}],
+    "accessors": [{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [-1, -1, 0], "max": [1, 1, 0]},
+                  {"bufferView": 1, "componentType": 5126, "count": 4, "type": "VEC3"},
+                  {"bufferView": 2, "componentType": 5126, "count": 4, "type": "VEC2"},
+                  {"bufferView": 3, "componentType": 5123, "count": 6, "type": "SCALAR"}],)" + tail + "}";
 }
 
 class Viewer : public ::testing::Test {

@@ -14,8 +14,6 @@
 #include <string>
 #include <vector>
 
-#include <stb_image_write.h>
-
 #include <ossa/loader/asset.h>
 
 #include "viewer_test_common.h"
@@ -101,33 +99,12 @@ TEST_P(ViewerTexture, GpuMemoryIsTheFilesChains) {
   EXPECT_EQ(bytes_of("source-textures"), GetParam().rgba8_bytes);
 }
 
-/// A flat 8 x 8 RGB PNG of one colour (the test writes its normal maps with it).
-std::vector<uint8_t> solid_png(uint8_t r, uint8_t g, uint8_t b) {
-  std::vector<uint8_t> texels;
-  for (int i = 0; i < 64; ++i) texels.insert(texels.end(), {r, g, b});
-  std::vector<uint8_t> out;
-  stbi_write_png_to_func([](void* ctx, void* data, int size) {
-    auto* o = static_cast<std::vector<uint8_t>*>(ctx);
-    o->insert(o->end(), static_cast<uint8_t*>(data), static_cast<uint8_t*>(data) + size);
-  }, &out, 8, 8, 3, texels.data(), 24);
-  return out;
-}
-
-/// A 2 x 2 unit quad facing +Z (positions, normals, texture coordinates, 6 indices) with a grey
-/// material and, when `normal_map` is given, that image as its normal texture.
-std::string quad_gltf(const std::string& normal_map) {
-  std::string j = R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
-    "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "NORMAL": 1, "TEXCOORD_0": 2}, "indices": 3, "material": 0}]}],
-    "buffers": [{"uri": "quad.bin", "byteLength": 140}],
-    "bufferViews": [{"buffer": 0, "byteLength": 48}, {"buffer": 0, "byteOffset": 48, "byteLength": 48},
-                    {"buffer": 0, "byteOffset": 96, "byteLength": 32}, {"buffer": 0, "byteOffset": 128, "byteLength": 12}],
-    "accessors": [{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [-1, -1, 0], "max": [1, 1, 0]},
-                  {"bufferView": 1, "componentType": 5126, "count": 4, "type": "VEC3"},
-                  {"bufferView": 2, "componentType": 5126, "count": 4, "type": "VEC2"},
-                  {"bufferView": 3, "componentType": 5123, "count": 6, "type": "SCALAR"}],)";
-  if (normal_map.empty()) return j + R"("materials": [{"pbrMetallicRoughness": {"baseColorFactor": [0.6, 0.6, 0.6, 1]}}]})";
-  return j + R"("images": [{"uri": ")" + normal_map + R"("}], "textures": [{"source": 0}],
-    "materials": [{"pbrMetallicRoughness": {"baseColorFactor": [0.6, 0.6, 0.6, 1]}, "normalTexture": {"index": 0}}]})";
+/// The quad's document with a grey material and, when `normal_map` is given, that image as its
+/// normal texture.
+std::string quad_with_normal_map(const std::string& normal_map) {
+  if (normal_map.empty()) return quad_gltf(R"("materials": [{"pbrMetallicRoughness": {"baseColorFactor": [0.6, 0.6, 0.6, 1]}}])");
+  return quad_gltf(R"("images": [{"uri": ")" + normal_map + R"("}], "textures": [{"source": 0}],
+    "materials": [{"pbrMetallicRoughness": {"baseColorFactor": [0.6, 0.6, 0.6, 1]}, "normalTexture": {"index": 0}}])");
 }
 
 // A BC5 normal map holds x and y only; the shader rebuilds z. A flat map (0, 0, 1) must then light
@@ -137,19 +114,12 @@ std::string quad_gltf(const std::string& normal_map) {
 TEST_F(Viewer, Bc5NormalMapsRebuildZ) {
   const fs::path src = dir_ / "src";
   fs::create_directories(src);
-  const float geometry[] = {-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0,  // positions
-                            0,  0,  1, 0, 0,  1, 0, 0, 1, 0,  0, 1,  // normals
-                            0,  1,  1, 1, 1,  0, 0, 0};              // texture coordinates
-  const uint16_t indices[] = {0, 1, 2, 0, 2, 3};
-  std::vector<uint8_t> bin(reinterpret_cast<const uint8_t*>(geometry), reinterpret_cast<const uint8_t*>(geometry) + sizeof geometry);
-  bin.insert(bin.end(), reinterpret_cast<const uint8_t*>(indices), reinterpret_cast<const uint8_t*>(indices) + sizeof indices);
-  ASSERT_EQ(bin.size(), 140u);
-  ASSERT_TRUE(write_file(src / "quad.bin", bin));
+  ASSERT_TRUE(write_quad_bin(src));
   ASSERT_TRUE(write_file(src / "flat.png", solid_png(128, 128, 255)));
   ASSERT_TRUE(write_file(src / "tilt.png", solid_png(128, 38, 218)));  // about 45 degrees away from the light
-  ASSERT_TRUE(write_file(src / "plain.gltf", quad_gltf("")));
-  ASSERT_TRUE(write_file(src / "flat.gltf", quad_gltf("flat.png")));
-  ASSERT_TRUE(write_file(src / "tilt.gltf", quad_gltf("tilt.png")));
+  ASSERT_TRUE(write_file(src / "plain.gltf", quad_with_normal_map("")));
+  ASSERT_TRUE(write_file(src / "flat.gltf", quad_with_normal_map("flat.png")));
+  ASSERT_TRUE(write_file(src / "tilt.gltf", quad_with_normal_map("tilt.png")));
   const std::string cook = quote((bin_dir() / "ossa-cook").string());
   const auto bc = run_command(cook + " -q " + quote(src.string()) + " -o " + quote((dir_ / "bc").string()));
   ASSERT_EQ(bc.exit_code, 0) << bc.err;

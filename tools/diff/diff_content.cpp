@@ -50,6 +50,8 @@ std::vector<TextureFact> textures_of(const fb::Material& m) {
   return out;
 }
 
+const fb::Vec3 kBlack(0.0f, 0.0f, 0.0f);  // an absent emissive colour
+
 double vec_delta(const fb::Vec3* a, const fb::Vec3* b) {
   if (!a || !b) return a == b ? 0.0 : INFINITY;
   return std::max({std::fabs(double(a->x()) - b->x()), std::fabs(double(a->y()) - b->y()), std::fabs(double(a->z()) - b->z())});
@@ -68,13 +70,20 @@ MaterialItem compare_material(Context& c, const std::string& label, const fb::Ma
     const char* name;
     const fb::Vec3 *x, *y;
   } colours[] = {{"ambient", a.ambient(), b.ambient()}, {"diffuse", a.diffuse(), b.diffuse()},
-                 {"specular", a.specular(), b.specular()}};
+                 {"specular", a.specular(), b.specular()},
+                 {"emissive", a.emissive() ? a.emissive() : &kBlack, b.emissive() ? b.emissive() : &kBlack}};
   for (const auto& col : colours)
     if (vec_delta(col.x, col.y) > kParameterEpsilon) changed(col.name, "largest component change " + num(vec_delta(col.x, col.y)));
   if (std::fabs(a.shininess() - b.shininess()) > kParameterEpsilon)
     changed("shininess", num(a.shininess()) + " -> " + num(b.shininess()));
   if (std::fabs(a.opacity() - b.opacity()) > kParameterEpsilon)
     changed("opacity", num(a.opacity()) + " -> " + num(b.opacity()));
+  const auto pbr_text = [](const fb::PbrFactors* p) {
+    return p ? "metallic " + num(p->metallic()) + ", roughness " + num(p->roughness()) : std::string("none (Phong)");
+  };
+  if (!a.pbr() != !b.pbr() || (a.pbr() && (std::fabs(a.pbr()->metallic() - b.pbr()->metallic()) > kParameterEpsilon ||
+                                           std::fabs(a.pbr()->roughness() - b.pbr()->roughness()) > kParameterEpsilon)))
+    changed("pbr", pbr_text(a.pbr()) + " -> " + pbr_text(b.pbr()));
   const auto &ta = item.old_textures, &tb = item.new_textures;
   if (ta.size() != tb.size())
     changed("textures", std::to_string(ta.size()) + " -> " + std::to_string(tb.size()) + " textures");

@@ -368,6 +368,9 @@ json describe_material(const fb::Material& m) {
               {"specular", vec3(m.specular())},
               {"shininess", round6(m.shininess())},
               {"opacity", round6(m.opacity())},
+              {"emissive", m.emissive() ? vec3(m.emissive()) : json::array({0.0, 0.0, 0.0})},
+              {"pbr", m.pbr() ? json{{"metallic", round6(m.pbr()->metallic())}, {"roughness", round6(m.pbr()->roughness())}}
+                              : json(nullptr)},
               {"textures", std::move(textures)}};
 }
 
@@ -606,6 +609,9 @@ std::string describe_text(const json& d) {
     line("  colours        ambient " + vec_text(m["ambient"]) + ", diffuse " + vec_text(m["diffuse"]) +
          ", specular " + vec_text(m["specular"]));
     line("  shininess      " + text(m["shininess"]) + ", opacity " + text(m["opacity"]));
+    if (m["emissive"] != json::array({0.0, 0.0, 0.0})) line("  emissive       " + vec_text(m["emissive"]));
+    if (!m["pbr"].is_null())
+      line("  pbr            metallic " + text(m["pbr"]["metallic"]) + ", roughness " + text(m["pbr"]["roughness"]));
     for (const json& t : m["textures"]) {
       std::string where;
       if (t["bytes"].get<size_t>() > 0 && t["encoding"].get<std::string>() != "Source")
