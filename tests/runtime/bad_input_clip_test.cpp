@@ -340,6 +340,22 @@ TEST(Texture, UnknownEncodingAndSourceWithLevels) {
   EXPECT_TRUE(rejects(source, {{"skin", "material 0"}, {"texture 0", "Diffuse"}, {"mip levels"}}));
 }
 
+// A PBR source's fields (format v11): the emissive colour finite, metallic and roughness in [0, 1].
+TEST(Material, PbrFieldsOutOfRangeRejected) {
+  SyntheticSpec spec;
+  spec.materials[0].emissive = fb::Vec3(1.0f, 0.5f, 0.0f);
+  spec.materials[0].pbr = fb::PbrFactors(0.25f, 0.75f);
+  EXPECT_TRUE(accepts(make_valid_file(spec)));
+  spec.materials[0].emissive = fb::Vec3(1.0f, std::numeric_limits<float>::quiet_NaN(), 0.0f);
+  EXPECT_TRUE(rejects(spec, {{"skin", "material 0"}, {"emissive"}, {"finite"}}));
+  spec.materials[0].emissive.reset();
+  for (const fb::PbrFactors bad : {fb::PbrFactors(1.5f, 0.5f), fb::PbrFactors(0.5f, -0.1f),
+                                   fb::PbrFactors(std::numeric_limits<float>::quiet_NaN(), 0.5f)}) {
+    spec.materials[0].pbr = bad;
+    EXPECT_TRUE(rejects(spec, {{"skin", "material 0"}, {"metallic"}, {"roughness"}}));
+  }
+}
+
 TEST(Texture, EveryEncodingsChainAccepted) {
   // Each encoding at an odd size: level sizes round up to whole blocks (or texels for RGBA8).
   for (const auto e : {fb::TextureEncoding::Rgba8, fb::TextureEncoding::Bc1, fb::TextureEncoding::Bc3,

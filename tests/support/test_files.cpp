@@ -441,7 +441,8 @@ flatbuffers::Offset<fb::Material> write_material(flatbuffers::FlatBufferBuilder&
   }
   const auto name = fbb.CreateString(m.name);
   const auto texture_vector = fbb.CreateVector(textures);
-  return fb::CreateMaterial(fbb, name, &m.ambient, &m.diffuse, &m.specular, m.shininess, m.opacity, texture_vector);
+  return fb::CreateMaterial(fbb, name, &m.ambient, &m.diffuse, &m.specular, m.shininess, m.opacity, texture_vector,
+                            m.emissive ? &*m.emissive : nullptr, m.pbr ? &*m.pbr : nullptr);
 }
 
 }  // namespace

@@ -206,6 +206,8 @@ struct SyntheticMaterial {
   fb::Vec3 specular{0.2f, 0.2f, 0.2f};
   float shininess = 16.0f;
   float opacity = 1.0f;
+  std::optional<fb::Vec3> emissive;      // format v11
+  std::optional<fb::PbrFactors> pbr;     // format v11
   /// An embedded 2x2 PNG (diffuse) and a normal map referenced by path.
   std::vector<SyntheticTexture> textures = default_textures();
 
