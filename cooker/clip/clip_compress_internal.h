@@ -104,7 +104,7 @@ struct ShareInput {
 /// one shared list, each channel within its own budget at every position, merging the pair of
 /// groups that saves the most bits first, while a merge saves bits. Rewrites the members' frames
 /// to their group's list and returns, per plan, whether it now shares its list with another.
-/// Deterministic. O(groups^2) key removals over the groups' channels.
+/// Deterministic. O(groups^2) key removals over the groups' channels; more than 512 groups: none.
 std::vector<bool> share_key_lists(std::vector<ChannelPlan>& plans, std::span<const ShareInput> inputs, uint32_t frames);
 
 }  // namespace ossa::cook::compress_detail

@@ -42,6 +42,10 @@ constexpr uint64_t kKeyFrameBits = 16;
 // and the montage's sample costs about 0.55k / 1.15k / 1.3k fewer instructions per update
 // (callgrind, ossa-bench-graph-updates --montage); 400 keeps the file smallest.
 constexpr int64_t kRunBits = 400;
+// Groups beyond which a clip keeps its own lists: the pairs are O(groups^2) in memory and key
+// removals (the shared assets have at most 56; a rig of hundreds of joints all dropping keys would
+// otherwise cost its cook minutes).
+constexpr size_t kMaxGroups = 512;
 
 struct Member {
   uint32_t plan = 0;
@@ -93,7 +97,7 @@ std::vector<bool> share_key_lists(std::vector<ChannelPlan>& plans, std::span<con
   }
   std::vector<bool> shared(plans.size(), false);
   const size_t count = groups.size();
-  if (count < 2) return shared;
+  if (count < 2 || count > kMaxGroups) return shared;
 
   std::vector<KeyFit> fits;
   auto evaluate = [&](const Group& a, const Group& b) {
