@@ -536,6 +536,7 @@ Result<CompressedClip> compress_clip(const SourceClip& clip, const SourceSkeleto
     for (uint32_t round = 0; round < kMaxShareRounds && !kept; ++round) {
       layout.plans = own;
       const std::vector<bool> shared_list = share_key_lists(layout.plans, inputs, frames);
+      if (std::find(shared_list.begin(), shared_list.end(), true) == shared_list.end()) break;  // own lists
       // Compensation again, parents first: each channel fitted to its target given its parents
       // with their shared lists, keeping its list when shared (its bits either way).
       for (uint32_t j = 0; j < joints; ++j) {
