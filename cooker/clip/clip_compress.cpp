@@ -75,6 +75,12 @@
 //    the clip reports. A bound no float data can hold is reported as measured, never hidden (none
 //    of the shared assets has one: every clip of them cooks within the default 0.1 mm).
 //
+// 7. Shared key lists (clip_compress_share.cpp). Channels whose lists can become one list within
+//    each one's budget are grouped while that saves bytes (a list fewer counted as kRunBits), then
+//    every channel is fitted again, parents first, to its compensated target given its parents as
+//    now decoded (its list and bits kept), and the clip verified again; a joint over the bound takes
+//    its chain out of sharing (kMaxShareRounds), and a clip that never holds keeps step 6's lists.
+//
 // Lossless mode (--no-clip-compression): a channel is bind or constant only when every frame is
 // bit-equal to that value; every other channel keeps every frame as raw floats. Translations and
 // scales are then bit-exact; rotations store their three kept components exactly (the quaternion
@@ -85,11 +91,12 @@
 // are contiguous in key_values and its key frames contiguous in key_frames, in frame order, so
 // forward playback reads both in memory order. Channels whose key frames are identical point at one
 // shared run of key_frames (first_key), which the format allows and which saves two bytes per key
-// for every channel keyed at every frame (mocap, lossless cooks).
+// for every channel keyed at every frame (mocap, lossless cooks) and for every list step 7 shares.
 //
 // Files: step 2 is in clip_compress_levers.cpp, steps 4-5 for one channel in
-// clip_compress_channel.cpp, what they share in clip_compress_internal.h; this file runs the whole
-// clip (classification order, compensation, packing, verification). Step 1 is clip_reference.h's.
+// clip_compress_channel.cpp, step 7's grouping in clip_compress_share.cpp, what they share in
+// clip_compress_internal.h; this file runs the whole clip (classification order, compensation,
+// packing, verification, step 7's refit). Step 1 is clip_reference.h's.
 #include "cooker/clip/clip_compress.h"
 
 #include <algorithm>
@@ -112,6 +119,8 @@ namespace {
 using namespace compress_detail;  // the stages in clip_compress_levers.cpp and clip_compress_channel.cpp
 
 constexpr uint32_t kMaxTightening = 8;
+// Rounds of step 7 (sharing key lists) before the clip keeps its own lists.
+constexpr uint32_t kMaxShareRounds = 4;
 // Joint-frames up to which model-space transforms are cached (two arrays of 96-byte Affines:
 // ~100 MB at the limit; the CMU clip, 38 joints x 4511 frames, takes 33 MB).
 constexpr uint64_t kModelCacheLimit = 1u << 19;
@@ -511,6 +520,58 @@ Result<CompressedClip> compress_clip(const SourceClip& clip, const SourceSkeleto
         if (round == kMaxTightening) lossless[i] = true;
         budget[i] *= factor[j];
       }
+    }
+  }
+  // 7. Shared key lists (clip_compress_share.cpp), kept when the clip still holds the bound; a
+  // joint over it takes its chain (itself and its ancestors) out of sharing, for kMaxShareRounds.
+  if (error.max <= tolerance) {
+    std::vector<ShareInput> inputs(channel_count);
+    for (size_t i = 0; i < channel_count; ++i) {
+      if (layout.plans[i].kind != Kind::Animated || lossless[i] || cache[i].budget < 0.0) continue;
+      inputs[i] = ShareInput{true, Metric{static_cast<uint32_t>(i % kChannelsPerJoint), cache[i].lever},
+                             cache[i].budget, &cache[i].target};
+    }
+    const std::vector<ChannelPlan> own = layout.plans;
+    bool kept = false;
+    for (uint32_t round = 0; round < kMaxShareRounds && !kept; ++round) {
+      layout.plans = own;
+      const std::vector<bool> shared_list = share_key_lists(layout.plans, inputs, frames);
+      if (std::find(shared_list.begin(), shared_list.end(), true) == shared_list.end()) break;  // own lists
+      // Compensation again, parents first: each channel fitted to its target given its parents
+      // with their shared lists, keeping its list when shared (its bits either way).
+      for (uint32_t j = 0; j < joints; ++j) {
+        for (uint32_t ch = 0; ch < kChannelsPerJoint; ++ch) {
+          const size_t i = j * 3 + ch;
+          ChannelPlan& plan = layout.plans[i];
+          if (layout.plans[i].kind == Kind::Animated && !lossless[i] && cache[i].budget >= 0.0) {
+            compensated_target(skeleton, ref, models, j, ch, target.data());
+            const Metric m{ch, cache[i].lever};
+            if (shared_list[i]) plan = refit_animated(m, target.data(), frames, budget[i], plan.bits, plan.frames);
+            else if (target != cache[i].target) plan = encode_animated(m, target.data(), frames, budget[i]);
+          }
+          decode_plan(plan, ch, frames, bind_value(skeleton.joints[j], ch), planned.channel(j, ch));
+        }
+        models.joint_planned(j);
+      }
+      if (Status st = pack(layout, joints, frames, out); !st) return st.error();
+      decode_clip(out, skeleton, decoded, kErrorSubdivisions);
+      const ClipError shared = measure_clip_error(skeleton, ref_positions, decoded, probe,
+                                                  ref_position_models.empty() ? nullptr : &ref_position_models,
+                                                  kErrorSubdivisions);
+      kept = shared.max <= tolerance;
+      if (kept) {
+        error = shared;
+        break;
+      }
+      for (uint32_t d = 0; d < joints; ++d) {
+        if (shared.joint_max[d] <= tolerance) continue;
+        for (int a = static_cast<int>(d); a >= 0; a = skeleton.joints[static_cast<size_t>(a)].parent)
+          for (uint32_t ch = 0; ch < kChannelsPerJoint; ++ch) inputs[static_cast<size_t>(a) * 3 + ch].share = false;
+      }
+    }
+    if (!kept) {
+      layout.plans = own;
+      if (Status st = pack(layout, joints, frames, out); !st) return st.error();
     }
   }
   finish(error);

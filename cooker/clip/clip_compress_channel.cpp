@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <span>
 #include <vector>
 
 #include "cooker/clip/clip_compress_internal.h"
@@ -81,22 +82,30 @@ glm::vec4 central_value(uint32_t channel, const glm::vec4* ref, uint32_t n) {
   return glm::vec4((glm::dvec4(lo) + glm::dvec4(hi)) * 0.5);
 }
 
-/// Greedy key removal on per-frame candidate key values `dec`: from each kept key, the furthest
-/// next key whose interpolation keeps every frame between them, and the points between frames
-/// (`ref_positions`: the reference at every position of kErrorSubdivisions per frame, as
-/// between_frames makes it), within tolerance. The points between frames matter where a channel
-/// turns fast: nlerp over a long span does not pass where two nlerps over its halves do (two
-/// keys 72 degrees apart put the quarter point 2 degrees from the midpoint of the first 36).
-std::vector<uint16_t> reduce_keys(const Metric& m, const glm::vec4* ref_positions, const glm::vec4* dec, uint32_t n,
-                                  double tolerance) {
+}  // namespace
+
+/// Greedy key removal on per-frame candidate key values (KeyFit::decoded): from each kept key, the
+/// furthest next key whose interpolation keeps every frame between them, and the points between
+/// frames (KeyFit::positions: the target at every position of kErrorSubdivisions per frame, as
+/// between_frames makes it), within tolerance, for every channel of `fits` at once. The points
+/// between frames matter where a channel turns fast: nlerp over a long span does not pass where two
+/// nlerps over its halves do (two keys 72 degrees apart put the quarter point 2 degrees from the
+/// midpoint of the first 36).
+std::vector<uint16_t> reduce_keys(std::span<const KeyFit> fits, uint32_t n) {
   constexpr uint32_t kSub = kErrorSubdivisions;
-  auto valid = [&](uint32_t a, uint32_t b) {
+  auto valid_one = [&](const KeyFit& fit, uint32_t a, uint32_t b) {
     const float inv_length = 1.0f / static_cast<float>(b - a);
     for (uint32_t p = a * kSub + 1; p < b * kSub; ++p) {
       const float x = static_cast<float>(p / kSub) + static_cast<float>(p % kSub) / static_cast<float>(kSub);
-      const glm::vec4 v = interpolate_keys(m.channel, dec[a], dec[b], (x - static_cast<float>(a)) * inv_length);
-      if (channel_error(m, ref_positions[p], v) > tolerance) return false;
+      const float alpha = (x - static_cast<float>(a)) * inv_length;
+      const glm::vec4 v = interpolate_keys(fit.metric.channel, fit.decoded[a], fit.decoded[b], alpha);
+      if (channel_error(fit.metric, fit.positions[p], v) > fit.tolerance) return false;
     }
+    return true;
+  };
+  auto valid = [&](uint32_t a, uint32_t b) {
+    for (const KeyFit& fit : fits)
+      if (!valid_one(fit, a, b)) return false;
     return true;
   };
   std::vector<uint16_t> keys{0};
@@ -124,6 +133,19 @@ std::vector<uint16_t> reduce_keys(const Metric& m, const glm::vec4* ref_position
   }
   return keys;
 }
+
+std::vector<glm::vec4> target_positions(uint32_t channel, const glm::vec4* target, uint32_t n) {
+  std::vector<glm::vec4> positions((n - 1) * kErrorSubdivisions + 1);
+  for (uint32_t p = 0; p < positions.size(); ++p) {
+    const uint32_t f = p / kErrorSubdivisions, k = p % kErrorSubdivisions;
+    positions[p] = k == 0 ? target[f]
+                          : interpolate_keys(channel, target[f], target[f + 1],
+                                             static_cast<float>(k) / static_cast<float>(kErrorSubdivisions));
+  }
+  return positions;
+}
+
+namespace {
 
 /// The component a rotation channel drops: the one whose smallest magnitude over the channel's
 /// frames is largest (sign-independent, so the same on any hemisphere choice). Rebuilding it
@@ -372,14 +394,12 @@ ChannelPlan encode_animated(const Metric& m, const glm::vec4* target, uint32_t n
   };
   // The target at every position between frames too, as the runtime would play it keyed at every
   // frame (what verification measures against).
-  std::vector<glm::vec4> target_positions((n - 1) * kErrorSubdivisions + 1);
-  for (uint32_t p = 0; p < target_positions.size(); ++p) {
-    const uint32_t f = p / kErrorSubdivisions, k = p % kErrorSubdivisions;
-    target_positions[p] = k == 0 ? target[f]
-                                 : interpolate_keys(m.channel, target[f], target[f + 1],
-                                                    static_cast<float>(k) / static_cast<float>(kErrorSubdivisions));
-  }
-  std::vector<uint16_t> raw_frames = reduce_keys(m, target_positions.data(), dec.data(), n, tolerance);
+  const std::vector<glm::vec4> positions = target_positions(m.channel, target, n);
+  auto reduce = [&] {
+    const KeyFit fit{m, positions.data(), dec.data(), tolerance};
+    return reduce_keys(std::span<const KeyFit>(&fit, 1), n);
+  };
+  std::vector<uint16_t> raw_frames = reduce();
   const size_t floor_keys = raw_frames.size();
   consider(kRawFloatBits, std::move(raw_frames));
 
@@ -394,8 +414,37 @@ ChannelPlan encode_animated(const Metric& m, const glm::vec4* target, uint32_t n
       dec[f] = decode_code(m.channel, plan.dropped, bits, plan.range_min, plan.range_extent, codes[f]);
       holds = channel_error(m, target[f], dec[f]) <= tolerance;
     }
-    if (holds && consider(bits, reduce_keys(m, target_positions.data(), dec.data(), n, tolerance))) plan.codes = codes;
+    if (holds && consider(bits, reduce())) plan.codes = codes;
   }
+  return plan;
+}
+
+ChannelPlan refit_animated(const Metric& m, const glm::vec4* target, uint32_t n, double tolerance, uint32_t bits,
+                           std::vector<uint16_t> frames) {
+  ChannelPlan plan;
+  plan.kind = Kind::Animated;
+  plan.bits = bits;
+  plan.frames = std::move(frames);
+  plan.dropped = m.channel == kRotation ? choose_dropped(target, n) : 0;
+  if (bits == kRawFloatBits) {
+    plan.codes = raw_codes(m.channel, plan.dropped, target, n);
+    return plan;
+  }
+  std::vector<glm::vec4> stored(n);
+  glm::vec4 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
+  for (uint32_t f = 0; f < n; ++f) {
+    stored[f] = stored_form(m.channel, plan.dropped, target[f]);
+    lo = glm::min(lo, stored[f]);
+    hi = glm::max(hi, stored[f]);
+  }
+  for (int c = 0; c < 3; ++c) {
+    plan.range_min[c] = lo[c];
+    plan.range_extent[c] = hi[c] - lo[c];
+  }
+  plan.codes.resize(n);
+  for (uint32_t f = 0; f < n; ++f)
+    plan.codes[f] = encode_quantized(m, target[f], stored[f], plan.dropped, bits, plan.range_min, plan.range_extent,
+                                     tolerance);
   return plan;
 }
 
@@ -418,6 +467,13 @@ void decode_plan(const ChannelPlan& plan, uint32_t channel, uint32_t n, const gl
     for (uint32_t f = f0; f <= f1; ++f) out[f] = interpolate_keys(channel, prev, next, static_cast<float>(f - f0) * inv_length);
     prev = next;
   }
+}
+
+std::vector<glm::vec4> decode_codes(const ChannelPlan& plan, uint32_t channel, uint32_t n) {
+  std::vector<glm::vec4> out(n);
+  for (uint32_t f = 0; f < n; ++f)
+    out[f] = decode_code(channel, plan.dropped, plan.bits, plan.range_min, plan.range_extent, plan.codes[f]);
+  return out;
 }
 
 }  // namespace ossa::cook::compress_detail

@@ -8,6 +8,7 @@
 
 #include <array>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "cooker/clip/clip_compress.h"
@@ -64,7 +65,46 @@ ChannelPlan classify_channel(const Metric& m, const glm::vec4* ref, uint32_t n, 
                              double tolerance);
 /// Step 5: keys and bits of an animated channel fitted to `target` (per frame) within tolerance.
 ChannelPlan encode_animated(const Metric& m, const glm::vec4* target, uint32_t n, double tolerance);
+/// One channel as key removal sees it: its metric, its target at every position between frames
+/// (target_positions), its candidate key value at every frame, and its budget.
+struct KeyFit {
+  Metric metric;
+  const glm::vec4* positions = nullptr;
+  const glm::vec4* decoded = nullptr;
+  double tolerance = 0.0;
+};
+/// Greedy key removal: the key frames (first 0, last n - 1) from which linear interpolation keeps
+/// every channel of `fits` within its budget at every position. One list for all of them: the
+/// list a group of channels shares (step 7) is made by the same function as each channel's own.
+std::vector<uint16_t> reduce_keys(std::span<const KeyFit> fits, uint32_t n);
+/// A channel's target at every position of kErrorSubdivisions per frame, as a runtime plays it.
+std::vector<glm::vec4> target_positions(uint32_t channel, const glm::vec4* target, uint32_t n);
+/// An animated plan's key at every frame (plan.codes), decoded.
+std::vector<glm::vec4> decode_codes(const ChannelPlan& plan, uint32_t channel, uint32_t n);
+/// An animated channel fitted to `target` with the bit count and key frames given (a list it
+/// shares), quantized at every frame as encode_animated does; the caller verifies the bound.
+ChannelPlan refit_animated(const Metric& m, const glm::vec4* target, uint32_t n, double tolerance, uint32_t bits,
+                           std::vector<uint16_t> frames);
 /// Every frame of a planned channel, decoded exactly as decode_clip decodes the packed bytes.
 void decode_plan(const ChannelPlan& plan, uint32_t channel, uint32_t n, const glm::vec4& bind, glm::vec4* out);
+
+// ---------------------------------------------------------------------------------------------
+// Step 7 (clip_compress_share.cpp)
+
+/// What key-list sharing needs of one animated channel: its metric and budget as last encoded
+/// and the target it was fitted to (every frame). `share` false: the channel keeps its own list.
+struct ShareInput {
+  bool share = false;
+  Metric metric;
+  double tolerance = 0.0;
+  const std::vector<glm::vec4>* target = nullptr;
+};
+
+/// Step 7: groups animated channels (plans[i], i = joint * 3 + channel) whose key lists can become
+/// one shared list, each channel within its own budget at every position, merging the pair of
+/// groups that saves the most bits first, while a merge saves bits. Rewrites the members' frames
+/// to their group's list and returns, per plan, whether it now shares its list with another.
+/// Deterministic. O(groups^2) key removals over the groups' channels; more than 512 groups: none.
+std::vector<bool> share_key_lists(std::vector<ChannelPlan>& plans, std::span<const ShareInput> inputs, uint32_t frames);
 
 }  // namespace ossa::cook::compress_detail

@@ -24,6 +24,7 @@
 #include <cstring>
 #include <filesystem>
 #include <map>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -473,6 +474,38 @@ const CompressedConstant* find_constant(const CompressedClip& c, uint16_t joint,
   for (const CompressedConstant& k : c.constants)
     if (k.joint == joint && k.channel == channel) return &k;
   return nullptr;
+}
+
+// Pab's crossarms: every animated channel drops keys, each on a list of its own unless step 7
+// shares them. A runtime tests one cursor per list at every sample (runtime/anim/sample.cpp).
+TEST(ClipCompressSharing, ChannelsShareKeyListsWithinTheBoundAndInFewerBytes) {
+  const fs::path dir = shared_assets() / "Pab";
+  if (!fs::exists(dir / "crossarms.fbx") || !fs::exists(dir / "skeleton.fbx"))
+    GTEST_SKIP() << "shared assets not found at " << shared_assets() << " (set OSSA_SHARED_ASSETS)";
+  auto rig = import_scene((dir / "skeleton.fbx").string());
+  ASSERT_TRUE(rig.ok()) << rig.error().message;
+  ImportOptions import_options;
+  import_options.reference = &rig->skeleton;
+  auto scene = import_scene((dir / "crossarms.fbx").string(), import_options);
+  ASSERT_TRUE(scene.ok()) << scene.error().message;
+  ASSERT_EQ(scene->clips.size(), 1u);
+  auto c = compress_clip(scene->clips[0], scene->skeleton, scene->metres_per_unit, ClipCompressionOptions{});
+  ASSERT_TRUE(c.ok()) << c.error().message;
+  expect_well_formed(*c);
+  EXPECT_LE(c->max_error, c->tolerance);
+  const Measured m = measure(scene->clips[0], *c, scene->skeleton);
+  EXPECT_LE(m.max, c->tolerance * 1.001);
+  std::set<uint32_t> lists;
+  uint32_t reduced = 0;
+  for (const CompressedAnimated& a : c->animated) {
+    lists.insert(a.first_key);
+    if (a.key_count < c->grid.frame_count) ++reduced;
+  }
+  // 56 channels, all with keys removed; each on its own list they took 31,763 bytes.
+  EXPECT_EQ(reduced, c->animated.size());
+  EXPECT_GE(c->animated.size(), 50u);
+  EXPECT_LE(lists.size(), c->animated.size() / 2) << c->animated.size() << " channels";
+  EXPECT_LT(c->cooked_bytes, 31763u);
 }
 
 TEST(ClipCompress, BindAndConstantChannelsAreStoredAsSuch) {
