@@ -81,7 +81,7 @@ MaterialItem compare_material(Context& c, const std::string& label, const fb::Ma
   const auto pbr_text = [](const fb::PbrFactors* p) {
     return p ? "metallic " + num(p->metallic()) + ", roughness " + num(p->roughness()) : std::string("none (Phong)");
   };
-  if (!a.pbr() != !b.pbr() || (a.pbr() && (std::fabs(a.pbr()->metallic() - b.pbr()->metallic()) > kParameterEpsilon ||
+  if ((a.pbr() == nullptr) != (b.pbr() == nullptr) || (a.pbr() && (std::fabs(a.pbr()->metallic() - b.pbr()->metallic()) > kParameterEpsilon ||
                                            std::fabs(a.pbr()->roughness() - b.pbr()->roughness()) > kParameterEpsilon)))
     changed("pbr", pbr_text(a.pbr()) + " -> " + pbr_text(b.pbr()));
   const auto &ta = item.old_textures, &tb = item.new_textures;
