@@ -61,7 +61,9 @@ ParsedOptions parse_options(int argc, const char* const* argv) {
   app.add_flag("--wireframe", o.wireframe, "wireframe overlay");
   app.add_flag("--skeleton", o.skeleton, "skeleton overlay");
   app.add_flag("--no-grid", no_grid, "no ground grid");
-  app.add_option("--yaw", o.yaw_degrees, "camera yaw in degrees (0: from +Z)");
+  app.add_option("--yaw", o.yaw_degrees, "camera yaw in degrees from the character's front (0: facing it)");
+  app.add_option("--front", o.front, "which way the character faces: auto (from its feet, bounds.h) or +z, -z, +x, -x")
+      ->check(CLI::IsMember({"auto", "+z", "-z", "+x", "-x"}));
   app.add_option("--pitch", o.pitch_degrees, "camera elevation in degrees")->check(CLI::Range(-89.0f, 89.0f));
   app.add_option("--size", size, "window / image size, WxH (default 1280x720)");
   app.add_option("--msaa", o.msaa, "multisampling (1: off)")->check(CLI::Range(1, 16));

@@ -2,7 +2,7 @@
 //
 //   ossa-view FILE.ossa [MORE.ossa ...] [--clip NAME] [--time T] [--speed S] [--paused]
 //             [--bind-pose] [--cpu-skinning] [--crowd N] [--wireframe] [--skeleton] [--no-grid]
-//             [--yaw DEG] [--pitch DEG] [--size WxH] [--msaa N]
+//             [--yaw DEG] [--pitch DEG] [--front auto|+z|-z|+x|-x] [--size WxH] [--msaa N]
 //             [--frames N] [--screenshot OUT.png] [--first-frame-time] [--stats]
 //             [--window-frames N] [--graph NAME [--set|--param PARAM=VALUE ...] [--show-procedural]
 //              [--montage NAME[@T] [--montage-next SECTION=NEXT[@T]] [--montage-jump SECTION[@T]]]]
@@ -12,6 +12,8 @@
 //             [-q | -v] [--version] [--help]
 //   ossa-view [--browse DIR] [--cook-and-open SOURCE ...] [...]     (the window, no file yet)
 //
+// --yaw turns the camera from the character's front: auto-detected from its feet (bounds.h
+// facing_of; +Z when they do not tell), or named with --front.
 // With --frames or --screenshot the viewer runs headless (hidden window, offscreen framebuffer):
 // it renders N frames 1/60 s apart ending at --time, writes the last one as a PNG, and exits.
 // --window-frames N runs the window mode (panel included) for N frames and exits, writing the
@@ -75,7 +77,8 @@ struct ViewerOptions {
   bool wireframe = false;
   bool skeleton = false;
   bool grid = true;
-  float yaw_degrees = 30.0f;
+  float yaw_degrees = 30.0f;     // from the character's front (--front)
+  std::string front = "auto";   // --front: auto (bounds.h facing_of) or +z, -z, +x, -x
   float pitch_degrees = 10.0f;
   int width = 1280;
   int height = 720;

@@ -3,6 +3,7 @@
 
 #include "viewer/montage_control.h"
 
+#include <cmath>
 #include <cstdio>
 #include <utility>
 
@@ -15,6 +16,7 @@ namespace ossa::view {
 void apply_view_options(App& app, const ViewerOptions& o) {
   app.angles.yaw = glm::radians(o.yaw_degrees);
   app.angles.pitch = glm::radians(o.pitch_degrees);
+  app.front = o.front;
   app.toggles.cpu_skinning = o.cpu_skinning;
   app.toggles.wireframe = o.wireframe;
   app.toggles.skeleton = o.skeleton;
@@ -38,6 +40,10 @@ Status setup_app(App& app, Scene scene, const ViewerOptions& o, float aspect) {
     std::fprintf(stderr, "ossa-view: %s: %zu joints, %zu meshes, %zu vertices, %zu triangles; %zu clips from %zu files\n",
                  name.c_str(), c.joints, c.meshes, c.vertices, c.triangles, app.scene.clips.size(),
                  app.scene.assets.size());
+    const char* why = app.facing.from_feet ? "from the feet" : o.front == "auto" ? "the feet do not tell: glTF's +z" : "--front";
+    std::fprintf(stderr, "ossa-view: front: %s (%s, lopsided by %.3f of the height); camera yaw %.0f deg\n",
+                 axis_name(app.facing.forward), why, app.facing.evidence,
+                 std::remainder(glm::degrees(app.facing.yaw + app.angles.yaw), 360.0f));
   }
 
   if (!o.clip.empty()) {
