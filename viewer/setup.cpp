@@ -79,6 +79,16 @@ Status setup_app(App& app, Scene scene, const ViewerOptions& o, float aspect) {
     if (Status s = set_retarget(app, o.retarget_from, o.retarget_map, o.retarget_clip, aspect); !s) return s;
     set_time(app.retarget->source, app.retarget->animator, o.time);
   }
+  if (o.move != 0.0f || !o.turn.empty()) {  // --move / --turn: the character's motion through the world
+    Drive& d = app.animator.drive;
+    const float metres = app.scene.character().file().metres_per_unit();
+    d.speed = o.move / (metres > 0.0f ? metres : 1.0f);
+    d.forward = app.facing.forward;
+    if (const auto turn = parse_turn(o.turn)) {
+      d.turn_rate = glm::radians(turn->first);
+      d.turn_after = turn->second;
+    }
+  }
   Playback& p = app.animator.playback;
   p.bind_pose = o.bind_pose;
   p.speed = o.speed;
