@@ -180,6 +180,10 @@ Status set_crowd(App& app, size_t crowd, float aspect) {
     }
   }
   app.crowd = crowd == 0 ? 1 : crowd;
+  Drive drive = app.animator.drive;  // --move / --turn carry over; the journey starts again
+  drive.clock = drive.heading = 0.0f;
+  drive.position = glm::vec3(0.0f);
+  drive.world = glm::mat4(1.0f);
   app.animator = make_animator(app.scene, app.crowd);
   {
     Result<ViewerCloth> cloth = make_viewer_cloth(app.scene, app.crowd);
@@ -199,6 +203,8 @@ Status set_crowd(App& app, size_t crowd, float aspect) {
   const Box one = posed_bounds(app.scene.character(), a.instances.front().model);
   app.bind_box = one;
   app.facing = facing_from(app.front, app.scene.character(), a.instances.front().model);
+  drive.forward = app.facing.forward;
+  a.drive = drive;
   app.offsets = crowd_offsets(app.crowd, one);
   app.framing = Box{};
   for (const glm::vec3& o : app.offsets) {

@@ -108,6 +108,30 @@ void morph_panel(App& app) {
 
 void cloth_panel(App& app);
 
+/// The character's motion through the world (animation.h Drive, --move / --turn): a speed along
+/// its front and a turn rate, as a game moves a character playing an in-place clip; the cloth
+/// feels both. "back to the start" puts it where it began.
+void drive_panel(App& app) {
+  Drive& d = app.animator.drive;
+  if (app.scene.assets.empty()) return;
+  const float metres = std::max(app.scene.character().file().metres_per_unit(), 1e-6f);
+  float move = d.speed * metres, turn = d.turn_rate * 57.29578f;
+  if (ImGui::SliderFloat("move m/s", &move, -8.0f, 8.0f, "%.1f")) d.speed = move / metres;
+  if (ImGui::SliderFloat("turn deg/s", &turn, -180.0f, 180.0f, "%.0f")) {
+    d.turn_rate = turn / 57.29578f;
+    d.turn_after = std::min(d.turn_after, d.clock);  // from now on
+  }
+  if (d.active() || d.clock > 0.0f) {
+    if (ImGui::Button("back to the start")) {
+      d.clock = d.heading = 0.0f;
+      d.position = glm::vec3(0.0f);
+      d.world = glm::mat4(1.0f);
+      d.speed = d.turn_rate = 0.0f;
+      reset_viewer_cloth(app.cloth);
+    }
+  }
+}
+
 void view_panel(App& app, UiState& ui, float aspect) {
   ImGui::Checkbox("skeleton (K)", &app.toggles.skeleton);
   ImGui::SameLine();
@@ -119,6 +143,7 @@ void view_panel(App& app, UiState& ui, float aspect) {
   ImGui::Checkbox("follow character", &app.follow);
   ImGui::SameLine();
   if (ImGui::Button("frame (R)")) frame_camera(app, aspect);
+  drive_panel(app);
   int crowd = static_cast<int>(app.crowd);
   if (ImGui::SliderInt("crowd", &crowd, 1, 256) && crowd != static_cast<int>(app.crowd)) {
     if (Status s = set_crowd(app, static_cast<size_t>(crowd), aspect); !s) ui.status = s.message();
@@ -364,8 +389,9 @@ struct Section {
 /// The labels drawn right of the panel's widgets: the fixed ones, the graph's parameters and the
 /// morph channels, whose widest decides how much room every widget leaves (panel_fit.h label_room).
 std::vector<std::string> panel_labels(const App& app) {
-  std::vector<std::string> labels = {"time", "speed", "cross-fade", "crowd", "wind m/s", "stiffness", "ground tilt",
-                                     "ground height left", "ground height right"};
+  std::vector<std::string> labels = {"time",        "speed",       "cross-fade",         "crowd",
+                                     "wind m/s",    "stiffness",   "ground tilt",        "ground height left",
+                                     "ground height right", "move m/s", "turn deg/s"};
   if (app.animator.graph && app.animator.graph->definition) {
     const GraphDefinition& d = *app.animator.graph->definition;
     for (size_t i = 0; i < d.parameter_count(); ++i) labels.emplace_back(d.parameter_name(i));

@@ -17,6 +17,7 @@
 
 #include "viewer/animation.h"
 #include "viewer/cloth_view.h"
+#include "viewer/options.h"
 #include "viewer/scene.h"
 #include "viewer_unit_common.h"
 
@@ -109,4 +110,38 @@ TEST(ViewerDrive, ClothReceivesTheTurningWorldTransform) {
   for (size_t i = 0; i < turning.particles.size(); ++i)
     most = std::max(most, glm::distance(turning.particles[i], still.particles[i]) * unit);
   EXPECT_GT(most, 0.02f) << "the cape did not react to the turn (metres)";
+}
+
+TEST(ViewerDrive, TurnOptionParses) {
+  EXPECT_EQ(parse_turn("90"), std::make_pair(90.0f, 0.0f));
+  EXPECT_EQ(parse_turn("-45@1.5"), std::make_pair(-45.0f, 1.5f));
+  EXPECT_FALSE(parse_turn(""));
+  EXPECT_FALSE(parse_turn("fast"));
+  EXPECT_FALSE(parse_turn("90@"));
+  EXPECT_FALSE(parse_turn("90@-1"));
+  EXPECT_FALSE(parse_turn("9000"));
+  EXPECT_FALSE(parse_turn("nan"));
+}
+
+// The path: straight along the front until the turn starts, then a circle of radius speed / rate;
+// the same at 30 and 144 Hz (1/240 s steps inside).
+TEST(ViewerDrive, PathIsTheSameAtAnyFrameRate) {
+  const auto drive_at = [](float hz) {
+    Drive d;
+    d.speed = 2.0f;
+    d.turn_rate = glm::half_pi<float>();
+    d.turn_after = 1.0f;
+    d.forward = glm::vec3(1.0f, 0.0f, 0.0f);
+    const int frames = static_cast<int>(std::lround(3.0f * hz));
+    for (int k = 0; k < frames; ++k) advance_drive(d, 1.0f / hz);
+    return d;
+  };
+  const Drive a = drive_at(30.0f), b = drive_at(144.0f);
+  EXPECT_NEAR(a.heading, glm::pi<float>(), 1e-3f) << "2 s of a quarter turn per second";
+  EXPECT_NEAR(glm::distance(a.position, b.position), 0.0f, 5e-3f);  // measured 1.1 mm over the 6 m path
+  // 2 m straight along +x, then a half circle of radius 4 / pi turning towards -z (+Y rotation of +x).
+  const float r = 2.0f / glm::half_pi<float>();
+  EXPECT_NEAR(a.position.x, 2.0f, 2e-2f);
+  EXPECT_NEAR(a.position.z, -2.0f * r, 2e-2f);
+  EXPECT_NEAR(a.world[3][0], a.position.x, 1e-6f);
 }
