@@ -6,6 +6,8 @@
 #include <cmath>
 #include <utility>
 
+#include <glm/gtc/matrix_transform.hpp>
+
 #include <ossa/anim/morph.h>
 #include <ossa/anim/pose_ops.h>
 
@@ -93,9 +95,24 @@ float loop_time(float time, float lo, float hi) {
 
 float clip_duration(const Scene& scene, const Animator& animator) { return duration_of(scene, animator.playback.clip); }
 
+void advance_drive(Drive& d, float played) {
+  if (!d.active() || !(played > 0.0f)) return;
+  constexpr float kStep = 1.0f / 240.0f;
+  for (float left = played; left > 0.0f; left -= kStep) {
+    const float h = std::min(left, kStep);
+    const float turning = std::clamp(d.clock + h - d.turn_after, 0.0f, h);  // the part of the step after turn_after
+    d.heading += d.turn_rate * turning;
+    const glm::vec3 ahead = glm::vec3(glm::rotate(glm::mat4(1.0f), d.heading, glm::vec3(0, 1, 0)) * glm::vec4(d.forward, 0.0f));
+    d.position += ahead * (d.speed * h);
+    d.clock += h;
+  }
+  d.world = glm::rotate(glm::translate(glm::mat4(1.0f), d.position), d.heading, glm::vec3(0, 1, 0));
+}
+
 void advance(const Scene& scene, Animator& animator, float dt) {
   Playback& p = animator.playback;
   if (!p.playing) return;
+  advance_drive(animator.drive, (animator.graph && animator.use_graph) ? dt : dt * std::fabs(p.speed));
   if (animator.graph && animator.use_graph && !p.bind_pose) animator.graph_dt += dt * std::max(p.speed, 0.0f);
   if (p.clip >= 0) {
     const float duration = duration_of(scene, p.clip);
@@ -208,7 +225,11 @@ void compute_model_poses(const Scene& scene, Animator& animator, PoseTimings& ti
   if (scene.joint_count() == 0) return;
   const auto t0 = Clock::now();
   const auto parents = scene.skeleton().parents();
-  for (AnimInstance& inst : animator.instances) local_to_model(parents, inst.local, inst.model);
+  for (AnimInstance& inst : animator.instances) {
+    local_to_model(parents, inst.local, inst.model);
+    if (animator.drive.active())
+      for (glm::mat4& m : inst.model) m = animator.drive.world * m;
+  }
   timings.blend_ms += ms_since(t0);
 }
 

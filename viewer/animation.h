@@ -62,8 +62,29 @@ struct MorphOverrides {
   std::vector<float> value;
 };
 
+/// The character's own motion through the world (--move, --turn): what a game does with an
+/// in-place clip, moving and turning the character's world transform as the clip plays. `world`
+/// (a turn about +Y through the model's origin, then the distance travelled) is applied to every
+/// instance's model matrices by compute_model_poses, so the drawing, the overlays and the camera's
+/// follow all see it, and the cloth (cloth_view.h) receives it as its model-to-world transform.
+struct Drive {
+  float speed = 0.0f;       // model units per second along the heading
+  float turn_rate = 0.0f;   // radians per second about +Y, once `turn_after` seconds have played
+  float turn_after = 0.0f;
+  glm::vec3 forward{0.0f, 0.0f, 1.0f};  // the character's front (bounds.h facing_of)
+  float clock = 0.0f;       // seconds played
+  float heading = 0.0f;     // radians turned so far
+  glm::vec3 position{0.0f}; // distance travelled, model units
+  glm::mat4 world{1.0f};    // translate(position) * rotate(heading about +Y)
+  bool active() const { return speed != 0.0f || turn_rate != 0.0f; }
+};
+/// Moves the drive on by `played` seconds (in 1/240 s steps, so the path does not depend on the
+/// frame rate beyond that) and updates its world transform.
+void advance_drive(Drive& drive, float played);
+
 struct Animator {
   Playback playback;
+  Drive drive;                         // --move / --turn: the character's motion through the world
   std::vector<AnimInstance> instances;
   std::unique_ptr<GraphDriver> graph;  // --graph: one graph instance per AnimInstance
   bool use_graph = false;              // the graph drives the poses (else the clip list does)

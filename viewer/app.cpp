@@ -28,6 +28,50 @@ std::vector<glm::vec3> crowd_offsets(size_t n, const Box& one) {
   return out;
 }
 
+/// The character's front: --front's axis, or found from its feet in the bind pose.
+Facing facing_from(const std::string& front, const Asset& asset, std::span<const glm::mat4> model) {
+  if (front == "auto" || front.size() != 2) return facing_of(asset, model);
+  Facing f;
+  const float sign = front[0] == '-' ? -1.0f : 1.0f;
+  f.forward = front[1] == 'x' ? glm::vec3(sign, 0.0f, 0.0f) : glm::vec3(0.0f, 0.0f, sign);
+  f.yaw = std::atan2(f.forward.x, f.forward.z);
+  return f;
+}
+
+/// Poses sampled over the clip for framing: enough that a limb's sweep between two samples is
+/// small next to the character, few enough to cost tens of milliseconds on the largest sample
+/// (one CPU skin each, bounds.h) when the camera is framed, never per frame.
+constexpr int kFramingSamples = 48;
+
+/// The character over its whole clip, each sample's box moved by the root's horizontal travel
+/// since the bind pose taken back (so a walk that leaves the origin is framed in place; following
+/// the root moves the camera with it). Empty when no clip plays (bind pose, a graph: graphs
+/// cannot seek). Playback is left as it was; the poses are not (the caller poses again).
+Box clip_motion_bounds(App& app) {
+  Animator& a = app.animator;
+  Playback& p = a.playback;
+  const float duration = clip_duration(app.scene, a);
+  if ((a.graph && a.use_graph) || p.clip < 0 || p.bind_pose || !(duration > 0.0f) || a.instances.empty()) return {};
+  const Playback saved = p;
+  p.fade = 1.0f;  // the selected clip alone, not a cross-fade in progress
+  PoseTimings ignored;
+  Box box;
+  for (int k = 0; k < kFramingSamples; ++k) {
+    p.time = duration * static_cast<float>(k) / static_cast<float>(kFramingSamples - 1);
+    produce_local_poses(app.scene, a, ignored);
+    compute_model_poses(app.scene, a, ignored);
+    const auto& model = a.instances.front().model;
+    const Box b = posed_bounds(app.scene.character(), model);
+    if (b.empty()) continue;
+    glm::vec3 travel = model.empty() ? glm::vec3(0.0f) : glm::vec3(model[0][3]) - app.root_bind;
+    travel.y = 0.0f;
+    box.add(b.min - travel);
+    box.add(b.max - travel);
+  }
+  p = saved;
+  return box;
+}
+
 }  // namespace
 
 void frame_camera(App& app, float aspect) {
@@ -36,11 +80,19 @@ void frame_camera(App& app, float aspect) {
     // One character: frame it as it is drawn now (the shown clip time, or the bind pose).
     Animator& a = app.animator;
     PoseTimings ignored;
+    // The whole clip's motion (issue 28: a wing or an arm that reaches out late left the image).
+    const Box motion = app.retarget ? Box{} : clip_motion_bounds(app);
     produce_local_poses(app.scene, a, ignored);
     if (app.retarget) retarget_poses(*app.retarget, a, app.bind_box, 0.0f);
     compute_model_poses(app.scene, a, ignored);
     const auto& model = a.instances.front().model;
     Box shown = posed_bounds(app.scene.character(), model);
+    if (!motion.empty()) {
+      glm::vec3 travel = model.empty() ? glm::vec3(0.0f) : glm::vec3(model[0][3]) - app.root_bind;
+      travel.y = 0.0f;
+      shown.add(motion.min + travel);
+      shown.add(motion.max + travel);
+    }
     // The source as first shown (the same box at any clip time, so --time moves only the figures).
     if (app.retarget && app.retarget->framing.empty()) app.retarget->framing = source_bounds(*app.retarget);
     if (app.retarget && app.retarget->show_source) shown.add(app.retarget->framing);
@@ -55,7 +107,7 @@ void frame_camera(App& app, float aspect) {
     set_grid(app.renderer, ground, ground.empty() ? 0.0f : ground.min.y,
              ground.empty() ? 1.0f : 0.5f * glm::length(ground.size()));
   }
-  app.camera = frame_box(app.framing, app.angles.yaw, app.angles.pitch, aspect);
+  app.camera = frame_box(app.framing, app.facing.yaw + app.angles.yaw, app.angles.pitch, aspect);
   // The framing already holds the root where it is now: following starts from here.
   app.follow_applied = moved;
 }
@@ -128,6 +180,10 @@ Status set_crowd(App& app, size_t crowd, float aspect) {
     }
   }
   app.crowd = crowd == 0 ? 1 : crowd;
+  Drive drive = app.animator.drive;  // --move / --turn carry over; the journey starts again
+  drive.clock = drive.heading = 0.0f;
+  drive.position = glm::vec3(0.0f);
+  drive.world = glm::mat4(1.0f);
   app.animator = make_animator(app.scene, app.crowd);
   {
     Result<ViewerCloth> cloth = make_viewer_cloth(app.scene, app.crowd);
@@ -146,6 +202,9 @@ Status set_crowd(App& app, size_t crowd, float aspect) {
   compute_model_poses(app.scene, a, ignored);
   const Box one = posed_bounds(app.scene.character(), a.instances.front().model);
   app.bind_box = one;
+  app.facing = facing_from(app.front, app.scene.character(), a.instances.front().model);
+  drive.forward = app.facing.forward;
+  a.drive = drive;
   app.offsets = crowd_offsets(app.crowd, one);
   app.framing = Box{};
   for (const glm::vec3& o : app.offsets) {

@@ -25,7 +25,7 @@
 namespace ossa::view {
 
 struct CameraAngles {
-  float yaw = 0.5235988f;   // 30 degrees: a three-quarter view of a character facing +Z
+  float yaw = 0.5235988f;   // 30 degrees from the character's front: a three-quarter view
   float pitch = 0.1745329f; // 10 degrees above
 };
 
@@ -34,7 +34,9 @@ struct App {
   Renderer renderer;
   Animator animator;
   OrbitCamera camera;
-  CameraAngles angles;
+  CameraAngles angles;             // from the character's front (facing): yaw 0 looks at its face
+  Facing facing;                   // which way the character faces (bounds.h), found when it is opened
+  std::string front = "auto";      // --front: auto, or the axis it faces ("+z", "-z", "+x", "-x")
   ViewToggles toggles;
   std::vector<glm::vec3> offsets;  // instance placements (crowd grid), one per instance
   Box framing;                     // what the camera frames: one character as shown, a crowd in its bind pose
@@ -66,8 +68,10 @@ Status set_crowd(App& app, size_t crowd, float aspect);
 /// added to the current character.
 Status open_or_add(App& app, std::span<const std::string> paths, float aspect);
 
-/// Points the camera at app.framing from app.angles. One character (crowd 1) is first re-framed
-/// as it is shown now: its skinned vertices at the current clip time or graph pose (bounds.h).
+/// Points the camera at app.framing from app.angles (turned by app.facing). One character (crowd 1)
+/// is first re-framed on its skinned vertices (bounds.h) over the whole clip (48 poses, each moved
+/// back by the root's travel, then placed where the root is now), plus the pose shown now (a graph
+/// pose: graphs cannot seek).
 void frame_camera(App& app, float aspect);
 
 /// Instantiates graph `name` (graph_driver.h) for every instance and lets it drive the poses.

@@ -44,4 +44,22 @@ Box posed_bounds(const Asset& asset, std::span<const glm::mat4> model);
 /// Box of the joint positions of a posed skeleton (model matrices' translations). O(joints).
 Box joint_bounds(std::span<const glm::mat4> model);
 
+/// Which way a character faces, read from its skinned vertices in a pose (the bind pose), in the
+/// model's Y-up space. The feet point forward: the vertices in the lowest 10 % of the height (feet,
+/// shoes, paws) reach further forward than those of the next 25 % (shins, the legs above the
+/// paws) reach backward, while sideways they are symmetric. The axis of the four horizontal ones
+/// (+Z, -Z, +X, -X) along which the foot band's extent is most lopsided, relative to the band
+/// above, is the front; when no axis stands out (lopsided by less than 1.5 % of the height:
+/// a ball, a figure without feet) it is +Z, glTF's convention (and most exporters' "forward").
+/// A skeleton without a mesh (a BVH capture) is judged by its joints the same way.
+struct Facing {
+  glm::vec3 forward{0.0f, 0.0f, 1.0f};  // unit, one of the four horizontal axes
+  float yaw = 0.0f;                     // radians about +Y from +Z to `forward`
+  float evidence = 0.0f;                // the lopsidedness found along `forward`, in units of the height
+  bool from_feet = false;               // false: the +Z default
+};
+Facing facing_of(const Asset& asset, std::span<const glm::mat4> model);
+/// "+z", "-z", "+x" or "-x".
+const char* axis_name(glm::vec3 forward);
+
 }  // namespace ossa::view

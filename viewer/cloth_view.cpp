@@ -76,6 +76,7 @@ Result<ViewerCloth> make_viewer_cloth(const Scene& scene, size_t instances) {
   std::stable_sort(out.sims.begin(), out.sims.end(),
                    [](const ClothSim& a, const ClothSim& b) { return a.instance < b.instance; });
   out.palette.resize(slots);
+  out.own_model.resize(scene.joint_count());
   out.positions.resize(particles);
   out.normals.resize(particles);
   return out;
@@ -85,12 +86,21 @@ Status step_viewer_cloth(ViewerCloth& cloth, const Scene& scene, const Animator&
                          std::span<const std::vector<glm::mat4>> bind, std::span<const glm::vec3> offsets, float dt) {
   if (!cloth.enabled || cloth.sims.empty()) return {};
   const Asset& character = scene.character();
+  const bool driven = animator.drive.active();
+  cloth.world = driven ? animator.drive.world : glm::mat4(1.0f);
+  const glm::mat4 unworld = glm::inverse(cloth.world);
   for (ClothSim& sim : cloth.sims) {
     if (sim.instance >= animator.instances.size() || sim.mesh >= bind.size()) continue;
     const AnimInstance& inst = animator.instances[sim.instance];
+    // The character's own space: the drawn model matrices without its motion through the world.
+    std::span<const glm::mat4> model = inst.model;
+    if (driven && cloth.own_model.size() >= inst.model.size()) {
+      for (size_t j = 0; j < inst.model.size(); ++j) cloth.own_model[j] = unworld * inst.model[j];
+      model = std::span<const glm::mat4>(cloth.own_model.data(), inst.model.size());
+    }
     const MeshView mesh = character.mesh(sim.mesh);
     const std::span<glm::mat4> palette(cloth.palette.data(), mesh.joints().size());
-    skinning_matrices(mesh.joints(), bind[sim.mesh], inst.model, palette);
+    skinning_matrices(mesh.joints(), bind[sim.mesh], model, palette);
     const size_t n = sim.state.particle_count();
     const std::span<glm::vec3> pos(cloth.positions.data(), n), nrm(cloth.normals.data(), n);
     if (Status s = skin_cloth_particles(sim.state.source, mesh, palette, pos, nrm); !s) return s;
@@ -103,7 +113,7 @@ Status step_viewer_cloth(ViewerCloth& cloth, const Scene& scene, const Animator&
     live.stretch_compliance = cooked.stretch_compliance / k;
     live.bend_compliance = cooked.bend_compliance / k;
 
-    const glm::vec3 root = inst.model.empty() ? glm::vec3(0.0f) : glm::vec3(inst.model[0][3]);
+    const glm::vec3 root = inst.model.empty() ? glm::vec3(0.0f) : glm::vec3(inst.model[0][3]);  // as drawn
     if (cooked.teleport_distance > 0.0f && glm::distance(root, sim.last_root) > cooked.teleport_distance)
       reset_cloth(sim.state);
     sim.last_root = root;
@@ -111,9 +121,9 @@ Status step_viewer_cloth(ViewerCloth& cloth, const Scene& scene, const Animator&
     ClothInput in;
     in.skinned_positions = pos;
     in.skinned_normals = nrm;
-    in.model = inst.model;
+    in.model = model;
     const glm::vec3 o = sim.instance < offsets.size() ? offsets[sim.instance] : glm::vec3(0.0f);
-    in.model_to_world = glm::translate(glm::mat4(1.0f), o);
+    in.model_to_world = glm::translate(glm::mat4(1.0f), o) * cloth.world;
     in.dt = dt;
     if (Status s = update_cloth(sim.state, in); !s)
       return Error{scene.paths.front() + ": cloth of mesh " + std::to_string(sim.mesh) + ": " + s.message()};
@@ -134,12 +144,13 @@ void build_cloth_overlay(const ViewerCloth& cloth, const Animator& animator, std
     const std::span<const glm::vec3> p = sim.state.positions();
     if (p.size() != sim.state.particle_count()) continue;  // not updated yet
     const ClothSource& src = sim.state.source;
-    for (const fb::ClothEdge& e : src.stretch) line(out.on_top, p[e.a()] + o, p[e.b()] + o, kEdge);
+    const auto at = [&](size_t i) { return glm::vec3(cloth.world * glm::vec4(p[i], 1.0f)) + o; };  // as drawn
+    for (const fb::ClothEdge& e : src.stretch) line(out.on_top, at(e.a()), at(e.b()), kEdge);
     const float s = 0.006f;
     for (size_t i = 0; i < p.size(); ++i) {
       const glm::vec4 c = src.inverse_masses[i] == 0.0f ? kFixed : kFree;
-      line(out.on_top, p[i] + o - glm::vec3(s, 0, 0), p[i] + o + glm::vec3(s, 0, 0), c);
-      line(out.on_top, p[i] + o - glm::vec3(0, s, 0), p[i] + o + glm::vec3(0, s, 0), c);
+      line(out.on_top, at(i) - glm::vec3(s, 0, 0), at(i) + glm::vec3(s, 0, 0), c);
+      line(out.on_top, at(i) - glm::vec3(0, s, 0), at(i) + glm::vec3(0, s, 0), c);
     }
     const auto& model = animator.instances[sim.instance].model;
     for (const fb::ClothCollider& c : src.colliders) {

@@ -4,9 +4,11 @@
 // One ClothInstance per (crowd instance, mesh with cloth), made when the scene or the crowd changes,
 // never per frame. Each frame, after the poses: the cloth particles' skinned positions come from
 // skin_cloth_particles with the instance's palette in model space (no crowd offset), and
-// update_cloth advances them with the joints' model matrices (colliders) and the crowd placement as
-// the model-to-world transform. The renderer then draws a cloth mesh from CPU-skinned streams with
-// the particles written over them (write_cloth_vertices), on both skinning paths: the GPU path
+// update_cloth advances them with the joints' model matrices (colliders) and the crowd placement,
+// after the character's own motion through the world (--move / --turn, animation.h Drive), as the
+// model-to-world transform. The renderer then draws a cloth mesh from CPU-skinned streams with
+// the particles written over them (write_cloth_vertices, then `world` and the crowd placement
+// applied), on both skinning paths: the GPU path
 // skins every other mesh in its vertex shader. A root that jumps further than the cloth's teleport
 // distance in one frame (a looping clip with root motion) restarts that cloth from the skinned pose,
 // as ClothInstance does for a jump of the world transform.
@@ -38,7 +40,12 @@ struct ViewerCloth {
   bool enabled = true;                // --cloth off / the panel: meshes drawn as skinned
   glm::vec3 wind{0.0f};               // metres per second, world space (the panel, --wind)
   float stiffness = 1.0f;             // scales the cooked compliances down (1: as cooked)
+  // The character's motion through the world (animation.h Drive) at the last step: the drawn
+  // model matrices hold it; the simulation runs without it in the character's own space and
+  // receives it in its model-to-world transform, so a turn swings the cape.
+  glm::mat4 world{1.0f};
   std::vector<glm::mat4> palette;     // scratch, sized once
+  std::vector<glm::mat4> own_model;   // scratch: the model matrices without `world`, one per joint
   std::vector<glm::vec3> positions, normals;
 
   bool empty() const { return sims.empty(); }

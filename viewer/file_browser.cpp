@@ -1,5 +1,6 @@
 // file_browser.cpp — see file_browser.h.
 #include "viewer/file_browser.h"
+#include "viewer/panel_fit.h"
 
 #include <algorithm>
 #include <cctype>
@@ -81,7 +82,7 @@ fs::path start_folder(const std::vector<std::string>& files, const fs::path& cwd
   return cwd;
 }
 
-std::optional<fs::path> browser_panel(FileBrowser& browser) {
+std::optional<fs::path> browser_panel(FileBrowser& browser, float* hidden) {
   std::optional<fs::path> chosen;
   ImGui::TextWrapped("%s", browser.folder.string().c_str());
   if (ImGui::SmallButton("Up") && browser.folder.has_parent_path() && browser.folder.parent_path() != browser.folder)
@@ -91,8 +92,8 @@ std::optional<fs::path> browser_panel(FileBrowser& browser) {
   ImGui::SameLine();
   ImGui::TextDisabled("%zu entries", browser.entries.size());
   if (!browser.error.empty()) ImGui::TextColored(ImVec4(1.0f, 0.4f, 0.4f, 1.0f), "%s", browser.error.c_str());
-  const float rows = std::clamp(static_cast<float>(browser.entries.size()) + 1.5f, 3.0f, 12.0f);
-  if (ImGui::BeginListBox("##files", ImVec2(-1.0f, rows * ImGui::GetTextLineHeightWithSpacing()))) {
+  const float rows = static_cast<float>(browser.entries.size()) + 1.5f;  // [..] and a half row of margin
+  if (ImGui::BeginListBox("##files", ImVec2(-1.0f, fill_list_height(rows, 0.0f, hidden)))) {
     std::optional<fs::path> into;  // browsed after the loop: the listing is not changed while drawn
     if (ImGui::Selectable("[..]")) into = browser.folder.parent_path();
     for (const BrowserEntry& e : browser.entries) {

@@ -50,6 +50,8 @@ std::filesystem::path start_folder(const std::vector<std::string>& files, const 
 
 /// Draws the browser (inside the panel). Returns the file clicked this frame (an .ossa to open
 /// or a source to cook); a click on a folder or ".." browses into it.
-std::optional<std::filesystem::path> browser_panel(FileBrowser& browser);
+/// The list fills the height the panel's section has left (panel_fit.h fill_list_height); the rows
+/// it cannot show are added to `*hidden`.
+std::optional<std::filesystem::path> browser_panel(FileBrowser& browser, float* hidden);
 
 }  // namespace ossa::view

@@ -192,6 +192,17 @@ void apply_ui_scale(float scale, float fb_per_window, bool remake_texture) {
   }
 }
 
+/// -v's account of the captured frame's panel (panel_fit.h): every region's rectangle, then each
+/// widget cut off, then a summary line the tests look for.
+void print_panel_audit(const PanelAudit& a) {
+  for (const PanelRegion& r : a.regions)
+    std::fprintf(stderr, "ossa-view: panel region %s: %.0f %.0f %.0f %.0f in panel %.0f %.0f %.0f %.0f\n", r.name.c_str(),
+                 r.rect.x, r.rect.y, r.rect.width, r.rect.height, a.panel.x, a.panel.y, a.panel.width, a.panel.height);
+  const std::vector<std::string> problems = a.problems();
+  for (const std::string& p : problems) std::fprintf(stderr, "ossa-view: panel cut off: %s\n", p.c_str());
+  std::fprintf(stderr, "ossa-view: panel check: %zu regions, %zu cut off\n", a.regions.size(), problems.size());
+}
+
 }  // namespace
 
 int run_interactive(const ViewerOptions& o) {
@@ -325,6 +336,7 @@ int run_interactive(const ViewerOptions& o) {
         std::fprintf(stderr, "ossa-view: layout: panel %.0f, scene %.0f %.0f %.0f %.0f, timeline %.0f (window %dx%d, framebuffer %dx%d)\n",
                      panel_width(ui), l.scene.x, l.scene.y, l.scene.width, l.scene.height, l.timeline.height, win_width,
                      win_height, fb_width, fb_height);
+      if (o.verbose && ui.panel_open) print_panel_audit(ui.audit);
       if (!o.screenshot.empty()) {
         glReadBuffer(GL_BACK);
         if (Status s = write_png(o.screenshot, fb_width, fb_height, read_framebuffer_rgb(fb_width, fb_height)); !s) {

@@ -25,6 +25,20 @@ std::optional<std::pair<int, int>> parse_size(const std::string& text) {
   return std::make_pair(w, h);
 }
 
+std::optional<std::pair<float, float>> parse_turn(const std::string& text) {
+  const size_t at = text.find('@');
+  const auto number = [](std::string_view t) -> std::optional<float> {
+    float v = 0.0f;
+    const auto r = std::from_chars(t.data(), t.data() + t.size(), v);
+    if (t.empty() || r.ec != std::errc() || r.ptr != t.data() + t.size() || !std::isfinite(v)) return std::nullopt;
+    return v;
+  };
+  const auto rate = number(std::string_view(text).substr(0, at));
+  const auto after = at == std::string::npos ? std::optional<float>(0.0f) : number(std::string_view(text).substr(at + 1));
+  if (!rate || !after || std::fabs(*rate) > 3600.0f || *after < 0.0f || *after > kMaxSeconds) return std::nullopt;
+  return std::make_pair(*rate, *after);
+}
+
 std::optional<std::pair<std::string, float>> parse_morph(const std::string& text) {
   const size_t eq = text.rfind('=');
   if (eq == std::string::npos || eq == 0 || eq + 1 == text.size()) return std::nullopt;
@@ -57,11 +71,17 @@ ParsedOptions parse_options(int argc, const char* const* argv) {
   app.add_option("--wind", o.wind, "wind for the cloth, X,Y,Z metres per second (world space)")
       ->delimiter(',')
       ->expected(3);
+  app.add_option("--move", o.move, "move the character forwards at this many metres per second (an in-place clip runs)")
+      ->check(CLI::Range(-100.0f, 100.0f));
+  app.add_option("--turn", o.turn, "turn the character DEG_PER_S degrees per second about +Y, from AFTER seconds of play "
+                                   "on (DEG_PER_S[@AFTER]); the cloth feels the turn");
   app.add_option("--crowd", o.crowd, "draw N instances with offset times, instanced")->check(CLI::Range(1u, 4096u));
   app.add_flag("--wireframe", o.wireframe, "wireframe overlay");
   app.add_flag("--skeleton", o.skeleton, "skeleton overlay");
   app.add_flag("--no-grid", no_grid, "no ground grid");
-  app.add_option("--yaw", o.yaw_degrees, "camera yaw in degrees (0: from +Z)");
+  app.add_option("--yaw", o.yaw_degrees, "camera yaw in degrees from the character's front (0: facing it)");
+  app.add_option("--front", o.front, "which way the character faces: auto (from its feet, bounds.h) or +z, -z, +x, -x")
+      ->check(CLI::IsMember({"auto", "+z", "-z", "+x", "-x"}));
   app.add_option("--pitch", o.pitch_degrees, "camera elevation in degrees")->check(CLI::Range(-89.0f, 89.0f));
   app.add_option("--size", size, "window / image size, WxH (default 1280x720)");
   app.add_option("--msaa", o.msaa, "multisampling (1: off)")->check(CLI::Range(1, 16));
@@ -126,6 +146,9 @@ ParsedOptions parse_options(int argc, const char* const* argv) {
     o.height = wh->second;
   }
   o.grid = !no_grid;
+  if (!o.turn.empty() && !parse_turn(o.turn))
+    return {std::nullopt, command.usage_error("--turn: expected DEG_PER_S[@AFTER] (degrees per second within +-3600, "
+                                              "seconds >= 0), got '" + o.turn + "'")};
   o.cloth = cloth == "on";
   for (const std::string& m : morphs) {
     const auto parsed = parse_morph(m);

@@ -2,16 +2,21 @@
 //
 //   ossa-view FILE.ossa [MORE.ossa ...] [--clip NAME] [--time T] [--speed S] [--paused]
 //             [--bind-pose] [--cpu-skinning] [--crowd N] [--wireframe] [--skeleton] [--no-grid]
-//             [--yaw DEG] [--pitch DEG] [--size WxH] [--msaa N]
+//             [--yaw DEG] [--pitch DEG] [--front auto|+z|-z|+x|-x] [--size WxH] [--msaa N]
 //             [--frames N] [--screenshot OUT.png] [--first-frame-time] [--stats]
 //             [--window-frames N] [--graph NAME [--set|--param PARAM=VALUE ...] [--show-procedural]
 //              [--montage NAME[@T] [--montage-next SECTION=NEXT[@T]] [--montage-jump SECTION[@T]]]]
-//             [--morph NAME=WEIGHT ...]
+//             [--morph NAME=WEIGHT ...] [--move M_PER_S] [--turn DEG_PER_S[@AFTER]]
 //             [--retarget-from SOURCE.ossa ... [--retarget-map MAP.json] [--retarget-clip NAME] [--show-mapping]]
 //             [--panel open|collapsed] [--ui-scale S] [--browse DIR] [--cook-and-open SOURCE ...]
 //             [-q | -v] [--version] [--help]
 //   ossa-view [--browse DIR] [--cook-and-open SOURCE ...] [...]     (the window, no file yet)
 //
+// --move and --turn move the character through the world as a game moves one playing an in-place
+// clip (animation.h Drive): forwards at M_PER_S metres per second, turning DEG_PER_S degrees per
+// second about +Y once AFTER seconds have played; the cloth receives the turn in its world transform.
+// --yaw turns the camera from the character's front: auto-detected from its feet (bounds.h
+// facing_of; +Z when they do not tell), or named with --front.
 // With --frames or --screenshot the viewer runs headless (hidden window, offscreen framebuffer):
 // it renders N frames 1/60 s apart ending at --time, writes the last one as a PNG, and exits.
 // --window-frames N runs the window mode (panel included) for N frames and exits, writing the
@@ -71,11 +76,14 @@ struct ViewerOptions {
   bool cloth = true;            // --cloth off: cloth meshes drawn as skinned (to compare)
   bool show_cloth = false;      // --show-cloth: the cloth overlay (particles, edges, colliders)
   std::vector<float> wind;      // --wind X,Y,Z: metres per second, world space
+  float move = 0.0f;            // --move: metres per second forwards (animation.h Drive)
+  std::string turn;             // --turn DEG_PER_S[@AFTER]: turning, from AFTER seconds of play on
   unsigned crowd = 1;
   bool wireframe = false;
   bool skeleton = false;
   bool grid = true;
-  float yaw_degrees = 30.0f;
+  float yaw_degrees = 30.0f;     // from the character's front (--front)
+  std::string front = "auto";   // --front: auto (bounds.h facing_of) or +z, -z, +x, -x
   float pitch_degrees = 10.0f;
   int width = 1280;
   int height = 720;
@@ -120,5 +128,8 @@ std::optional<std::pair<std::string, float>> parse_morph(const std::string& text
 
 /// "640x480" -> (640, 480); nullopt unless both are in 1..16384.
 std::optional<std::pair<int, int>> parse_size(const std::string& text);
+
+/// "90@1.5" -> (90, 1.5), "-45" -> (-45, 0); nullopt unless finite, |rate| <= 3600, after >= 0.
+std::optional<std::pair<float, float>> parse_turn(const std::string& text);
 
 }  // namespace ossa::view

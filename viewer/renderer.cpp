@@ -480,10 +480,24 @@ Status render_frame(Renderer& r, const Scene& scene, const Animator& animator, s
           if (!morphed) skin_cpu(view, palette, SkinningMethod::Linear, out);
           if (const ClothInstance* c = cloth != nullptr ? cloth->find(i, m) : nullptr;
               c != nullptr && c->positions().size() == c->particle_count()) {
-            (void)write_cloth_vertices(*c, r.skinned_positions, r.skinned_normals);  // model space
+            (void)write_cloth_vertices(*c, r.skinned_positions, r.skinned_normals);  // the character's own space
+            // Then where it is drawn: its motion through the world (cloth_view.h), the crowd placement.
             const glm::vec3 o = i < offsets.size() ? offsets[i] : glm::vec3(0.0f);
-            for (const uint32_t cv : c->source.vertices)
-              for (int k = 0; k < 3; ++k) r.skinned_positions[3 * cv + static_cast<size_t>(k)] += o[k];
+            const glm::mat4& w = cloth->world;
+            const bool normals = r.skinned_normals.size() == r.skinned_positions.size();
+            for (const uint32_t cv : c->source.vertices) {
+              float* p = &r.skinned_positions[3 * static_cast<size_t>(cv)];
+              const glm::vec3 q = glm::vec3(w * glm::vec4(p[0], p[1], p[2], 1.0f)) + o;
+              p[0] = q.x;
+              p[1] = q.y;
+              p[2] = q.z;
+              if (!normals) continue;
+              float* nv = &r.skinned_normals[3 * static_cast<size_t>(cv)];
+              const glm::vec3 turned = glm::mat3(w) * glm::vec3(nv[0], nv[1], nv[2]);
+              nv[0] = turned.x;
+              nv[1] = turned.y;
+              nv[2] = turned.z;
+            }
           }
           upload_stream(g.cpu_positions, r.skinned_positions);
           if (g.has_normals) upload_stream(g.cpu_normals, r.skinned_normals);

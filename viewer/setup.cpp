@@ -3,6 +3,7 @@
 
 #include "viewer/montage_control.h"
 
+#include <cmath>
 #include <cstdio>
 #include <utility>
 
@@ -15,6 +16,7 @@ namespace ossa::view {
 void apply_view_options(App& app, const ViewerOptions& o) {
   app.angles.yaw = glm::radians(o.yaw_degrees);
   app.angles.pitch = glm::radians(o.pitch_degrees);
+  app.front = o.front;
   app.toggles.cpu_skinning = o.cpu_skinning;
   app.toggles.wireframe = o.wireframe;
   app.toggles.skeleton = o.skeleton;
@@ -38,6 +40,10 @@ Status setup_app(App& app, Scene scene, const ViewerOptions& o, float aspect) {
     std::fprintf(stderr, "ossa-view: %s: %zu joints, %zu meshes, %zu vertices, %zu triangles; %zu clips from %zu files\n",
                  name.c_str(), c.joints, c.meshes, c.vertices, c.triangles, app.scene.clips.size(),
                  app.scene.assets.size());
+    const char* why = app.facing.from_feet ? "from the feet" : o.front == "auto" ? "the feet do not tell: glTF's +z" : "--front";
+    std::fprintf(stderr, "ossa-view: front: %s (%s, lopsided by %.3f of the height); camera yaw %.0f deg\n",
+                 axis_name(app.facing.forward), why, app.facing.evidence,
+                 std::remainder(glm::degrees(app.facing.yaw + app.angles.yaw), 360.0f));
   }
 
   if (!o.clip.empty()) {
@@ -72,6 +78,16 @@ Status setup_app(App& app, Scene scene, const ViewerOptions& o, float aspect) {
   if (!o.retarget_from.empty()) {
     if (Status s = set_retarget(app, o.retarget_from, o.retarget_map, o.retarget_clip, aspect); !s) return s;
     set_time(app.retarget->source, app.retarget->animator, o.time);
+  }
+  if (o.move != 0.0f || !o.turn.empty()) {  // --move / --turn: the character's motion through the world
+    Drive& d = app.animator.drive;
+    const float metres = app.scene.character().file().metres_per_unit();
+    d.speed = o.move / (metres > 0.0f ? metres : 1.0f);
+    d.forward = app.facing.forward;
+    if (const auto turn = parse_turn(o.turn)) {
+      d.turn_rate = glm::radians(turn->first);
+      d.turn_after = turn->second;
+    }
   }
   Playback& p = app.animator.playback;
   p.bind_pose = o.bind_pose;

@@ -5,10 +5,13 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
+#include <span>
 #include <string>
 #include <vector>
 
 #include <imgui.h>
+#include <imgui_internal.h>
 
 #include "viewer/montage_panel.h"
 
@@ -17,12 +20,17 @@ namespace {
 
 void smooth(double& into, double value) { into += 0.05 * (value - into); }
 
-void clips_panel(App& app, UiState& ui) {
+/// The rows of controls under the clip list (play / loop, time, speed, cross-fade): what the list
+/// leaves room for when it fills the section.
+constexpr float kClipControlRows = 4.0f;
+
+void clips_panel(App& app, UiState& ui, float* hidden) {
   Playback& p = app.animator.playback;
+  const float below = kClipControlRows * ImGui::GetFrameHeightWithSpacing();
   if (app.scene.clips.empty()) {
     ImGui::TextDisabled("no clips: drop clip files cooked for this skeleton");
-  } else if (ImGui::BeginListBox("##clips", ImVec2(-1.0f, std::min(8.0f, static_cast<float>(app.scene.clips.size()) + 0.5f) *
-                                                               ImGui::GetTextLineHeightWithSpacing()))) {
+  } else if (ImGui::BeginListBox("##clips", ImVec2(-1.0f, fill_list_height(static_cast<float>(app.scene.clips.size()) + 0.5f,
+                                                                            below, hidden)))) {
     for (size_t i = 0; i < app.scene.clips.size(); ++i) {
       const SceneClip& c = app.scene.clips[i];
       ImGui::PushID(static_cast<int>(i));
@@ -47,14 +55,14 @@ void clips_panel(App& app, UiState& ui) {
 
 /// The retarget mode (retarget_view.h): the source's clips (the one picked drives the character),
 /// the source and mapping toggles, and a way back to the character's own clips.
-void retarget_panel(App& app, UiState& ui, float aspect) {
+void retarget_panel(App& app, UiState& ui, float aspect, float* hidden) {
   RetargetView& v = *app.retarget;
   ImGui::TextWrapped("source: %s", std::filesystem::path(v.files.front()).filename().string().c_str());
   if (!v.map_file.empty()) ImGui::TextWrapped("map: %s", std::filesystem::path(v.map_file).filename().string().c_str());
   const Playback& p = v.animator.playback;
+  const float below = 3.0f * ImGui::GetFrameHeightWithSpacing();  // the line, the toggles and the button under it
   if (ImGui::BeginListBox("##retarget-clips",
-                          ImVec2(-1.0f, std::min(6.0f, static_cast<float>(v.source.clips.size()) + 0.5f) *
-                                            ImGui::GetTextLineHeightWithSpacing()))) {
+                          ImVec2(-1.0f, fill_list_height(static_cast<float>(v.source.clips.size()) + 0.5f, below, hidden)))) {
     for (size_t i = 0; i < v.source.clips.size(); ++i) {
       ImGui::PushID(static_cast<int>(i));
       if (ImGui::Selectable(v.source.clips[i].label.c_str(), p.clip == static_cast<int>(i))) {
@@ -100,6 +108,30 @@ void morph_panel(App& app) {
 
 void cloth_panel(App& app);
 
+/// The character's motion through the world (animation.h Drive, --move / --turn): a speed along
+/// its front and a turn rate, as a game moves a character playing an in-place clip; the cloth
+/// feels both. "back to the start" puts it where it began.
+void drive_panel(App& app) {
+  Drive& d = app.animator.drive;
+  if (app.scene.assets.empty()) return;
+  const float metres = std::max(app.scene.character().file().metres_per_unit(), 1e-6f);
+  float move = d.speed * metres, turn = d.turn_rate * 57.29578f;
+  if (ImGui::SliderFloat("move m/s", &move, -8.0f, 8.0f, "%.1f")) d.speed = move / metres;
+  if (ImGui::SliderFloat("turn deg/s", &turn, -180.0f, 180.0f, "%.0f")) {
+    d.turn_rate = turn / 57.29578f;
+    d.turn_after = std::min(d.turn_after, d.clock);  // from now on
+  }
+  if (d.active() || d.clock > 0.0f) {
+    if (ImGui::Button("back to the start")) {
+      d.clock = d.heading = 0.0f;
+      d.position = glm::vec3(0.0f);
+      d.world = glm::mat4(1.0f);
+      d.speed = d.turn_rate = 0.0f;
+      reset_viewer_cloth(app.cloth);
+    }
+  }
+}
+
 void view_panel(App& app, UiState& ui, float aspect) {
   ImGui::Checkbox("skeleton (K)", &app.toggles.skeleton);
   ImGui::SameLine();
@@ -111,6 +143,7 @@ void view_panel(App& app, UiState& ui, float aspect) {
   ImGui::Checkbox("follow character", &app.follow);
   ImGui::SameLine();
   if (ImGui::Button("frame (R)")) frame_camera(app, aspect);
+  drive_panel(app);
   int crowd = static_cast<int>(app.crowd);
   if (ImGui::SliderInt("crowd", &crowd, 1, 256) && crowd != static_cast<int>(app.crowd)) {
     if (Status s = set_crowd(app, static_cast<size_t>(crowd), aspect); !s) ui.status = s.message();
@@ -308,8 +341,10 @@ void open_panel(UiState& ui) {
   ImGui::InputText("##path", ui.open_path, sizeof ui.open_path);
   ImGui::SameLine();
   if (ImGui::Button("Open") && ui.open_path[0] != '\0') request_paths(ui.work, {ui.open_path});
-  ImGui::TextDisabled("a character replaces the scene; clip files add clips; sources (FBX, glTF, ...) are cooked first "
-                      "(or drop files here)");
+  ImGui::PushStyleColor(ImGuiCol_Text, ImGui::GetStyleColorVec4(ImGuiCol_TextDisabled));
+  ImGui::TextWrapped("a character replaces the scene; clip files add clips; sources (FBX, glTF, ...) are cooked first "
+                     "(or drop files here)");
+  ImGui::PopStyleColor();
 }
 
 /// A turning arc: the loading indicator's spinner.
@@ -339,8 +374,65 @@ void loading_indicator(const UiState& ui, const SceneLayout& layout) {
               text->c_str());
 }
 
-void files_panel(UiState& ui) {
-  if (const auto chosen = browser_panel(ui.browser)) request_paths(ui.work, {chosen->string()});
+void files_panel(UiState& ui, float* hidden) {
+  if (const auto chosen = browser_panel(ui.browser, hidden)) request_paths(ui.work, {chosen->string()});
+}
+
+/// One collapsible section of the panel: its header, and a body drawn into a child region of the
+/// height panel_fit.h shares out (the body adds to `*hidden` the list rows it could not show).
+struct Section {
+  const char* label;
+  ImGuiTreeNodeFlags flags;
+  std::function<void(float* hidden)> body;
+};
+
+/// The labels drawn right of the panel's widgets: the fixed ones, the graph's parameters and the
+/// morph channels, whose widest decides how much room every widget leaves (panel_fit.h label_room).
+std::vector<std::string> panel_labels(const App& app) {
+  std::vector<std::string> labels = {"time",        "speed",       "cross-fade",         "crowd",
+                                     "wind m/s",    "stiffness",   "ground tilt",        "ground height left",
+                                     "ground height right", "move m/s", "turn deg/s"};
+  if (app.animator.graph && app.animator.graph->definition) {
+    const GraphDefinition& d = *app.animator.graph->definition;
+    for (size_t i = 0; i < d.parameter_count(); ++i) labels.emplace_back(d.parameter_name(i));
+  }
+  for (std::string_view m : app.scene.morph_channels) labels.emplace_back(m);
+  return labels;
+}
+
+/// The sections between the panel's top button and its help lines, each open one in a region of
+/// its share of the height (panel_fit.h); the column scrolls as a whole only when even their
+/// minimum heights do not fit.
+void draw_sections(UiState& ui, std::span<const Section> sections, float height, float room) {
+  const ImGuiStyle& style = ImGui::GetStyle();
+  ImGui::BeginChild("##sections", ImVec2(0.0f, height), false);
+  std::vector<float> wanted(sections.size(), -1.0f);
+  std::vector<bool> open_flags(sections.size(), false);
+  float available = ImGui::GetContentRegionAvail().y;
+  for (size_t i = 0; i < sections.size(); ++i) {
+    for (const SectionFit& f : ui.sections)
+      if (f.name == sections[i].label) wanted[i] = f.wanted;
+    open_flags[i] = ImGui::TreeNodeBehaviorIsOpen(ImGui::GetID(sections[i].label), sections[i].flags);
+    available -= ImGui::GetFrameHeight() + style.ItemSpacing.y + (open_flags[i] ? style.ItemSpacing.y : 0.0f);
+  }
+  const std::vector<float> share =
+      share_heights(std::floor(available), wanted, open_flags, 3.0f * ImGui::GetFrameHeightWithSpacing());
+  std::vector<SectionFit> measured;
+  for (size_t i = 0; i < sections.size(); ++i) {
+    const Section& sec = sections[i];
+    if (!ImGui::CollapsingHeader(sec.label, sec.flags)) continue;
+    ImGui::BeginChild((std::string(sec.label) + "##body").c_str(), ImVec2(0.0f, std::max(share[i], 1.0f)), false);
+    ImGui::PushItemWidth(-room);
+    float hidden = 0.0f;
+    sec.body(&hidden);
+    ImGui::PopItemWidth();
+    measured.push_back({sec.label, std::ceil(ImGui::GetCursorPosY() - style.ItemSpacing.y + hidden)});
+    audit_current_window(ui.audit, sec.label, true);
+    ImGui::EndChild();
+  }
+  audit_current_window(ui.audit, "sections", true);
+  ImGui::EndChild();
+  ui.sections = std::move(measured);
 }
 
 }  // namespace
@@ -373,34 +465,49 @@ void draw_panels(App& app, UiState& ui, const SceneLayout& layout) {
     const std::string title =
         (app.scene.paths.empty() ? std::string("ossa-view") : std::filesystem::path(app.scene.paths.front()).filename().string()) +
         "###ossa";
-    ImGui::Begin(title.c_str(), nullptr, ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse |
-                                             ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoBringToFrontOnFocus);
+    ImGui::Begin(title.c_str(), nullptr,
+                 ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse | ImGuiWindowFlags_NoSavedSettings |
+                     ImGuiWindowFlags_NoBringToFrontOnFocus | ImGuiWindowFlags_NoScrollbar | ImGuiWindowFlags_NoScrollWithMouse);
+    ui.audit = PanelAudit{};
+    ui.audit.panel = Rect{0.0f, 0.0f, panel_width(ui), io.DisplaySize.y};
     if (ImGui::SmallButton("<< hide panel (Tab)")) ui.panel_open = false;
     const bool scene = !app.scene.assets.empty();
+    std::vector<Section> sections;
     if (scene) {
-      if (ImGui::CollapsingHeader("Graph", app.animator.graph ? ImGuiTreeNodeFlags_DefaultOpen : 0)) graph_panel(app, ui);
-      if (ImGui::CollapsingHeader("Clips", app.animator.graph ? 0 : ImGuiTreeNodeFlags_DefaultOpen)) clips_panel(app, ui);
-      if (app.retarget && ImGui::CollapsingHeader("Retarget", ImGuiTreeNodeFlags_DefaultOpen))
-        retarget_panel(app, ui, aspect);
-      if (!app.scene.morph_channels.empty() && ImGui::CollapsingHeader("Morph targets", ImGuiTreeNodeFlags_DefaultOpen))
-        morph_panel(app);
-      if (ImGui::CollapsingHeader("View", ImGuiTreeNodeFlags_DefaultOpen)) view_panel(app, ui, aspect);
-      if (ImGui::CollapsingHeader("Stats", ImGuiTreeNodeFlags_DefaultOpen)) stats_panel(app, ui);
+      const ImGuiTreeNodeFlags open = ImGuiTreeNodeFlags_DefaultOpen;
+      sections.push_back({"Graph", app.animator.graph ? open : 0, [&](float*) { graph_panel(app, ui); }});
+      sections.push_back({"Clips", app.animator.graph ? 0 : open, [&](float* hidden) { clips_panel(app, ui, hidden); }});
+      if (app.retarget)
+        sections.push_back({"Retarget", open, [&](float* hidden) { retarget_panel(app, ui, aspect, hidden); }});
+      if (!app.scene.morph_channels.empty()) sections.push_back({"Morph targets", open, [&](float*) { morph_panel(app); }});
+      sections.push_back({"View", open, [&](float*) { view_panel(app, ui, aspect); }});
+      sections.push_back({"Stats", open, [&](float*) { stats_panel(app, ui); }});
     }
-    if (ImGui::CollapsingHeader("Files", scene && !ui.browser.open_section ? 0 : ImGuiTreeNodeFlags_DefaultOpen))
-      files_panel(ui);
-    if (ImGui::CollapsingHeader("Open")) open_panel(ui);
+    sections.push_back({"Files", scene && !ui.browser.open_section ? 0 : ImGuiTreeNodeFlags_DefaultOpen,
+                        [&](float* hidden) { files_panel(ui, hidden); }});
+    sections.push_back({"Open", 0, [&](float*) { open_panel(ui); }});
+    // The help and status lines keep their place at the bottom: the sections get what they leave
+    // (their height as measured on the previous frame).
+    const ImGuiStyle& style = ImGui::GetStyle();
+    const float footer = ui.footer_height > 0.0f ? ui.footer_height : 3.0f * ImGui::GetTextLineHeightWithSpacing();
+    const float column = std::max(ImGui::GetContentRegionAvail().y - footer - style.ItemSpacing.y, ImGui::GetFrameHeight());
+    draw_sections(ui, sections, std::floor(column), label_room(panel_labels(app), 0.45f * panel_width(ui)));
+    const float footer_top = ImGui::GetCursorPosY();
     if (const auto busy_text = indicator_text(ui.work)) ImGui::TextDisabled("%s", busy_text->c_str());
     if (!ui.status.empty()) {
       ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1.0f, 0.4f, 0.4f, 1.0f));
       ImGui::TextWrapped("%s", ui.status.c_str());
       ImGui::PopStyleColor();
     }
-    for (const std::string& m : app.messages) ImGui::TextColored(ImVec4(1.0f, 0.8f, 0.3f, 1.0f), "%s", m.c_str());
+    ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1.0f, 0.8f, 0.3f, 1.0f));
+    for (const std::string& m : app.messages) ImGui::TextWrapped("%s", m.c_str());
+    ImGui::PopStyleColor();
     ImGui::PushStyleColor(ImGuiCol_Text, ImGui::GetStyleColorVec4(ImGuiCol_TextDisabled));
     ImGui::TextWrapped("drag: orbit  right-drag: pan  wheel: zoom  ctrl+drag: move a target");
     ImGui::TextWrapped("space: play/pause  B: bind pose  up/down: clip  Tab: panel");
     ImGui::PopStyleColor();
+    ui.footer_height = ImGui::GetCursorPosY() - footer_top;
+    audit_current_window(ui.audit, "panel", false);
     ImGui::End();
   }
   if (!app.scene.assets.empty()) timeline_panel(app, ui.timeline, layout.timeline, ui.ui_scale);

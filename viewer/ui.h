@@ -3,7 +3,7 @@
 //
 // The panel is a sidebar pinned to the window's left edge, full height, its width scaled with the
 // UI scale (layout.h): the scene is drawn in the rest of the window, so the panel never hides the
-// character. "Hide panel" (or Tab) collapses it to a small button and gives the scene the whole
+// character; its sections share its height (panel_fit.h), so it fits any window. "Hide panel" (or Tab) collapses it to a small button and gives the scene the whole
 // width. A click on an .ossa in the browser, or Open, is a request (cook_job.h): the indicator
 // says "loading NAME..." for a frame before the open runs; a source file is cooked in the
 // background, the indicator showing a spinner, the elapsed time and the file name.
@@ -16,10 +16,12 @@
 // weight the clip gives it live, and holds it where the user moves it (a tick box per channel).
 #pragma once
 #include <string>
+#include <vector>
 
 #include "viewer/app.h"
 #include "viewer/file_browser.h"
 #include "viewer/layout.h"
+#include "viewer/panel_fit.h"
 #include "viewer/cook_job.h"
 
 namespace ossa::view {
@@ -35,6 +37,9 @@ struct UiState {
   FileBrowser browser;
   TimelineState timeline;
   PendingWork work;          // opens and cooks in progress
+  std::vector<SectionFit> sections;  // what each open section needed when last drawn (panel_fit.h)
+  float footer_height = 0.0f;        // the help and status lines' height when last drawn
+  PanelAudit audit;          // this frame's panel regions (panel_fit.h): printed by -v, checked by the tests
 };
 
 /// The panel's width in window units for the UI state (0 when collapsed).

@@ -67,7 +67,7 @@ void start_xvfb(XServer& x) {
   // Close the read end before the dup2: pipe() may have returned it as fd 3 itself.
   posix_spawn_file_actions_addclose(&actions, fds[0]);
   posix_spawn_file_actions_adddup2(&actions, fds[1], 3);
-  const char* argv[] = {"Xvfb", "-displayfd", "3", "-screen", "0", "1280x1024x24", "-nolisten", "tcp", "-noreset", nullptr};
+  const char* argv[] = {"Xvfb", "-displayfd", "3", "-screen", "0", "1920x1200x24", "-nolisten", "tcp", "-noreset", nullptr};
   const int rc = posix_spawnp(&x.pid, "Xvfb", &actions, nullptr, const_cast<char**>(argv), environ);
   posix_spawn_file_actions_destroy(&actions);
   close(fds[1]);

@@ -336,3 +336,61 @@ TEST_F(ViewerWindow, StartsWithoutAFileInTheBrowser) {
 }
 
 }  // namespace
+
+namespace {
+
+struct PanelCheck {
+  int regions = -1, cut = -1;
+  std::vector<std::string> region_lines, cut_lines;
+};
+
+/// -v's panel lines (interactive.cpp print_panel_audit) for the captured frame.
+PanelCheck parse_panel_check(const std::string& err) {
+  PanelCheck c;
+  const size_t at = err.find("panel check: ");
+  if (at != std::string::npos) std::sscanf(err.c_str() + at, "panel check: %d regions, %d cut off", &c.regions, &c.cut);
+  size_t from = 0;
+  for (size_t eol; (eol = err.find('\n', from)) != std::string::npos; from = eol + 1) {
+    const std::string line = err.substr(from, eol - from);
+    if (line.find("panel region ") != std::string::npos) c.region_lines.push_back(line);
+    if (line.find("panel cut off: ") != std::string::npos) c.cut_lines.push_back(line);
+  }
+  return c;
+}
+
+}  // namespace
+
+// The panel fits the window (issue 28): at the default 1280x720 and at 1600x1000, with the Pab
+// graph's long panel, with the Pab clips and with no file (the browser), every region of the
+// panel (its sections, the help lines) lies inside it and no widget reaches past a region's edge,
+// sideways (labels) or downwards where the region does not scroll. The rectangles are Dear
+// ImGui's own, printed by -v (panel_fit.h).
+TEST_F(ViewerWindow, PanelFitsTheWindowAt1280x720And1600x1000) {
+  const std::string pab_graph = quote(cooked("Pab/pab.ossa").string()) + " --graph pab --ui-scale 1";
+  std::string clips = quote(cooked("Pab/arnaud.ossa").string());
+  for (const char* c : {"walk", "jog", "run", "crossarms"})
+    clips += " " + quote(cooked((std::string("Pab/") + c + ".ossa").c_str()).string());
+  const std::string browser = "--browse " + quote(cooked("").string()) + " --ui-scale 1";
+  int n = 0;
+  for (const std::string& files : {pab_graph, clips + " --ui-scale 1", browser}) {
+    for (const char* size : {"1280x720", "1600x1000"}) {
+      const std::string tag = "fit" + std::to_string(n++);
+      const CommandResult r = window(files + " --size " + size, tag);
+      ASSERT_EQ(r.exit_code, 0) << r.err;
+      const PanelCheck c = parse_panel_check(r.err);
+      ASSERT_GE(c.regions, 1) << files << " at " << size << ": no panel check in\n" << r.err;
+      EXPECT_EQ(c.cut, 0) << files << " at " << size << ":\n" << r.err;
+      for (const std::string& line : c.region_lines) {
+        float x, y, w, h, px, py, pw, ph;
+        const size_t at = line.find(": ", line.find("panel region "));
+        const int got = std::sscanf(line.c_str() + at + 2, "%f %f %f %f in panel %f %f %f %f", &x, &y, &w, &h, &px, &py,
+                                    &pw, &ph);
+        ASSERT_EQ(got, 8) << line;
+        EXPECT_GE(x, px - 1.0f) << line;
+        EXPECT_GE(y, py - 1.0f) << line;
+        EXPECT_LE(x + w, px + pw + 1.0f) << line;
+        EXPECT_LE(y + h, py + ph + 1.0f) << line;
+      }
+    }
+  }
+}

@@ -22,6 +22,7 @@
 #include "viewer/file_browser.h"
 #include "viewer/layout.h"
 #include "viewer/options.h"
+#include "viewer/panel_fit.h"
 #include "viewer/scene.h"
 #include "viewer_unit_common.h"
 
@@ -32,6 +33,47 @@ using namespace ossa::view;
 namespace {
 
 fs::path cooked(const char* rel) { return test::viewer_unit_cooked(rel); }
+
+// The panel's sections share its height (panel_fit.h): one that needs less than an equal share
+// gets what it needs, the others split the rest; closed ones get nothing; an unmeasured one (-1)
+// takes what is fair; minimums hold even when they overflow.
+TEST(ViewerLayout, SectionsShareThePanelsHeight) {
+  const std::vector<float> wanted = {900.0f, 80.0f, 100.0f, 500.0f, -1.0f};
+  const std::vector<bool> open = {true, true, true, false, false};
+  const std::vector<float> h = share_heights(600.0f, wanted, open, 60.0f);
+  ASSERT_EQ(h.size(), 5u);
+  EXPECT_FLOAT_EQ(h[1], 80.0f) << "a short section gets all it needs";
+  EXPECT_FLOAT_EQ(h[2], 100.0f);
+  EXPECT_FLOAT_EQ(h[0], 420.0f) << "the long one gets the rest";
+  EXPECT_FLOAT_EQ(h[3], 0.0f);
+  EXPECT_FLOAT_EQ(h[4], 0.0f);
+  const std::vector<float> all = share_heights(600.0f, wanted, {true, true, true, true, true}, 60.0f);
+  float sum = 0.0f;
+  for (const float v : all) sum += v;
+  EXPECT_LE(sum, 600.0f + 1e-3f);
+  EXPECT_FLOAT_EQ(all[4], all[0]) << "unmeasured and long sections split equally";
+  EXPECT_FLOAT_EQ(all[0], all[3]);
+  const std::vector<float> tiny = share_heights(50.0f, {300.0f, 300.0f, 20.0f}, {true, true, true}, 60.0f);
+  EXPECT_FLOAT_EQ(tiny[0], 60.0f) << "minimums hold (the column scrolls then)";
+  EXPECT_FLOAT_EQ(tiny[2], 20.0f) << "but never more than wanted";
+}
+
+// Regions of the panel whose items reach past their clip rectangle are reported; a scrolling
+// region only sideways; a region outside the panel is reported too.
+TEST(ViewerLayout, PanelAuditNamesWhatIsCutOff) {
+  PanelAudit a;
+  a.panel = Rect{0.0f, 0.0f, 380.0f, 720.0f};
+  a.regions.push_back({"fits", Rect{8, 40, 364, 200}, Rect{8, 40, 364, 200}, 372.0f, 500.0f, true});
+  EXPECT_TRUE(a.problems().empty());
+  a.regions.push_back({"label", Rect{8, 40, 364, 200}, Rect{8, 40, 364, 200}, 391.0f, 100.0f, true});
+  a.regions.push_back({"below", Rect{0, 0, 380, 720}, Rect{0, 0, 380, 719}, 370.0f, 1188.0f, false});
+  a.regions.push_back({"outside", Rect{8, 700, 364, 200}, Rect{8, 700, 364, 200}, 300.0f, 710.0f, true});
+  const std::vector<std::string> p = a.problems();
+  ASSERT_EQ(p.size(), 3u);
+  EXPECT_NE(p[0].find("label: items reach x 391"), std::string::npos) << p[0];
+  EXPECT_NE(p[1].find("below: items reach y 1188"), std::string::npos) << p[1];
+  EXPECT_NE(p[2].find("outside: region"), std::string::npos) << p[2];
+}
 
 TEST(ViewerLayout, SceneTakesWhatThePanelAndTimelineLeave) {
   const SceneLayout l = compute_layout(800, 500, 800, 500, 380.0f, 56.0f);
