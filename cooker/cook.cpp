@@ -45,9 +45,25 @@ uint64_t bytes_read(const std::vector<InputFile>& files) {
   return total;
 }
 
+/// A warning as the output keeps it: the input's directory (as given and absolute) left out of the
+/// paths it names, so the bytes do not depend on where the tree lives or where the cook ran from.
+std::string portable_warning(std::string warning, const fs::path& input) {
+  std::error_code ec;
+  const fs::path given = input.parent_path();
+  const fs::path absolute = fs::absolute(input, ec).lexically_normal().parent_path();
+  for (const fs::path& dir : {absolute, given}) {
+    if (dir.empty()) continue;
+    const std::string prefix = dir.string() + "/";
+    for (size_t at = warning.find(prefix); at != std::string::npos; at = warning.find(prefix, at))
+      warning.erase(at, prefix.size());
+  }
+  return warning;
+}
+
 bool finish_provenance(WriteProvenance& provenance, CookRecord& record, const fs::path& input,
                        const CookOptions& options) {
   provenance.source_name = input.filename().string();
+  for (const std::string& w : record.warnings) provenance.warnings.push_back(portable_warning(w, input));
   provenance.options = options.canonical();
   const InputLog* log = current_input_log();
   record.inputs_read = log != nullptr ? log->files() : std::vector<InputFile>{};
@@ -221,6 +237,11 @@ bool up_to_date(CookRecord& record, const fs::path& input, const fs::path& outpu
   record.vertices = vertices;
   record.triangles = triangles;
   record.clips = static_cast<uint32_t>(asset->clip_count());
+  // The warnings of the cook that wrote it; a file from a cooker before the field has none to give.
+  record.warnings.clear();
+  if (prov->warnings() != nullptr)
+    for (const flatbuffers::String* w : *prov->warnings())
+      if (w != nullptr) record.warnings.push_back(w->str());
   return true;
 }
 
