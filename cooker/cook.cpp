@@ -91,7 +91,7 @@ Result<std::vector<CompressedClip>> cook_clips(SourceScene& scene, const CookOpt
                                                const std::string& label) {
   if (options.root_motion) {
     for (SourceClip& clip : scene.clips) {
-      if (Status st = extract_root_motion(clip, scene.skeleton, options.up_axis); !st)
+      if (Status st = extract_root_motion(clip, scene.skeleton, 1); !st)
         return Error{label + ": " + st.message()};
     }
   }
@@ -289,6 +289,7 @@ void cook_into(CookRecord& record, const fs::path& input, const fs::path& output
   ImportOptions import_options;
   import_options.reference = options.reference;
   import_options.metres_per_unit = options.metres_per_unit;
+  import_options.up_axis = options.up_axis;
   auto scene = import_scene(input.string(), import_options);
   if (!scene) {
     record.error = scene.error().message;

@@ -188,7 +188,7 @@ int main(int argc, char** argv) {
   std::string depfile_path;
   double clip_tolerance_mm = 0.1;
   double metres_per_unit = 0.0;
-  std::string up_axis = "y";
+  std::string up_axis;
   app.add_option("inputs", inputs,
                  "source files (X.fbx -> X.ossa; sources of one folder that share a stem keep their extension: "
                  "X.fbx -> X.fbx.ossa beside X.dae -> X.dae.ossa), graph files (X.graph.json -> X.ossa) or "
@@ -236,7 +236,8 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1e-6, 1e4));
   app.add_flag("--no-clip-compression", lossless_clips, "keep every clip key exact (raw floats at every frame)");
   app.add_flag("--root-motion", root_motion, "extract root translation and yaw from clips into a root-motion track");
-  app.add_option("--up-axis", up_axis, "up axis for --root-motion")->check(CLI::IsMember({"x", "y", "z"}));
+  app.add_option("--up-axis", up_axis, "the sources' up axis, over what each file states (FBX UpAxis, Collada <up_axis>) or its "
+                 "format's convention (SMD: z); every output is Y-up")->check(CLI::IsMember({"x", "y", "z"}));
   app.add_option("--metres-per-unit", metres_per_unit,
                  "length of one source unit in metres, for sources that state none (BVH: 1 assumed) or state it "
                  "wrongly; clips cooked with --skeleton are converted into the rig's unit")
@@ -276,7 +277,7 @@ int main(int argc, char** argv) {
   options.clips.enabled = !lossless_clips;
   options.clips.tolerance_metres = static_cast<float>(clip_tolerance_mm / 1000.0);
   options.root_motion = root_motion;
-  options.up_axis = static_cast<uint8_t>(up_axis == "x" ? 0 : up_axis == "z" ? 2 : 1);
+  options.up_axis = up_axis.empty() ? -1 : up_axis == "x" ? 0 : up_axis == "z" ? 2 : 1;
   options.metres_per_unit = static_cast<float>(metres_per_unit);
   options.force = force;
   options.root = root;

@@ -39,7 +39,8 @@ std::string CookOptions::canonical() const {
                   static_cast<double>(clips.probe_metres));
     s += buf;
   }
-  if (root_motion) s += std::string(";root_motion=") + "xyz"[up_axis % 3];
+  if (root_motion) s += ";root_motion=y";  // outputs are Y-up
+  if (up_axis >= 0) s += std::string(";up_axis=") + "xyz"[up_axis % 3];
   if (textures != TextureOutput::Compressed) s += std::string(";textures=") + texture_output_name(textures);
   if (metres_per_unit > 0.0f) {
     char unit[64];

@@ -53,7 +53,9 @@ struct CookOptions {
   TextureOutput textures = TextureOutput::Compressed;  // --texture-format
   ClipCompressionOptions clips;       // --clip-tolerance, --no-clip-compression
   bool root_motion = false;           // --root-motion: extract root motion from every clip
-  uint8_t up_axis = 1;                // --up-axis: 0 x, 1 y, 2 z
+  /// --up-axis: the sources' up axis (0 x, 1 y, 2 z) over what each file states; -1: the file's.
+  /// Every output is Y-up (import_axes.cpp), so root motion and cloth gravity are about Y.
+  int up_axis = -1;
   /// --metres-per-unit: the sources' length unit, overriding the file (BVH states none); 0: the file's.
   float metres_per_unit = 0.0f;
   /// Clip-only cooking against this rig (loaded from --skeleton REF.ossa); null otherwise.
