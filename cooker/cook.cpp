@@ -15,6 +15,7 @@
 #include <cstring>
 #include <fstream>
 #include <iterator>
+#include <memory>
 
 #include "cooker/cache/cook_cache.h"
 #include "cooker/clip/clip_events.h"
@@ -261,8 +262,23 @@ bool from_cache(CookRecord& record, const fs::path& input, const fs::path& outpu
   return true;
 }
 
+/// The warning for a source with clips and no mesh cooked with a rig of its own: its clips play
+/// only on that rig. Not for a folder's rig itself, nor for BVH (motion capture brings its rig).
+void warn_own_rig(CookRecord& record, const fs::path& input, const CookOptions& options) {
+  std::string ext = input.extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (ext == ".bvh" || has_folder_rig_name(input)) return;
+  std::string why =
+      "holds clips and no mesh, so it is cooked with a rig of its own and its clips play only on that rig";
+  if (!options.folder_rig.empty())
+    why += " (its folder's rig " + options.folder_rig.filename().string() + " could not be read)";
+  record.warnings.push_back(why +
+                            ": name the character's rig with --skeleton RIG.ossa or a \"skeleton\" cook setting, or "
+                            "cook it in one batch with a skeleton.* or <folder>.* source beside it (docs/COOKING.md)");
+}
+
 void cook_into(CookRecord& record, const fs::path& input, const fs::path& output, const CookOptions& options,
-               const AppliedSettings& settings) {
+               const AppliedSettings& settings, const CookOptions* rig_options = nullptr) {
   std::error_code ec;
   if (fs::is_directory(input, ec)) {
     record.error = input.string() + ": is a directory, not a source file";
@@ -297,6 +313,12 @@ void cook_into(CookRecord& record, const fs::path& input, const fs::path& output
   }
   record.warnings = scene->warnings;
   count_scene(record, *scene);
+  if (scene->meshes.empty() && !scene->clips.empty() && options.reference == nullptr &&
+      options.retarget_target == nullptr) {
+    // Clips without a mesh: against the folder's rig when the batch has one, else said.
+    if (rig_options != nullptr) return cook_into(record, input, output, *rig_options, settings);
+    warn_own_rig(record, input, options);
+  }
   // Events authored beside the source (clip_events.h); its bytes count as the source's.
   auto sidecar = attach_sidecar_events(input, scene->clips);
   if (!sidecar) {
@@ -370,6 +392,17 @@ std::optional<CookRecord> cook_or_check(const fs::path& input, const fs::path& o
   InputLogScope scope(&log);
   // The batch's options with this input's settings files layered over them (cook_settings.h).
   CookOptions options = batch_options;
+  // The folder rig (cook_options.h) lies in the output tree, outside the read sandbox: read before
+  // it, and kept out of this input's log (it enters the key through canonical(), as --skeleton's).
+  std::unique_ptr<SourceSkeleton> folder_rig;
+  InputFile folder_rig_input;
+  if (!options.folder_rig.empty() && options.reference == nullptr && options.retarget_target == nullptr &&
+      !is_graph_file(input)) {
+    InputLog rig_log;
+    InputLogScope rig_scope(&rig_log);
+    if (auto rig = load_reference_skeleton(options.folder_rig, &folder_rig_input))
+      folder_rig = std::make_unique<SourceSkeleton>(std::move(*rig));
+  }
   AppliedSettings settings;
   std::vector<fs::path> allowed = options.allow_dirs;
   allowed.push_back(options.root.empty() ? input.parent_path() : options.root);
@@ -379,8 +412,21 @@ std::optional<CookRecord> cook_or_check(const fs::path& input, const fs::path& o
     if (Status st = apply_cook_settings(input, options, settings); !st) {
       if (only_if_up_to_date) return std::nullopt;
       record.error = input.string() + ": cook settings: " + st.message();
-    } else if (options.force || !up_to_date(record, input, output, options)) {
-      if (only_if_up_to_date) {
+    } else {
+      // The folder rig applies unless a settings file named a rig; an output cooked either way
+      // may be up to date.
+      CookOptions rig_options = options;
+      const bool rig = folder_rig != nullptr && options.reference == nullptr;
+      if (rig) {
+        rig_options.reference = folder_rig.get();
+        rig_options.reference_name = options.folder_rig.filename().string();
+        rig_options.reference_input = folder_rig_input;
+      }
+      const bool fresh = !options.force && (up_to_date(record, input, output, options) ||
+                                            (rig && up_to_date(record, input, output, rig_options)));
+      if (fresh) {
+        // the record is the output's
+      } else if (only_if_up_to_date) {
         if (!from_cache(record, input, output, options)) {
           if (miss != nullptr) {
             miss->cache_note = record.cache_note;
@@ -390,8 +436,10 @@ std::optional<CookRecord> cook_or_check(const fs::path& input, const fs::path& o
           return std::nullopt;
         }
       } else if (!from_cache(record, input, output, options)) {
-        cook_into(record, input, output, options, settings);
-        if (record.ok && options.write && options.cache != nullptr)
+        cook_into(record, input, output, options, settings, rig ? &rig_options : nullptr);
+        // Stored under its options' key: a folder rig's dependants are not (which key they took
+        // is the cook's choice), they cook again elsewhere.
+        if (record.ok && options.write && options.cache != nullptr && !rig)
           cache_store_output(*options.cache, record, output, options.canonical());
       }
     }

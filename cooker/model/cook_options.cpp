@@ -14,6 +14,16 @@ bool is_graph_file(const std::filesystem::path& path) {
   return name.size() > kSuffix.size() && name.compare(name.size() - kSuffix.size(), kSuffix.size(), kSuffix) == 0;
 }
 
+bool has_folder_rig_name(const std::filesystem::path& path) {
+  const auto lower = [](std::string s) {
+    for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return s;
+  };
+  if (is_graph_file(path)) return false;
+  const std::string stem = lower(path.stem().string());
+  return stem == "skeleton" || stem == lower(path.parent_path().filename().string());
+}
+
 std::optional<TextureOutput> parse_texture_output(std::string_view name) {
   if (name == "bc") return TextureOutput::Compressed;
   if (name == "rgba8") return TextureOutput::Rgba8;

@@ -48,6 +48,10 @@ const char* texture_output_name(TextureOutput output);
 /// True for `*.graph.json` (case-insensitive): an animation graph file rather than a source.
 bool is_graph_file(const std::filesystem::path& path);
 
+/// True for a source named as its folder's rig: stem `skeleton`, or the folder's own name
+/// (`Pab/Pab.fbx`), case-insensitive; never a graph file (the folder-rig convention, docs/COOKING.md).
+bool has_folder_rig_name(const std::filesystem::path& path);
+
 struct CookOptions {
   bool float_vertices = false;
   TextureOutput textures = TextureOutput::Compressed;  // --texture-format
@@ -60,6 +64,10 @@ struct CookOptions {
   float metres_per_unit = 0.0f;
   /// Clip-only cooking against this rig (loaded from --skeleton REF.ossa); null otherwise.
   const SourceSkeleton* reference = nullptr;
+  /// A batch's folder rig for this input (cli/batch.h: assign_folder_rigs), a cooked .ossa: the
+  /// input is cooked against it, as with --skeleton, when it holds clips and no mesh; then the rig
+  /// enters canonical() through `reference`. Empty: none.
+  std::filesystem::path folder_rig;
   std::string reference_name;  // REF.ossa's file name, recorded in the options string
   InputFile reference_input;   // REF.ossa as read (absolute path, hash): its hash is in canonical()
   ClothOptions cloth;          // the "cloth" cook setting (docs/CLOTH.md)
