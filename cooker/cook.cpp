@@ -277,8 +277,10 @@ void warn_own_rig(CookRecord& record, const fs::path& input, const CookOptions& 
                             "cook it in one batch with a skeleton.* or <folder>.* source beside it (docs/COOKING.md)");
 }
 
+/// Cooks `input` with `options`, or with `rig_options` (the folder rig's) when it holds clips and no
+/// mesh; `*used` says which (true: rig_options).
 void cook_into(CookRecord& record, const fs::path& input, const fs::path& output, const CookOptions& options,
-               const AppliedSettings& settings, const CookOptions* rig_options = nullptr) {
+               const AppliedSettings& settings, const CookOptions* rig_options = nullptr, bool* used = nullptr) {
   std::error_code ec;
   if (fs::is_directory(input, ec)) {
     record.error = input.string() + ": is a directory, not a source file";
@@ -316,7 +318,10 @@ void cook_into(CookRecord& record, const fs::path& input, const fs::path& output
   if (scene->meshes.empty() && !scene->clips.empty() && options.reference == nullptr &&
       options.retarget_target == nullptr) {
     // Clips without a mesh: against the folder's rig when the batch has one, else said.
-    if (rig_options != nullptr) return cook_into(record, input, output, *rig_options, settings);
+    if (rig_options != nullptr) {
+      if (used != nullptr) *used = true;
+      return cook_into(record, input, output, *rig_options, settings);
+    }
     warn_own_rig(record, input, options);
   }
   // Events authored beside the source (clip_events.h); its bytes count as the source's.
@@ -427,7 +432,7 @@ std::optional<CookRecord> cook_or_check(const fs::path& input, const fs::path& o
       if (fresh) {
         // the record is the output's
       } else if (only_if_up_to_date) {
-        if (!from_cache(record, input, output, options)) {
+        if (!from_cache(record, input, output, options) && !(rig && from_cache(record, input, output, rig_options))) {
           if (miss != nullptr) {
             miss->cache_note = record.cache_note;
             miss->cache_down = record.cache_down;
@@ -435,12 +440,12 @@ std::optional<CookRecord> cook_or_check(const fs::path& input, const fs::path& o
           }
           return std::nullopt;
         }
-      } else if (!from_cache(record, input, output, options)) {
-        cook_into(record, input, output, options, settings, rig ? &rig_options : nullptr);
-        // Stored under its options' key: a folder rig's dependants are not (which key they took
-        // is the cook's choice), they cook again elsewhere.
-        if (record.ok && options.write && options.cache != nullptr && !rig)
-          cache_store_output(*options.cache, record, output, options.canonical());
+      } else if (!from_cache(record, input, output, options) &&
+                 !(rig && from_cache(record, input, output, rig_options))) {
+        bool used_rig = false;
+        cook_into(record, input, output, options, settings, rig ? &rig_options : nullptr, &used_rig);
+        if (record.ok && options.write && options.cache != nullptr)  // under the key of the options it took
+          cache_store_output(*options.cache, record, output, (used_rig ? rig_options : options).canonical());
       }
     }
   } catch (const std::exception& e) {
