@@ -154,6 +154,7 @@ void record_morphs(CookRecord& record, const std::vector<CookedMesh>& meshes, fl
       r.stored_bytes = static_cast<uint32_t>(4 * t.vertices.size() +
                                              2 * (t.position_deltas.size() + t.normal_deltas.size() + t.tangent_deltas.size()));
       r.position_error_mm = static_cast<float>(mm * t.position_error);
+      r.position_bound_mm = static_cast<float>(mm * t.position_bound);
       r.normal_error_deg = static_cast<float>(t.normal_error * 57.29577951308232);
       record.morph_records.push_back(std::move(r));
     }

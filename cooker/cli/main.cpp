@@ -132,9 +132,12 @@ void print_details(const CookRecord& r) {
   if (r.ok) std::fprintf(stderr, ", cooked %s", human_bytes(r.cooked_bytes).c_str());
   std::fprintf(stderr, "\n");
   for (const MorphRecord& m : r.morph_records)
-    std::fprintf(stderr, "    morph target '%s' of mesh '%s': %u vertices, error %.4f mm / %.3f deg, %u -> %u bytes (%.1f:1)\n",
+    std::fprintf(stderr,
+                 "    morph target '%s' of mesh '%s': %u vertices, error %.4f mm (bound %.4f) / %.3f deg, "
+                 "%u -> %u bytes (%.1f:1)\n",
                  shown(m.name).c_str(), shown(m.mesh).c_str(), m.vertices, static_cast<double>(m.position_error_mm),
-                 static_cast<double>(m.normal_error_deg), m.raw_bytes, m.stored_bytes,
+                 static_cast<double>(m.position_bound_mm), static_cast<double>(m.normal_error_deg), m.raw_bytes,
+                 m.stored_bytes,
                  m.stored_bytes > 0 ? static_cast<double>(m.raw_bytes) / m.stored_bytes : 0.0);
   for (const TextureRecord& t : r.texture_records) {
     std::fprintf(stderr, "    texture '%s' (%s): %u x %u, %s%s, %u mips, %s -> %s (decoded RGBA8 + mips: %s), PSNR %.1f dB",
