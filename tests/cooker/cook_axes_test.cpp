@@ -113,8 +113,9 @@ Objects:  {
 )";
   const char* names[3] = {"Hips", "Spine", "Head"};
   for (int i = 0; i < 3; ++i)
-    text += "\tModel: " + std::to_string(1000 + i) + ", \"Model::" + names[i] + "\", \"LimbNode\" {\n\t\tVersion: 232\n" +
-            "\t\tProperties70:  {\n\t\t\tP: \"Lcl Translation\", \"Lcl Translation\", \"\", \"A\"," + t(i == 0 ? 0.5f : 1) +
+    text += "\tModel: " + std::to_string(1000 + i) + ", \"Model::" + names[i] + "\", \"LimbNode\" {\n" +
+            "\t\tVersion: 232\n\t\tProperties70:  {\n" +
+            "\t\t\tP: \"Lcl Translation\", \"Lcl Translation\", \"\", \"A\"," + t(i == 0 ? 0.5f : 1) +
             "\n\t\t}\n\t}\n";
   return text + "}\nConnections:  {\n\tC: \"OO\",1000,0\n\tC: \"OO\",1001,1000\n\tC: \"OO\",1002,1001\n}\n";
 }

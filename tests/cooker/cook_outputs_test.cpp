@@ -117,7 +117,8 @@ TEST_F(CookOutputs, AnUpToDateRunReportsTheWarningsOfTheCookThatMadeTheOutput) {
   for (const auto& [name, text] : warning_sources()) ASSERT_TRUE(ossa::test::write_file(src / name, text));
   const fs::path report = dir / "r.json";
   const auto run = [&](const std::string& name, const std::string& flags) {
-    const auto r = run_command(cook_cmd() + " " + q(src / name) + " -o " + q(out) + " " + flags + " --report " + q(report));
+    const auto r =
+        run_command(cook_cmd() + " " + q(src / name) + " -o " + q(out) + " " + flags + " --report " + q(report));
     EXPECT_EQ(r.exit_code, 0) << r.err;
     return std::make_pair(only_record(report), r);
   };

@@ -446,11 +446,13 @@ std::string lwo2_square(float y) {
     return std::string(tag, 4) + be32(static_cast<uint32_t>(data.size())) + data;
   };
   std::string points;
-  for (const auto& [x, z] : {std::pair{0.f, 0.f}, {1.f, 0.f}, {1.f, 1.f}, {0.f, 1.f}}) points += f32(x) + f32(y) + f32(z);
+  for (const auto& [x, z] : {std::pair{0.f, 0.f}, {1.f, 0.f}, {1.f, 1.f}, {0.f, 1.f}})
+    points += f32(x) + f32(y) + f32(z);
   const std::string body = "LWO2" + chunk("TAGS", std::string("Default\0", 8)) +
                            chunk("LAYR", be16(0) + be16(0) + f32(0) + f32(0) + f32(0) + std::string("layer\0", 6)) +
                            chunk("PNTS", points) +
-                           chunk("POLS", "FACE" + be16(3) + be16(0) + be16(1) + be16(2) + be16(3) + be16(0) + be16(2) + be16(3));
+                           chunk("POLS", "FACE" + be16(3) + be16(0) + be16(1) + be16(2) +  // two triangles
+                                             be16(3) + be16(0) + be16(2) + be16(3));
   return "FORM" + be32(static_cast<uint32_t>(body.size())) + body;
 }
 
@@ -481,7 +483,9 @@ TEST_F(CookSandbox, LightWaveScenesCookTheSameFromAnyWorkingDirectory) {
     float height;  // of the object it must load
   };
   const Scene scenes[] = {
-      {"beside.lws", "beside.lwo", 1}, {"below.lws", "Objects/below.lwo", 2}, {"content.lws", "Objects/content.lwo", 3}};
+      {"beside.lws", "beside.lwo", 1},
+      {"below.lws", "Objects/below.lwo", 2},
+      {"content.lws", "Objects/content.lwo", 3}};
   for (const auto& [scene, object, height] : scenes) {
     SCOPED_TRACE(scene);
     const fs::path input = content / "Scenes" / scene;

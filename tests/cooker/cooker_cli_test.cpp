@@ -313,8 +313,8 @@ TEST(CookerCli, ClipOnlySourcesInATreeBindToTheirFolderRig) {
     fs::copy_file(shared / "skeleton.dae", tree / "Pab" / "skeleton.dae");
     fs::copy_file(shared / "walk.dae", tree / "Pab" / "walk.dae");
   }
-  const std::string command = cook_cmd() + " " + q(tree) + " -o " + q(out) + " --root " + q(tree) + " --jobs 2 -v --report " +
-                              q(dir / "r.json");
+  const std::string command = cook_cmd() + " " + q(tree) + " -o " + q(out) + " --root " + q(tree) +
+                              " --jobs 2 -v --report " + q(dir / "r.json");
   const auto r = run_command(command);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto bound = [&](const fs::path& clip_file, const fs::path& rig_file) {
@@ -335,8 +335,10 @@ TEST(CookerCli, ClipOnlySourcesInATreeBindToTheirFolderRig) {
   auto lone = ossa::Asset::open((out / "Lone" / "run.ossa").string());
   ASSERT_TRUE(lone.ok());
   EXPECT_FALSE(lone->skeleton().empty());
-  EXPECT_NE(r.err.find("warning: " + (tree / "Lone" / "run.fbx").string() + ": holds clips and no mesh, so it is cooked "
-                       "with a rig of its own"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("warning: " + (tree / "Lone" / "run.fbx").string() +
+                       ": holds clips and no mesh, so it is cooked with a rig of its own"),
+            std::string::npos)
+      << r.err;
   EXPECT_EQ(r.err.find("Pab/walk.fbx: holds clips and no mesh"), std::string::npos) << r.err;
   EXPECT_EQ(r.err.find("skeleton.fbx: holds clips and no mesh"), std::string::npos) << r.err;
   // Again: everything up to date, the bound clips included.
