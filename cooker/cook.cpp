@@ -15,6 +15,7 @@
 #include <cstring>
 #include <fstream>
 #include <iterator>
+#include <memory>
 
 #include "cooker/cache/cook_cache.h"
 #include "cooker/clip/clip_events.h"
@@ -45,9 +46,25 @@ uint64_t bytes_read(const std::vector<InputFile>& files) {
   return total;
 }
 
+/// A warning as the output keeps it: the input's directory (as given and absolute) left out of the
+/// paths it names, so the bytes do not depend on where the tree lives or where the cook ran from.
+std::string portable_warning(std::string warning, const fs::path& input) {
+  std::error_code ec;
+  const fs::path given = input.parent_path();
+  const fs::path absolute = fs::absolute(input, ec).lexically_normal().parent_path();
+  for (const fs::path& dir : {absolute, given}) {
+    if (dir.empty()) continue;
+    const std::string prefix = dir.string() + "/";
+    for (size_t at = warning.find(prefix); at != std::string::npos; at = warning.find(prefix, at))
+      warning.erase(at, prefix.size());
+  }
+  return warning;
+}
+
 bool finish_provenance(WriteProvenance& provenance, CookRecord& record, const fs::path& input,
                        const CookOptions& options) {
   provenance.source_name = input.filename().string();
+  for (const std::string& w : record.warnings) provenance.warnings.push_back(portable_warning(w, input));
   provenance.options = options.canonical();
   const InputLog* log = current_input_log();
   record.inputs_read = log != nullptr ? log->files() : std::vector<InputFile>{};
@@ -75,7 +92,7 @@ Result<std::vector<CompressedClip>> cook_clips(SourceScene& scene, const CookOpt
                                                const std::string& label) {
   if (options.root_motion) {
     for (SourceClip& clip : scene.clips) {
-      if (Status st = extract_root_motion(clip, scene.skeleton, options.up_axis); !st)
+      if (Status st = extract_root_motion(clip, scene.skeleton, 1); !st)
         return Error{label + ": " + st.message()};
     }
   }
@@ -137,6 +154,7 @@ void record_morphs(CookRecord& record, const std::vector<CookedMesh>& meshes, fl
       r.stored_bytes = static_cast<uint32_t>(4 * t.vertices.size() +
                                              2 * (t.position_deltas.size() + t.normal_deltas.size() + t.tangent_deltas.size()));
       r.position_error_mm = static_cast<float>(mm * t.position_error);
+      r.position_bound_mm = static_cast<float>(mm * t.position_bound);
       r.normal_error_deg = static_cast<float>(t.normal_error * 57.29577951308232);
       record.morph_records.push_back(std::move(r));
     }
@@ -221,6 +239,11 @@ bool up_to_date(CookRecord& record, const fs::path& input, const fs::path& outpu
   record.vertices = vertices;
   record.triangles = triangles;
   record.clips = static_cast<uint32_t>(asset->clip_count());
+  // The warnings of the cook that wrote it; a file from a cooker before the field has none to give.
+  record.warnings.clear();
+  if (prov->warnings() != nullptr)
+    for (const flatbuffers::String* w : *prov->warnings())
+      if (w != nullptr) record.warnings.push_back(w->str());
   return true;
 }
 
@@ -240,8 +263,25 @@ bool from_cache(CookRecord& record, const fs::path& input, const fs::path& outpu
   return true;
 }
 
+/// The warning for a source with clips and no mesh cooked with a rig of its own: its clips play
+/// only on that rig. Not for a folder's rig itself, nor for BVH (motion capture brings its rig).
+void warn_own_rig(CookRecord& record, const fs::path& input, const CookOptions& options) {
+  std::string ext = input.extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (ext == ".bvh" || has_folder_rig_name(input)) return;
+  std::string why =
+      "holds clips and no mesh, so it is cooked with a rig of its own and its clips play only on that rig";
+  if (!options.folder_rig.empty())
+    why += " (its folder's rig " + options.folder_rig.filename().string() + " could not be read)";
+  record.warnings.push_back(why +
+                            ": name the character's rig with --skeleton RIG.ossa or a \"skeleton\" cook setting, or "
+                            "cook it in one batch with a skeleton.* or <folder>.* source beside it (docs/COOKING.md)");
+}
+
+/// Cooks `input` with `options`, or with `rig_options` (the folder rig's) when it holds clips and no
+/// mesh; `*used` says which (true: rig_options).
 void cook_into(CookRecord& record, const fs::path& input, const fs::path& output, const CookOptions& options,
-               const AppliedSettings& settings) {
+               const AppliedSettings& settings, const CookOptions* rig_options = nullptr, bool* used = nullptr) {
   std::error_code ec;
   if (fs::is_directory(input, ec)) {
     record.error = input.string() + ": is a directory, not a source file";
@@ -268,6 +308,7 @@ void cook_into(CookRecord& record, const fs::path& input, const fs::path& output
   ImportOptions import_options;
   import_options.reference = options.reference;
   import_options.metres_per_unit = options.metres_per_unit;
+  import_options.up_axis = options.up_axis;
   auto scene = import_scene(input.string(), import_options);
   if (!scene) {
     record.error = scene.error().message;
@@ -275,6 +316,15 @@ void cook_into(CookRecord& record, const fs::path& input, const fs::path& output
   }
   record.warnings = scene->warnings;
   count_scene(record, *scene);
+  if (scene->meshes.empty() && !scene->clips.empty() && options.reference == nullptr &&
+      options.retarget_target == nullptr) {
+    // Clips without a mesh: against the folder's rig when the batch has one, else said.
+    if (rig_options != nullptr) {
+      if (used != nullptr) *used = true;
+      return cook_into(record, input, output, *rig_options, settings);
+    }
+    warn_own_rig(record, input, options);
+  }
   // Events authored beside the source (clip_events.h); its bytes count as the source's.
   auto sidecar = attach_sidecar_events(input, scene->clips);
   if (!sidecar) {
@@ -348,6 +398,17 @@ std::optional<CookRecord> cook_or_check(const fs::path& input, const fs::path& o
   InputLogScope scope(&log);
   // The batch's options with this input's settings files layered over them (cook_settings.h).
   CookOptions options = batch_options;
+  // The folder rig (cook_options.h) lies in the output tree, outside the read sandbox: read before
+  // it, and kept out of this input's log (it enters the key through canonical(), as --skeleton's).
+  std::unique_ptr<SourceSkeleton> folder_rig;
+  InputFile folder_rig_input;
+  if (!options.folder_rig.empty() && options.reference == nullptr && options.retarget_target == nullptr &&
+      !is_graph_file(input)) {
+    InputLog rig_log;
+    InputLogScope rig_scope(&rig_log);
+    if (auto rig = load_reference_skeleton(options.folder_rig, &folder_rig_input))
+      folder_rig = std::make_unique<SourceSkeleton>(std::move(*rig));
+  }
   AppliedSettings settings;
   std::vector<fs::path> allowed = options.allow_dirs;
   allowed.push_back(options.root.empty() ? input.parent_path() : options.root);
@@ -357,9 +418,22 @@ std::optional<CookRecord> cook_or_check(const fs::path& input, const fs::path& o
     if (Status st = apply_cook_settings(input, options, settings); !st) {
       if (only_if_up_to_date) return std::nullopt;
       record.error = input.string() + ": cook settings: " + st.message();
-    } else if (options.force || !up_to_date(record, input, output, options)) {
-      if (only_if_up_to_date) {
-        if (!from_cache(record, input, output, options)) {
+    } else {
+      // The folder rig applies unless a settings file named a rig; an output cooked either way
+      // may be up to date.
+      CookOptions rig_options = options;
+      const bool rig = folder_rig != nullptr && options.reference == nullptr;
+      if (rig) {
+        rig_options.reference = folder_rig.get();
+        rig_options.reference_name = options.folder_rig.filename().string();
+        rig_options.reference_input = folder_rig_input;
+      }
+      const bool fresh = !options.force && (up_to_date(record, input, output, options) ||
+                                            (rig && up_to_date(record, input, output, rig_options)));
+      if (fresh) {
+        // the record is the output's
+      } else if (only_if_up_to_date) {
+        if (!from_cache(record, input, output, options) && !(rig && from_cache(record, input, output, rig_options))) {
           if (miss != nullptr) {
             miss->cache_note = record.cache_note;
             miss->cache_down = record.cache_down;
@@ -367,10 +441,12 @@ std::optional<CookRecord> cook_or_check(const fs::path& input, const fs::path& o
           }
           return std::nullopt;
         }
-      } else if (!from_cache(record, input, output, options)) {
-        cook_into(record, input, output, options, settings);
-        if (record.ok && options.write && options.cache != nullptr)
-          cache_store_output(*options.cache, record, output, options.canonical());
+      } else if (!from_cache(record, input, output, options) &&
+                 !(rig && from_cache(record, input, output, rig_options))) {
+        bool used_rig = false;
+        cook_into(record, input, output, options, settings, rig ? &rig_options : nullptr, &used_rig);
+        if (record.ok && options.write && options.cache != nullptr)  // under the key of the options it took
+          cache_store_output(*options.cache, record, output, (used_rig ? rig_options : options).canonical());
       }
     }
   } catch (const std::exception& e) {

@@ -211,7 +211,9 @@ void cook_graph(CookRecord& record, const fs::path& input, const fs::path& outpu
 
   // The rig, and its meshes.
   SourceScene character;
-  if (!cook.import(cook.resolve(manifest->skeleton), manifest->skeleton_pos, {}, &character)) return;
+  ImportOptions rig_options;
+  rig_options.up_axis = options.up_axis;
+  if (!cook.import(cook.resolve(manifest->skeleton), manifest->skeleton_pos, rig_options, &character)) return;
   if (character.skeleton.joints.empty()) {
     cook.fail(manifest->skeleton_pos,
               cook.resolve(manifest->skeleton).string() + ": has no skeleton for the graph to animate");
@@ -228,6 +230,7 @@ void cook_graph(CookRecord& record, const fs::path& input, const fs::path& outpu
   record.joints = static_cast<uint32_t>(rig.joints.size());
   ImportOptions against_rig;
   against_rig.reference = &rig;
+  against_rig.up_axis = options.up_axis;
 
   // Mesh sources bound to the rig: their meshes and materials appended, material indices moved.
   for (size_t m = 0; m < manifest->meshes.size(); ++m) {

@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -34,6 +35,35 @@ std::string output_stem(const fs::path& input) {
   const std::string name = input.filename().string();
   if (is_graph_file(input)) return name.substr(0, name.size() - std::string_view(".graph.json").size());
   return input.stem().string();
+}
+
+namespace {
+std::string lower(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+}  // namespace
+
+bool is_folder_rig(const fs::path& input) { return is_source_extension(input) && has_folder_rig_name(input); }
+
+void assign_folder_rigs(std::vector<BatchItem>& items) {
+  std::map<fs::path, std::vector<const BatchItem*>> rigs;  // folder -> its rigs, by input path
+  for (const BatchItem& item : items)
+    if (is_folder_rig(item.input)) rigs[item.input.parent_path()].push_back(&item);
+  for (auto& [folder, list] : rigs)
+    std::sort(list.begin(), list.end(), [](const BatchItem* a, const BatchItem* b) { return a->input < b->input; });
+  for (BatchItem& item : items) {
+    if (is_folder_rig(item.input) || is_graph_file(item.input)) continue;
+    const auto it = rigs.find(item.input.parent_path());
+    if (it == rigs.end()) continue;
+    const BatchItem* pick = it->second.front();
+    for (const BatchItem* r : it->second)
+      if (lower(r->input.extension().string()) == lower(item.input.extension().string())) {
+        pick = r;
+        break;
+      }
+    item.rig = pick->output;
+  }
 }
 
 Result<std::vector<BatchItem>> plan_batch(const std::vector<fs::path>& inputs, const fs::path& out_dir,
@@ -88,7 +118,7 @@ Result<std::vector<BatchItem>> plan_batch(const std::vector<fs::path>& inputs, c
       return Error{"inputs " + it->second.string() + " and " + input.string() + " would both write " +
                    output.string() +
                    (root.empty() ? " (use --root to mirror the source tree)" : " (cook them into separate output directories)")};
-    items.push_back({input, output, tree});
+    items.push_back({input, output, tree, {}});
   }
   return items;
 }

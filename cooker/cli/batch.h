@@ -28,7 +28,20 @@ struct BatchItem {
   /// The folder tree this input's cook may read without --root: the directory argument it was
   /// found in, or for an input named as a file, its own folder (input_log.h's read sandbox).
   std::filesystem::path tree;
+  /// The output of this input's folder rig (assign_folder_rigs), cooked earlier in the batch; empty
+  /// when it has none or is one.
+  std::filesystem::path rig;
 };
+
+/// True for a model source that is its folder's rig by convention (has_folder_rig_name).
+bool is_folder_rig(const std::filesystem::path& input);
+
+/// The folder-rig convention (docs/COOKING.md): every other model source of a folder that holds
+/// a folder rig in `items` gets that rig's output as BatchItem::rig, the rig of its own extension
+/// first (walk.fbx -> skeleton.fbx beside skeleton.dae), else the first by path. The cook uses it
+/// only if the source turns out to hold clips and no mesh. Call it when no --skeleton or
+/// --retarget-to applies to the whole batch. O(items log items).
+void assign_folder_rigs(std::vector<BatchItem>& items);
 
 /// File extensions ossa-cook picks up when an input is a directory (lower case, with the dot).
 bool is_source_extension(const std::filesystem::path& path);

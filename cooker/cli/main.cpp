@@ -132,9 +132,12 @@ void print_details(const CookRecord& r) {
   if (r.ok) std::fprintf(stderr, ", cooked %s", human_bytes(r.cooked_bytes).c_str());
   std::fprintf(stderr, "\n");
   for (const MorphRecord& m : r.morph_records)
-    std::fprintf(stderr, "    morph target '%s' of mesh '%s': %u vertices, error %.4f mm / %.3f deg, %u -> %u bytes (%.1f:1)\n",
+    std::fprintf(stderr,
+                 "    morph target '%s' of mesh '%s': %u vertices, error %.4f mm (bound %.4f) / %.3f deg, "
+                 "%u -> %u bytes (%.1f:1)\n",
                  shown(m.name).c_str(), shown(m.mesh).c_str(), m.vertices, static_cast<double>(m.position_error_mm),
-                 static_cast<double>(m.normal_error_deg), m.raw_bytes, m.stored_bytes,
+                 static_cast<double>(m.position_bound_mm), static_cast<double>(m.normal_error_deg), m.raw_bytes,
+                 m.stored_bytes,
                  m.stored_bytes > 0 ? static_cast<double>(m.raw_bytes) / m.stored_bytes : 0.0);
   for (const TextureRecord& t : r.texture_records) {
     std::fprintf(stderr, "    texture '%s' (%s): %u x %u, %s%s, %u mips, %s -> %s (decoded RGBA8 + mips: %s), PSNR %.1f dB",
@@ -188,7 +191,7 @@ int main(int argc, char** argv) {
   std::string depfile_path;
   double clip_tolerance_mm = 0.1;
   double metres_per_unit = 0.0;
-  std::string up_axis = "y";
+  std::string up_axis;
   app.add_option("inputs", inputs,
                  "source files (X.fbx -> X.ossa; sources of one folder that share a stem keep their extension: "
                  "X.fbx -> X.fbx.ossa beside X.dae -> X.dae.ossa), graph files (X.graph.json -> X.ossa) or "
@@ -236,7 +239,9 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1e-6, 1e4));
   app.add_flag("--no-clip-compression", lossless_clips, "keep every clip key exact (raw floats at every frame)");
   app.add_flag("--root-motion", root_motion, "extract root translation and yaw from clips into a root-motion track");
-  app.add_option("--up-axis", up_axis, "up axis for --root-motion")->check(CLI::IsMember({"x", "y", "z"}));
+  app.add_option("--up-axis", up_axis,
+                 "the sources' up axis, over what each file states (FBX UpAxis, Collada <up_axis>) or its format's "
+                 "convention (SMD: z); every output is Y-up")->check(CLI::IsMember({"x", "y", "z"}));
   app.add_option("--metres-per-unit", metres_per_unit,
                  "length of one source unit in metres, for sources that state none (BVH: 1 assumed) or state it "
                  "wrongly; clips cooked with --skeleton are converted into the rig's unit")
@@ -276,7 +281,7 @@ int main(int argc, char** argv) {
   options.clips.enabled = !lossless_clips;
   options.clips.tolerance_metres = static_cast<float>(clip_tolerance_mm / 1000.0);
   options.root_motion = root_motion;
-  options.up_axis = static_cast<uint8_t>(up_axis == "x" ? 0 : up_axis == "z" ? 2 : 1);
+  options.up_axis = up_axis.empty() ? -1 : up_axis == "x" ? 0 : up_axis == "z" ? 2 : 1;
   options.metres_per_unit = static_cast<float>(metres_per_unit);
   options.force = force;
   options.root = root;
@@ -358,6 +363,8 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "ossa-cook: no source files found in the inputs given\n");
     return ossa::cli::kExitUsage;
   }
+  // Without a rig for the whole batch, clip-only sources bind to their folder's rig (batch.h).
+  if (options.reference == nullptr && options.retarget_target == nullptr) assign_folder_rigs(*plan);
   BatchLimits limits;
   limits.timeout_seconds = timeout_seconds;
   // The default share is of the workers that will run: no more than there are inputs.
@@ -397,7 +404,30 @@ int main(int argc, char** argv) {
     if (tty && done == total && !quiet) std::fprintf(stderr, "\n");
     std::fflush(stderr);
   };
-  const std::vector<CookRecord> records = run_batch(*plan, options, limits, jobs, progress);
+  // Folder rigs others bind to cook first, the rest after them; records keep the plan's order.
+  std::vector<BatchItem> first, then;
+  std::vector<size_t> first_at, then_at;
+  {
+    std::set<fs::path> rigs;
+    for (const BatchItem& item : *plan)
+      if (!item.rig.empty()) rigs.insert(item.rig);
+    for (size_t i = 0; i < plan->size(); ++i) {
+      const bool is_rig = rigs.count((*plan)[i].output) > 0;
+      (is_rig ? first : then).push_back((*plan)[i]);
+      (is_rig ? first_at : then_at).push_back(i);
+    }
+  }
+  std::vector<CookRecord> records(plan->size());
+  size_t done_before = 0;
+  for (const auto& [part, at] : {std::pair{&first, &first_at}, std::pair{&then, &then_at}}) {
+    if (part->empty()) continue;
+    const auto part_progress = [&](size_t done, size_t, const CookRecord& r) {
+      progress(done_before + done, plan->size(), r);
+    };
+    std::vector<CookRecord> got = run_batch(*part, options, limits, jobs, part_progress);
+    for (size_t k = 0; k < got.size(); ++k) records[(*at)[k]] = std::move(got[k]);
+    done_before += part->size();
+  }
   {
     std::vector<fs::path> own;
     for (const std::string& p : {report_path, depfile_path})

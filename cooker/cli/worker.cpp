@@ -249,6 +249,7 @@ void inject_fault_before(std::string_view fault, const BatchItem& item, int reco
 
   CookOptions item_options = options;
   if (item_options.root.empty()) item_options.root = item.tree;  // the read sandbox's default
+  item_options.folder_rig = item.rig;
   const CookRecord record = cook_file(item.input, item.output, item_options);
   if (fault == "abort-after") std::abort();  // the output is in place: the parent must remove it
   std::vector<uint8_t> bytes;
@@ -348,6 +349,7 @@ void cook_in_workers(const std::vector<BatchItem>& items, const CookOptions& opt
     if (!options.force && test_fault(item.input.string()).empty()) {
       CookOptions item_options = options;
       if (item_options.root.empty()) item_options.root = item.tree;
+      item_options.folder_rig = item.rig;
       if (std::optional<CookRecord> fresh = up_to_date_record(item.input, item.output, item_options, &w.cache_miss)) {
         finished(next, std::move(*fresh));
         ++next;

@@ -182,4 +182,16 @@ Result<SourceScene> convert_scene(const aiScene& scene, const std::string& path,
 
 SourceFormat format_of(const std::string& path);
 
+/// The source's up axis (import_axes.cpp) and what says so.
+struct SourceUp {
+  int axis = 1;  // 0 x, 1 y, 2 z
+  int sign = 1;  // +1 or -1
+  const char* by = "";
+};
+/// True when Assimp turns this file to Y-up itself (Collada's <up_axis>, with no --up-axis).
+bool assimp_applies_up_axis(const std::string& path, const ImportOptions& options);
+SourceUp source_up(const aiScene& scene, const std::string& path, const ImportOptions& options);
+/// Turns the scene so that `up` becomes +Y; leaves a Y-up scene untouched.
+void turn_to_y_up(aiScene& scene, const SourceUp& up);
+
 }  // namespace ossa::cook::detail

@@ -65,13 +65,23 @@ std::string normal_absolute(const char* path) {
 }
 }  // namespace
 
-LoggedIOSystem::LoggedIOSystem(std::string main) : main_(normal_absolute(main.c_str())) {}
+LoggedIOSystem::LoggedIOSystem(std::string main)
+    : main_(normal_absolute(main.c_str())), folder_(std::filesystem::path(main_).parent_path().string()) {}
 
-bool LoggedIOSystem::Exists(const char* path) const { return path != nullptr && probe_input(path, kReference); }
+std::string LoggedIOSystem::resolve(const char* path) const {
+  const std::filesystem::path p(path);
+  return p.is_relative() && !folder_.empty() ? (std::filesystem::path(folder_) / p).string() : std::string(path);
+}
+
+bool LoggedIOSystem::Exists(const char* path) const {
+  return path != nullptr && probe_input(resolve(path), kReference);
+}
 
 Assimp::IOStream* LoggedIOSystem::Open(const char* path, const char* mode) {
   if (path == nullptr || (mode != nullptr && (std::strchr(mode, 'w') || std::strchr(mode, 'a') || std::strchr(mode, '+'))))
     return nullptr;
+  const std::string resolved = resolve(path);
+  path = resolved.c_str();
   auto bytes = read_input(path, UINT64_MAX, kReference);
   if (!bytes) return nullptr;
   if (normal_absolute(path) == main_) {

@@ -5,6 +5,10 @@
 // Why not Assimp's DefaultIOSystem: it reads behind the cooker's back (a glTF's .bin, an OBJ's
 // .mtl), which left those files out of the cache key. Serving each file from memory costs one
 // copy of a source the importer reads whole anyway.
+//
+// Relative paths resolve against the source's folder, never the working directory, so a cook is
+// the same from any directory (a LightWave scene names its objects relative to itself or to its
+// content folder, and Assimp's LWS importer passes them on as they are).
 #pragma once
 #include <string>
 
@@ -27,7 +31,13 @@ class LoggedIOSystem : public Assimp::IOSystem {
   void Close(Assimp::IOStream* stream) override;
 
  private:
+  /// A relative path against the main source's folder, never the working directory: the importer
+  /// is given the source's absolute path, so every path it builds from it is absolute, and only
+  /// those a scene names as they are (LightWave's LoadObjectLayer) stay relative.
+  std::string resolve(const char* path) const;
+
   std::string main_;     // absolute, lexically normal
+  std::string folder_;   // main_'s folder
   std::string refused_;
 };
 

@@ -195,7 +195,14 @@ Result<SourceScene> read_and_convert(const std::string& path, const ImportOption
   importer.SetPropertyBool(AI_CONFIG_IMPORT_FBX_PRESERVE_PIVOTS, false);
   importer.SetPropertyBool(AI_CONFIG_FBX_CONVERT_TO_M, false);  // keep source units
   importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, 0);      // drop lines ourselves, with a warning
-  const aiScene* scene = importer.ReadFile(path, assimp_import_flags());
+  // Collada's <up_axis> is applied by Assimp unless --up-axis overrides it (import_axes.cpp).
+  importer.SetPropertyBool(AI_CONFIG_IMPORT_COLLADA_IGNORE_UP_DIRECTION, !assimp_applies_up_axis(path, options));
+  // By its absolute path: every path an importer builds from it is then absolute, and a path a
+  // scene names as it is (a LightWave scene's objects) resolves against the source's folder in
+  // the IO system, not against the working directory (import_io.h).
+  std::error_code ec;
+  const std::filesystem::path absolute = std::filesystem::absolute(path, ec);
+  const aiScene* scene = importer.ReadFile(ec ? path : absolute.lexically_normal().string(), assimp_import_flags());
   if (!io->refused().empty()) return Error{path + ": " + io->refused()};
   if (!scene) {
     // A file whose extension no Assimp reader claims was sniffed by content; a failure there is
@@ -206,6 +213,8 @@ Result<SourceScene> read_and_convert(const std::string& path, const ImportOption
       return Error{path + ": not a model file ossa-cook can read (FBX, glTF, GLB, DAE, BVH, OBJ, ...)"};
     return Error{path + ": " + importer.GetErrorString()};
   }
+  // Y-up from here on: the importer's own scene, ours to edit.
+  turn_to_y_up(*const_cast<aiScene*>(scene), source_up(*scene, path, options));
   if (wants_tangents(*scene)) {
     scene = importer.ApplyPostProcessing(aiProcess_CalcTangentSpace);
     if (!scene) return Error{path + ": " + importer.GetErrorString()};

@@ -22,6 +22,9 @@ struct ImportOptions {
   /// The source's length unit in metres, overriding what the file says or what is assumed for a
   /// unit-less format (BVH); 0: from the file (--metres-per-unit, the per-asset setting).
   float metres_per_unit = 0.0f;
+  /// The source's up axis (0 x, 1 y, 2 z), overriding what the file states or its format's
+  /// convention; -1: those (--up-axis, the per-asset setting). Every scene is turned Y-up.
+  int up_axis = -1;
 };
 
 /// Imports `path`. Errors name the file and what is wrong (Assimp's message when it cannot read

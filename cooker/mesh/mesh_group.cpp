@@ -373,12 +373,20 @@ Result<CookedMesh> build_group(const SourceScene& scene, const std::vector<Clean
     std::vector<glm::vec3> base_tangents;
     if (attrs.tangents)
       for (const glm::vec4& t : s.tangents) base_tangents.emplace_back(t);
+    // The bound stated and met: the absolute one, or 2e-5 of the mesh's own size where that is
+    // larger. 16-bit deltas err by up to 1/65534 of a target's largest delta, so a target that
+    // moves vertices by up to the mesh's size (whole-body vertex animation, or a model whose
+    // stated unit is not the one it was authored in) meets it; the absolute bound alone could not.
+    const float size_bound = 2e-5f * glm::length(out.bounds_max - out.bounds_min);
+    const float bound = std::max(bounds.position, std::isfinite(size_bound) ? size_bound : 0.0f);
     for (const MorphStreams& t : s.targets) {
       dense.push_back(quantize_morph(t, s.normals, base_tangents, bounds));
-      if (dense.back().position_error > bounds.position * 1.0001f)
+      dense.back().position_bound = bound;
+      if (dense.back().position_error > bound * 1.0001f)
         warnings.push_back("mesh '" + out.name + "': morph target '" + t.name + "' moves vertices so far that its " +
                            "16-bit deltas err by " + std::to_string(dense.back().position_error) +
-                           " units, past the bound " + std::to_string(bounds.position));
+                           " units, past the bound " + std::to_string(bound) + " (the larger of " +
+                           std::to_string(bounds.position) + " and 2e-5 of the mesh's size)");
     }
   }
 

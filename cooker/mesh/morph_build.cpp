@@ -104,6 +104,7 @@ CookedMorphTarget sparsify(const DenseMorph& target) {
   out.tangent_step = target.tangent_step;
   out.position_error = target.position_error;
   out.normal_error = target.normal_error;
+  out.position_bound = target.position_bound;
   const size_t n = target.positions.size();
   const size_t streams = 1 + (target.normals.empty() ? 0 : 1) + (target.tangents.empty() ? 0 : 1);
   out.source_bytes = static_cast<uint32_t>(std::min<size_t>(n * 12 * streams, UINT32_MAX));

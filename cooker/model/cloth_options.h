@@ -40,14 +40,14 @@ struct ClothOptions {
   float tether_scale = 1.0f;
   float damping = 1.0f;
   float drag = 0.5f;
-  float gravity_ms2 = 9.81f;          // along the model's down axis (CookOptions::up_axis)
+  float gravity_ms2 = 9.81f;          // along the model's down axis, -Y (outputs are Y-up)
   float linear_inertia = 1.0f, angular_inertia = 1.0f;
   float teleport_distance_m = 2.0f;
   float max_speed_ms = 30.0f;
   bool auto_colliders = true;         // fit colliders when none are named
   std::vector<ClothColliderSetting> colliders;
   uint32_t max_colliders = 6;
-  uint8_t up_axis = 1;                // 0 x, 1 y, 2 z (the cook's --up-axis)
+  uint8_t up_axis = 1;                // 0 x, 1 y, 2 z: always 1, outputs are Y-up (import_axes.cpp)
   bool from_settings = false;         // a settings file gave these (canonical() then records them)
   /// Canonical text for the cook's options string ("" when there is nothing to say).
   std::string canonical() const;

@@ -14,6 +14,16 @@ bool is_graph_file(const std::filesystem::path& path) {
   return name.size() > kSuffix.size() && name.compare(name.size() - kSuffix.size(), kSuffix.size(), kSuffix) == 0;
 }
 
+bool has_folder_rig_name(const std::filesystem::path& path) {
+  const auto lower = [](std::string s) {
+    for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return s;
+  };
+  if (is_graph_file(path)) return false;
+  const std::string stem = lower(path.stem().string());
+  return stem == "skeleton" || stem == lower(path.parent_path().filename().string());
+}
+
 std::optional<TextureOutput> parse_texture_output(std::string_view name) {
   if (name == "bc") return TextureOutput::Compressed;
   if (name == "rgba8") return TextureOutput::Rgba8;
@@ -39,7 +49,8 @@ std::string CookOptions::canonical() const {
                   static_cast<double>(clips.probe_metres));
     s += buf;
   }
-  if (root_motion) s += std::string(";root_motion=") + "xyz"[up_axis % 3];
+  if (root_motion) s += ";root_motion=y";  // outputs are Y-up
+  if (up_axis >= 0) s += std::string(";up_axis=") + "xyz"[up_axis % 3];
   if (textures != TextureOutput::Compressed) s += std::string(";textures=") + texture_output_name(textures);
   if (metres_per_unit > 0.0f) {
     char unit[64];

@@ -48,16 +48,26 @@ const char* texture_output_name(TextureOutput output);
 /// True for `*.graph.json` (case-insensitive): an animation graph file rather than a source.
 bool is_graph_file(const std::filesystem::path& path);
 
+/// True for a source named as its folder's rig: stem `skeleton`, or the folder's own name
+/// (`Pab/Pab.fbx`), case-insensitive; never a graph file (the folder-rig convention, docs/COOKING.md).
+bool has_folder_rig_name(const std::filesystem::path& path);
+
 struct CookOptions {
   bool float_vertices = false;
   TextureOutput textures = TextureOutput::Compressed;  // --texture-format
   ClipCompressionOptions clips;       // --clip-tolerance, --no-clip-compression
   bool root_motion = false;           // --root-motion: extract root motion from every clip
-  uint8_t up_axis = 1;                // --up-axis: 0 x, 1 y, 2 z
+  /// --up-axis: the sources' up axis (0 x, 1 y, 2 z) over what each file states; -1: the file's.
+  /// Every output is Y-up (import_axes.cpp), so root motion and cloth gravity are about Y.
+  int up_axis = -1;
   /// --metres-per-unit: the sources' length unit, overriding the file (BVH states none); 0: the file's.
   float metres_per_unit = 0.0f;
   /// Clip-only cooking against this rig (loaded from --skeleton REF.ossa); null otherwise.
   const SourceSkeleton* reference = nullptr;
+  /// A batch's folder rig for this input (cli/batch.h: assign_folder_rigs), a cooked .ossa: the
+  /// input is cooked against it, as with --skeleton, when it holds clips and no mesh; then the rig
+  /// enters canonical() through `reference`. Empty: none.
+  std::filesystem::path folder_rig;
   std::string reference_name;  // REF.ossa's file name, recorded in the options string
   InputFile reference_input;   // REF.ossa as read (absolute path, hash): its hash is in canonical()
   ClothOptions cloth;          // the "cloth" cook setting (docs/CLOTH.md)

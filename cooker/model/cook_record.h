@@ -36,6 +36,7 @@ struct MorphRecord {
   uint32_t raw_bytes = 0;             // dense float deltas over the mesh's vertices
   uint32_t stored_bytes = 0;          // the sparse form in the file
   float position_error_mm = 0.0f;     // millimetres (via metres_per_unit)
+  float position_bound_mm = 0.0f;     // what that error is held to: 0.02 mm or 2e-5 of the mesh's size
   float normal_error_deg = 0.0f;
 };
 
@@ -156,6 +157,7 @@ constexpr void morph_record_fields(F&& f, R&... r) {
   f("raw_bytes", r.raw_bytes...);
   f("stored_bytes", r.stored_bytes...);
   f("position_error_mm", r.position_error_mm...);
+  f("position_bound_mm", r.position_bound_mm...);
   f("normal_error_deg", r.normal_error_deg...);
 }
 

@@ -178,7 +178,7 @@ Status apply_cook_settings(const fs::path& input, CookOptions& options, AppliedS
       if (l.cloth) options.cloth = *l.cloth;
     }
   }
-  options.cloth.up_axis = options.up_axis;
+  options.cloth.up_axis = 1;  // outputs are Y-up (import_axes.cpp)
   if (skeleton) {
     InputFile as_read;
     auto rig = load_reference_skeleton(*skeleton, &as_read);

@@ -427,8 +427,11 @@ std::vector<uint8_t> write_ossa(const SourceScene& scene, std::span<const Cooked
     input_offsets.push_back(fb::CreateInputFile(fbb, path, f.hash, f.size, !f.present));
   }
   const auto inputs_v = fbb.CreateVector(input_offsets);
+  // Absent when empty: a warning-free file keeps the bytes it had before the field existed.
+  const auto warnings_v = provenance.warnings.empty() ? Offset<Vector<Offset<flatbuffers::String>>>()
+                                                      : fbb.CreateVectorOfStrings(provenance.warnings);
   const auto prov = fb::CreateProvenance(fbb, source_name, provenance.source_hash, cooker_version, options_text,
-                                         inputs_v, provenance.cook_key);
+                                         inputs_v, provenance.cook_key, warnings_v);
 
   std::vector<Offset<fb::Graph>> graph_offsets;
   for (const GraphDef& graph : options.graphs) graph_offsets.push_back(write_graph(fbb, graph));

@@ -24,6 +24,7 @@ struct WriteProvenance {
   std::string options;       // canonical option string
   std::vector<InputFile> inputs;  // every file read, relative to the input's directory, sorted
   uint64_t cook_key = 0;     // cook_key(inputs, options)
+  std::vector<std::string> warnings;  // the cook's, paths relative to the input's directory
 };
 
 struct WriteOptions {

@@ -367,6 +367,7 @@ TEST(CookIsolation, RecordRoundTripsEveryField) {
   m.raw_bytes = 56789;
   m.stored_bytes = 9876;
   m.position_error_mm = 0.0199f;
+  m.position_bound_mm = 0.0283f;
   m.normal_error_deg = 0.0625f;
   r.morph_records = {m, ossa::cook::MorphRecord{}};
   ossa::cook::TextureRecord t;

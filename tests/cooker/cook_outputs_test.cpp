@@ -4,6 +4,8 @@
 // - temporaries left by writers that died (a batch killed mid-write) go at the next run, even
 //   when every output is up to date, and a live writer's temporary stays;
 // - output names up to NAME_MAX (242-255 bytes) cook: their temporaries fit too;
+// - an up-to-date run reports the warnings of the cook that made the output (kept in its
+//   provenance); an output from a cooker before that field reads as having none;
 // - every write error (a full disk — a file-size limit here —, a read-only output, a name too long)
 //   names the input it concerns, and a report that cannot be written does not silence the depfile.
 #include <signal.h>
@@ -15,11 +17,13 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <string>
 
 #include <nlohmann/json.hpp>
 
+#include <ossa/loader/asset.h>
 #include "cooker/write/atomic_file.h"
 #include "test_files.h"
 
@@ -97,6 +101,71 @@ TEST_F(CookOutputs, AnOutputIsUpToDateOnlyForTheInputThatMadeIt) {
   ASSERT_TRUE(ossa::test::write_file(src / "tri.bin", triangle_bytes(1.0f)));
   EXPECT_FALSE(cook("x.gltf")["up_to_date"].get<bool>());
   EXPECT_FALSE(cook("x.obj")["up_to_date"].get<bool>());
+}
+
+/// Sources that warn, each in its own way: an OBJ with lines and a degenerate triangle, one with
+/// no normals, a glTF in a folder below (paths in warnings stay portable).
+std::vector<std::pair<std::string, std::string>> warning_sources() {
+  return {{"lines.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 2 2 2\nf 1 2 3\nf 1 1 2\nl 1 4\n"},
+          {"bare.obj", kObj},
+          {"sub/tri.gltf", triangle_gltf()},
+          {"sub/tri.bin", triangle_bytes()}};
+}
+
+TEST_F(CookOutputs, AnUpToDateRunReportsTheWarningsOfTheCookThatMadeTheOutput) {
+  fs::create_directories(src / "sub");
+  for (const auto& [name, text] : warning_sources()) ASSERT_TRUE(ossa::test::write_file(src / name, text));
+  const fs::path report = dir / "r.json";
+  const auto run = [&](const std::string& name, const std::string& flags) {
+    const auto r =
+        run_command(cook_cmd() + " " + q(src / name) + " -o " + q(out) + " " + flags + " --report " + q(report));
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    return std::make_pair(only_record(report), r);
+  };
+  for (const char* name : {"lines.obj", "bare.obj", "sub/tri.gltf"}) {
+    SCOPED_TRACE(name);
+    const auto [first, first_run] = run(name, "");
+    ASSERT_FALSE(first["up_to_date"].get<bool>());
+    const auto warnings = first["warnings"];
+    ASSERT_FALSE(warnings.empty()) << "the source was made to warn";
+    EXPECT_NE(first_run.err.find(std::to_string(warnings.size()) + " warning"), std::string::npos) << first_run.err;
+    // Up to date: the same warnings in the report, and -v prints each.
+    const auto [again, verbose_run] = run(name, "-v");
+    EXPECT_TRUE(again["up_to_date"].get<bool>());
+    EXPECT_EQ(again["warnings"], warnings);
+    for (const auto& w : warnings)
+      EXPECT_NE(verbose_run.err.find(w.get<std::string>()), std::string::npos) << verbose_run.err;
+    const auto [quiet, plain_run] = run(name, "");
+    EXPECT_NE(plain_run.err.find(std::to_string(warnings.size()) + " warning"), std::string::npos) << plain_run.err;
+  }
+  // The output does not depend on where the tree is: no absolute path of it is kept.
+  const auto bytes = ossa::test::read_text(out / "tri.ossa");
+  ASSERT_TRUE(bytes);
+  EXPECT_EQ(bytes->find(src.string()), std::string::npos);
+
+  // An output written before the field existed: the same file without it (its vtable slot
+  // cleared, as an older writer leaves it) is up to date and reports no warnings.
+  auto file = ossa::test::read_file(out / "bare.ossa");
+  ASSERT_TRUE(file);
+  {
+    const auto* root = ossa::fb::GetFile(file->data());
+    const auto* prov = root->provenance();
+    ASSERT_NE(prov->warnings(), nullptr);
+    const auto* table = reinterpret_cast<const uint8_t*>(prov);
+    int32_t soffset = 0;
+    std::memcpy(&soffset, table, 4);
+    uint8_t* vtable = file->data() + (table - file->data()) - soffset;
+    uint16_t vtable_size = 0;
+    std::memcpy(&vtable_size, vtable, 2);
+    ASSERT_GT(vtable_size, ossa::fb::Provenance::VT_WARNINGS);
+    std::memset(vtable + ossa::fb::Provenance::VT_WARNINGS, 0, 2);
+    ASSERT_EQ(ossa::fb::GetFile(file->data())->provenance()->warnings(), nullptr);
+  }
+  ASSERT_TRUE(ossa::test::write_file(out / "bare.ossa", *file));
+  ASSERT_TRUE(ossa::Asset::open((out / "bare.ossa").string()).ok());
+  const auto [old, old_run] = run("bare.obj", "-v");
+  EXPECT_TRUE(old["up_to_date"].get<bool>()) << "an older record is read, not a reason to cook";
+  EXPECT_TRUE(old["warnings"].empty());
 }
 
 /// A pid that named a process a moment ago and names none now.

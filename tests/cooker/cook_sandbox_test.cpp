@@ -8,6 +8,8 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <cstring>
+#include <optional>
 #include <filesystem>
 #include <string>
 
@@ -425,6 +427,99 @@ TEST_F(CookSandbox, BrokenContainersAreDescribedAsSuch) {
   EXPECT_NE(r.err.find("cutb.glb: is a GLB file that declares " + std::to_string(glb->size()) + " bytes but has 5000"),
             std::string::npos) << r.err;
   EXPECT_NE(r.err.find("zero.bvh: declares \"Frames: 0\": a BVH motion needs at least one frame"), std::string::npos) << r.err;
+}
+
+/// A minimal binary LightWave object (LWO2): one layer, the four corners of a unit square at
+/// height `y`, two triangles. IFF: big-endian sizes, chunks padded to even length.
+std::string lwo2_square(float y) {
+  const auto be32 = [](uint32_t v) {
+    return std::string{char(v >> 24), char(v >> 16), char(v >> 8), char(v)};
+  };
+  const auto be16 = [](uint16_t v) { return std::string{char(v >> 8), char(v)}; };
+  const auto f32 = [&](float f) {
+    uint32_t u = 0;
+    std::memcpy(&u, &f, 4);
+    return be32(u);
+  };
+  const auto chunk = [&](const char* tag, std::string data) {
+    if (data.size() % 2) data += '\0';
+    return std::string(tag, 4) + be32(static_cast<uint32_t>(data.size())) + data;
+  };
+  std::string points;
+  for (const auto& [x, z] : {std::pair{0.f, 0.f}, {1.f, 0.f}, {1.f, 1.f}, {0.f, 1.f}})
+    points += f32(x) + f32(y) + f32(z);
+  const std::string body = "LWO2" + chunk("TAGS", std::string("Default\0", 8)) +
+                           chunk("LAYR", be16(0) + be16(0) + f32(0) + f32(0) + f32(0) + std::string("layer\0", 6)) +
+                           chunk("PNTS", points) +
+                           chunk("POLS", "FACE" + be16(3) + be16(0) + be16(1) + be16(2) +  // two triangles
+                                             be16(3) + be16(0) + be16(2) + be16(3));
+  return "FORM" + be32(static_cast<uint32_t>(body.size())) + body;
+}
+
+/// A LightWave scene that loads one object by the path `object`, as LoadObjectLayer names it.
+std::string lws_scene(const std::string& object) {
+  return "LWSC\n3\n\nFirstFrame 1\nLastFrame 1\nFrameStep 1\nFramesPerSecond 30\n\nLoadObjectLayer 1 " + object +
+         "\nShowObject 8 7\n";
+}
+
+// LightWave scenes name their objects relative to the scene or to its content folder, and
+// Assimp opens them as named: the same command used to cook from one directory and fail (or
+// read another file) from the next. Every layout cooks the same bytes from any directory.
+TEST_F(CookSandbox, LightWaveScenesCookTheSameFromAnyWorkingDirectory) {
+  const fs::path content = tree / "lw";
+  fs::create_directories(content / "Scenes" / "Objects");
+  fs::create_directories(content / "Objects");
+  fs::create_directories(dir / "elsewhere" / "Objects");
+  ASSERT_TRUE(ossa::test::write_file(content / "Scenes" / "beside.lwo", lwo2_square(1)));
+  ASSERT_TRUE(ossa::test::write_file(content / "Scenes" / "Objects" / "below.lwo", lwo2_square(2)));
+  ASSERT_TRUE(ossa::test::write_file(content / "Objects" / "content.lwo", lwo2_square(3)));
+  // Decoys where a working directory would find them: read, they would change the output.
+  for (const fs::path& decoy : {dir / "elsewhere" / "beside.lwo", dir / "elsewhere" / "Objects" / "below.lwo",
+                                dir / "elsewhere" / "Objects" / "content.lwo", content / "Objects" / "below.lwo"})
+    ASSERT_TRUE(ossa::test::write_file(decoy, lwo2_square(9)));
+  struct Scene {
+    const char* file;
+    const char* object;
+    float height;  // of the object it must load
+  };
+  const Scene scenes[] = {
+      {"beside.lws", "beside.lwo", 1},
+      {"below.lws", "Objects/below.lwo", 2},
+      {"content.lws", "Objects/content.lwo", 3}};
+  for (const auto& [scene, object, height] : scenes) {
+    SCOPED_TRACE(scene);
+    const fs::path input = content / "Scenes" / scene;
+    ASSERT_TRUE(ossa::test::write_file(input, lws_scene(object)));
+    std::optional<std::vector<uint8_t>> first;
+    for (const fs::path& cwd : {dir, content / "Scenes", content / "Objects", dir / "elsewhere"}) {
+      SCOPED_TRACE(cwd.string());
+      const fs::path out = dir / "out" / cwd.filename();
+      const auto r = run_command("cd " + q(cwd) + " && " + cook_cmd() + " " + q(fs::relative(input, cwd)) + " -o " +
+                                 q(out) + " -q --force --root " + q(fs::relative(tree, cwd)));
+      ASSERT_EQ(r.exit_code, 0) << r.err;
+      const auto bytes = ossa::test::read_file(out / "lw" / "Scenes" / (fs::path(scene).stem().string() + ".ossa"));
+      ASSERT_TRUE(bytes);
+      if (!first) {
+        first = bytes;
+        auto a = ossa::Asset::open((out / "lw" / "Scenes" / (fs::path(scene).stem().string() + ".ossa")).string());
+        ASSERT_TRUE(a.ok() && a->file().meshes() && a->file().meshes()->size() == 1);
+        EXPECT_FLOAT_EQ(a->file().meshes()->Get(0)->bounds_max()->y(), height) << "not the object the scene names";
+      }
+      EXPECT_EQ(*bytes, *first) << "another directory, another output";
+    }
+  }
+  // Nothing but the tree: an object outside --root is refused by name, whichever way it is named.
+  ASSERT_TRUE(ossa::test::write_file(secret / "box.lwo", lwo2_square(0)));
+  for (const std::string& object : {std::string("../../../secret/box.lwo"), (secret / "box.lwo").string()}) {
+    SCOPED_TRACE(object);
+    ASSERT_TRUE(ossa::test::write_file(content / "Scenes" / "out.lws", lws_scene(object)));
+    const auto r = run_command("cd " + q(secret) + " && " + cook_cmd() + " " + q(content / "Scenes" / "out.lws") +
+                               " -o " + q(dir / "out") + " --root " + q(tree));
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_NE(r.err.find((secret / "box.lwo").string() + ": refused: outside the folders this cook may read"),
+              std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("out.lws"), std::string::npos) << r.err;
+  }
 }
 
 }  // namespace

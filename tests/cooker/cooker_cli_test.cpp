@@ -293,6 +293,61 @@ TEST(CookerCli, ClipOnlyFileBindsToItsSkeleton) {
   EXPECT_GT(walk->clip(0).constants().size() + walk->clip(0).animated().size(), 10u);
 }
 
+// A studio tree cooked with one command and no --skeleton: a clip-only source binds to its
+// folder's rig (a source named skeleton.* or after its folder, cooked first in the same batch; of
+// the same format when there are several), and one with no rig beside it is said to have become a
+// rig of its own, by name.
+TEST(CookerCli, ClipOnlySourcesInATreeBindToTheirFolderRig) {
+  const fs::path dir = ossa::test::make_temp_dir("cli-folder-rig");
+  const fs::path tree = dir / "tree", out = dir / "out";
+  for (const char* d : {"Pab", "Pabby", "Lone"}) fs::create_directories(tree / d);
+  fs::copy_file(asset("Pab/skeleton.fbx"), tree / "Pab" / "skeleton.fbx");
+  fs::copy_file(asset("Pab/walk.fbx"), tree / "Pab" / "walk.fbx");
+  fs::copy_file(asset("Pab/skeleton.fbx"), tree / "Pabby" / "Pabby.fbx");
+  fs::copy_file(asset("Pab/run.fbx"), tree / "Pabby" / "run.fbx");
+  fs::copy_file(asset("Pab/run.fbx"), tree / "Lone" / "run.fbx");
+  // The Collada pair from the shared assets, when present: walk.dae must take skeleton.dae.
+  const fs::path shared = ossa::test::shared_assets() / "Pab";
+  const bool collada = fs::exists(shared / "skeleton.dae") && fs::exists(shared / "walk.dae");
+  if (collada) {
+    fs::copy_file(shared / "skeleton.dae", tree / "Pab" / "skeleton.dae");
+    fs::copy_file(shared / "walk.dae", tree / "Pab" / "walk.dae");
+  }
+  const std::string command = cook_cmd() + " " + q(tree) + " -o " + q(out) + " --root " + q(tree) +
+                              " --jobs 2 -v --report " + q(dir / "r.json");
+  const auto r = run_command(command);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto bound = [&](const fs::path& clip_file, const fs::path& rig_file) {
+    SCOPED_TRACE(clip_file.string());
+    auto clip = ossa::Asset::open((out / clip_file).string());
+    auto rig = ossa::Asset::open((out / rig_file).string());
+    ASSERT_TRUE(clip.ok() && rig.ok());
+    EXPECT_TRUE(clip->skeleton().empty()) << "bound to its folder's rig, it carries none of its own";
+    ASSERT_GE(clip->clip_count(), 1u);
+    EXPECT_EQ(clip->clip(0).skeleton_hash(), rig->skeleton().hash());
+    EXPECT_TRUE(ossa::check_clip_binding(clip->clip(0), rig->skeleton(), clip_file.string()).ok());
+  };
+  const std::string fbx = collada ? ".fbx" : "";  // same-stem sources keep their extension
+  bound(fs::path("Pab") / ("walk" + fbx + ".ossa"), fs::path("Pab") / ("skeleton" + fbx + ".ossa"));
+  bound(fs::path("Pabby") / "run.ossa", fs::path("Pabby") / "Pabby.ossa");
+  if (collada) bound(fs::path("Pab") / "walk.dae.ossa", fs::path("Pab") / "skeleton.dae.ossa");
+  // Alone, the clip keeps a rig of its own, and the warning names it.
+  auto lone = ossa::Asset::open((out / "Lone" / "run.ossa").string());
+  ASSERT_TRUE(lone.ok());
+  EXPECT_FALSE(lone->skeleton().empty());
+  EXPECT_NE(r.err.find("warning: " + (tree / "Lone" / "run.fbx").string() +
+                       ": holds clips and no mesh, so it is cooked with a rig of its own"),
+            std::string::npos)
+      << r.err;
+  EXPECT_EQ(r.err.find("Pab/walk.fbx: holds clips and no mesh"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("skeleton.fbx: holds clips and no mesh"), std::string::npos) << r.err;
+  // Again: everything up to date, the bound clips included.
+  const auto again = run_command(command);
+  ASSERT_EQ(again.exit_code, 0) << again.err;
+  const auto report = nlohmann::json::parse(*ossa::test::read_text(dir / "r.json"));
+  for (const auto& record : report["records"]) EXPECT_TRUE(record["up_to_date"].get<bool>()) << record["input"];
+}
+
 TEST(CookerCli, ClipAgainstTheWrongRigNamesMissingJoints) {
   const fs::path dir = ossa::test::make_temp_dir("cli-wrong");
   auto r = run_command(cook_cmd() + " " + q(asset("Fox/Fox.glb")) + " -o " + q(dir));

@@ -519,7 +519,7 @@ TEST(RootMotionDelta, DoesNotAllocate) {
 
 TEST(RootMotionCooked, PabWalkMovesForwardWithTheRootInPlace) {
   // Cooked by ossa-cook into the committed fixtures (tests/fixtures/cook_fixtures.cmake): the walk
-  // against Pab's skeleton with --root-motion --up-axis y.
+  // against Pab's skeleton with --root-motion.
   const std::filesystem::path dir = test::fixtures_dir();
   auto rig_asset = Asset::open((dir / "Pab" / "skeleton.ossa").string());
   ASSERT_TRUE(rig_asset) << rig_asset.error().message;
