@@ -354,15 +354,15 @@ ChannelPlan classify_channel(const Metric& m, const glm::vec4* ref, uint32_t n, 
   return plan;
 }
 
-/// Step 5: keys and bits of an animated channel fitted to `target` (per frame) within tolerance.
-ChannelPlan encode_animated(const Metric& m, const glm::vec4* target, uint32_t n, double tolerance) {
-  ChannelPlan plan;
-  plan.kind = Kind::Animated;
-  plan.dropped = m.channel == kRotation ? choose_dropped(target, n) : 0;
+namespace {
+
+/// `target`'s frames in the stored form of `plan.dropped`, and their range written to `plan`
+/// (range_min, range_extent per stored component). O(n).
+std::vector<glm::vec4> stored_with_range(uint32_t channel, const glm::vec4* target, uint32_t n, ChannelPlan& plan) {
   std::vector<glm::vec4> stored(n);
   glm::vec4 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
   for (uint32_t f = 0; f < n; ++f) {
-    stored[f] = stored_form(m.channel, plan.dropped, target[f]);
+    stored[f] = stored_form(channel, plan.dropped, target[f]);
     lo = glm::min(lo, stored[f]);
     hi = glm::max(hi, stored[f]);
   }
@@ -370,6 +370,17 @@ ChannelPlan encode_animated(const Metric& m, const glm::vec4* target, uint32_t n
     plan.range_min[c] = lo[c];
     plan.range_extent[c] = hi[c] - lo[c];
   }
+  return stored;
+}
+
+}  // namespace
+
+/// Step 5: keys and bits of an animated channel fitted to `target` (per frame) within tolerance.
+ChannelPlan encode_animated(const Metric& m, const glm::vec4* target, uint32_t n, double tolerance) {
+  ChannelPlan plan;
+  plan.kind = Kind::Animated;
+  plan.dropped = m.channel == kRotation ? choose_dropped(target, n) : 0;
+  const std::vector<glm::vec4> stored = stored_with_range(m.channel, target, n, plan);
 
   // Raw floats: the fallback, and (its key count) the floor no bit count can go below.
   std::vector<glm::vec4> dec(n);
@@ -430,17 +441,7 @@ ChannelPlan refit_animated(const Metric& m, const glm::vec4* target, uint32_t n,
     plan.codes = raw_codes(m.channel, plan.dropped, target, n);
     return plan;
   }
-  std::vector<glm::vec4> stored(n);
-  glm::vec4 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
-  for (uint32_t f = 0; f < n; ++f) {
-    stored[f] = stored_form(m.channel, plan.dropped, target[f]);
-    lo = glm::min(lo, stored[f]);
-    hi = glm::max(hi, stored[f]);
-  }
-  for (int c = 0; c < 3; ++c) {
-    plan.range_min[c] = lo[c];
-    plan.range_extent[c] = hi[c] - lo[c];
-  }
+  const std::vector<glm::vec4> stored = stored_with_range(m.channel, target, n, plan);
   plan.codes.resize(n);
   for (uint32_t f = 0; f < n; ++f)
     plan.codes[f] = encode_quantized(m, target[f], stored[f], plan.dropped, bits, plan.range_min, plan.range_extent,

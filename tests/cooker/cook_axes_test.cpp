@@ -19,9 +19,11 @@
 #include <ossa/anim/sample.h>
 #include <ossa/loader/asset.h>
 #include <ossa/skinning/skinning.h>
+#include "fbx_text.h"
 #include "test_files.h"
 
 namespace fs = std::filesystem;
+using ossa::test::fbx_ascii_head;
 using ossa::test::run_command;
 
 namespace {
@@ -96,21 +98,10 @@ std::string chain_fbx(int up) {
     const glm::vec3 s = in_source({0, y, 0}, up);
     return std::to_string(s.x) + "," + std::to_string(s.y) + "," + std::to_string(s.z);
   };
-  std::string text = R"(; FBX 7.4.0 project file
-FBXHeaderExtension:  {
-	FBXHeaderVersion: 1003
-	FBXVersion: 7400
-}
-GlobalSettings:  {
-	Version: 1000
-	Properties70:  {
-		P: "UpAxis", "int", "Integer", "",)" + std::to_string(up) + R"(
-		P: "UpAxisSign", "int", "Integer", "",1
-		P: "UnitScaleFactor", "double", "Number", "",100
-	}
-}
-Objects:  {
-)";
+  std::string text = fbx_ascii_head("\t\tP: \"UpAxis\", \"int\", \"Integer\", \"\"," + std::to_string(up) +
+                                    "\n\t\tP: \"UpAxisSign\", \"int\", \"Integer\", \"\",1\n"
+                                    "\t\tP: \"UnitScaleFactor\", \"double\", \"Number\", \"\",100\n") +
+                     "Objects:  {\n";
   const char* names[3] = {"Hips", "Spine", "Head"};
   for (int i = 0; i < 3; ++i)
     text += "\tModel: " + std::to_string(1000 + i) + ", \"Model::" + names[i] + "\", \"LimbNode\" {\n" +

@@ -18,6 +18,7 @@
 #include <ossa/anim/sample.h>
 #include <ossa/format/vertex_codec.h>
 #include <ossa/loader/asset.h>
+#include "fbx_text.h"
 #include "test_files.h"
 
 namespace fs = std::filesystem;
@@ -57,18 +58,7 @@ const char* kRigDae = R"(<?xml version="1.0" encoding="utf-8"?>
 
 /// An ASCII FBX rig: LimbNodes Hips > "" > "", the two below Hips without names (some exporters
 /// write "Model::" and Assimp keeps the empty name).
-const char* kUnnamedFbx = R"(; FBX 7.4.0 project file
-FBXHeaderExtension:  {
-	FBXHeaderVersion: 1003
-	FBXVersion: 7400
-}
-GlobalSettings:  {
-	Version: 1000
-	Properties70:  {
-		P: "UnitScaleFactor", "double", "Number", "",1
-	}
-}
-Objects:  {
+const std::string kUnnamedFbx = ossa::test::fbx_ascii_head("\t\tP: \"UnitScaleFactor\", \"double\", \"Number\", \"\",1\n") + R"(Objects:  {
 	Model: 1000, "Model::Hips", "LimbNode" {
 		Version: 232
 		Properties70:  {

@@ -7,22 +7,14 @@
 // Assimp 5.2.5 merges all channels' keys into one list per time (only the channels keyed then)
 // and reports weight = DeformPercent / 100.
 #pragma once
+#include <string>
+
+#include "fbx_text.h"
 
 namespace ossa::test {
 
-inline constexpr const char* kBlendShapeFbx = R"(; FBX 7.4.0 project file
-FBXHeaderExtension:  {
-	FBXHeaderVersion: 1003
-	FBXVersion: 7400
-}
-GlobalSettings:  {
-	Version: 1000
-	Properties70:  {
-		P: "UnitScaleFactor", "double", "Number", "",100
-		P: "TimeMode", "enum", "", "",6
-	}
-}
-Objects:  {
+inline const std::string kBlendShapeFbx = fbx_ascii_head(
+    "\t\tP: \"UnitScaleFactor\", \"double\", \"Number\", \"\",100\n\t\tP: \"TimeMode\", \"enum\", \"\", \"\",6\n") + R"(Objects:  {
 	Geometry: 2000, "Geometry::face", "Mesh" {
 		Vertices: *12 {
 			a: 0,0,0,1,0,0,0,1,0,1,1,0
