@@ -142,9 +142,7 @@ std::unique_ptr<AclClip> AclClip::compress(const RawClipData& raw, double precis
 
 uint32_t AclClip::bytes() const { return impl_->tracks->get_size(); }
 
-uint32_t AclClip::segments() const {
-  return acl::acl_impl::get_transform_tracks_header(*impl_->tracks).num_segments;
-}
+uint32_t AclClip::segments() const { return acl::acl_impl::get_transform_tracks_header(*impl_->tracks).num_segments; }
 
 void AclClip::sample(float time, PoseSpan out) {
   impl_->context.seek(time, acl::sample_rounding_policy::none);

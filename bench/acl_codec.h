@@ -35,9 +35,9 @@ struct RawTransform {
 struct RawClipData {
   uint32_t joints = 0, frames = 0;
   float sample_rate = 30.0f;
-  std::vector<int> parents;              // parents[j] < j, -1 for a root
-  std::vector<RawTransform> bind;        // per joint
-  std::vector<RawTransform> samples;     // frames * joints
+  std::vector<int> parents;           // parents[j] < j, -1 for a root
+  std::vector<RawTransform> bind;     // per joint
+  std::vector<RawTransform> samples;  // frames * joints
 };
 
 class AclClip {

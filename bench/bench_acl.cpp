@@ -66,12 +66,12 @@ std::vector<Source> default_sources() {
   std::vector<Source> s = {{"CMU_BVH/01_03.bvh", ""}};
   for (const char* clip : {"walk", "jog", "run", "crossarms", "atlas", "crackhead"})
     s.push_back({std::string("Pab/") + clip + ".fbx", "Pab/skeleton.fbx"});
-  for (const char* main : {"Pab/skeleton.fbx", "Fox/Fox.glb", "CesiumMan/CesiumMan.glb",
-                           "RobotExpressive/RobotExpressive.glb", "RiggedSimple/RiggedSimple.glb",
-                           "Quaternius_Alien/Alien.fbx", "Quaternius_Cowboy/Cowboy.fbx", "Quaternius_Eagle/Eagle.fbx",
-                           "Quaternius_Male/Smooth_Male_Casual.fbx", "Quaternius_Robot/Robot.fbx",
-                           "Quaternius_Spider/Spider.fbx", "Quaternius_Trex/Trex.fbx",
-                           "Khronos_embedded/interpolation_test.gltf", "Khronos_embedded/box_animated.gltf"})
+  for (const char* main :
+       {"Pab/skeleton.fbx", "Fox/Fox.glb", "CesiumMan/CesiumMan.glb", "RobotExpressive/RobotExpressive.glb",
+        "RiggedSimple/RiggedSimple.glb", "Quaternius_Alien/Alien.fbx", "Quaternius_Cowboy/Cowboy.fbx",
+        "Quaternius_Eagle/Eagle.fbx", "Quaternius_Male/Smooth_Male_Casual.fbx", "Quaternius_Robot/Robot.fbx",
+        "Quaternius_Spider/Spider.fbx", "Quaternius_Trex/Trex.fbx", "Khronos_embedded/interpolation_test.gltf",
+        "Khronos_embedded/box_animated.gltf"})
     s.push_back({main, ""});
   return s;
 }
@@ -158,11 +158,12 @@ void time_clip(SideBySideClip& c, AclClip& acl, int runs, uint32_t min_poses, Ro
 double ratio(double a, double b) { return b > 0.0 ? a / b : 0.0; }
 
 void print_row(const Row& r, double mm) {
-  std::printf("%s\t%s\t%u\t%u\t%u\t%u\t%.3f\t%.4f\t%.4f\t%.4f\t%.4f\t%.5f\t%d\t%u\t%.1f\t%.1f\t%.2f\t%.1f\t%.1f\t%.2f\n",
-              r.asset.c_str(), r.clip.c_str(), r.joints, r.frames, r.ossa_bytes, r.acl_bytes,
-              ratio(r.ossa_bytes, r.acl_bytes), r.ossa_err.max() * mm, r.acl_err.max() * mm, r.ossa_err.at_frames * mm,
-              r.acl_err.at_frames * mm, r.acl_precision * 1000.0, r.acl_reached ? 1 : 0, r.acl_segments, r.ossa_fwd,
-              r.acl_fwd, ratio(r.ossa_fwd, r.acl_fwd), r.ossa_rand, r.acl_rand, ratio(r.ossa_rand, r.acl_rand));
+  std::printf(
+      "%s\t%s\t%u\t%u\t%u\t%u\t%.3f\t%.4f\t%.4f\t%.4f\t%.4f\t%.5f\t%d\t%u\t%.1f\t%.1f\t%.2f\t%.1f\t%.1f\t%.2f\n",
+      r.asset.c_str(), r.clip.c_str(), r.joints, r.frames, r.ossa_bytes, r.acl_bytes, ratio(r.ossa_bytes, r.acl_bytes),
+      r.ossa_err.max() * mm, r.acl_err.max() * mm, r.ossa_err.at_frames * mm, r.acl_err.at_frames * mm,
+      r.acl_precision * 1000.0, r.acl_reached ? 1 : 0, r.acl_segments, r.ossa_fwd, r.acl_fwd,
+      ratio(r.ossa_fwd, r.acl_fwd), r.ossa_rand, r.acl_rand, ratio(r.ossa_rand, r.acl_rand));
   std::printf("# %s/%s: worst joint ossa %u at frame %.2f, ACL %u at frame %.2f\n", r.asset.c_str(), r.clip.c_str(),
               r.ossa_err.worst_joint, static_cast<double>(r.ossa_err.worst_frame), r.acl_err.worst_joint,
               static_cast<double>(r.acl_err.worst_frame));
@@ -180,10 +181,11 @@ void print_summary(const std::vector<Row>& rows, const std::vector<double>& mm, 
     over += rows[i].ossa_err.max() * mm[i] > tolerance_mm;
     acl_over += !rows[i].acl_reached;
   }
-  std::printf("# clips %zu: bytes ossa %llu, ACL %llu, ratio %.3f; ossa larger than ACL on %zu clips; ossa over "
-              "%.4g mm on %zu clips (ACL not brought within it on %zu)\n",
-              rows.size(), static_cast<unsigned long long>(ossa), static_cast<unsigned long long>(acl),
-              ratio(static_cast<double>(ossa), static_cast<double>(acl)), larger, tolerance_mm, over, acl_over);
+  std::printf(
+      "# clips %zu: bytes ossa %llu, ACL %llu, ratio %.3f; ossa larger than ACL on %zu clips; ossa over "
+      "%.4g mm on %zu clips (ACL not brought within it on %zu)\n",
+      rows.size(), static_cast<unsigned long long>(ossa), static_cast<unsigned long long>(acl),
+      ratio(static_cast<double>(ossa), static_cast<double>(acl)), larger, tolerance_mm, over, acl_over);
   const auto worst = [&](const char* what, auto key) {
     std::vector<size_t> order(rows.size());
     for (size_t i = 0; i < order.size(); ++i) order[i] = i;
@@ -229,20 +231,26 @@ int main(int argc, char** argv) {
     else if (a == "--filter" && more) filter = argv[++i];
     else if (a == "--metres-per-unit" && more) bvh_unit = std::strtof(argv[++i], nullptr);
     else if (!a.empty() && a[0] == '-') return usage();
-    else if (const size_t at = a.find('@'); at != std::string::npos) sources.push_back({a.substr(0, at), a.substr(at + 1)});
+    else if (const size_t at = a.find('@'); at != std::string::npos)
+      sources.push_back({a.substr(0, at), a.substr(at + 1)});
     else sources.push_back({a, ""});
   }
   if (!(bvh_unit > 0.0f)) return usage();
   if (sources.empty()) sources = default_sources();
-  const auto resolve = [&](const std::string& p) { return fs::path(p).is_absolute() ? fs::path(p) : fs::path(assets) / p; };
+  const auto resolve = [&](const std::string& p) {
+    return fs::path(p).is_absolute() ? fs::path(p) : fs::path(assets) / p;
+  };
 
   std::printf("# %s\n# %s, built %s; ossa-cook's defaults (%.4g mm at %.4g cm probes)\n", machine_line().c_str(),
               acl_version().c_str(), OSSA_BENCH_BUILD, kToleranceMetres * 1000.0, kProbeMetres * 100.0);
-  std::printf("# bytes: ossa cooked_bytes / ACL get_size(); errors in mm, the larger of frames and between frames "
-              "(_frames: frames only); times in ns per pose, median of %d runs\n", runs);
-  std::printf("asset\tclip\tjoints\tframes\tossa_bytes\tacl_bytes\tbytes_ratio\tossa_mm\tacl_mm\tossa_frames_mm"
-              "\tacl_frames_mm\tacl_precision_mm\tacl_reached\tacl_segments\tossa_fwd_ns\tacl_fwd_ns\tfwd_ratio"
-              "\tossa_rand_ns\tacl_rand_ns\trand_ratio\n");
+  std::printf(
+      "# bytes: ossa cooked_bytes / ACL get_size(); errors in mm, the larger of frames and between frames "
+      "(_frames: frames only); times in ns per pose, median of %d runs\n",
+      runs);
+  std::printf(
+      "asset\tclip\tjoints\tframes\tossa_bytes\tacl_bytes\tbytes_ratio\tossa_mm\tacl_mm\tossa_frames_mm"
+      "\tacl_frames_mm\tacl_precision_mm\tacl_reached\tacl_segments\tossa_fwd_ns\tacl_fwd_ns\tfwd_ratio"
+      "\tossa_rand_ns\tacl_rand_ns\trand_ratio\n");
   std::map<std::string, cook::SourceSkeleton> rigs;
   std::vector<Row> rows;
   std::vector<double> mm_per_unit;
@@ -281,7 +289,8 @@ int main(int argc, char** argv) {
       const double tolerance = kToleranceMetres / c.metres_per_unit;
       std::unique_ptr<AclClip> acl = acl_within(c, tolerance, row, &error);
       if (!acl) {
-        std::fprintf(stderr, "ossa-bench-acl: %s: clip '%s': ACL: %s\n", s.path.c_str(), row.clip.c_str(), error.c_str());
+        std::fprintf(stderr, "ossa-bench-acl: %s: clip '%s': ACL: %s\n", s.path.c_str(), row.clip.c_str(),
+                     error.c_str());
         status = 1;
         continue;
       }

@@ -78,8 +78,8 @@ const PoseBench& pose_bench() {
 
 /// ns per joint per call: the rate of (joints * 1e-9) per iteration, inverted.
 void set_ns_per_joint(benchmark::State& state, uint32_t joints) {
-  state.counters["ns_per_joint"] =
-      benchmark::Counter(double(joints) * 1e-9, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+  state.counters["ns_per_joint"] = benchmark::Counter(
+      double(joints) * 1e-9, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
 }
 
 void BM_Blend2(benchmark::State& state) {

@@ -59,9 +59,8 @@ std::vector<float> playback_times(const ossa::ClipView& clip, size_t n, float st
 
 void per_joint_counter(benchmark::State& state, uint32_t joints) {
   // Iteration-invariant rate, inverted: seconds per iteration / joints, shown in ns.
-  state.counters["ns_per_joint"] =
-      benchmark::Counter(static_cast<double>(joints) * 1e-9, benchmark::Counter::kIsIterationInvariantRate |
-                                                                 benchmark::Counter::kInvert);
+  state.counters["ns_per_joint"] = benchmark::Counter(
+      static_cast<double>(joints) * 1e-9, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
 }
 
 void BM_Sample(benchmark::State& state) {

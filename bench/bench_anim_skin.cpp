@@ -165,7 +165,9 @@ void BM_SkinOrder(benchmark::State& state) {
 }
 BENCHMARK(BM_SkinOrder)->ArgNames({"ordered", "full"})->ArgsProduct({{0, 1}, {0, 1}});
 
-void BM_SkinDualQuaternionFull(benchmark::State& state) { skin_loop(state, ossa::SkinningMethod::DualQuaternion, true); }
+void BM_SkinDualQuaternionFull(benchmark::State& state) {
+  skin_loop(state, ossa::SkinningMethod::DualQuaternion, true);
+}
 BENCHMARK(BM_SkinDualQuaternionFull);
 
 void BM_SkinningMatrices(benchmark::State& state) {
@@ -175,8 +177,8 @@ void BM_SkinningMatrices(benchmark::State& state) {
     benchmark::DoNotOptimize(b.palette.data());
     benchmark::ClobberMemory();
   }
-  state.counters["ns_per_slot"] = benchmark::Counter(double(b.palette.size()) * 1e-9,
-                                                     benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+  state.counters["ns_per_slot"] = benchmark::Counter(
+      double(b.palette.size()) * 1e-9, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
 }
 BENCHMARK(BM_SkinningMatrices);
 
@@ -191,8 +193,8 @@ void BM_SkinningMatricesPrepared(benchmark::State& state) {
     benchmark::DoNotOptimize(b.palette.data());
     benchmark::ClobberMemory();
   }
-  state.counters["ns_per_slot"] = benchmark::Counter(double(b.palette.size()) * 1e-9,
-                                                     benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+  state.counters["ns_per_slot"] = benchmark::Counter(
+      double(b.palette.size()) * 1e-9, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
 }
 BENCHMARK(BM_SkinningMatricesPrepared);
 

@@ -67,17 +67,18 @@ void print_breakdown(const CompressedClip& c) {
   const size_t constant_bytes = c.constants.size() * sizeof(ossa::fb::ConstantChannel);
   const size_t record_bytes = c.animated.size() * sizeof(ossa::fb::AnimatedChannel);
   const size_t frame_bytes = c.key_frames.size() * sizeof(uint16_t);
-  std::printf("# %s: constants %zu x %zu = %zu B + channel records %zu x %zu = %zu B + key_frames %zu x 2 = %zu B"
-              " + key_values %zu B = %zu B\n",
-              name, c.constants.size(), sizeof(ossa::fb::ConstantChannel), constant_bytes, c.animated.size(),
-              sizeof(ossa::fb::AnimatedChannel), record_bytes, c.key_frames.size(), frame_bytes, c.key_values.size(),
-              constant_bytes + record_bytes + frame_bytes + c.key_values.size());
+  std::printf(
+      "# %s: constants %zu x %zu = %zu B + channel records %zu x %zu = %zu B + key_frames %zu x 2 = %zu B"
+      " + key_values %zu B = %zu B\n",
+      name, c.constants.size(), sizeof(ossa::fb::ConstantChannel), constant_bytes, c.animated.size(),
+      sizeof(ossa::fb::AnimatedChannel), record_bytes, c.key_frames.size(), frame_bytes, c.key_values.size(),
+      constant_bytes + record_bytes + frame_bytes + c.key_values.size());
   const uint32_t frames = c.grid.frame_count;
   size_t every_channels = 0, reduced_channels = 0;
   uint64_t every_keys = 0, reduced_keys = 0, every_bits = 0, reduced_bits = 0;
   std::set<uint32_t> every_runs, reduced_runs;  // first_key of the key-frame runs each group reads
   uint64_t reduced_run_frames = 0;
-  std::map<uint32_t, uint32_t> bits_used[3];    // per channel kind: bits -> channels
+  std::map<uint32_t, uint32_t> bits_used[3];  // per channel kind: bits -> channels
   for (const CompressedAnimated& a : c.animated) {
     if (a.key_count == frames) {
       ++every_channels;
@@ -92,13 +93,14 @@ void print_breakdown(const CompressedClip& c) {
     }
     if (a.channel < 3) ++bits_used[a.channel][a.bits];
   }
-  std::printf("# %s: keyed at every frame: %zu channels, %llu keys, %.0f B of values, %zu run(s) of %u frames;"
-              " keys removed: %zu channels, %llu of %llu frames kept, %.0f B of values, %llu B of key frames"
-              " (%zu runs)\n",
-              name, every_channels, static_cast<unsigned long long>(every_keys), static_cast<double>(every_bits) / 8.0,
-              every_runs.size(), frames, reduced_channels, static_cast<unsigned long long>(reduced_keys),
-              static_cast<unsigned long long>(reduced_channels) * frames, static_cast<double>(reduced_bits) / 8.0,
-              static_cast<unsigned long long>(reduced_run_frames * sizeof(uint16_t)), reduced_runs.size());
+  std::printf(
+      "# %s: keyed at every frame: %zu channels, %llu keys, %.0f B of values, %zu run(s) of %u frames;"
+      " keys removed: %zu channels, %llu of %llu frames kept, %.0f B of values, %llu B of key frames"
+      " (%zu runs)\n",
+      name, every_channels, static_cast<unsigned long long>(every_keys), static_cast<double>(every_bits) / 8.0,
+      every_runs.size(), frames, reduced_channels, static_cast<unsigned long long>(reduced_keys),
+      static_cast<unsigned long long>(reduced_channels) * frames, static_cast<double>(reduced_bits) / 8.0,
+      static_cast<unsigned long long>(reduced_run_frames * sizeof(uint16_t)), reduced_runs.size());
   static const char* const kKinds[3] = {"translation", "rotation", "scale"};
   std::printf("# %s: bits (bits:channels):", name);
   for (int k = 0; k < 3; ++k) {
@@ -160,8 +162,9 @@ int main(int argc, char** argv) {
   }
 
   std::printf("# %s\n", ossa::bench::machine_line().c_str());
-  std::printf("asset\tclip\tjoints\tunit_m\traw_bytes\tcooked_bytes\tratio\tmax_error_mm\tmean_error_mm"
-              "\ttolerance_mm\n");
+  std::printf(
+      "asset\tclip\tjoints\tunit_m\traw_bytes\tcooked_bytes\tratio\tmax_error_mm\tmean_error_mm"
+      "\ttolerance_mm\n");
   int status = 0;
   for (const std::string& asset : assets) {
     auto scene = import_scene(asset, import_options);
@@ -183,9 +186,8 @@ int main(int argc, char** argv) {
         std::printf("%s\t%s\t%zu\t%g\t%u\t%u\t%.2f\t%.4f\t%.4f\t%g\n", fs::path(asset).filename().string().c_str(),
                     c.name.c_str(), scene->skeleton.joints.size(), static_cast<double>(scene->metres_per_unit),
                     c.raw_bytes, c.cooked_bytes,
-                    c.cooked_bytes ? static_cast<double>(c.raw_bytes) / c.cooked_bytes : 0.0,
-                    c.max_error * mm_per_unit, c.mean_error * mm_per_unit,
-                    static_cast<double>(options.tolerance_metres) * 1000.0);
+                    c.cooked_bytes ? static_cast<double>(c.raw_bytes) / c.cooked_bytes : 0.0, c.max_error * mm_per_unit,
+                    c.mean_error * mm_per_unit, static_cast<double>(options.tolerance_metres) * 1000.0);
         if (breakdown) print_breakdown(c);
       }
     }

@@ -5,7 +5,8 @@
 //
 // The repo's samples (CesiumMan, Fox, RiggedSimple, Pab's skeleton.fbx, and Pab's arnaud.fbx
 // cooked against that skeleton, as scripts/demo.sh does) — or the SOURCE files given instead —
-// are cooked in-process into a temporary directory. Then, per asset, N runs of each variant alternate, each a fresh child process:
+// are cooked in-process into a temporary directory. Then, per asset, N runs of each variant alternate, each a fresh
+// child process:
 //   cooked: ossa-view FILE.ossa --frames 1 --first-frame-time --no-grid (the real viewer,
 //           headless, drawing only the character as the other side does);
 //   assimp: this program re-run as --assimp-child SOURCE (bench/first_frame_assimp.h).
@@ -96,7 +97,8 @@ std::optional<ChildRun> time_child(const std::vector<std::string>& args) {
         line += buf[i];
         continue;
       }
-      if (line.rfind("first-frame-ms", 0) == 0) ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+      if (line.rfind("first-frame-ms", 0) == 0)
+        ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
       if (line.rfind("texture-bytes ", 0) == 0) texture_bytes = std::strtoull(line.c_str() + 14, nullptr, 10);
       line.clear();
     }
@@ -148,7 +150,9 @@ int main(int argc, char** argv) {
     } else if (!a.empty() && a[0] != '-') {
       sources.emplace_back(a);
     } else {
-      std::printf("usage: ossa-bench-first-frame [--runs N] [--size WxH] [--msaa N] [--assets DIR] [--shared DIR] [SOURCE...]\n");
+      std::printf(
+          "usage: ossa-bench-first-frame [--runs N] [--size WxH] [--msaa N] [--assets DIR] [--shared DIR] "
+          "[SOURCE...]\n");
       return a == "-h" || a == "--help" ? 0 : 2;
     }
   }
@@ -232,13 +236,16 @@ int main(int argc, char** argv) {
   const std::string self = (self_dir() / "ossa-bench-first-frame").string();
   const std::string size = std::to_string(width) + "x" + std::to_string(height), msaa = std::to_string(samples);
   std::printf("# %s\n", ossa::bench::machine_line().c_str());
-  std::printf("# first frame, process start to glFinish, median of %d runs, %s, MSAA %s\n", runs, size.c_str(), msaa.c_str());
-  std::printf("# texture MiB: GPU memory of the textures each side uploaded (cooked: the file's mip chains;\n"
-              "# assimp: RGBA8 + glGenerateMipmap's chain)\n");
-  std::printf("# floor: a child making the same context and framebuffer and drawing nothing; 'over floor' is\n"
-              "# each side's median minus the floor's (the work it does for its asset)\n");
-  std::printf("%-20s %9s %9s %9s %7s %9s %9s %7s %10s %10s %6s\n", "asset", "cooked ms", "assimp ms", "floor ms", "speedup",
-              "ossa over", "asmp over", "speedup", "cooked tex", "assimp tex", "tex");
+  std::printf("# first frame, process start to glFinish, median of %d runs, %s, MSAA %s\n", runs, size.c_str(),
+              msaa.c_str());
+  std::printf(
+      "# texture MiB: GPU memory of the textures each side uploaded (cooked: the file's mip chains;\n"
+      "# assimp: RGBA8 + glGenerateMipmap's chain)\n");
+  std::printf(
+      "# floor: a child making the same context and framebuffer and drawing nothing; 'over floor' is\n"
+      "# each side's median minus the floor's (the work it does for its asset)\n");
+  std::printf("%-20s %9s %9s %9s %7s %9s %9s %7s %10s %10s %6s\n", "asset", "cooked ms", "assimp ms", "floor ms",
+              "speedup", "ossa over", "asmp over", "speedup", "cooked tex", "assimp tex", "tex");
   const auto mib = [](uint64_t b) { return static_cast<double>(b) / (1024.0 * 1024.0); };
   const std::vector<std::string> frame_args = {"--size", size, "--msaa", msaa};
   const auto with = [&](std::vector<std::string> head, const std::vector<std::string>& tail) {
@@ -271,7 +278,9 @@ int main(int argc, char** argv) {
     char over_ratio[32] = "-";
     if (oc >= 1.0 && os >= 1.0) std::snprintf(over_ratio, sizeof over_ratio, "%.2fx", os / oc);
     char tex_ratio[32] = "-";
-    if (assimp_tex > 0) std::snprintf(tex_ratio, sizeof tex_ratio, "%.3f", static_cast<double>(cooked_tex) / static_cast<double>(assimp_tex));
+    if (assimp_tex > 0)
+      std::snprintf(tex_ratio, sizeof tex_ratio, "%.3f",
+                    static_cast<double>(cooked_tex) / static_cast<double>(assimp_tex));
     std::printf("%-20s %9.1f %9.1f %9.1f %6.2fx %9.1f %9.1f %7s %10.2f %10.2f %6s\n", label.c_str(), mc, ms, mf,
                 ms / mc, oc, os, over_ratio, mib(cooked_tex), mib(assimp_tex), tex_ratio);
     std::fflush(stdout);
@@ -280,7 +289,8 @@ int main(int argc, char** argv) {
     row(a.label, with({viewer, a.cooked.string(), "--frames", "1", "--first-frame-time", "--no-grid"}, frame_args),
         with({self, "--assimp-child", a.source.string()}, frame_args));
   if (!all_sources.empty()) {
-    std::vector<std::string> cooked_cmd = with({self, "--ossa-child"}, frame_args), assimp_cmd = with({self, "--assimp-child"}, frame_args);
+    std::vector<std::string> cooked_cmd = with({self, "--ossa-child"}, frame_args),
+                             assimp_cmd = with({self, "--assimp-child"}, frame_args);
     for (const fs::path& p : all_cooked) cooked_cmd.push_back(p.string());
     for (const fs::path& p : all_sources) assimp_cmd.push_back(p.string());
     row("all " + std::to_string(all_sources.size()) + " shared", cooked_cmd, assimp_cmd);

@@ -50,9 +50,9 @@ std::unique_ptr<BenchData> load() {
   bound.reference_name = "skeleton.ossa";
   for (const char* name : {"walk", "jog", "run", "arnaud"})
     cook_or_die(pab / (std::string(name) + ".fbx"), dir / (std::string(name) + ".ossa"), bound);
-  auto data = std::unique_ptr<BenchData>(new BenchData{open_or_die(dir / "skeleton.ossa"), open_or_die(dir / "walk.ossa"),
-                                                       open_or_die(dir / "jog.ossa"), open_or_die(dir / "run.ossa"),
-                                                       open_or_die(dir / "arnaud.ossa")});
+  auto data = std::unique_ptr<BenchData>(
+      new BenchData{open_or_die(dir / "skeleton.ossa"), open_or_die(dir / "walk.ossa"), open_or_die(dir / "jog.ossa"),
+                    open_or_die(dir / "run.ossa"), open_or_die(dir / "arnaud.ossa")});
   std::error_code ec;
   fs::remove_all(dir, ec);  // the mappings stay valid after unlink
   return data;
@@ -82,7 +82,8 @@ std::vector<uint8_t> dealt_copy(const Asset& asset) {
   size_t n = 0;
   for (size_t i = 0; n < mesh.vertex_count(); ++i)
     for (const auto& run : runs)
-      if (i < run.size()) std::memcpy(out.data() + at + n++ * stride, mesh.vertex_bytes().data() + run[i] * stride, stride);
+      if (i < run.size())
+        std::memcpy(out.data() + at + n++ * stride, mesh.vertex_bytes().data() + run[i] * stride, stride);
   return out;
 }
 

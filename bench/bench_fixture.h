@@ -12,9 +12,9 @@
 namespace ossa::bench {
 
 struct BenchData {
-  Asset skeleton;  // Pab/skeleton.ossa (rig + its own mesh + clip)
+  Asset skeleton;        // Pab/skeleton.ossa (rig + its own mesh + clip)
   Asset walk, jog, run;  // clip-only files bound to skeleton
-  Asset arnaud;    // skinned mesh on the same rig
+  Asset arnaud;          // skinned mesh on the same rig
 };
 
 /// Cooks the assets into a temporary directory on first use; exits with a message on failure.

@@ -107,9 +107,7 @@ std::vector<Character> make_characters(const GraphDefinition& def, const Params&
 }
 
 /// Microseconds of process CPU time (every thread's) since `start`, a std::clock() reading.
-double cpu_micros_since(std::clock_t start) {
-  return 1e6 * static_cast<double>(std::clock() - start) / CLOCKS_PER_SEC;
-}
+double cpu_micros_since(std::clock_t start) { return 1e6 * static_cast<double>(std::clock() - start) / CLOCKS_PER_SEC; }
 
 /// One scratch per thread: what a game's job system would keep per worker. Returns wall-clock
 /// microseconds; *cpu gets the CPU microseconds all threads spent meanwhile (barrier waits too).
@@ -167,7 +165,9 @@ int main(int argc, char** argv) {
     else if (a == "--repeat" && i + 1 < argc) repeat = std::max(1, std::atoi(argv[++i]));
     else if (a == "--characters" && i + 1 < argc) counts = {static_cast<size_t>(std::max(1, std::atoi(argv[++i])))};
     else {
-      std::fprintf(stderr, "usage: ossa-bench-graph [--file CHARACTER.ossa --graph NAME] [--frames N] [--repeat N] [--characters N] [--clone baseline|avx2|avx512]\n");
+      std::fprintf(stderr,
+                   "usage: ossa-bench-graph [--file CHARACTER.ossa --graph NAME] [--frames N] [--repeat N] "
+                   "[--characters N] [--clone baseline|avx2|avx512]\n");
       return 2;
     }
   }
@@ -219,8 +219,8 @@ int main(int argc, char** argv) {
   std::printf("graph '%s' of %s: %u joints, %zu nodes, %zu state machines, %zu clips; %d frames of %.1f ms\n",
               graph_name.c_str(), file.c_str(), def->joint_count(), def->node_count(), def->machine_count(),
               def->clip_count(), frames, 1000.0 * kDt);
-  std::printf("%-40s %-11s %-8s %14s %22s %14s\n", "graph", "characters", "threads", "us/char/frame", "characters/16.7ms",
-              "cpu_us/char");
+  std::printf("%-40s %-11s %-8s %14s %22s %14s\n", "graph", "characters", "threads", "us/char/frame",
+              "characters/16.7ms", "cpu_us/char");
   const auto row = [&](const GraphDefinition& d, const Params& p, const char* label, size_t count, unsigned threads) {
     // More frames for fewer characters, so every row times a similar amount of work.
     const int n = count == 1 ? frames * 50 : count == 100 ? frames * 2 : frames / 5;
@@ -288,8 +288,8 @@ int main(int argc, char** argv) {
       const double per_char = best[k] / (static_cast<double>(n) * static_cast<double>(many));
       fit[k] = kFrameMicros / per_char;
       std::printf("%-40s %-11zu %-8u %14.3f %22.0f\n",
-                  k == 0 ? "locomotion, no montage (interleaved)" : "+ upper-body montage on every character", many,
-                  2u, per_char, fit[k]);
+                  k == 0 ? "locomotion, no montage (interleaved)" : "+ upper-body montage on every character", many, 2u,
+                  per_char, fit[k]);
     }
     // What the montages take of a frame filled with characters that play none: with / without - 1.
     std::printf("montage_cost_percent_of_frame: %.1f\n", 100.0 * (fit[0] / fit[1] - 1.0));

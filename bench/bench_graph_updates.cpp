@@ -53,8 +53,9 @@ int main(int argc, char** argv) {
     }
   }
   if (!file) {
-    std::fprintf(stderr, "usage: ossa-bench-graph-updates PAB.ossa [--montage] [--crossed] [--characters N] "
-                         "[--preroll N] [--updates N]\n");
+    std::fprintf(stderr,
+                 "usage: ossa-bench-graph-updates PAB.ossa [--montage] [--crossed] [--characters N] "
+                 "[--preroll N] [--updates N]\n");
     return 2;
   }
   auto asset = Asset::open(file);

@@ -172,15 +172,21 @@ bool plain_rows(int trials, const ossa::bench::BenchData& data, std::vector<Row>
   const auto sample_row = [&](const char* name, ossa::SamplingCache& cache, double limit) {
     const auto [ossa_s, plain_s] = interleaved_min(
         trials, 64,
-        [&] { ossa::sample(clips[0], times[i++ & 255], {}, cache, poses[0]); g_sink = g_sink + static_cast<uint32_t>(poses[0].span().base[0]); },
-        [&] { flushed([&] { ossa::bench::plain_sample(plain[0], times[k++ & 255], local[0].data()); });
-              g_sink = g_sink + static_cast<uint32_t>(local[0][0].t[0]); });
+        [&] {
+          ossa::sample(clips[0], times[i++ & 255], {}, cache, poses[0]);
+          g_sink = g_sink + static_cast<uint32_t>(poses[0].span().base[0]);
+        },
+        [&] {
+          flushed([&] { ossa::bench::plain_sample(plain[0], times[k++ & 255], local[0].data()); });
+          g_sink = g_sink + static_cast<uint32_t>(local[0][0].t[0]);
+        });
     rows.push_back({name, ossa_s * 1e9, plain_s * 1e9, limit});
   };
   // AMD Zen 5: 0.40-0.41 measured, 0.55 once in a CI run beside four other builds, 0.71-0.72 with
   // the denormal regression put back; the limit sits between the last two. Intel: not yet measured.
   sample_row("sample.plain", *caches[0], limit_for(0.63, 1.1));
-  sample_row("sample.noisy", *caches[3], limit_for(0.63, 1.1));  // the same; a runtime without FTZ/DAZ alone fails this row
+  sample_row("sample.noisy", *caches[3],
+             limit_for(0.63, 1.1));  // the same; a runtime without FTZ/DAZ alone fails this row
 
   const std::span<const int16_t> parents = skeleton.parents();
   const ossa::ConstPoseSpan inputs[3] = {poses[0], poses[1], poses[2]};
@@ -207,7 +213,8 @@ bool plain_rows(int trials, const ossa::bench::BenchData& data, std::vector<Row>
           });
           g_sink = g_sink + static_cast<uint32_t>(plain_palette[0][3][0]);
         });
-    rows.push_back({"frame.plain", ossa_s * 1e9, plain_s * 1e9, limit_for(0.32, 0.7)});  // Zen 5: 0.256-0.263, 0.349-0.352 regressed; Intel: not yet measured
+    rows.push_back({"frame.plain", ossa_s * 1e9, plain_s * 1e9,
+                    limit_for(0.32, 0.7)});  // Zen 5: 0.256-0.263, 0.349-0.352 regressed; Intel: not yet measured
   }
   {
     // Skinning with the frame's last palette.
@@ -217,16 +224,21 @@ bool plain_rows(int trials, const ossa::bench::BenchData& data, std::vector<Row>
     const ossa::SkinnedStreams streams{positions, normals, {}};
     const auto [ossa_s, plain_s] = interleaved_min(
         trials, 4,
-        [&] { ossa::skin_cpu(mesh, palette, ossa::SkinningMethod::Linear, streams); g_sink = g_sink + static_cast<uint32_t>(positions[0]); },
         [&] {
-          flushed([&] { ossa::bench::plain_skin(plain_mesh, palette.data(), plain_positions.data(), plain_normals.data()); });
+          ossa::skin_cpu(mesh, palette, ossa::SkinningMethod::Linear, streams);
+          g_sink = g_sink + static_cast<uint32_t>(positions[0]);
+        },
+        [&] {
+          flushed([&] {
+            ossa::bench::plain_skin(plain_mesh, palette.data(), plain_positions.data(), plain_normals.data());
+          });
           g_sink = g_sink + static_cast<uint32_t>(plain_positions[0]);
         });
-    rows.push_back({"skin.plain", ossa_s * 1e9, plain_s * 1e9, limit_for(0.35, 0.7)});  // Zen 5: 0.20-0.23; Intel: not yet measured
+    rows.push_back({"skin.plain", ossa_s * 1e9, plain_s * 1e9,
+                    limit_for(0.35, 0.7)});  // Zen 5: 0.20-0.23; Intel: not yet measured
   }
   return true;
 }
-
 
 }  // namespace
 
@@ -254,7 +266,8 @@ int main(int argc, char** argv) {
   std::uniform_real_distribution<float> u(-1.0f, 1.0f);
   for (uint32_t j = 0; j < joints; ++j) {
     ossa::Transform t = ossa::get_transform(pose, j);
-    t.rotation = glm::normalize(t.rotation * glm::angleAxis(0.1f * u(gen), glm::normalize(glm::vec3(u(gen), u(gen), 1.0f))));
+    t.rotation =
+        glm::normalize(t.rotation * glm::angleAxis(0.1f * u(gen), glm::normalize(glm::vec3(u(gen), u(gen), 1.0f))));
     ossa::set_transform(pose, j, t);
   }
   std::vector<glm::mat4> model(joints), palette(std::max<size_t>(1, mesh.joints().size()));
@@ -282,7 +295,8 @@ int main(int argc, char** argv) {
     }
     ossa::set_skinning_isa(best);
     // Measured: AMD EPYC Zen 5 (avx512) 0.08-0.10; Intel Xeon 6/207: within the limit (issue 25).
-    rows.push_back({"skin.isa", fast * 1e9, portable * 1e9, best == ossa::SkinningIsa::Portable ? 1.5 : limit_for(0.35, 0.35)});
+    rows.push_back(
+        {"skin.isa", fast * 1e9, portable * 1e9, best == ossa::SkinningIsa::Portable ? 1.5 : limit_for(0.35, 0.35)});
   }
   const std::vector<uint8_t> dealt_bytes = ossa::bench::dealt_copy(data.arnaud);
   auto dealt = ossa::Asset::from_bytes(dealt_bytes, "arnaud-dealt");
@@ -291,7 +305,8 @@ int main(int argc, char** argv) {
     return 1;
   }
   {
-    const auto [ordered, classified] = interleaved_min(trials, 8, skin(mesh, positions_only), skin(dealt->mesh(0), positions_only));
+    const auto [ordered, classified] =
+        interleaved_min(trials, 8, skin(mesh, positions_only), skin(dealt->mesh(0), positions_only));
     // Measured: AMD EPYC Zen 5 0.60-0.61 (0.58-0.76 earlier); Intel Xeon 6/207: within the limit.
     rows.push_back({"skin.order", ordered * 1e9, classified * 1e9, limit_for(0.95, 0.95)});
   }
@@ -301,7 +316,11 @@ int main(int argc, char** argv) {
   const std::span<const int16_t> parents = skeleton.parents();
   {
     const auto [ossa_s, glm_s] = interleaved_min(
-        trials, 64, [&] { ossa::local_to_model(parents, pose, model); g_sink = g_sink + static_cast<uint32_t>(model[1][3][0]); },
+        trials, 64,
+        [&] {
+          ossa::local_to_model(parents, pose, model);
+          g_sink = g_sink + static_cast<uint32_t>(model[1][3][0]);
+        },
         [&] {
           for (uint32_t j = 0; j < joints; ++j) {
             const ossa::Transform t = ossa::get_transform(pose, j);
@@ -333,7 +352,11 @@ int main(int argc, char** argv) {
     const ossa::ConstPoseSpan inputs[3] = {poses[0], poses[1], poses[2]};
     const float weights[3] = {0.2f, 0.5f, 0.3f};
     const auto [ossa_s, glm_s] = interleaved_min(
-        trials, 64, [&] { ossa::blend_n(inputs, weights, blended); g_sink = g_sink + static_cast<uint32_t>(blended.span().base[0]); },
+        trials, 64,
+        [&] {
+          ossa::blend_n(inputs, weights, blended);
+          g_sink = g_sink + static_cast<uint32_t>(blended.span().base[0]);
+        },
         [&] {
           for (uint32_t j = 0; j < joints; ++j) {
             ossa::Transform out;
@@ -393,7 +416,10 @@ int main(int argc, char** argv) {
     size_t i = 0, k = 0;
     const auto [forward, reset] = interleaved_min(
         trials, 64,
-        [&] { ossa::sample(clips[0], times[i++ & 255], {}, *caches[0], poses[0]); g_sink = g_sink + static_cast<uint32_t>(poses[0].span().base[0]); },
+        [&] {
+          ossa::sample(clips[0], times[i++ & 255], {}, *caches[0], poses[0]);
+          g_sink = g_sink + static_cast<uint32_t>(poses[0].span().base[0]);
+        },
         [&] {
           ossa::reset(*cold);
           ossa::sample(clips[0], times[k++ & 255], {}, *cold, poses[1]);

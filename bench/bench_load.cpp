@@ -65,7 +65,6 @@ double median_ms(double min_seconds, int min_runs, S&& setup, F&& run) {
   return samples[samples.size() / 2];
 }
 
-
 /// Medians of each of runs' durations, the runs called in turn once per round, for at least
 /// min_rounds rounds and min_seconds; an empty result when a run fails.
 std::vector<double> interleaved_medians_ms(double min_seconds, int min_rounds,
@@ -109,8 +108,9 @@ int main(int argc, char** argv) {
   const fs::path tmp = fs::temp_directory_path() / ("ossa-bench-load-" + std::to_string(::getpid()));
   int status = 0;
   std::printf("# %s\n", ossa::bench::machine_line().c_str());
-  std::printf("asset\tsource_bytes\tcooked_bytes\tassimp_import_ms\tossa_open_ms\tread_ms\topen_over_read\t"
-              "stat_read_ms\topen_over_stat_read\tspeedup\n");
+  std::printf(
+      "asset\tsource_bytes\tcooked_bytes\tassimp_import_ms\tossa_open_ms\tread_ms\topen_over_read\t"
+      "stat_read_ms\topen_over_stat_read\tspeedup\n");
   for (size_t i = 0; i < assets.size(); ++i) {
     const fs::path& src = assets[i];
     const fs::path cooked = tmp / (std::to_string(i) + "-" + src.stem().string() + ".ossa");
@@ -133,11 +133,11 @@ int main(int argc, char** argv) {
         },
         [&] { return importer->ReadFile(src.string(), flags) != nullptr; });
     std::vector<char> buffer(static_cast<size_t>(rec.cooked_bytes));
-    const std::vector<double> loads = interleaved_medians_ms(
-        min_seconds, 200,
-        {[&] { return ossa::Asset::open(cooked.string()).ok(); },
-         [&] { return ossa::bench::read_whole(cooked, buffer); },
-         [&] { return ossa::bench::stat_read_whole(cooked, buffer); }});
+    const std::vector<double> loads =
+        interleaved_medians_ms(min_seconds, 200,
+                               {[&] { return ossa::Asset::open(cooked.string()).ok(); },
+                                [&] { return ossa::bench::read_whole(cooked, buffer); },
+                                [&] { return ossa::bench::stat_read_whole(cooked, buffer); }});
     const double ossa_ms = loads[0], read_ms = loads[1], stat_read_ms = loads[2];
     if (assimp_ms < 0 || ossa_ms < 0 || read_ms < 0 || stat_read_ms < 0) {
       std::fprintf(stderr, "ossa-bench-load: %s: load failed during timing\n", src.string().c_str());

@@ -161,17 +161,16 @@ void apply_rows(const std::string& asset, const ossa::Asset& a, double min_secon
         constexpr int kBatch = 100;
         const auto t0 = Clock::now();
         for (int i = 0; i < kBatch; ++i) {
-          if (with_normals)
-            ossa::apply_morphs(mesh, channel, weights, positions, normals);
-          else
-            ossa::apply_morphs(mesh, channel, weights, positions);
+          if (with_normals) ossa::apply_morphs(mesh, channel, weights, positions, normals);
+          else ossa::apply_morphs(mesh, channel, weights, positions);
         }
         per_call.push_back(seconds_since(t0) / kBatch);
       }
       std::sort(per_call.begin(), per_call.end());
       const double median = per_call[per_call.size() / 2];
       std::printf("apply\t%s\t%zu\t%zu\t%s\t%.2f\t%.3f\n", asset.c_str(), targets, moved,
-                  with_normals ? "positions+normals" : "positions", median * 1e6, median * 1e9 / static_cast<double>(moved));
+                  with_normals ? "positions+normals" : "positions", median * 1e6,
+                  median * 1e9 / static_cast<double>(moved));
     }
     volatile float sink = positions[0].x + normals[0].x;
     (void)sink;
@@ -215,7 +214,8 @@ int main(int argc, char** argv) {
     return 1;
   }
   const std::string stem = std::string(source.substr(source.find_last_of('/') + 1));
-  std::printf("kind\tasset\ttarget\tvertices\tlisted\traw_bytes\tstored_bytes\tratio\tposition_error_mm\tnormal_error_deg\n");
+  std::printf(
+      "kind\tasset\ttarget\tvertices\tlisted\traw_bytes\tstored_bytes\tratio\tposition_error_mm\tnormal_error_deg\n");
   std::printf("kind\tasset\ttargets_active\tmoved_vertex_targets\tstreams\tus_per_apply\tns_per_moved_vertex_target\n");
   const std::string face_name = "face" + std::to_string(generated);
   struct Case {

@@ -31,7 +31,8 @@ void reference_pose(const SideBySideClip& c, uint32_t frame, float alpha, PoseSp
       const glm::vec4* k = r.channel(j, ch);
       v[ch] = alpha == 0.0f ? k[frame] : cook::interpolate_keys(ch, k[frame], k[next], alpha);
     }
-    const float values[kPoseComponents] = {v[0].x, v[0].y, v[0].z, v[1].x, v[1].y, v[1].z, v[1].w, v[2].x, v[2].y, v[2].z};
+    const float values[kPoseComponents] = {v[0].x, v[0].y, v[0].z, v[1].x, v[1].y,
+                                           v[1].z, v[1].w, v[2].x, v[2].y, v[2].z};
     for (uint32_t comp = 0; comp < kPoseComponents; ++comp) out[static_cast<PoseComponent>(comp)][j] = values[comp];
   }
 }
@@ -99,7 +100,8 @@ Result<SideBySideFile> cook_side_by_side(const std::string& path, const cook::Im
     }
     raw.samples.resize(static_cast<size_t>(raw.frames) * joints);
     for (uint32_t f = 0; f < raw.frames; ++f)
-      for (uint32_t j = 0; j < joints; ++j) raw.samples[static_cast<size_t>(f) * joints + j] = raw_transform(c.reference, j, f);
+      for (uint32_t j = 0; j < joints; ++j)
+        raw.samples[static_cast<size_t>(f) * joints + j] = raw_transform(c.reference, j, f);
     file.clips.push_back(std::move(c));
   }
   return file;

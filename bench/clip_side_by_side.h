@@ -37,14 +37,14 @@ inline constexpr double kProbeMetres = 0.1;
 inline constexpr uint32_t kPointsBetweenFrames = kClipErrorSubdivisions - 1;
 
 struct SideBySideClip {
-  ClipView clip;            // ossa's cooked clip (in SideBySideFile::asset)
+  ClipView clip;  // ossa's cooked clip (in SideBySideFile::asset)
   SkeletonView rig;
-  SamplingCache cache;      // for measuring
+  SamplingCache cache;                        // for measuring
   SamplingCache forward_cache, random_cache;  // for timing
   Pose pose;
   cook::ClipSamples reference;  // the raw keys on the grid
   std::vector<int16_t> parents;
-  RawClipData raw;          // the same keys for ACL
+  RawClipData raw;            // the same keys for ACL
   std::vector<double> shell;  // per joint: where the probe points sit, in the joint's local units
   double metres_per_unit = 1.0;
   double probe = 0.1;       // kProbeMetres in the clip's units

@@ -206,7 +206,8 @@ Status draw_source(const std::string& source, int width, int height, int samples
       }
     }
     const glm::mat4 placement = palette[d.palette_first];
-    for (const Vertex& x : vertices) bounds.add(glm::vec3(placement * glm::vec4(x.position[0], x.position[1], x.position[2], 1.0f)));
+    for (const Vertex& x : vertices)
+      bounds.add(glm::vec3(placement * glm::vec4(x.position[0], x.position[1], x.position[2], 1.0f)));
     std::vector<uint32_t> indices;
     for (unsigned f = 0; f < mesh.mNumFaces; ++f) {
       if (mesh.mFaces[f].mNumIndices != 3) continue;
@@ -217,7 +218,8 @@ Status draw_source(const std::string& source, int width, int height, int samples
     GLuint vb = 0, ib = 0;
     glGenBuffers(1, &vb);
     glBindBuffer(GL_ARRAY_BUFFER, vb);
-    glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(vertices.size() * sizeof(Vertex)), vertices.data(), GL_STATIC_DRAW);
+    glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(vertices.size() * sizeof(Vertex)), vertices.data(),
+                 GL_STATIC_DRAW);
     glGenBuffers(1, &ib);
     glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, ib);
     glBufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(indices.size() * 4), indices.data(), GL_STATIC_DRAW);

@@ -92,8 +92,7 @@ Result<std::vector<CompressedClip>> cook_clips(SourceScene& scene, const CookOpt
                                                const std::string& label) {
   if (options.root_motion) {
     for (SourceClip& clip : scene.clips) {
-      if (Status st = extract_root_motion(clip, scene.skeleton, 1); !st)
-        return Error{label + ": " + st.message()};
+      if (Status st = extract_root_motion(clip, scene.skeleton, 1); !st) return Error{label + ": " + st.message()};
     }
   }
   std::vector<CompressedClip> clips;
@@ -151,8 +150,8 @@ void record_morphs(CookRecord& record, const std::vector<CookedMesh>& meshes, fl
       r.name = t.name;
       r.vertices = static_cast<uint32_t>(t.vertices.size());
       r.raw_bytes = t.source_bytes;
-      r.stored_bytes = static_cast<uint32_t>(4 * t.vertices.size() +
-                                             2 * (t.position_deltas.size() + t.normal_deltas.size() + t.tangent_deltas.size()));
+      r.stored_bytes = static_cast<uint32_t>(
+          4 * t.vertices.size() + 2 * (t.position_deltas.size() + t.normal_deltas.size() + t.tangent_deltas.size()));
       r.position_error_mm = static_cast<float>(mm * t.position_error);
       r.position_bound_mm = static_cast<float>(mm * t.position_bound);
       r.normal_error_deg = static_cast<float>(t.normal_error * 57.29577951308232);
@@ -288,13 +287,15 @@ void cook_into(CookRecord& record, const fs::path& input, const fs::path& output
     return;
   }
   if (is_graph_file(input) && options.retarget_target != nullptr) {
-    record.error = input.string() + ": --retarget-to applies to sources, not graph files (retarget the clips a graph "
+    record.error = input.string() +
+                   ": --retarget-to applies to sources, not graph files (retarget the clips a graph "
                    "plays, then cook the graph: docs/RETARGET.md)";
     return;
   }
   if (is_graph_file(input)) {
     if (!settings.clip_names.empty())
-      record.warnings.push_back("\"clip_names\" in cook settings is not used for a graph file: the graph names its clips");
+      record.warnings.push_back(
+          "\"clip_names\" in cook settings is not used for a graph file: the graph names its clips");
     detail::cook_graph(record, input, output, options);
     return;
   }
@@ -338,7 +339,8 @@ void cook_into(CookRecord& record, const fs::path& input, const fs::path& output
     return;
   }
   if (options.retarget_target != nullptr) {
-    RetargetTarget target{options.retarget_target, options.retarget_name, options.retarget_map, options.retarget_map_name};
+    RetargetTarget target{options.retarget_target, options.retarget_name, options.retarget_map,
+                          options.retarget_map_name};
     if (Status st = retarget_scene(*scene, target, input.string(), &record.retarget_records); !st) {
       record.error = st.message();
       return;
@@ -373,7 +375,8 @@ void cook_into(CookRecord& record, const fs::path& input, const fs::path& output
   // A clip-only file binds to its rig by hash and carries no skeleton; a file with meshes always
   // carries the rig its joint palettes index (with --skeleton, the reference's, hash-identical).
   WriteOptions write_options;
-  write_options.include_skeleton = (options.reference == nullptr && options.retarget_target == nullptr) || !meshes->empty();
+  write_options.include_skeleton =
+      (options.reference == nullptr && options.retarget_target == nullptr) || !meshes->empty();
   const std::vector<uint8_t> bytes = write_ossa(*scene, *meshes, *clips, provenance, write_options);
   if (!detail::write_verified(record, bytes, input, output, options.write)) return;
 

@@ -219,7 +219,7 @@ void cook_graph(CookRecord& record, const fs::path& input, const fs::path& outpu
               cook.resolve(manifest->skeleton).string() + ": has no skeleton for the graph to animate");
     return;
   }
-  character.clips.clear();  // only the clips the graph names are cooked
+  character.clips.clear();           // only the clips the graph names are cooked
   if (!manifest->skeleton_meshes) {  // the rig alone: its source's own body is not the character's
     character.meshes.clear();
     character.materials.clear();

@@ -102,7 +102,8 @@ void advance_drive(Drive& d, float played) {
     const float h = std::min(left, kStep);
     const float turning = std::clamp(d.clock + h - d.turn_after, 0.0f, h);  // the part of the step after turn_after
     d.heading += d.turn_rate * turning;
-    const glm::vec3 ahead = glm::vec3(glm::rotate(glm::mat4(1.0f), d.heading, glm::vec3(0, 1, 0)) * glm::vec4(d.forward, 0.0f));
+    const glm::vec3 ahead =
+        glm::vec3(glm::rotate(glm::mat4(1.0f), d.heading, glm::vec3(0, 1, 0)) * glm::vec4(d.forward, 0.0f));
     d.position += ahead * (d.speed * h);
     d.clock += h;
   }
@@ -193,7 +194,8 @@ void produce_morph_weights(const Scene& scene, Animator& animator) {
       const std::span<const float> w = animator.graph->instances[i].morph_weights();
       const std::vector<int32_t>& map = animator.graph->morph_map;
       for (size_t ch = 0; ch < channels && ch < map.size(); ++ch)
-        if (map[ch] >= 0 && static_cast<size_t>(map[ch]) < w.size()) inst.morph_weights[ch] = w[static_cast<size_t>(map[ch])];
+        if (map[ch] >= 0 && static_cast<size_t>(map[ch]) < w.size())
+          inst.morph_weights[ch] = w[static_cast<size_t>(map[ch])];
     }
     if (clip) {
       const SceneClip& c = scene.clips[static_cast<size_t>(p.clip)];

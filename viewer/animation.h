@@ -31,12 +31,12 @@
 namespace ossa::view {
 
 struct Playback {
-  int clip = -1;            // index into Scene::clips; -1: none (bind pose)
-  float time = 0.0f;        // seconds into the clip, for instance 0
-  float speed = 1.0f;       // playback rate (negative plays backwards)
+  int clip = -1;       // index into Scene::clips; -1: none (bind pose)
+  float time = 0.0f;   // seconds into the clip, for instance 0
+  float speed = 1.0f;  // playback rate (negative plays backwards)
   bool playing = true;
   bool loop = true;
-  bool bind_pose = false;   // show the skeleton's bind pose instead of the clip
+  bool bind_pose = false;  // show the skeleton's bind pose instead of the clip
   // The timeline's loop range (layout.h): with loop on, playback wraps within [loop_start,
   // loop_end] when loop_end > loop_start; otherwise over the whole clip. Reset by select_clip.
   float loop_start = 0.0f;
@@ -44,21 +44,21 @@ struct Playback {
   // Cross-fade from the previously selected clip, which keeps playing until the fade ends.
   int from_clip = -1;
   float from_time = 0.0f;
-  float fade = 1.0f;        // 0 -> 1 over fade_seconds; 1: no fade in progress
+  float fade = 1.0f;  // 0 -> 1 over fade_seconds; 1: no fade in progress
   float fade_seconds = 0.25f;
 };
 
 struct AnimInstance {
-  float time_offset = 0.0f;   // phase of this instance relative to Playback::time
+  float time_offset = 0.0f;  // phase of this instance relative to Playback::time
   SamplingCache cache, from_cache;
   Pose local, from_local;
-  std::vector<glm::mat4> model;  // model-space joint matrices, one per skeleton joint
+  std::vector<glm::mat4> model;                          // model-space joint matrices, one per skeleton joint
   std::vector<float> morph_weights, from_morph_weights;  // one per morph channel (scene.h)
 };
 
 /// Channels the user holds at a weight (panel sliders, --morph); the others follow the clip.
 struct MorphOverrides {
-  std::vector<uint8_t> held;   // one per morph channel
+  std::vector<uint8_t> held;  // one per morph channel
   std::vector<float> value;
 };
 
@@ -68,14 +68,14 @@ struct MorphOverrides {
 /// instance's model matrices by compute_model_poses, so the drawing, the overlays and the camera's
 /// follow all see it, and the cloth (cloth_view.h) receives it as its model-to-world transform.
 struct Drive {
-  float speed = 0.0f;       // model units per second along the heading
-  float turn_rate = 0.0f;   // radians per second about +Y, once `turn_after` seconds have played
+  float speed = 0.0f;      // model units per second along the heading
+  float turn_rate = 0.0f;  // radians per second about +Y, once `turn_after` seconds have played
   float turn_after = 0.0f;
   glm::vec3 forward{0.0f, 0.0f, 1.0f};  // the character's front (bounds.h facing_of)
-  float clock = 0.0f;       // seconds played
-  float heading = 0.0f;     // radians turned so far
-  glm::vec3 position{0.0f}; // distance travelled, model units
-  glm::mat4 world{1.0f};    // translate(position) * rotate(heading about +Y)
+  float clock = 0.0f;                   // seconds played
+  float heading = 0.0f;                 // radians turned so far
+  glm::vec3 position{0.0f};             // distance travelled, model units
+  glm::mat4 world{1.0f};                // translate(position) * rotate(heading about +Y)
   bool active() const { return speed != 0.0f || turn_rate != 0.0f; }
 };
 /// Moves the drive on by `played` seconds (in 1/240 s steps, so the path does not depend on the
@@ -84,7 +84,7 @@ void advance_drive(Drive& drive, float played);
 
 struct Animator {
   Playback playback;
-  Drive drive;                         // --move / --turn: the character's motion through the world
+  Drive drive;  // --move / --turn: the character's motion through the world
   std::vector<AnimInstance> instances;
   std::unique_ptr<GraphDriver> graph;  // --graph: one graph instance per AnimInstance
   bool use_graph = false;              // the graph drives the poses (else the clip list does)

@@ -142,7 +142,8 @@ Status open_loaded_scene(App& app, Scene scene, size_t crowd, float aspect) {
   app.animator = Animator{};
   // Keep playing the graph by name if the new files have it; otherwise back to clips.
   bool has_graph = false;
-  for (const Asset& a : app.scene.assets) has_graph = has_graph || (!app.graph_name.empty() && find_graph(a, app.graph_name));
+  for (const Asset& a : app.scene.assets)
+    has_graph = has_graph || (!app.graph_name.empty() && find_graph(a, app.graph_name));
   if (!has_graph) app.graph_name.clear();
   return set_crowd(app, crowd, aspect);
 }
@@ -248,7 +249,8 @@ Status open_or_add(App& app, std::span<const std::string> paths, float aspect) {
     if (!has_mesh) return has_mesh.error();
     if (*has_mesh) return open_scene(app, paths, app.crowd, aspect);
   }
-  if (app.scene.assets.empty()) return Error{paths.empty() ? "nothing to open" : paths.front() + ": has no mesh to show"};
+  if (app.scene.assets.empty())
+    return Error{paths.empty() ? "nothing to open" : paths.front() + ": has no mesh to show"};
   const size_t before = app.scene.clips.size();
   for (const std::string& p : paths) {
     if (Status s = add_clip_file(app.scene, p); !s) return s;

@@ -25,8 +25,8 @@
 namespace ossa::view {
 
 struct CameraAngles {
-  float yaw = 0.5235988f;   // 30 degrees from the character's front: a three-quarter view
-  float pitch = 0.1745329f; // 10 degrees above
+  float yaw = 0.5235988f;    // 30 degrees from the character's front: a three-quarter view
+  float pitch = 0.1745329f;  // 10 degrees above
 };
 
 struct App {
@@ -34,22 +34,22 @@ struct App {
   Renderer renderer;
   Animator animator;
   OrbitCamera camera;
-  CameraAngles angles;             // from the character's front (facing): yaw 0 looks at its face
-  Facing facing;                   // which way the character faces (bounds.h), found when it is opened
-  std::string front = "auto";      // --front: auto, or the axis it faces ("+z", "-z", "+x", "-x")
+  CameraAngles angles;         // from the character's front (facing): yaw 0 looks at its face
+  Facing facing;               // which way the character faces (bounds.h), found when it is opened
+  std::string front = "auto";  // --front: auto, or the axis it faces ("+z", "-z", "+x", "-x")
   ViewToggles toggles;
   std::vector<glm::vec3> offsets;  // instance placements (crowd grid), one per instance
   Box framing;                     // what the camera frames: one character as shown, a crowd in its bind pose
   Box bind_box;                    // one character in its bind pose (crowd spacing, the floor)
   size_t crowd = 1;
-  bool follow = true;              // keep the camera on instance 0's root as it moves (crowd: off)
-  glm::vec3 root_bind{0.0f};       // instance 0's root in the bind pose
-  glm::vec3 follow_applied{0.0f};  // how far follow has moved the camera target so far
-  std::vector<std::string> messages;  // warnings and errors for the panel / stderr
-  std::string graph_name;          // --graph: re-instantiated when the crowd or the files change
-  int active_handle = -1;          // the target gizmo being dragged (ProceduralInfo::targets), or -1
-  ViewerCloth cloth;               // the character's cloth, per instance (cloth_view.h)
-  bool show_cloth = false;         // the cloth overlay: particles, edges, colliders
+  bool follow = true;                      // keep the camera on instance 0's root as it moves (crowd: off)
+  glm::vec3 root_bind{0.0f};               // instance 0's root in the bind pose
+  glm::vec3 follow_applied{0.0f};          // how far follow has moved the camera target so far
+  std::vector<std::string> messages;       // warnings and errors for the panel / stderr
+  std::string graph_name;                  // --graph: re-instantiated when the crowd or the files change
+  int active_handle = -1;                  // the target gizmo being dragged (ProceduralInfo::targets), or -1
+  ViewerCloth cloth;                       // the character's cloth, per instance (cloth_view.h)
+  bool show_cloth = false;                 // the cloth overlay: particles, edges, colliders
   std::unique_ptr<RetargetView> retarget;  // --retarget-from: a clip of another rig drives the character
 };
 
@@ -97,8 +97,8 @@ Status play_clip(App& app, int clip, bool crossfade);
 Status step_cloth(App& app, float dt);
 
 /// Advances playback by dt (when playing), produces this frame's poses, steps the cloth by the
-/// time played (cloth_view.h), follows the character, builds the procedural and cloth overlays (toggles.procedural, procedural_draw.h) and draws into the
-/// bound framebuffer. Timings accumulate into `timings`.
+/// time played (cloth_view.h), follows the character, builds the procedural and cloth overlays (toggles.procedural,
+/// procedural_draw.h) and draws into the bound framebuffer. Timings accumulate into `timings`.
 Status step_and_render(App& app, float dt, int width, int height, FrameTimings& timings);
 
 }  // namespace ossa::view

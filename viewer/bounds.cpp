@@ -72,7 +72,8 @@ Facing facing_of(const Asset& asset, std::span<const glm::mat4> model) {
   });
   if (feet.empty() || legs.empty()) return out;
   // How far the feet reach past the legs above them, towards each of the four horizontal axes.
-  const float reach[4] = {feet.max.z - legs.max.z, legs.min.z - feet.min.z, feet.max.x - legs.max.x, legs.min.x - feet.min.x};
+  const float reach[4] = {feet.max.z - legs.max.z, legs.min.z - feet.min.z, feet.max.x - legs.max.x,
+                          legs.min.x - feet.min.x};
   const glm::vec3 axes[4] = {{0, 0, 1}, {0, 0, -1}, {1, 0, 0}, {-1, 0, 0}};
   // Lopsidedness along an axis: the reach forward minus the reach backward (a heel reaches back a
   // little, toes far forward; sideways both sides reach alike).

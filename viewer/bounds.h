@@ -29,7 +29,10 @@ struct Box {
     max = glm::max(max, p);
   }
   void add(const Box& b) {
-    if (!b.empty()) { add(b.min); add(b.max); }
+    if (!b.empty()) {
+      add(b.min);
+      add(b.max);
+    }
   }
   glm::vec3 centre() const { return (min + max) * 0.5f; }
   glm::vec3 size() const { return max - min; }

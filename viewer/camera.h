@@ -14,8 +14,8 @@ namespace ossa::view {
 struct OrbitCamera {
   glm::vec3 target{0.0f};
   float distance = 3.0f;
-  float yaw = 0.0f;      // radians
-  float pitch = 0.0f;    // radians, clamped to (-89, 89) degrees
+  float yaw = 0.0f;          // radians
+  float pitch = 0.0f;        // radians, clamped to (-89, 89) degrees
   float fov_y = 0.6981317f;  // 40 degrees
   float radius = 1.0f;       // extent of what was framed: bounds zoom and the depth range
   float near_plane = 0.01f;

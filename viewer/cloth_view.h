@@ -36,16 +36,16 @@ struct ClothSim {
 };
 
 struct ViewerCloth {
-  std::vector<ClothSim> sims;         // instance-major, meshes in order
-  bool enabled = true;                // --cloth off / the panel: meshes drawn as skinned
-  glm::vec3 wind{0.0f};               // metres per second, world space (the panel, --wind)
-  float stiffness = 1.0f;             // scales the cooked compliances down (1: as cooked)
+  std::vector<ClothSim> sims;  // instance-major, meshes in order
+  bool enabled = true;         // --cloth off / the panel: meshes drawn as skinned
+  glm::vec3 wind{0.0f};        // metres per second, world space (the panel, --wind)
+  float stiffness = 1.0f;      // scales the cooked compliances down (1: as cooked)
   // The character's motion through the world (animation.h Drive) at the last step: the drawn
   // model matrices hold it; the simulation runs without it in the character's own space and
   // receives it in its model-to-world transform, so a turn swings the cape.
   glm::mat4 world{1.0f};
-  std::vector<glm::mat4> palette;     // scratch, sized once
-  std::vector<glm::mat4> own_model;   // scratch: the model matrices without `world`, one per joint
+  std::vector<glm::mat4> palette;    // scratch, sized once
+  std::vector<glm::mat4> own_model;  // scratch: the model matrices without `world`, one per joint
   std::vector<glm::vec3> positions, normals;
 
   bool empty() const { return sims.empty(); }

@@ -103,7 +103,8 @@ fs::path executable_dir() {
 }
 
 fs::path cook_cache_root(const char* xdg_cache_home, const char* home) {
-  if (xdg_cache_home != nullptr && fs::path(xdg_cache_home).is_absolute()) return fs::path(xdg_cache_home) / "ossa-view";
+  if (xdg_cache_home != nullptr && fs::path(xdg_cache_home).is_absolute())
+    return fs::path(xdg_cache_home) / "ossa-view";
   if (home != nullptr && fs::path(home).is_absolute()) return fs::path(home) / ".cache" / "ossa-view";
   std::error_code ec;
   const fs::path tmp = fs::temp_directory_path(ec);
@@ -114,7 +115,8 @@ fs::path cook_output_for(const fs::path& cache_root, const fs::path& source) {
   std::error_code ec;
   const fs::path absolute = fs::absolute(source, ec).lexically_normal();
   char folder[17];
-  std::snprintf(folder, sizeof folder, "%016llx", static_cast<unsigned long long>(fnv1a((ec ? source : absolute).string())));
+  std::snprintf(folder, sizeof folder, "%016llx",
+                static_cast<unsigned long long>(fnv1a((ec ? source : absolute).string())));
   return cache_root / folder / (source.stem().string() + ".ossa");
 }
 
@@ -166,8 +168,12 @@ void CookJob::run(fs::path cooker, fs::path output) {
 #else
   // --root: the source's own folder, so the output is OUT/<stem>.ossa and the cook may read the
   // files beside the source (a .gltf's buffers and textures) and nothing else.
-  const std::vector<std::string> args = {cooker.string(), "--quiet", source_.string(), "--root",
-                                         fs::absolute(source_).parent_path().string(), "-o",
+  const std::vector<std::string> args = {cooker.string(),
+                                         "--quiet",
+                                         source_.string(),
+                                         "--root",
+                                         fs::absolute(source_).parent_path().string(),
+                                         "-o",
                                          output.parent_path().string()};
   std::vector<char*> argv;
   for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
@@ -207,10 +213,11 @@ void CookJob::run(fs::path cooker, fs::path output) {
       } else {
         r.error = tidy_errors(err);
         if (r.error.empty())
-          r.error = source_.string() + ": the cooker " +
-                    (WIFSIGNALED(status) ? "was killed by signal " + std::to_string(WTERMSIG(status))
-                                         : "exited with status " + std::to_string(WEXITSTATUS(status))) +
-                    (WIFEXITED(status) && WEXITSTATUS(status) == 0 ? " but wrote no " + output.filename().string() : "");
+          r.error =
+              source_.string() + ": the cooker " +
+              (WIFSIGNALED(status) ? "was killed by signal " + std::to_string(WTERMSIG(status))
+                                   : "exited with status " + std::to_string(WEXITSTATUS(status))) +
+              (WIFEXITED(status) && WEXITSTATUS(status) == 0 ? " but wrote no " + output.filename().string() : "");
       }
     }
     close(fds[0]);
@@ -268,7 +275,8 @@ void step_pending_work(PendingWork& work, App& app, float aspect, std::string& s
     const CookResult& r = work.cook.result();
     char line[96];
     std::snprintf(line, sizeof line, " in %.2f s (%d frames drawn meanwhile)", r.seconds, work.frames_while_cooking);
-    work.log.push_back((r.ok ? "cooked " : "could not cook ") + work.cook.source().string() + " -> " + r.output.string() + line);
+    work.log.push_back((r.ok ? "cooked " : "could not cook ") + work.cook.source().string() + " -> " +
+                       r.output.string() + line);
     if (r.ok) request_paths(work, {r.output.string()});
     else status = r.error;
   }
@@ -284,7 +292,8 @@ void step_pending_work(PendingWork& work, App& app, float aspect, std::string& s
     if (work.cache_root.empty()) work.cache_root = cook_cache_root(std::getenv("XDG_CACHE_HOME"), std::getenv("HOME"));
     std::string error;
     if (work.cooker.empty()) {
-      status = source.string() + ": cannot cook it: ossa-cook was found neither beside ossa-view nor on PATH (OSSA_COOK names one)";
+      status = source.string() +
+               ": cannot cook it: ossa-cook was found neither beside ossa-view nor on PATH (OSSA_COOK names one)";
     } else if (!work.cook.start(work.cooker, source, cook_output_for(work.cache_root, source), error)) {
       status = source.string() + ": " + error;
     } else {

@@ -102,15 +102,15 @@ class CookJob {
 // ---- opens and cooks in progress
 
 struct PendingWork {
-  std::vector<std::string> open;       // .ossa files to open next (open_or_add)
-  bool open_announced = false;         // a frame saying "loading" was presented
+  std::vector<std::string> open;  // .ossa files to open next (open_or_add)
+  bool open_announced = false;    // a frame saying "loading" was presented
   std::deque<std::filesystem::path> cook_queue;
   CookJob cook;
-  std::filesystem::path cooker;        // empty: not found yet (looked for on the first cook)
-  std::filesystem::path cache_root;    // cook_cache_root from the environment
-  int frames_while_cooking = 0;        // frames drawn while the current cook ran (-v reports it)
-  int progress_logged = 0;             // whole seconds of the current cook already reported in `log`
-  std::vector<std::string> log;        // lines for -v: what was cooked / opened, and how long it took
+  std::filesystem::path cooker;      // empty: not found yet (looked for on the first cook)
+  std::filesystem::path cache_root;  // cook_cache_root from the environment
+  int frames_while_cooking = 0;      // frames drawn while the current cook ran (-v reports it)
+  int progress_logged = 0;           // whole seconds of the current cook already reported in `log`
+  std::vector<std::string> log;      // lines for -v: what was cooked / opened, and how long it took
 };
 
 /// Splits `paths` into sources to cook (is_cook_source) and files to open, and queues them.

@@ -36,10 +36,10 @@ void sort_entries(std::vector<BrowserEntry>& entries);
 std::vector<BrowserEntry> list_folder(const std::filesystem::path& folder, std::string& error);
 
 struct FileBrowser {
-  std::filesystem::path folder;        // absolute
+  std::filesystem::path folder;  // absolute
   std::vector<BrowserEntry> entries;
   std::string error;
-  bool open_section = false;           // the panel's "Files" section starts open (--browse)
+  bool open_section = false;  // the panel's "Files" section starts open (--browse)
 };
 
 /// Moves to `folder` (made absolute) and reads its listing.

@@ -75,15 +75,16 @@ void make_texture_buffer(GLenum format, const void* data, size_t bytes, GLuint& 
 }
 
 /// The mesh's morph entry lists as two texture buffers (morphs.h build_morph_entries).
-Status upload_morphs(GpuMesh& g, const MeshView& mesh, std::string_view asset_name, std::span<const int32_t> target_channel) {
+Status upload_morphs(GpuMesh& g, const MeshView& mesh, std::string_view asset_name,
+                     std::span<const int32_t> target_channel) {
   const MorphEntries e = build_morph_entries(mesh, target_channel);
   if (e.empty()) return {};
   GLint max_texels = 0;
   glGetIntegerv(GL_MAX_TEXTURE_BUFFER_SIZE, &max_texels);
   const size_t texels = e.entry_count * static_cast<size_t>(e.texels_per_entry);
   if (texels > static_cast<size_t>(max_texels) || mesh.vertex_count() > static_cast<size_t>(max_texels)) {
-    return Error{where(mesh, asset_name) + ": " + std::to_string(texels) + " morph texels exceed this GL's texture buffer (" +
-                 std::to_string(max_texels) + " texels)"};
+    return Error{where(mesh, asset_name) + ": " + std::to_string(texels) +
+                 " morph texels exceed this GL's texture buffer (" + std::to_string(max_texels) + " texels)"};
   }
   make_texture_buffer(GL_RG32I, e.ranges.data(), e.ranges.size() * sizeof(int32_t), g.morph_range_buffer,
                       g.morph_range_texture);
@@ -95,7 +96,8 @@ Status upload_morphs(GpuMesh& g, const MeshView& mesh, std::string_view asset_na
 
 }  // namespace
 
-Result<GpuMesh> create_gpu_mesh(const MeshView& mesh, std::string_view asset_name, std::span<const int32_t> target_channel) {
+Result<GpuMesh> create_gpu_mesh(const MeshView& mesh, std::string_view asset_name,
+                                std::span<const int32_t> target_channel) {
   GpuMesh g;
   g.vertex_count = mesh.vertex_count();
   g.index_type = mesh.index_format() == fb::IndexFormat::Uint32 ? GL_UNSIGNED_INT : GL_UNSIGNED_SHORT;
@@ -108,11 +110,15 @@ Result<GpuMesh> create_gpu_mesh(const MeshView& mesh, std::string_view asset_nam
   if (position == nullptr) return Error{where(mesh, asset_name) + ": has no positions"};
   g.has_normals = normal != nullptr;
   g.has_tangents = tangent != nullptr;
-  g.has_joints = mesh.attribute(fb::VertexSemantic::Joints) != nullptr && mesh.attribute(fb::VertexSemantic::Weights) != nullptr;
+  g.has_joints =
+      mesh.attribute(fb::VertexSemantic::Joints) != nullptr && mesh.attribute(fb::VertexSemantic::Weights) != nullptr;
   g.has_colors = mesh.attribute(fb::VertexSemantic::Color0) != nullptr;
-  if (normal) g.normal_encoding = vertex_format_info(normal->format()).components == 2 ? NormalEncoding::Octahedral : NormalEncoding::Xyz;
+  if (normal)
+    g.normal_encoding =
+        vertex_format_info(normal->format()).components == 2 ? NormalEncoding::Octahedral : NormalEncoding::Xyz;
   if (tangent) {
-    const bool octahedral = tangent->format() == fb::VertexFormat::Snorm16x4 || vertex_format_info(tangent->format()).components == 2;
+    const bool octahedral =
+        tangent->format() == fb::VertexFormat::Snorm16x4 || vertex_format_info(tangent->format()).components == 2;
     g.tangent_encoding = octahedral ? TangentEncoding::OctahedralSignZ : TangentEncoding::XyzSignW;
   }
   // Directions are divided by the per-axis position scale that the palette folds in (skinning.h).
@@ -154,8 +160,8 @@ Result<GpuMesh> create_gpu_mesh(const MeshView& mesh, std::string_view asset_nam
 }
 
 void destroy_gpu_mesh(GpuMesh& g) {
-  const GLuint buffers[] = {g.vertex_buffer, g.index_buffer, g.cpu_positions, g.cpu_normals, g.cpu_tangents,
-                            g.morph_range_buffer, g.morph_entry_buffer};
+  const GLuint buffers[] = {g.vertex_buffer, g.index_buffer,       g.cpu_positions,     g.cpu_normals,
+                            g.cpu_tangents,  g.morph_range_buffer, g.morph_entry_buffer};
   for (GLuint b : buffers) {
     if (b != 0) glDeleteBuffers(1, &b);
   }

@@ -28,7 +28,15 @@
 namespace ossa::view {
 
 /// Vertex attribute locations in shaders/skinned.vert.glsl (= fb::VertexSemantic values).
-enum AttributeLocation : GLuint { kPosition = 0, kNormal = 1, kTangent = 2, kTexCoord0 = 3, kColor0 = 4, kJoints = 5, kWeights = 6 };
+enum AttributeLocation : GLuint {
+  kPosition = 0,
+  kNormal = 1,
+  kTangent = 2,
+  kTexCoord0 = 3,
+  kColor0 = 4,
+  kJoints = 5,
+  kWeights = 6
+};
 
 /// How the shader must read directions (uniforms u_normal_encoding / u_tangent_encoding).
 enum class NormalEncoding : int { Xyz = 0, Octahedral = 1 };
@@ -39,10 +47,10 @@ struct GpuMesh {
   GLenum index_type = GL_UNSIGNED_SHORT;
   uint32_t index_size = 2;
   uint32_t vertex_count = 0;
-  uint32_t palette_slots = 1;           // max(1, mesh joints): matrices in this mesh's palette
+  uint32_t palette_slots = 1;  // max(1, mesh joints): matrices in this mesh's palette
   NormalEncoding normal_encoding = NormalEncoding::Xyz;
   TangentEncoding tangent_encoding = TangentEncoding::None;
-  glm::vec3 direction_prescale{1.0f};   // 1 / position_scale for quantized positions
+  glm::vec3 direction_prescale{1.0f};  // 1 / position_scale for quantized positions
   bool has_normals = false, has_tangents = false, has_joints = false, has_colors = false;
 
   // CPU-skinning path: float streams skinned by skin_cpu (empty until used).
@@ -50,7 +58,7 @@ struct GpuMesh {
 
   // Morph targets (0 when the mesh has none bound to a channel).
   GLuint morph_range_buffer = 0, morph_range_texture = 0, morph_entry_buffer = 0, morph_entry_texture = 0;
-  int morph_texels = 0;        // texels per entry: 1 positions, 2 + normals, 3 + tangents
+  int morph_texels = 0;  // texels per entry: 1 positions, 2 + normals, 3 + tangents
   bool has_morphs() const { return morph_texels > 0; }
 };
 

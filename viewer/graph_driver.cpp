@@ -14,7 +14,6 @@
 namespace ossa::view {
 namespace {
 
-
 std::string graph_names(const Scene& scene) {
   std::string names;
   for (size_t a = 0; a < scene.assets.size(); ++a) {
@@ -50,8 +49,8 @@ Result<GraphDriver> make_graph_driver(const Scene& scene, std::string_view name,
     if (find_graph(scene.assets[a], name) != nullptr) holder = a;
   }
   if (holder == scene.assets.size()) {
-    return Error{scene.paths.front() + ": no graph named '" + std::string(name) + "' in the files given (graphs: " +
-                 graph_names(scene) + ")"};
+    return Error{scene.paths.front() + ": no graph named '" + std::string(name) +
+                 "' in the files given (graphs: " + graph_names(scene) + ")"};
   }
   d.asset = holder;
   const fb::Graph* g = find_graph(scene.assets[holder], name);
@@ -88,7 +87,9 @@ Result<GraphDriver> make_graph_driver(const Scene& scene, std::string_view name,
   return d;
 }
 
-int graph_parameter(const GraphDriver& driver, std::string_view name) { return driver.definition->find_parameter(name); }
+int graph_parameter(const GraphDriver& driver, std::string_view name) {
+  return driver.definition->find_parameter(name);
+}
 
 void set_graph_value(GraphDriver& driver, int index, float value) {
   const fb::ParameterType type = driver.definition->parameter_type(static_cast<size_t>(index));
@@ -98,7 +99,9 @@ void set_graph_value(GraphDriver& driver, int index, float value) {
       case fb::ParameterType::Int: g.set_int(index, static_cast<int>(std::lround(value))); break;
       case fb::ParameterType::Bool: g.set_bool(index, value != 0.0f); break;
       case fb::ParameterType::Enum: g.set_enum(index, static_cast<int>(std::lround(value))); break;
-      case fb::ParameterType::Trigger: if (value != 0.0f) g.set_trigger(index); break;
+      case fb::ParameterType::Trigger:
+        if (value != 0.0f) g.set_trigger(index);
+        break;
       case fb::ParameterType::Vector: break;  // three numbers: set_graph_vector
     }
   }
@@ -135,10 +138,12 @@ Status set_graph_parameter(GraphDriver& driver, std::string_view name, std::stri
   if (p < 0) {
     std::string names;
     for (size_t i = 0; i < def.parameter_count(); ++i) names += (i ? ", " : "") + std::string(def.parameter_name(i));
-    return Error{"graph '" + driver.name + "' has no parameter '" + std::string(name) + "' (parameters: " + names + ")"};
+    return Error{"graph '" + driver.name + "' has no parameter '" + std::string(name) + "' (parameters: " + names +
+                 ")"};
   }
   const fb::ParameterType type = def.parameter_type(static_cast<size_t>(p));
-  const std::string where = "graph '" + driver.name + "' parameter '" + std::string(name) + "' (" + parameter_type_name(type) + ")";
+  const std::string where =
+      "graph '" + driver.name + "' parameter '" + std::string(name) + "' (" + parameter_type_name(type) + ")";
   if (type == fb::ParameterType::Vector) {
     const auto v = parse_vector(text);
     if (!v) return Error{where + ": cannot read '" + std::string(text) + "' as three finite numbers x,y,z"};

@@ -39,11 +39,11 @@ struct MontageCommand {
 
 struct GraphDriver {
   std::string name;
-  size_t asset = 0;                                // Scene::assets index of the file holding it
-  std::unique_ptr<GraphDefinition> definition;     // stays put: the instances point at it
-  std::vector<GraphInstance> instances;            // one per crowd instance
-  std::deque<std::string> recent_events;           // instance 0's last events, newest first
-  double time = 0.0;                               // seconds of graph time played
+  size_t asset = 0;                             // Scene::assets index of the file holding it
+  std::unique_ptr<GraphDefinition> definition;  // stays put: the instances point at it
+  std::vector<GraphInstance> instances;         // one per crowd instance
+  std::deque<std::string> recent_events;        // instance 0's last events, newest first
+  double time = 0.0;                            // seconds of graph time played
   /// Per scene morph channel (Scene::morph_channels): the graph's channel of that name, or -1.
   std::vector<int32_t> morph_map;
   /// What the procedural nodes read and move, for the overlays and the panel's ground controls.

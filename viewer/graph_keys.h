@@ -6,10 +6,10 @@
 // held walks (speed eases to the blend space's slowest sample, the walk), Shift+W runs (its
 // fastest sample), releasing W eases speed to 0 (the sample graph then strikes its pose); C
 // toggles crossed_arms; M plays the graph's montage (the one shown, or its first) and, pressed while
-// it plays, lets it finish (montage_control.h toggle_montage). The target speeds are read from the blend space driven by `speed`, not
-// hard-coded (1.0 and 3.0 without one). Speed eases at 3 units/s, as a game's input smoothing
-// would, so the blend space and the transitions are visible. The keys take over `speed` only once
-// W has been pressed; the panel's slider hands it back.
+// it plays, lets it finish (montage_control.h toggle_montage). The target speeds are read from the blend space driven
+// by `speed`, not hard-coded (1.0 and 3.0 without one). Speed eases at 3 units/s, as a game's input smoothing would, so
+// the blend space and the transitions are visible. The keys take over `speed` only once W has been pressed; the panel's
+// slider hands it back.
 #pragma once
 #include "viewer/graph_driver.h"
 
@@ -22,10 +22,10 @@ struct KeySpeeds {
 KeySpeeds key_speeds(const GraphDriver& graph);
 
 struct GraphKeys {
-  bool walk = false;      // W held
-  bool run = false;       // Shift held
-  bool driving = false;   // the keys own `speed` (until the panel touches it)
-  float speed = 0.0f;     // the eased value last written
+  bool walk = false;     // W held
+  bool run = false;      // Shift held
+  bool driving = false;  // the keys own `speed` (until the panel touches it)
+  float speed = 0.0f;    // the eased value last written
 };
 
 /// Key events (GLFW key codes and actions). Returns true when the key was one of these.

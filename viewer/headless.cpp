@@ -120,9 +120,11 @@ Status render_headless(const ViewerOptions& o, bool& cannot_run) {
     const double n = o.frames;
     std::printf("framed (%g %g %g) .. (%g %g %g)\n", app.framing.min.x, app.framing.min.y, app.framing.min.z,
                 app.framing.max.x, app.framing.max.y, app.framing.max.z);
-    std::printf("frames %d  sample %.3f ms  blend %.3f ms  graph %.3f ms  skin %.3f ms  draw %.3f ms  gpu %.3f ms (per frame)\n",
-                o.frames, total.sample_ms / n, total.blend_ms / n, total.graph_ms / n, total.skin_ms / n,
-                total.draw_ms / n, total.gpu_ms / n);
+    std::printf(
+        "frames %d  sample %.3f ms  blend %.3f ms  graph %.3f ms  skin %.3f ms  draw %.3f ms  gpu %.3f ms (per "
+        "frame)\n",
+        o.frames, total.sample_ms / n, total.blend_ms / n, total.graph_ms / n, total.skin_ms / n, total.draw_ms / n,
+        total.gpu_ms / n);
   }
   destroy_offscreen(*target);
   release_scene(app.renderer);

@@ -48,12 +48,12 @@ struct InputState {
   App* app = nullptr;
   UiState* ui = nullptr;
   GraphKeys graph_keys;
-  SceneLayout layout;              // this frame's (the scene's region and aspect ratio)
+  SceneLayout layout;  // this frame's (the scene's region and aspect ratio)
   bool orbiting = false, panning = false;
   std::vector<glm::vec3> handles;  // scratch: the target markers' positions when a drag starts
   double last_x = 0.0, last_y = 0.0;
   std::vector<std::string> dropped;
-  bool scale_changed = false;      // the window moved to a monitor of another content scale
+  bool scale_changed = false;  // the window moved to a monitor of another content scale
 };
 
 InputState& input_of(GLFWwindow* w) { return *static_cast<InputState*>(glfwGetWindowUserPointer(w)); }
@@ -81,8 +81,9 @@ void drag_handle(const InputState& in, App& app, double dx, double dy) {
   const TargetHandle& h = g.procedural.targets[static_cast<size_t>(app.active_handle)];
   const glm::vec3 offset = app.offsets.empty() ? glm::vec3(0.0f) : app.offsets.front();
   const glm::vec3 p = handle_position(g.instances.front(), h, offset);
-  const glm::vec3 moved = drag_in_view_plane(p, view_matrix(app.camera), app.camera.fov_y, std::max(in.layout.scene.height, 1.0f),
-                                             static_cast<float>(dx), static_cast<float>(dy));
+  const glm::vec3 moved =
+      drag_in_view_plane(p, view_matrix(app.camera), app.camera.fov_y, std::max(in.layout.scene.height, 1.0f),
+                         static_cast<float>(dx), static_cast<float>(dy));
   (void)set_graph_vector(g, h.parameter, handle_value(h, moved, offset));
 }
 
@@ -106,7 +107,8 @@ void on_key(GLFWwindow* w, int key, int /*scancode*/, int action, int /*mods*/) 
     if (action == GLFW_PRESS && key == GLFW_KEY_ESCAPE) glfwSetWindowShouldClose(w, GLFW_TRUE);
     return;
   }
-  if (app.animator.graph && app.animator.use_graph && graph_key(*app.animator.graph, in.graph_keys, key, action)) return;
+  if (app.animator.graph && app.animator.use_graph && graph_key(*app.animator.graph, in.graph_keys, key, action))
+    return;
   if (action == GLFW_RELEASE) return;
   Playback& p = app.animator.playback;
   switch (key) {
@@ -196,8 +198,9 @@ void apply_ui_scale(float scale, float fb_per_window, bool remake_texture) {
 /// widget cut off, then a summary line the tests look for.
 void print_panel_audit(const PanelAudit& a) {
   for (const PanelRegion& r : a.regions)
-    std::fprintf(stderr, "ossa-view: panel region %s: %.0f %.0f %.0f %.0f in panel %.0f %.0f %.0f %.0f\n", r.name.c_str(),
-                 r.rect.x, r.rect.y, r.rect.width, r.rect.height, a.panel.x, a.panel.y, a.panel.width, a.panel.height);
+    std::fprintf(stderr, "ossa-view: panel region %s: %.0f %.0f %.0f %.0f in panel %.0f %.0f %.0f %.0f\n",
+                 r.name.c_str(), r.rect.x, r.rect.y, r.rect.width, r.rect.height, a.panel.x, a.panel.y, a.panel.width,
+                 a.panel.height);
   const std::vector<std::string> problems = a.problems();
   for (const std::string& p : problems) std::fprintf(stderr, "ossa-view: panel cut off: %s\n", p.c_str());
   std::fprintf(stderr, "ossa-view: panel check: %zu regions, %zu cut off\n", a.regions.size(), problems.size());
@@ -244,7 +247,8 @@ int run_interactive(const ViewerOptions& o) {
   float fb_per_window = measure();
   ui.ui_scale = current_ui_scale(w, o, fb_per_window);
   const auto layout_now = [&] {
-    return compute_layout(win_width, win_height, fb_width, fb_height, panel_width(ui), timeline_height(app, ui.ui_scale));
+    return compute_layout(win_width, win_height, fb_width, fb_height, panel_width(ui),
+                          timeline_height(app, ui.ui_scale));
   };
   input.layout = layout_now();
   apply_view_options(app, o);
@@ -255,7 +259,8 @@ int run_interactive(const ViewerOptions& o) {
   }
   std::error_code no_cwd;
   const std::filesystem::path cwd = std::filesystem::current_path(no_cwd);
-  browse(ui.browser, o.browse.empty() ? start_folder(o.files, no_cwd ? std::filesystem::path("/") : cwd) : std::filesystem::path(o.browse));
+  browse(ui.browser, o.browse.empty() ? start_folder(o.files, no_cwd ? std::filesystem::path("/") : cwd)
+                                      : std::filesystem::path(o.browse));
   ui.browser.open_section = !o.browse.empty();
   if (o.verbose)
     std::fprintf(stderr, "ossa-view: browsing %s: %zu entries\n", ui.browser.folder.c_str(), ui.browser.entries.size());
@@ -271,7 +276,7 @@ int run_interactive(const ViewerOptions& o) {
 
   IMGUI_CHECKVERSION();
   ImGui::CreateContext();
-  ImGui::GetIO().IniFilename = nullptr;  // no imgui.ini written into the working directory
+  ImGui::GetIO().IniFilename = nullptr;   // no imgui.ini written into the working directory
   ImGui_ImplGlfw_InitForOpenGL(w, true);  // chains to the callbacks above
   ImGui_ImplOpenGL3_Init("#version 330 core");
   apply_ui_scale(ui.ui_scale, fb_per_window, false);  // the backend makes the font texture on its first frame
@@ -297,7 +302,8 @@ int run_interactive(const ViewerOptions& o) {
       input.dropped.clear();
     }
     step_pending_work(ui.work, app, input.layout.aspect, ui.status);
-    for (; o.verbose && logged < ui.work.log.size(); ++logged) std::fprintf(stderr, "ossa-view: %s\n", ui.work.log[logged].c_str());
+    for (; o.verbose && logged < ui.work.log.size(); ++logged)
+      std::fprintf(stderr, "ossa-view: %s\n", ui.work.log[logged].c_str());
     const auto now = std::chrono::steady_clock::now();
     const double frame_ms = std::chrono::duration<double, std::milli>(now - last).count();
     last = now;
@@ -331,9 +337,12 @@ int run_interactive(const ViewerOptions& o) {
     // --window-frames N counts frames once nothing is pending, so a capture waits for every cook
     // and open; without it (0) the window stays until it is closed.
     counted += busy(ui.work) ? 0 : 1;
-    if (o.window_frames > 0 && counted == o.window_frames) {  // automation: capture the window, panel included, and stop
+    if (o.window_frames > 0 &&
+        counted == o.window_frames) {  // automation: capture the window, panel included, and stop
       if (o.verbose)
-        std::fprintf(stderr, "ossa-view: layout: panel %.0f, scene %.0f %.0f %.0f %.0f, timeline %.0f (window %dx%d, framebuffer %dx%d)\n",
+        std::fprintf(stderr,
+                     "ossa-view: layout: panel %.0f, scene %.0f %.0f %.0f %.0f, timeline %.0f (window %dx%d, "
+                     "framebuffer %dx%d)\n",
                      panel_width(ui), l.scene.x, l.scene.y, l.scene.width, l.scene.height, l.timeline.height, win_width,
                      win_height, fb_width, fb_height);
       if (o.verbose && ui.panel_open) print_panel_audit(ui.audit);

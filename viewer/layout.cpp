@@ -35,7 +35,6 @@ float ui_scale_for(float content_scale, float framebuffer_per_window) {
   return std::clamp(sane(content_scale) / sane(framebuffer_per_window), 0.5f, 4.0f);
 }
 
-
 std::vector<KeyMark> clip_key_marks(const ClipView& clip) {
   std::vector<KeyMark> out;
   const uint32_t frames = std::max<uint32_t>(clip.frame_count(), 1);
@@ -72,7 +71,8 @@ TimelineGrab timeline_grab(float x, bool in_handle_row, float loop_start_x, floa
   if (in_handle_row) {
     const float ds = std::fabs(x - loop_start_x), de = std::fabs(x - loop_end_x);
     // Both handles at one spot (an empty range): grab the end when pressing right of it.
-    if (std::min(ds, de) <= reach) return ds < de || (ds == de && x < loop_start_x) ? TimelineGrab::kLoopStart : TimelineGrab::kLoopEnd;
+    if (std::min(ds, de) <= reach)
+      return ds < de || (ds == de && x < loop_start_x) ? TimelineGrab::kLoopStart : TimelineGrab::kLoopEnd;
   }
   return TimelineGrab::kPlayhead;
 }
@@ -111,14 +111,17 @@ void timeline_panel(App& app, TimelineState& st, const Rect& strip, float ui_sca
   const float label_w = ImGui::CalcTextSize("000.00 / 000.00 s").x + 12.0f * ui_scale;  // the time read-out
   const float x0 = strip.x + label_w, width = std::max(strip.width - label_w - pad, 1.0f);
   const float handle_h = 10.0f * ui_scale;
-  const float top = strip.y + 4.0f * ui_scale, track_top = top + handle_h, bottom = strip.y + strip.height - 4.0f * ui_scale;
+  const float top = strip.y + 4.0f * ui_scale, track_top = top + handle_h,
+              bottom = strip.y + strip.height - 4.0f * ui_scale;
   const float track_h = bottom - track_top;
 
-  dl->AddRectFilled(ImVec2(strip.x, strip.y), ImVec2(strip.x + strip.width, strip.y + strip.height), IM_COL32(24, 26, 30, 255));
+  dl->AddRectFilled(ImVec2(strip.x, strip.y), ImVec2(strip.x + strip.width, strip.y + strip.height),
+                    IM_COL32(24, 26, 30, 255));
   dl->AddRectFilled(ImVec2(x0, track_top), ImVec2(x0 + width, bottom), IM_COL32(40, 44, 52, 255));
   // The loop range: shaded, with a handle at each end.
   const float ls = time_to_x(loop_start, duration, x0, width), le = time_to_x(loop_end, duration, x0, width);
-  dl->AddRectFilled(ImVec2(ls, track_top), ImVec2(le, bottom), p.loop ? IM_COL32(60, 90, 140, 255) : IM_COL32(55, 60, 70, 255));
+  dl->AddRectFilled(ImVec2(ls, track_top), ImVec2(le, bottom),
+                    p.loop ? IM_COL32(60, 90, 140, 255) : IM_COL32(55, 60, 70, 255));
   for (const float hx : {ls, le}) {
     dl->AddTriangleFilled(ImVec2(hx - 5.0f * ui_scale, top), ImVec2(hx + 5.0f * ui_scale, top), ImVec2(hx, track_top),
                           IM_COL32(120, 170, 240, 255));
@@ -136,7 +139,8 @@ void timeline_panel(App& app, TimelineState& st, const Rect& strip, float ui_sca
   const EventMark* hovered = nullptr;
   for (const EventMark& e : st.events) {
     const float x = time_to_x(e.time, duration, x0, width), r = 5.0f * ui_scale, y = track_top + r + 1.0f;
-    dl->AddQuadFilled(ImVec2(x, y - r), ImVec2(x + r, y), ImVec2(x, y + r), ImVec2(x - r, y), IM_COL32(250, 200, 60, 255));
+    dl->AddQuadFilled(ImVec2(x, y - r), ImVec2(x + r, y), ImVec2(x, y + r), ImVec2(x - r, y),
+                      IM_COL32(250, 200, 60, 255));
     if (std::fabs(mouse.x - x) <= r + 1.0f && std::fabs(mouse.y - y) <= r + 1.0f) hovered = &e;
   }
   // The playhead.

@@ -39,8 +39,8 @@ struct Rect {
 };
 
 struct SceneLayout {
-  Rect scene;      // the 3D view, window coordinates
-  Rect timeline;   // the strip under it (height 0 when there is none)
+  Rect scene;     // the 3D view, window coordinates
+  Rect timeline;  // the strip under it (height 0 when there is none)
   // The scene in framebuffer pixels, for glViewport (bottom-left origin).
   int fb_x = 0, fb_y = 0, fb_width = 1, fb_height = 1;
   float aspect = 1.0f;  // fb_width / fb_height: the projection's aspect ratio
@@ -61,8 +61,8 @@ float ui_scale_for(float content_scale, float framebuffer_per_window);
 // ---- what the timeline shows
 
 struct KeyMark {
-  float time = 0.0f;       // seconds
-  uint32_t channels = 0;   // animated channels with a key at this frame
+  float time = 0.0f;      // seconds
+  uint32_t channels = 0;  // animated channels with a key at this frame
 };
 struct EventMark {
   std::string name;
@@ -88,11 +88,11 @@ enum class TimelineGrab { kNone, kPlayhead, kLoopStart, kLoopEnd };
 TimelineGrab timeline_grab(float x, bool in_handle_row, float loop_start_x, float loop_end_x, float reach);
 
 struct TimelineState {
-  const void* clip = nullptr;   // the clip whose marks are cached (ClipView::fb)
+  const void* clip = nullptr;  // the clip whose marks are cached (ClipView::fb)
   std::vector<KeyMark> keys;
   std::vector<EventMark> events;
   TimelineGrab dragging = TimelineGrab::kNone;
-  bool was_playing = false;     // playback is paused while the playhead is dragged
+  bool was_playing = false;  // playback is paused while the playhead is dragged
 };
 
 /// The strip's height in window units for the UI scale, or 0 when nothing is shown (no clip

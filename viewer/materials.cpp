@@ -255,8 +255,9 @@ std::vector<GpuMaterial> create_materials(const Asset& asset, const std::string&
     std::string names;
     for (size_t i = 0; i < pbr_only.size() && i < 4; ++i) names += (i ? ", " : "") + pbr_only[i];
     if (pbr_only.size() > 4) names += " and " + std::to_string(pbr_only.size() - 4) + " more";
-    warnings.push_back(asset_path + ": metallic-roughness of material" + (pbr_only.size() > 1 ? "s " : " ") + names +
-                       " not shown (the viewer shades Phong: base colour, normal, occlusion and emissive maps are used)");
+    warnings.push_back(
+        asset_path + ": metallic-roughness of material" + (pbr_only.size() > 1 ? "s " : " ") + names +
+        " not shown (the viewer shades Phong: base colour, normal, occlusion and emissive maps are used)");
   }
   if (out.empty()) out.push_back(GpuMaterial{});
   return out;

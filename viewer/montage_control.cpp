@@ -52,19 +52,22 @@ Status add_montage_commands(GraphDriver& driver, const std::vector<std::string>&
   for (const std::string& text : plays) {
     std::string_view name;
     MontageCommand c;
-    if (!split_time(text, &name, &c.time)) return Error{where + ": --montage '" + text + "': expected NAME or NAME@SECONDS"};
+    if (!split_time(text, &name, &c.time))
+      return Error{where + ": --montage '" + text + "': expected NAME or NAME@SECONDS"};
     c.montage = montage = def.find_montage(name);
     if (montage < 0)
-      return Error{where + ": --montage '" + text + "': no montage named '" + std::string(name) + "' (montages: " +
-                   list(driver, -1) + ")"};
+      return Error{where + ": --montage '" + text + "': no montage named '" + std::string(name) +
+                   "' (montages: " + list(driver, -1) + ")"};
     driver.montage_commands.push_back(c);
   }
-  const auto section = [&](std::string_view name, const std::string& option, const std::string& text, int* out) -> Status {
+  const auto section = [&](std::string_view name, const std::string& option, const std::string& text,
+                           int* out) -> Status {
     if (montage < 0) return Error{where + ": " + option + " '" + text + "' needs a --montage to act on"};
     *out = def.find_section(static_cast<size_t>(montage), name);
     if (*out < 0)
-      return Error{where + ": " + option + " '" + text + "': montage '" + std::string(def.montage_name(static_cast<size_t>(montage))) +
-                   "' has no section '" + std::string(name) + "' (sections: " + list(driver, montage) + ")"};
+      return Error{where + ": " + option + " '" + text + "': montage '" +
+                   std::string(def.montage_name(static_cast<size_t>(montage))) + "' has no section '" +
+                   std::string(name) + "' (sections: " + list(driver, montage) + ")"};
     return {};
   };
   for (const std::string& text : nexts) {
@@ -84,7 +87,8 @@ Status add_montage_commands(GraphDriver& driver, const std::vector<std::string>&
     std::string_view name;
     MontageCommand c;
     c.kind = MontageCommand::Kind::Jump;
-    if (!split_time(text, &name, &c.time)) return Error{where + ": --montage-jump '" + text + "': expected SECTION@SECONDS"};
+    if (!split_time(text, &name, &c.time))
+      return Error{where + ": --montage-jump '" + text + "': expected SECTION@SECONDS"};
     c.montage = montage;
     if (Status s = section(name, "--montage-jump", text, &c.section); !s) return s;
     driver.montage_commands.push_back(c);
@@ -118,9 +122,9 @@ void log_montage_events(GraphDriver& driver) {
   for (const MontageEvent& e : driver.instances.front().montage_events()) {
     char line[200];
     const std::string_view m = def.montage_name(e.montage);
-    std::snprintf(line, sizeof line, "%8.2f s  %.*s: %s%s%.*s @ %.2f s%s", driver.time, static_cast<int>(m.size()), m.data(),
-                  event_word(e.type), e.name.empty() ? "" : " ", static_cast<int>(e.name.size()), e.name.data(), e.position,
-                  e.interrupted ? " (interrupted)" : "");
+    std::snprintf(line, sizeof line, "%8.2f s  %.*s: %s%s%.*s @ %.2f s%s", driver.time, static_cast<int>(m.size()),
+                  m.data(), event_word(e.type), e.name.empty() ? "" : " ", static_cast<int>(e.name.size()),
+                  e.name.data(), e.position, e.interrupted ? " (interrupted)" : "");
     driver.recent_events.emplace_front(line);
     if (driver.recent_events.size() > kGraphEventLog) driver.recent_events.pop_back();
   }
@@ -149,10 +153,11 @@ std::string montage_state_text(const GraphDriver& driver, int m) {
   if (!st.playing) return "stopped";
   const GraphDefinition& def = *driver.definition;
   char text[160];
-  const std::string_view section = def.section_name(static_cast<size_t>(m), static_cast<size_t>(std::max(st.section, 0)));
+  const std::string_view section =
+      def.section_name(static_cast<size_t>(m), static_cast<size_t>(std::max(st.section, 0)));
   std::snprintf(text, sizeof text, "%s  %.*s  %.2f / %.2f s  weight %.2f", st.blending_out ? "blending out" : "playing",
-                static_cast<int>(section.size()), section.data(), st.position, def.montage_length(static_cast<size_t>(m)),
-                st.weight);
+                static_cast<int>(section.size()), section.data(), st.position,
+                def.montage_length(static_cast<size_t>(m)), st.weight);
   return text;
 }
 

@@ -30,7 +30,8 @@ void montage_panel(GraphDriver& g) {
     if (ImGui::Button("stop"))
       for (GraphInstance& inst : g.instances) inst.stop_montage(mi);
     ImGui::SameLine();
-    ImGui::Text("%s (group %s, %.2f s)", str(d.montage_name(m)).c_str(), str(d.montage_group(m)).c_str(), d.montage_length(m));
+    ImGui::Text("%s (group %s, %.2f s)", str(d.montage_name(m)).c_str(), str(d.montage_group(m)).c_str(),
+                d.montage_length(m));
     const MontageStatus st = g.instances.front().montage_status(mi);
     const std::string state = montage_state_text(g, mi);
     ImGui::ProgressBar(st.playing ? st.position / std::max(d.montage_length(m), 1e-6f) : 0.0f, ImVec2(-1.0f, 0.0f),
@@ -84,7 +85,8 @@ void montage_timeline(App& app, const Rect& strip, float ui_scale) {
   const float x0 = strip.x + label_w, width = std::max(strip.width - label_w - pad, 1.0f);
   const float top = strip.y + 4.0f * ui_scale, bottom = strip.y + strip.height - 4.0f * ui_scale;
   const float row = (bottom - top) / 3.0f;  // sections, events, windows
-  dl->AddRectFilled(ImVec2(strip.x, strip.y), ImVec2(strip.x + strip.width, strip.y + strip.height), IM_COL32(24, 26, 30, 255));
+  dl->AddRectFilled(ImVec2(strip.x, strip.y), ImVec2(strip.x + strip.width, strip.y + strip.height),
+                    IM_COL32(24, 26, 30, 255));
   const ImVec2 mouse = ImGui::GetIO().MousePos;
 
   // Sections: spans in alternating shades, named; the playing one brighter; a loop says so.
@@ -93,14 +95,18 @@ void montage_timeline(App& app, const Rect& strip, float ui_scale) {
     const float s1 = k + 1 < d.section_count(mu) ? d.section_start(mu, k + 1) : length;
     const float xa = time_to_x(s0, length, x0, width), xb = time_to_x(s1, length, x0, width);
     const bool playing = st.playing && st.section == static_cast<int>(k);
-    const ImU32 fill = playing ? IM_COL32(70, 110, 170, 255) : (k % 2 ? IM_COL32(48, 54, 66, 255) : IM_COL32(56, 62, 76, 255));
+    const ImU32 fill =
+        playing ? IM_COL32(70, 110, 170, 255) : (k % 2 ? IM_COL32(48, 54, 66, 255) : IM_COL32(56, 62, 76, 255));
     dl->AddRectFilled(ImVec2(xa, top), ImVec2(xb - 1.0f, bottom), fill);
     const int next = d.section_next(mu, k);
-    const std::string label = str(d.section_name(mu, k)) + (next == static_cast<int>(k) ? " (loop)" : next < 0 ? " |" : "");
+    const std::string label = str(d.section_name(mu, k)) + (next == static_cast<int>(k) ? " (loop)"
+                                                            : next < 0                  ? " |"
+                                                                                        : "");
     dl->PushClipRect(ImVec2(xa, top), ImVec2(xb - 2.0f, top + row), true);
     dl->AddText(ImVec2(xa + 3.0f * ui_scale, top), IM_COL32(225, 225, 225, 255), label.c_str());
     dl->PopClipRect();
-    if (ImGui::IsMouseClicked(ImGuiMouseButton_Left) && mouse.x >= xa && mouse.x < xb && mouse.y >= top && mouse.y < bottom) {
+    if (ImGui::IsMouseClicked(ImGuiMouseButton_Left) && mouse.x >= xa && mouse.x < xb && mouse.y >= top &&
+        mouse.y < bottom) {
       for (GraphInstance& inst : g.instances) inst.jump_to_section(m, static_cast<int>(k));
     }
   }
@@ -113,11 +119,13 @@ void montage_timeline(App& app, const Rect& strip, float ui_scale) {
       if (n->kind() == fb::MontageNotifyKind::Window) {
         const float xe = time_to_x(n->time() + n->duration(), length, x0, width);
         dl->AddRectFilled(ImVec2(x, top + 2.2f * row), ImVec2(xe, bottom - 2.0f), IM_COL32(120, 200, 140, 170));
-        if (mouse.x >= x && mouse.x <= xe && mouse.y >= top + 2.2f * row && mouse.y <= bottom) hovered = n->name()->c_str();
+        if (mouse.x >= x && mouse.x <= xe && mouse.y >= top + 2.2f * row && mouse.y <= bottom)
+          hovered = n->name()->c_str();
       } else if (n->kind() == fb::MontageNotifyKind::BranchingPoint) {
         dl->AddTriangleFilled(ImVec2(x - r, y - r), ImVec2(x + r, y - r), ImVec2(x, y + r), IM_COL32(240, 90, 80, 255));
       } else {
-        dl->AddQuadFilled(ImVec2(x, y - r), ImVec2(x + r, y), ImVec2(x, y + r), ImVec2(x - r, y), IM_COL32(250, 200, 60, 255));
+        dl->AddQuadFilled(ImVec2(x, y - r), ImVec2(x + r, y), ImVec2(x, y + r), ImVec2(x - r, y),
+                          IM_COL32(250, 200, 60, 255));
       }
       if (std::fabs(mouse.x - x) <= r + 1.0f && std::fabs(mouse.y - y) <= r + 1.0f) hovered = n->name()->c_str();
       if (hovered == n->name()->c_str()) hovered_time = n->time();

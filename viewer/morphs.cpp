@@ -66,9 +66,12 @@ MorphEntries build_morph_entries(const MeshView& mesh, std::span<const int32_t> 
     const fb::MorphTarget& target = mesh.morph_target(t);
     const auto* listed = target.vertices();
     const int16_t* dp = target.position_deltas()->data();
-    const int16_t* dn = target.normal_deltas() && target.normal_deltas()->size() ? target.normal_deltas()->data() : nullptr;
-    const int16_t* dt = target.tangent_deltas() && target.tangent_deltas()->size() ? target.tangent_deltas()->data() : nullptr;
-    const glm::vec3 sp = to_vec3(target.position_step()), sn = to_vec3(target.normal_step()), st = to_vec3(target.tangent_step());
+    const int16_t* dn =
+        target.normal_deltas() && target.normal_deltas()->size() ? target.normal_deltas()->data() : nullptr;
+    const int16_t* dt =
+        target.tangent_deltas() && target.tangent_deltas()->size() ? target.tangent_deltas()->data() : nullptr;
+    const glm::vec3 sp = to_vec3(target.position_step()), sn = to_vec3(target.normal_step()),
+                    st = to_vec3(target.tangent_step());
     for (size_t i = 0; i < listed->size(); ++i) {
       const uint32_t v = listed->Get(static_cast<flatbuffers::uoffset_t>(i));
       const size_t entry = static_cast<size_t>(e.ranges[2 * v] + fill[v]++);
@@ -114,8 +117,8 @@ Result<MorphBase> decode_morph_base(const MeshView& mesh) {
   if (normal) b.normals.resize(n);
   if (tangent) b.tangents.resize(n);
   const bool normal_octahedral = normal && vertex_format_info(normal->format()).components == 2;
-  const bool tangent_octahedral =
-      tangent && (tangent->format() == fb::VertexFormat::Snorm16x4 || vertex_format_info(tangent->format()).components == 2);
+  const bool tangent_octahedral = tangent && (tangent->format() == fb::VertexFormat::Snorm16x4 ||
+                                              vertex_format_info(tangent->format()).components == 2);
   for (size_t v = 0; v < n; ++v) {
     const uint8_t* vertex = bytes + v * stride;
     b.positions[v] = glm::vec3(fetch_vertex_attribute(vertex + position->offset(), position->format()));
@@ -126,9 +129,9 @@ Result<MorphBase> decode_morph_base(const MeshView& mesh) {
     if (tangent) {
       const glm::vec4 f = fetch_vertex_attribute(vertex + tangent->offset(), tangent->format());
       if (tangent_octahedral)
-        b.tangents[v] = glm::vec4(octahedral(f.x, f.y), tangent->format() == fb::VertexFormat::Snorm16x4 && f.z < 0.0f ? -1.0f : 1.0f);
-      else
-        b.tangents[v] = glm::vec4(glm::vec3(f), f.w < 0.0f ? -1.0f : 1.0f);
+        b.tangents[v] = glm::vec4(octahedral(f.x, f.y),
+                                  tangent->format() == fb::VertexFormat::Snorm16x4 && f.z < 0.0f ? -1.0f : 1.0f);
+      else b.tangents[v] = glm::vec4(glm::vec3(f), f.w < 0.0f ? -1.0f : 1.0f);
     }
     if (joints) {
       b.slots[v] = glm::uvec4(fetch_vertex_attribute(vertex + joints->offset(), joints->format()));

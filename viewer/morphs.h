@@ -56,9 +56,9 @@ struct MorphBase {
   std::vector<glm::vec4> tangents;            // empty without a Tangent attribute
   std::vector<glm::uvec4> slots;
   std::vector<glm::vec4> weights;
-  bool dequantize = false;                    // positions are stored normalized (D in the palette)
-  glm::vec3 offset{0.0f}, scale{1.0f};        // D = translate(offset) * scale(scale)
-  glm::vec3 direction_prescale{1.0f};         // 1 / scale (0 on a zero axis)
+  bool dequantize = false;              // positions are stored normalized (D in the palette)
+  glm::vec3 offset{0.0f}, scale{1.0f};  // D = translate(offset) * scale(scale)
+  glm::vec3 direction_prescale{1.0f};   // 1 / scale (0 on a zero axis)
 };
 
 /// Decodes `mesh` for morph_and_skin_cpu. Errors name the mesh for a layout it cannot read.

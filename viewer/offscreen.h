@@ -14,8 +14,8 @@ namespace ossa::view {
 
 struct Offscreen {
   int width = 0, height = 0, samples = 1;
-  GLuint draw_fbo = 0, color = 0, depth = 0;    // where drawing goes (multisampled if samples > 1)
-  GLuint resolve_fbo = 0, resolve_color = 0;    // single-sampled copy when samples > 1
+  GLuint draw_fbo = 0, color = 0, depth = 0;  // where drawing goes (multisampled if samples > 1)
+  GLuint resolve_fbo = 0, resolve_color = 0;  // single-sampled copy when samples > 1
 };
 
 /// samples is clamped to GL_MAX_SAMPLES. Errors when the framebuffer is incomplete.

@@ -11,7 +11,7 @@ namespace ossa::view {
 namespace {
 constexpr float kMaxSeconds = 3600.0f;
 constexpr float kMaxMorphWeight = 1000.0f;  // runtime/internal/validator.h kMaxMorphWeight
-}
+}  // namespace
 
 std::optional<std::pair<int, int>> parse_size(const std::string& text) {
   const size_t x = text.find('x');
@@ -34,7 +34,8 @@ std::optional<std::pair<float, float>> parse_turn(const std::string& text) {
     return v;
   };
   const auto rate = number(std::string_view(text).substr(0, at));
-  const auto after = at == std::string::npos ? std::optional<float>(0.0f) : number(std::string_view(text).substr(at + 1));
+  const auto after =
+      at == std::string::npos ? std::optional<float>(0.0f) : number(std::string_view(text).substr(at + 1));
   if (!rate || !after || std::fabs(*rate) > 3600.0f || *after < 0.0f || *after > kMaxSeconds) return std::nullopt;
   return std::make_pair(*rate, *after);
 }
@@ -51,13 +52,16 @@ std::optional<std::pair<std::string, float>> parse_morph(const std::string& text
 }
 
 ParsedOptions parse_options(int argc, const char* const* argv) {
-  cli::Command command("ossa-view", "ossa-view: look at cooked .ossa characters and play their clips; the window also cooks sources dropped on it (GLFW + OpenGL 3.3)",
+  cli::Command command("ossa-view",
+                       "ossa-view: look at cooked .ossa characters and play their clips; the window also cooks sources "
+                       "dropped on it (GLFW + OpenGL 3.3)",
                        "when the files could not be shown (a file refused, a name not found, a GL error)");
   CLI::App& app = command.app();
   ViewerOptions o;
   std::string size;
   bool no_grid = false;
-  app.add_option("files", o.files, "a character .ossa, then any clip files cooked for its skeleton (the window may start without)");
+  app.add_option("files", o.files,
+                 "a character .ossa, then any clip files cooked for its skeleton (the window may start without)");
   app.add_option("--clip", o.clip, "start with this clip (its name)");
   app.add_option("--time", o.time, "clip time in seconds (headless: of the captured frame)");
   app.add_option("--speed", o.speed, "playback rate");
@@ -73,8 +77,9 @@ ParsedOptions parse_options(int argc, const char* const* argv) {
       ->expected(3);
   app.add_option("--move", o.move, "move the character forwards at this many metres per second (an in-place clip runs)")
       ->check(CLI::Range(-100.0f, 100.0f));
-  app.add_option("--turn", o.turn, "turn the character DEG_PER_S degrees per second about +Y, from AFTER seconds of play "
-                                   "on (DEG_PER_S[@AFTER]); the cloth feels the turn");
+  app.add_option("--turn", o.turn,
+                 "turn the character DEG_PER_S degrees per second about +Y, from AFTER seconds of play "
+                 "on (DEG_PER_S[@AFTER]); the cloth feels the turn");
   app.add_option("--crowd", o.crowd, "draw N instances with offset times, instanced")->check(CLI::Range(1u, 4096u));
   app.add_flag("--wireframe", o.wireframe, "wireframe overlay");
   app.add_flag("--skeleton", o.skeleton, "skeleton overlay");
@@ -85,18 +90,21 @@ ParsedOptions parse_options(int argc, const char* const* argv) {
   app.add_option("--pitch", o.pitch_degrees, "camera elevation in degrees")->check(CLI::Range(-89.0f, 89.0f));
   app.add_option("--size", size, "window / image size, WxH (default 1280x720)");
   app.add_option("--msaa", o.msaa, "multisampling (1: off)")->check(CLI::Range(1, 16));
-  app.add_option("--frames", o.frames, "headless: render N frames, 1/60 s apart, ending at --time")->check(CLI::Range(1, 100000));
+  app.add_option("--frames", o.frames, "headless: render N frames, 1/60 s apart, ending at --time")
+      ->check(CLI::Range(1, 100000));
   app.add_option("--screenshot", o.screenshot, "headless: write the last frame to this PNG");
   app.add_flag("--first-frame-time", o.first_frame_time, "print first-frame-ms once the first frame is finished");
   app.add_flag("--stats", o.stats, "headless: print the average frame-time split");
   app.add_option("--graph", o.graph, "drive the character with the animation graph of this name");
-  app.add_option("--set,--param", o.set, "graph parameter start value, NAME=VALUE (a trigger: NAME; a vector: NAME=X,Y,Z); repeatable")
+  app.add_option("--set,--param", o.set,
+                 "graph parameter start value, NAME=VALUE (a trigger: NAME; a vector: NAME=X,Y,Z); repeatable")
       ->needs("--graph")
       ->allow_extra_args(false);  // one value per --set: the files may follow
   app.add_flag("--show-procedural", o.show_procedural,
                "draw the procedural overlays (targets, ground under the feet, springs) in headless images too")
       ->needs("--graph");
-  app.add_option("--montage", o.montage, "play the graph's montage NAME when the graph's time reaches T (default 0); repeatable")
+  app.add_option("--montage", o.montage,
+                 "play the graph's montage NAME when the graph's time reaches T (default 0); repeatable")
       ->type_name("NAME[@T]")
       ->needs("--graph")
       ->allow_extra_args(false);
@@ -120,10 +128,12 @@ ParsedOptions parse_options(int argc, const char* const* argv) {
   app.add_flag("--show-mapping", o.show_mapping, "draw the retarget's joint mapping in headless images too")
       ->needs("--retarget-from");
   std::vector<std::string> morphs;
-  app.add_option("--morph", morphs, "hold the morph targets named NAME at WEIGHT (clips no longer drive them); repeatable")
+  app.add_option("--morph", morphs,
+                 "hold the morph targets named NAME at WEIGHT (clips no longer drive them); repeatable")
       ->type_name("NAME=WEIGHT")
       ->allow_extra_args(false);  // one value per --morph: the files may follow
-  app.add_option("--window-frames", o.window_frames, "window mode: exit after N frames (--screenshot captures the window)")
+  app.add_option("--window-frames", o.window_frames,
+                 "window mode: exit after N frames (--screenshot captures the window)")
       ->check(CLI::Range(1, 1000000));
   std::string panel;
   app.add_option("--panel", panel, "window: start with the panel open or collapsed (Tab toggles it)")
@@ -131,9 +141,10 @@ ParsedOptions parse_options(int argc, const char* const* argv) {
   app.add_option("--ui-scale", o.ui_scale, "window: panel text and widget size (default: the monitor's content scale)")
       ->check(CLI::Range(0.5f, 4.0f));
   app.add_option("--browse", o.browse, "window: start the panel's file browser in this folder");
-  app.add_option("--cook-and-open", o.cook_and_open,
-                 "window: cook this source (FBX, glTF, GLB, DAE, BVH, OBJ) with ossa-cook in the background, then open it; "
-                 "repeatable")
+  app.add_option(
+         "--cook-and-open", o.cook_and_open,
+         "window: cook this source (FBX, glTF, GLB, DAE, BVH, OBJ) with ossa-cook in the background, then open it; "
+         "repeatable")
       ->allow_extra_args(false);
   if (const auto exit_now = command.parse(argc, argv)) return {std::nullopt, *exit_now};
   o.panel_collapsed = panel == "collapsed";
@@ -141,33 +152,38 @@ ParsedOptions parse_options(int argc, const char* const* argv) {
   o.verbose = command.verbose();
   if (!size.empty()) {
     const auto wh = parse_size(size);
-    if (!wh) return {std::nullopt, command.usage_error("--size: expected WxH with both in 1..16384, got '" + size + "'")};
+    if (!wh)
+      return {std::nullopt, command.usage_error("--size: expected WxH with both in 1..16384, got '" + size + "'")};
     o.width = wh->first;
     o.height = wh->second;
   }
   o.grid = !no_grid;
   if (!o.turn.empty() && !parse_turn(o.turn))
     return {std::nullopt, command.usage_error("--turn: expected DEG_PER_S[@AFTER] (degrees per second within +-3600, "
-                                              "seconds >= 0), got '" + o.turn + "'")};
+                                              "seconds >= 0), got '" +
+                                              o.turn + "'")};
   o.cloth = cloth == "on";
   for (const std::string& m : morphs) {
     const auto parsed = parse_morph(m);
     if (!parsed)
-      return {std::nullopt, command.usage_error("--morph: expected NAME=WEIGHT with a finite weight within +-1000, got '" + m + "'")};
+      return {std::nullopt,
+              command.usage_error("--morph: expected NAME=WEIGHT with a finite weight within +-1000, got '" + m + "'")};
     o.morphs.push_back(*parsed);
   }
   // A graph cannot seek: headless --time T plays T seconds in 1/60 s steps, so T is bounded (an
   // hour is 216,000 steps); a clip's time wraps, but must still be a number.
   if (!std::isfinite(o.time) || std::fabs(o.time) > kMaxSeconds)
-    return {std::nullopt, command.usage_error("--time: expected a finite number of seconds within +-" +
-                                              std::to_string(static_cast<int>(kMaxSeconds)) + ", got " +
-                                              std::to_string(o.time))};
+    return {std::nullopt,
+            command.usage_error("--time: expected a finite number of seconds within +-" +
+                                std::to_string(static_cast<int>(kMaxSeconds)) + ", got " + std::to_string(o.time))};
   if (!o.screenshot.empty() && o.frames == 0 && o.window_frames == 0) o.frames = 1;
   if (o.files.empty() && o.headless())
-    return {std::nullopt, command.usage_error("files is required: a character .ossa to render (only the window may start "
-                                              "without one)")};
+    return {std::nullopt,
+            command.usage_error("files is required: a character .ossa to render (only the window may start "
+                                "without one)")};
   if (o.headless() && (!o.cook_and_open.empty() || !o.browse.empty()))
-    return {std::nullopt, command.usage_error("--cook-and-open and --browse are for the window (use --window-frames N)")};
+    return {std::nullopt,
+            command.usage_error("--cook-and-open and --browse are for the window (use --window-frames N)")};
   return {o, 0};
 }
 

@@ -67,49 +67,49 @@ namespace ossa::view {
 
 struct ViewerOptions {
   std::vector<std::string> files;
-  std::string clip;             // empty: the first clip
-  float time = 0.0f;            // clip time (s) of the captured frame / where playback starts
+  std::string clip;   // empty: the first clip
+  float time = 0.0f;  // clip time (s) of the captured frame / where playback starts
   float speed = 1.0f;
   bool paused = false;
   bool bind_pose = false;
   bool cpu_skinning = false;
-  bool cloth = true;            // --cloth off: cloth meshes drawn as skinned (to compare)
-  bool show_cloth = false;      // --show-cloth: the cloth overlay (particles, edges, colliders)
-  std::vector<float> wind;      // --wind X,Y,Z: metres per second, world space
-  float move = 0.0f;            // --move: metres per second forwards (animation.h Drive)
-  std::string turn;             // --turn DEG_PER_S[@AFTER]: turning, from AFTER seconds of play on
+  bool cloth = true;        // --cloth off: cloth meshes drawn as skinned (to compare)
+  bool show_cloth = false;  // --show-cloth: the cloth overlay (particles, edges, colliders)
+  std::vector<float> wind;  // --wind X,Y,Z: metres per second, world space
+  float move = 0.0f;        // --move: metres per second forwards (animation.h Drive)
+  std::string turn;         // --turn DEG_PER_S[@AFTER]: turning, from AFTER seconds of play on
   unsigned crowd = 1;
   bool wireframe = false;
   bool skeleton = false;
   bool grid = true;
-  float yaw_degrees = 30.0f;     // from the character's front (--front)
-  std::string front = "auto";   // --front: auto (bounds.h facing_of) or +z, -z, +x, -x
+  float yaw_degrees = 30.0f;   // from the character's front (--front)
+  std::string front = "auto";  // --front: auto (bounds.h facing_of) or +z, -z, +x, -x
   float pitch_degrees = 10.0f;
   int width = 1280;
   int height = 720;
   int msaa = 4;
-  int frames = 0;               // headless: frames to render (default 1 with --screenshot)
-  std::string screenshot;       // headless: PNG to write
+  int frames = 0;                 // headless: frames to render (default 1 with --screenshot)
+  std::string screenshot;         // headless: PNG to write
   bool first_frame_time = false;  // print "first-frame-ms X" (since main) once the first frame is finished
-  bool stats = false;           // headless: print the frame-time split
-  int window_frames = 0;        // window mode: exit after this many frames (0: when closed)
-  std::string graph;            // drive the character with this graph
-  std::vector<std::string> set; // graph parameter start values, "name=value" (or "trigger"; a vector "name=x,y,z")
-  bool show_procedural = false; // headless: draw the procedural overlays (the window shows them by default)
+  bool stats = false;             // headless: print the frame-time split
+  int window_frames = 0;          // window mode: exit after this many frames (0: when closed)
+  std::string graph;              // drive the character with this graph
+  std::vector<std::string> set;   // graph parameter start values, "name=value" (or "trigger"; a vector "name=x,y,z")
+  bool show_procedural = false;   // headless: draw the procedural overlays (the window shows them by default)
   std::vector<std::string> retarget_from;  // --retarget-from: the source character and its clip files
-  std::string retarget_map;     // --retarget-map: a humanoid map file (tools/retarget/map_file.h)
-  std::string retarget_clip;    // --retarget-clip: the source clip (empty: its first)
-  bool show_mapping = false;    // headless: draw the retarget mapping (the window shows it by default)
-  std::vector<std::string> montage;       // --montage NAME[@T]: montages played at graph times
-  std::vector<std::string> montage_next;  // --montage-next SECTION=NEXT[@T]
-  std::vector<std::string> montage_jump;  // --montage-jump SECTION[@T]
+  std::string retarget_map;                // --retarget-map: a humanoid map file (tools/retarget/map_file.h)
+  std::string retarget_clip;               // --retarget-clip: the source clip (empty: its first)
+  bool show_mapping = false;               // headless: draw the retarget mapping (the window shows it by default)
+  std::vector<std::string> montage;        // --montage NAME[@T]: montages played at graph times
+  std::vector<std::string> montage_next;   // --montage-next SECTION=NEXT[@T]
+  std::vector<std::string> montage_jump;   // --montage-jump SECTION[@T]
   std::vector<std::pair<std::string, float>> morphs;  // --morph: channels held at a weight
-  bool panel_collapsed = false; // --panel collapsed: the window starts with the panel hidden
-  float ui_scale = 0.0f;        // --ui-scale: panel size factor (0: from the monitor's content scale)
-  std::string browse;           // --browse: the file browser's first folder (empty: the default)
+  bool panel_collapsed = false;                       // --panel collapsed: the window starts with the panel hidden
+  float ui_scale = 0.0f;                   // --ui-scale: panel size factor (0: from the monitor's content scale)
+  std::string browse;                      // --browse: the file browser's first folder (empty: the default)
   std::vector<std::string> cook_and_open;  // --cook-and-open: sources cooked in the background, then opened
-  bool quiet = false;           // -q: errors only
-  bool verbose = false;         // -v: GL information and what was loaded
+  bool quiet = false;                      // -q: errors only
+  bool verbose = false;                    // -v: GL information and what was loaded
 
   bool headless() const { return window_frames == 0 && (frames > 0 || !screenshot.empty()); }
 };

@@ -39,10 +39,10 @@ std::vector<float> share_heights(float available, const std::vector<float>& want
 /// One region of the panel as laid out this frame, in window coordinates.
 struct PanelRegion {
   std::string name;
-  Rect rect;            // where the region is
-  Rect clip;            // what of it is visible (items are cut off outside)
+  Rect rect;                             // where the region is
+  Rect clip;                             // what of it is visible (items are cut off outside)
   float reach_x = 0.0f, reach_y = 0.0f;  // the furthest right / bottom edge an item reached
-  bool scrolls = false; // items below the clip rectangle are reached by scrolling: not cut off
+  bool scrolls = false;                  // items below the clip rectangle are reached by scrolling: not cut off
 };
 
 struct PanelAudit {

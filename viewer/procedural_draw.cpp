@@ -58,7 +58,8 @@ void perpendiculars(const glm::vec3& d, glm::vec3& u, glm::vec3& w) {
   w = glm::cross(d, u);
 }
 
-void wire_sphere(std::vector<LineVertex>& v, const glm::vec3& c, float r, const glm::vec3& axis, const glm::vec4& color) {
+void wire_sphere(std::vector<LineVertex>& v, const glm::vec3& c, float r, const glm::vec3& axis,
+                 const glm::vec4& color) {
   glm::vec3 u, w;
   perpendiculars(axis, u, w);
   circle(v, c, u, w, r, color);
@@ -101,7 +102,8 @@ void targets(const GraphDriver& g, const AnimInstance& shown, const glm::vec3& o
     if (h.effector >= 0 && static_cast<size_t>(h.effector) < shown.model.size() && h.node >= 0 &&
         inst.node_weight(static_cast<size_t>(h.node)) > 0.0f) {
       const bool reached = !h.pole && inst.reached(static_cast<size_t>(h.node));
-      line(out.on_top, position(shown.model[static_cast<size_t>(h.effector)]) + offset, p, reached ? kReached : kNotReached);
+      line(out.on_top, position(shown.model[static_cast<size_t>(h.effector)]) + offset, p,
+           reached ? kReached : kNotReached);
     }
   }
 }
@@ -116,7 +118,8 @@ void ground_patches(const GraphDriver& g, const GraphInstance& inst, const AnimI
     glm::vec3 n = leg.normal >= 0 ? inst.vector(leg.normal) : up;
     const float len = glm::length(n);
     n = len > 1e-6f && glm::dot(n, up) > 0.05f * len ? n / len : up;  // as the node: a wall is no ground
-    const glm::vec3 c = ground_point(position(shown.model[leg.ankle]), std::isfinite(height) ? height : 0.0f, n) + offset;
+    const glm::vec3 c =
+        ground_point(position(shown.model[leg.ankle]), std::isfinite(height) ? height : 0.0f, n) + offset;
     // Patch axes: the character's x kept in the plane, and the slope's direction.
     glm::vec3 a = glm::cross(n, glm::vec3(0.0f, 0.0f, 1.0f));
     a = glm::length(a) > 1e-4f ? glm::normalize(a) : glm::vec3(1.0f, 0.0f, 0.0f);
@@ -138,7 +141,8 @@ void ground_patches(const GraphDriver& g, const GraphInstance& inst, const AnimI
   }
 }
 
-void springs(const GraphDriver& g, const AnimInstance& shown, const glm::vec3& offset, float size, OverlayGeometry& out) {
+void springs(const GraphDriver& g, const AnimInstance& shown, const glm::vec3& offset, float size,
+             OverlayGeometry& out) {
   const size_t joints = shown.model.size();
   for (const SpringChainInfo& chain : g.procedural.chains) {
     const float s = std::max(chain.radius, 0.01f * size);

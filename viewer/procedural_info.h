@@ -24,19 +24,19 @@ namespace ossa::view {
 /// A Vector parameter that an AimNode or TwoBoneIkNode reaches for (or bends towards): a gizmo.
 struct TargetHandle {
   int parameter = -1;
-  bool pole = false;                              // a two-bone node's pole, not a target
-  bool world = false;                             // ParameterSpace::World (else model space)
-  int node = -1;                                  // the first node that reads it (GraphInstance::reached)
-  int effector = -1;                              // the joint that reaches (aim: the chain's last), or -1
-  std::string name;                               // the parameter's name, for the panel
+  bool pole = false;   // a two-bone node's pole, not a target
+  bool world = false;  // ParameterSpace::World (else model space)
+  int node = -1;       // the first node that reads it (GraphInstance::reached)
+  int effector = -1;   // the joint that reaches (aim: the chain's last), or -1
+  std::string name;    // the parameter's name, for the panel
 };
 
 /// One leg of a FootPlacementNode.
 struct FootLegInfo {
   uint16_t ankle = 0;
-  int ground = -1;   // a Float parameter: the ground's height under the foot (model units), or -1
-  int normal = -1;   // a Vector parameter: the ground's normal (model space), or -1
-  bool left = false; // the ankle's name says left (else: the first leg is the left one)
+  int ground = -1;    // a Float parameter: the ground's height under the foot (model units), or -1
+  int normal = -1;    // a Vector parameter: the ground's normal (model space), or -1
+  bool left = false;  // the ankle's name says left (else: the first leg is the left one)
 };
 
 struct SpringChainInfo {
@@ -51,9 +51,9 @@ struct SpringColliderInfo {
 };
 
 struct ProceduralInfo {
-  std::vector<TargetHandle> targets;   // one per distinct parameter
-  std::vector<FootLegInfo> legs;       // of every FootPlacementNode
-  std::vector<SpringChainInfo> chains; // of every SpringNode
+  std::vector<TargetHandle> targets;    // one per distinct parameter
+  std::vector<FootLegInfo> legs;        // of every FootPlacementNode
+  std::vector<SpringChainInfo> chains;  // of every SpringNode
   std::vector<SpringColliderInfo> colliders;
   bool empty() const { return targets.empty() && legs.empty() && chains.empty() && colliders.empty(); }
 };

@@ -60,8 +60,10 @@ void bind_material(const Renderer& r, const GpuMaterial& m) {
     GLenum unit;
     GLuint map;
     GLint flag;
-  } maps[] = {{GL_TEXTURE1, m.diffuse_map, u.has_diffuse_map},     {GL_TEXTURE2, m.normal_map, u.has_normal_map},
-              {GL_TEXTURE3, m.specular_map, u.has_specular_map},   {GL_TEXTURE7, m.occlusion_map, u.has_occlusion_map},
+  } maps[] = {{GL_TEXTURE1, m.diffuse_map, u.has_diffuse_map},
+              {GL_TEXTURE2, m.normal_map, u.has_normal_map},
+              {GL_TEXTURE3, m.specular_map, u.has_specular_map},
+              {GL_TEXTURE7, m.occlusion_map, u.has_occlusion_map},
               {GL_TEXTURE8, m.emissive_map, u.has_emissive_map}};
   for (const auto& map : maps) {
     glActiveTexture(map.unit);
@@ -84,7 +86,8 @@ void set_mesh_encoding(const Renderer& r, const GpuMesh& m, bool cpu_skinned) {
   const auto& u = r.mesh_uniforms;
   if (cpu_skinned) {  // skin_cpu wrote unit xyz normals and xyz + sign tangents, in world space
     glUniform1i(u.normal_encoding, static_cast<int>(NormalEncoding::Xyz));
-    glUniform1i(u.tangent_encoding, static_cast<int>(m.has_tangents ? TangentEncoding::XyzSignW : TangentEncoding::None));
+    glUniform1i(u.tangent_encoding,
+                static_cast<int>(m.has_tangents ? TangentEncoding::XyzSignW : TangentEncoding::None));
     glUniform3f(u.direction_prescale, 1.0f, 1.0f, 1.0f);
   } else {
     glUniform1i(u.normal_encoding, static_cast<int>(m.normal_encoding));
@@ -159,7 +162,8 @@ void draw_overlay(Renderer& r, const glm::mat4& view_projection) {
 
 Result<Renderer> create_renderer() {
   Renderer r;
-  Result<GLuint> mesh = build_program("skinned.vert.glsl + phong.frag.glsl", shaders::kSkinnedVert, shaders::kPhongFrag);
+  Result<GLuint> mesh =
+      build_program("skinned.vert.glsl + phong.frag.glsl", shaders::kSkinnedVert, shaders::kPhongFrag);
   if (!mesh) return mesh.error();
   r.mesh_program = *mesh;
   Result<GLuint> lines = build_program("lines.vert.glsl + lines.frag.glsl", shaders::kLinesVert, shaders::kLinesFrag);
@@ -310,7 +314,8 @@ Status upload_scene(Renderer& r, const Scene& scene, std::vector<std::string>& w
 void set_grid(Renderer& r, const Box& area, float ground, float character_radius) {
   const float cell = 0.5f * std::pow(10.0f, std::round(std::log10(std::max(character_radius, 1e-6f))));
   const glm::vec3 c = area.empty() ? glm::vec3(0.0f) : area.centre();
-  const float half_extent = std::max(5.0f * character_radius, area.empty() ? 0.0f : 0.75f * std::max(area.size().x, area.size().z));
+  const float half_extent =
+      std::max(5.0f * character_radius, area.empty() ? 0.0f : 0.75f * std::max(area.size().x, area.size().z));
   const int n = std::clamp(static_cast<int>(std::ceil(half_extent / cell)), 1, 200);
   const float x0 = std::round(c.x / cell) * cell, z0 = std::round(c.z / cell) * cell;
   std::vector<LineVertex> v;
@@ -330,8 +335,8 @@ void set_grid(Renderer& r, const Box& area, float ground, float character_radius
 }
 
 Status render_frame(Renderer& r, const Scene& scene, const Animator& animator, std::span<const glm::vec3> offsets,
-                    const OrbitCamera& camera, const ViewToggles& toggles, int width, int height,
-                    FrameTimings& timings, const ViewerCloth* cloth) {
+                    const OrbitCamera& camera, const ViewToggles& toggles, int width, int height, FrameTimings& timings,
+                    const ViewerCloth* cloth) {
   const Asset& asset = scene.character();
   const size_t instances = animator.instances.size();
 
@@ -348,7 +353,8 @@ Status render_frame(Renderer& r, const Scene& scene, const Animator& animator, s
     const auto& model = animator.instances[i].model;
     const glm::vec3 o = i < offsets.size() ? offsets[i] : glm::vec3(0.0f);
     for (size_t m = 0; m < r.meshes.size(); ++m) {
-      const std::span<glm::mat4> out(r.palette.data() + i * r.instance_matrices + r.palette_base[m], r.meshes[m].palette_slots);
+      const std::span<glm::mat4> out(r.palette.data() + i * r.instance_matrices + r.palette_base[m],
+                                     r.meshes[m].palette_slots);
       skinning_matrices(asset.mesh(m).joints(), r.bind[m], model, out);
       for (glm::mat4& p : out) p[3] += glm::vec4(o * p[3].w, 0.0f);  // translate(o) * p
     }
@@ -359,7 +365,8 @@ Status render_frame(Renderer& r, const Scene& scene, const Animator& animator, s
                GL_STREAM_DRAW);
   // Morph weights of every instance, one upload (only when some mesh has targets).
   const size_t channels = scene.morph_channels.size();
-  const bool morphs = channels > 0 && std::any_of(r.meshes.begin(), r.meshes.end(), [](const GpuMesh& g) { return g.has_morphs(); });
+  const bool morphs =
+      channels > 0 && std::any_of(r.meshes.begin(), r.meshes.end(), [](const GpuMesh& g) { return g.has_morphs(); });
   if (morphs) {
     if (instances * channels > static_cast<size_t>(r.max_texels)) {
       return Error{scene.paths.front() + ": " + std::to_string(instances) + " instances x " + std::to_string(channels) +
@@ -368,11 +375,12 @@ Status render_frame(Renderer& r, const Scene& scene, const Animator& animator, s
     r.morph_weights.resize(instances * channels);
     for (size_t i = 0; i < instances; ++i) {
       const std::vector<float>& w = animator.instances[i].morph_weights;
-      std::copy_n(w.begin(), std::min(w.size(), channels), r.morph_weights.begin() + static_cast<std::ptrdiff_t>(i * channels));
+      std::copy_n(w.begin(), std::min(w.size(), channels),
+                  r.morph_weights.begin() + static_cast<std::ptrdiff_t>(i * channels));
     }
     glBindBuffer(GL_TEXTURE_BUFFER, r.morph_weight_buffer);
-    glBufferData(GL_TEXTURE_BUFFER, static_cast<GLsizeiptr>(r.morph_weights.size() * sizeof(float)), r.morph_weights.data(),
-                 GL_STREAM_DRAW);
+    glBufferData(GL_TEXTURE_BUFFER, static_cast<GLsizeiptr>(r.morph_weights.size() * sizeof(float)),
+                 r.morph_weights.data(), GL_STREAM_DRAW);
   }
   timings.skin_ms += ms_since(t_skin);
 
@@ -472,7 +480,8 @@ Status render_frame(Renderer& r, const Scene& scene, const Animator& animator, s
           r.skinned_positions.resize(3 * n);
           r.skinned_normals.resize(g.has_normals ? 3 * n : 0);
           r.skinned_tangents.resize(g.has_tangents ? 4 * n : 0);
-          const std::span<const glm::mat4> palette(r.palette.data() + i * r.instance_matrices + r.palette_base[m], g.palette_slots);
+          const std::span<const glm::mat4> palette(r.palette.data() + i * r.instance_matrices + r.palette_base[m],
+                                                   g.palette_slots);
           const SkinnedStreams out{r.skinned_positions, r.skinned_normals, r.skinned_tangents};
           const bool morphed = g.has_morphs() && m < scene.morph_targets.size() &&
                                morph_and_skin_cpu(view, r.morph_base[m], scene.morph_targets[m],

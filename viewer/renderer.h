@@ -129,7 +129,7 @@ void set_grid(Renderer& r, const Box& area, float ground, float character_radius
 /// Meshes with live cloth (`cloth`, cloth_view.h) are drawn with their simulated particles.
 /// Errors: too many instances x joints for the palette buffer (or x morph channels).
 Status render_frame(Renderer& r, const Scene& scene, const Animator& animator, std::span<const glm::vec3> offsets,
-                    const OrbitCamera& camera, const ViewToggles& toggles, int width, int height,
-                    FrameTimings& timings, const ViewerCloth* cloth = nullptr);
+                    const OrbitCamera& camera, const ViewToggles& toggles, int width, int height, FrameTimings& timings,
+                    const ViewerCloth* cloth = nullptr);
 
 }  // namespace ossa::view

@@ -74,8 +74,10 @@ Result<Scene> load_scene(std::span<const std::string> paths) {
   for (size_t i = 0; character == paths.size() && i < opened.size(); ++i)
     if (!opened[i].skeleton().empty() && opened[i].skeleton().joint_count() > 0) character = i;
   if (character == paths.size()) {
-    return Error{paths.size() == 1 ? paths[0] + ": has no mesh or skeleton to show (a clip-only file needs its "
-                                                "character: ossa-view CHARACTER.ossa " + paths[0] + ")"
+    return Error{paths.size() == 1 ? paths[0] +
+                                         ": has no mesh or skeleton to show (a clip-only file needs its "
+                                         "character: ossa-view CHARACTER.ossa " +
+                                         paths[0] + ")"
                                    : paths[0] + " and the other files given: none has a mesh or skeleton to show"};
   }
   Scene scene;

@@ -25,13 +25,13 @@ namespace ossa::view {
 
 struct SceneClip {
   ClipView clip;
-  size_t asset = 0;    // index into Scene::assets
-  std::string label;   // "walk" or "walk (walk.ossa)" when it comes from another file
+  size_t asset = 0;                   // index into Scene::assets
+  std::string label;                  // "walk" or "walk (walk.ossa)" when it comes from another file
   std::vector<int32_t> morph_tracks;  // the clip's weight track k -> morph channel, or -1
 };
 
 struct Scene {
-  std::vector<Asset> assets;     // [0] is the character
+  std::vector<Asset> assets;  // [0] is the character
   std::vector<std::string> paths;
   std::vector<SceneClip> clips;
   // Morph targets of the character (empty when it has none).

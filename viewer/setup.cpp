@@ -37,10 +37,12 @@ Status setup_app(App& app, Scene scene, const ViewerOptions& o, float aspect) {
   if (o.verbose) {
     const SceneCounts c = count(app.scene);
     std::fprintf(stderr, "ossa-view: %s\n", gl_description().c_str());
-    std::fprintf(stderr, "ossa-view: %s: %zu joints, %zu meshes, %zu vertices, %zu triangles; %zu clips from %zu files\n",
-                 name.c_str(), c.joints, c.meshes, c.vertices, c.triangles, app.scene.clips.size(),
-                 app.scene.assets.size());
-    const char* why = app.facing.from_feet ? "from the feet" : o.front == "auto" ? "the feet do not tell: glTF's +z" : "--front";
+    std::fprintf(
+        stderr, "ossa-view: %s: %zu joints, %zu meshes, %zu vertices, %zu triangles; %zu clips from %zu files\n",
+        name.c_str(), c.joints, c.meshes, c.vertices, c.triangles, app.scene.clips.size(), app.scene.assets.size());
+    const char* why = app.facing.from_feet ? "from the feet"
+                      : o.front == "auto"  ? "the feet do not tell: glTF's +z"
+                                           : "--front";
     std::fprintf(stderr, "ossa-view: front: %s (%s, lopsided by %.3f of the height); camera yaw %.0f deg\n",
                  axis_name(app.facing.forward), why, app.facing.evidence,
                  std::remainder(glm::degrees(app.facing.yaw + app.angles.yaw), 360.0f));
@@ -61,7 +63,8 @@ Status setup_app(App& app, Scene scene, const ViewerOptions& o, float aspect) {
       const size_t eq = assignment.find('=');
       const std::string parameter = assignment.substr(0, eq);
       const std::string value = eq == std::string::npos ? "1" : assignment.substr(eq + 1);
-      if (Status s = set_graph_parameter(*app.animator.graph, parameter, value); !s) return Error{name + ": " + s.message()};
+      if (Status s = set_graph_parameter(*app.animator.graph, parameter, value); !s)
+        return Error{name + ": " + s.message()};
     }
     if (Status s = add_montage_commands(*app.animator.graph, o.montage, o.montage_next, o.montage_jump); !s)
       return Error{name + ": " + s.message()};
@@ -71,7 +74,8 @@ Status setup_app(App& app, Scene scene, const ViewerOptions& o, float aspect) {
     if (c < 0) {
       std::string names;
       for (std::string_view n : app.scene.morph_channels) names += (names.empty() ? "'" : ", '") + std::string(n) + "'";
-      return Error{name + ": no morph target named '" + morph + "' (morph targets: " + (names.empty() ? "none" : names) + ")"};
+      return Error{name + ": no morph target named '" + morph +
+                   "' (morph targets: " + (names.empty() ? "none" : names) + ")"};
     }
     hold_morph(app.animator, static_cast<size_t>(c), true, weight);
   }

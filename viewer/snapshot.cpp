@@ -15,10 +15,12 @@ std::vector<uint8_t> read_framebuffer_rgb(int width, int height) {
 }
 
 Status write_png(const std::string& path, int width, int height, std::span<const uint8_t> rgb) {
-  if (rgb.size() < static_cast<size_t>(width) * static_cast<size_t>(height) * 3) return Error{path + ": image data too short"};
+  if (rgb.size() < static_cast<size_t>(width) * static_cast<size_t>(height) * 3)
+    return Error{path + ": image data too short"};
   // Start at the last row and step backwards: the PNG's first row is GL's top row.
   const uint8_t* top = rgb.data() + static_cast<size_t>(height - 1) * static_cast<size_t>(width) * 3;
-  if (stbi_write_png(path.c_str(), width, height, 3, top, -width * 3) == 0) return Error{path + ": cannot write the PNG"};
+  if (stbi_write_png(path.c_str(), width, height, 3, top, -width * 3) == 0)
+    return Error{path + ": cannot write the PNG"};
   return {};
 }
 

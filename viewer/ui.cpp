@@ -29,8 +29,9 @@ void clips_panel(App& app, UiState& ui, float* hidden) {
   const float below = kClipControlRows * ImGui::GetFrameHeightWithSpacing();
   if (app.scene.clips.empty()) {
     ImGui::TextDisabled("no clips: drop clip files cooked for this skeleton");
-  } else if (ImGui::BeginListBox("##clips", ImVec2(-1.0f, fill_list_height(static_cast<float>(app.scene.clips.size()) + 0.5f,
-                                                                            below, hidden)))) {
+  } else if (ImGui::BeginListBox(
+                 "##clips",
+                 ImVec2(-1.0f, fill_list_height(static_cast<float>(app.scene.clips.size()) + 0.5f, below, hidden)))) {
     for (size_t i = 0; i < app.scene.clips.size(); ++i) {
       const SceneClip& c = app.scene.clips[i];
       ImGui::PushID(static_cast<int>(i));
@@ -61,8 +62,9 @@ void retarget_panel(App& app, UiState& ui, float aspect, float* hidden) {
   if (!v.map_file.empty()) ImGui::TextWrapped("map: %s", std::filesystem::path(v.map_file).filename().string().c_str());
   const Playback& p = v.animator.playback;
   const float below = 3.0f * ImGui::GetFrameHeightWithSpacing();  // the line, the toggles and the button under it
-  if (ImGui::BeginListBox("##retarget-clips",
-                          ImVec2(-1.0f, fill_list_height(static_cast<float>(v.source.clips.size()) + 0.5f, below, hidden)))) {
+  if (ImGui::BeginListBox(
+          "##retarget-clips",
+          ImVec2(-1.0f, fill_list_height(static_cast<float>(v.source.clips.size()) + 0.5f, below, hidden)))) {
     for (size_t i = 0; i < v.source.clips.size(); ++i) {
       ImGui::PushID(static_cast<int>(i));
       if (ImGui::Selectable(v.source.clips[i].label.c_str(), p.clip == static_cast<int>(i))) {
@@ -164,7 +166,8 @@ void graph_parameters(GraphDriver& g, UiState& ui) {
     float v = first.value(p);
     switch (d.parameter_type(i)) {
       case fb::ParameterType::Float: {
-        const bool changed = bounded ? ImGui::SliderFloat(label.c_str(), &v, lo, hi) : ImGui::DragFloat(label.c_str(), &v, 0.01f);
+        const bool changed =
+            bounded ? ImGui::SliderFloat(label.c_str(), &v, lo, hi) : ImGui::DragFloat(label.c_str(), &v, 0.01f);
         if (changed) {
           set_graph_value(g, p, v);
           if (label == "speed") ui.graph_slider_touched = true;
@@ -213,8 +216,11 @@ void graph_status(const GraphDriver& g) {
   const GraphInstance& first = g.instances.front();
   for (size_t m = 0; m < d.machine_count(); ++m) {
     const MachineStatus st = first.machine_status(m);
-    const auto state = [&](int s) { return s >= 0 ? std::string(d.state_name(m, static_cast<size_t>(s))) : std::string("-"); };
-    ImGui::Text("%.*s: %s", static_cast<int>(d.machine_name(m).size()), d.machine_name(m).data(), state(st.current).c_str());
+    const auto state = [&](int s) {
+      return s >= 0 ? std::string(d.state_name(m, static_cast<size_t>(s))) : std::string("-");
+    };
+    ImGui::Text("%.*s: %s", static_cast<int>(d.machine_name(m).size()), d.machine_name(m).data(),
+                state(st.current).c_str());
     if (st.previous >= 0) {
       ImGui::Text("  from %s  %.2f / %.2f s", state(st.previous).c_str(), st.elapsed, st.duration);
       ImGui::ProgressBar(st.weight, ImVec2(-1.0f, 0.0f), "transition weight");
@@ -227,8 +233,8 @@ void graph_status(const GraphDriver& g) {
     if (w <= 0.0f) continue;
     const fb::Node& node = *d.graph().nodes()->Get(static_cast<flatbuffers::uoffset_t>(n));
     char overlay[96];
-    std::snprintf(overlay, sizeof overlay, "%s (%s) %.2f", node.name() && node.name()->size() ? node.name()->c_str() : "-",
-                  node_kind(node), w);
+    std::snprintf(overlay, sizeof overlay, "%s (%s) %.2f",
+                  node.name() && node.name()->size() ? node.name()->c_str() : "-", node_kind(node), w);
     ImGui::ProgressBar(w, ImVec2(-1.0f, 0.0f), overlay);
   }
   ImGui::TextDisabled("events");
@@ -266,7 +272,9 @@ void procedural_panel(App& app) {
     const glm::vec3 v = first.vector(h.parameter);
     const bool reached = !h.pole && h.node >= 0 && first.reached(static_cast<size_t>(h.node));
     ImGui::Text("%s %s (%.1f %.1f %.1f)%s", h.pole ? "pole" : "target", h.name.c_str(), v.x, v.y, v.z,
-                h.pole ? "" : reached ? "  reached" : "  not reached");
+                h.pole    ? ""
+                : reached ? "  reached"
+                          : "  not reached");
   }
   if (!info.targets.empty()) {
     ImGui::PushStyleColor(ImGuiCol_Text, ImGui::GetStyleColorVec4(ImGuiCol_TextDisabled));
@@ -333,7 +341,8 @@ void stats_panel(const App& app, const UiState& ui) {
   const FrameTimings& t = ui.smoothed;
   ImGui::Text("frame %.2f ms (%.0f fps)", ui.frame_ms, ui.frame_ms > 0 ? 1000.0 / ui.frame_ms : 0.0);
   ImGui::Text("sample %.3f  blend %.3f  skin %.3f ms", t.sample_ms, t.blend_ms, t.skin_ms);
-  if (app.animator.graph && app.animator.use_graph) ImGui::Text("graph update %.3f ms (sampling and blending)", t.graph_ms);
+  if (app.animator.graph && app.animator.use_graph)
+    ImGui::Text("graph update %.3f ms (sampling and blending)", t.graph_ms);
   ImGui::Text("draw %.3f ms (CPU)   GPU %.3f ms", t.draw_ms, t.gpu_ms);
 }
 
@@ -342,8 +351,9 @@ void open_panel(UiState& ui) {
   ImGui::SameLine();
   if (ImGui::Button("Open") && ui.open_path[0] != '\0') request_paths(ui.work, {ui.open_path});
   ImGui::PushStyleColor(ImGuiCol_Text, ImGui::GetStyleColorVec4(ImGuiCol_TextDisabled));
-  ImGui::TextWrapped("a character replaces the scene; clip files add clips; sources (FBX, glTF, ...) are cooked first "
-                     "(or drop files here)");
+  ImGui::TextWrapped(
+      "a character replaces the scene; clip files add clips; sources (FBX, glTF, ...) are cooked first "
+      "(or drop files here)");
   ImGui::PopStyleColor();
 }
 
@@ -367,8 +377,8 @@ void loading_indicator(const UiState& ui, const SceneLayout& layout) {
   const ImVec2 size = ImGui::CalcTextSize(text->c_str());
   const float w = size.x + 2.0f * radius + 30.0f * s, h = std::max(size.y, 2.0f * radius) + 20.0f * s;
   const ImVec2 c(layout.scene.x + 0.5f * layout.scene.width, layout.scene.y + 0.5f * layout.scene.height);
-  dl->AddRectFilled(ImVec2(c.x - 0.5f * w, c.y - 0.5f * h), ImVec2(c.x + 0.5f * w, c.y + 0.5f * h), IM_COL32(20, 22, 26, 230),
-                    6.0f * s);
+  dl->AddRectFilled(ImVec2(c.x - 0.5f * w, c.y - 0.5f * h), ImVec2(c.x + 0.5f * w, c.y + 0.5f * h),
+                    IM_COL32(20, 22, 26, 230), 6.0f * s);
   spinner(dl, ImVec2(c.x - 0.5f * w + 10.0f * s + radius, c.y), radius, IM_COL32(120, 170, 240, 255));
   dl->AddText(ImVec2(c.x - 0.5f * w + 20.0f * s + 2.0f * radius, c.y - 0.5f * size.y), IM_COL32(235, 235, 235, 255),
               text->c_str());
@@ -389,9 +399,17 @@ struct Section {
 /// The labels drawn right of the panel's widgets: the fixed ones, the graph's parameters and the
 /// morph channels, whose widest decides how much room every widget leaves (panel_fit.h label_room).
 std::vector<std::string> panel_labels(const App& app) {
-  std::vector<std::string> labels = {"time",        "speed",       "cross-fade",         "crowd",
-                                     "wind m/s",    "stiffness",   "ground tilt",        "ground height left",
-                                     "ground height right", "move m/s", "turn deg/s"};
+  std::vector<std::string> labels = {"time",
+                                     "speed",
+                                     "cross-fade",
+                                     "crowd",
+                                     "wind m/s",
+                                     "stiffness",
+                                     "ground tilt",
+                                     "ground height left",
+                                     "ground height right",
+                                     "move m/s",
+                                     "turn deg/s"};
   if (app.animator.graph && app.animator.graph->definition) {
     const GraphDefinition& d = *app.animator.graph->definition;
     for (size_t i = 0; i < d.parameter_count(); ++i) labels.emplace_back(d.parameter_name(i));
@@ -455,19 +473,22 @@ void draw_panels(App& app, UiState& ui, const SceneLayout& layout) {
   ui.graph_slider_touched = false;
   if (!ui.panel_open) {
     ImGui::SetNextWindowPos(ImVec2(6.0f * ui.ui_scale, 6.0f * ui.ui_scale));
-    ImGui::Begin("##show-panel", nullptr, ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_AlwaysAutoResize |
-                                              ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoMove);
+    ImGui::Begin("##show-panel", nullptr,
+                 ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoSavedSettings |
+                     ImGuiWindowFlags_NoMove);
     if (ImGui::Button(">> panel (Tab)")) ui.panel_open = true;
     ImGui::End();
   } else {
     ImGui::SetNextWindowPos(ImVec2(0.0f, 0.0f));
     ImGui::SetNextWindowSize(ImVec2(panel_width(ui), io.DisplaySize.y));
     const std::string title =
-        (app.scene.paths.empty() ? std::string("ossa-view") : std::filesystem::path(app.scene.paths.front()).filename().string()) +
+        (app.scene.paths.empty() ? std::string("ossa-view")
+                                 : std::filesystem::path(app.scene.paths.front()).filename().string()) +
         "###ossa";
     ImGui::Begin(title.c_str(), nullptr,
-                 ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse | ImGuiWindowFlags_NoSavedSettings |
-                     ImGuiWindowFlags_NoBringToFrontOnFocus | ImGuiWindowFlags_NoScrollbar | ImGuiWindowFlags_NoScrollWithMouse);
+                 ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse |
+                     ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoBringToFrontOnFocus |
+                     ImGuiWindowFlags_NoScrollbar | ImGuiWindowFlags_NoScrollWithMouse);
     ui.audit = PanelAudit{};
     ui.audit.panel = Rect{0.0f, 0.0f, panel_width(ui), io.DisplaySize.y};
     if (ImGui::SmallButton("<< hide panel (Tab)")) ui.panel_open = false;
@@ -476,10 +497,12 @@ void draw_panels(App& app, UiState& ui, const SceneLayout& layout) {
     if (scene) {
       const ImGuiTreeNodeFlags open = ImGuiTreeNodeFlags_DefaultOpen;
       sections.push_back({"Graph", app.animator.graph ? open : 0, [&](float*) { graph_panel(app, ui); }});
-      sections.push_back({"Clips", app.animator.graph ? 0 : open, [&](float* hidden) { clips_panel(app, ui, hidden); }});
+      sections.push_back(
+          {"Clips", app.animator.graph ? 0 : open, [&](float* hidden) { clips_panel(app, ui, hidden); }});
       if (app.retarget)
         sections.push_back({"Retarget", open, [&](float* hidden) { retarget_panel(app, ui, aspect, hidden); }});
-      if (!app.scene.morph_channels.empty()) sections.push_back({"Morph targets", open, [&](float*) { morph_panel(app); }});
+      if (!app.scene.morph_channels.empty())
+        sections.push_back({"Morph targets", open, [&](float*) { morph_panel(app); }});
       sections.push_back({"View", open, [&](float*) { view_panel(app, ui, aspect); }});
       sections.push_back({"Stats", open, [&](float*) { stats_panel(app, ui); }});
     }
@@ -490,7 +513,8 @@ void draw_panels(App& app, UiState& ui, const SceneLayout& layout) {
     // (their height as measured on the previous frame).
     const ImGuiStyle& style = ImGui::GetStyle();
     const float footer = ui.footer_height > 0.0f ? ui.footer_height : 3.0f * ImGui::GetTextLineHeightWithSpacing();
-    const float column = std::max(ImGui::GetContentRegionAvail().y - footer - style.ItemSpacing.y, ImGui::GetFrameHeight());
+    const float column =
+        std::max(ImGui::GetContentRegionAvail().y - footer - style.ItemSpacing.y, ImGui::GetFrameHeight());
     draw_sections(ui, sections, std::floor(column), label_room(panel_labels(app), 0.45f * panel_width(ui)));
     const float footer_top = ImGui::GetCursorPosY();
     if (const auto busy_text = indicator_text(ui.work)) ImGui::TextDisabled("%s", busy_text->c_str());
@@ -512,7 +536,9 @@ void draw_panels(App& app, UiState& ui, const SceneLayout& layout) {
   }
   if (!app.scene.assets.empty()) timeline_panel(app, ui.timeline, layout.timeline, ui.ui_scale);
   if (app.scene.assets.empty() && !indicator_text(ui.work)) {  // an empty window says what to do
-    const char* hint = "drop an .ossa file here, or a source to cook\n(FBX, glTF, GLB, DAE, BVH, OBJ),\nor pick one in the panel's Files";
+    const char* hint =
+        "drop an .ossa file here, or a source to cook\n(FBX, glTF, GLB, DAE, BVH, OBJ),\nor pick one in the panel's "
+        "Files";
     const ImVec2 size = ImGui::CalcTextSize(hint);
     ImGui::GetForegroundDrawList()->AddText(ImVec2(layout.scene.x + 0.5f * (layout.scene.width - size.x),
                                                    layout.scene.y + 0.5f * (layout.scene.height - size.y)),

@@ -37,7 +37,8 @@ Window::~Window() {
 
 Result<Window> create_window(const WindowOptions& options) {
   glfwSetErrorCallback(on_glfw_error);
-  if (glfwInit() != GLFW_TRUE) return glfw_failure("cannot initialize GLFW (is there a display? set DISPLAY or run under xvfb-run)");
+  if (glfwInit() != GLFW_TRUE)
+    return glfw_failure("cannot initialize GLFW (is there a display? set DISPLAY or run under xvfb-run)");
   glfwDefaultWindowHints();
   glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
   glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);

@@ -173,9 +173,7 @@ struct OssaSide {
     ossa::local_to_model(skeleton.parents(), frame_blended, frame_model);
     ossa::skinning_matrices(mesh.joints(), bind, frame_model, palette);
   }
-  void skin(const ossa::SkinnedStreams& out) {
-    ossa::skin_cpu(mesh, skin_palette, ossa::SkinningMethod::Linear, out);
-  }
+  void skin(const ossa::SkinnedStreams& out) { ossa::skin_cpu(mesh, skin_palette, ossa::SkinningMethod::Linear, out); }
 };
 
 template <class F>
@@ -282,8 +280,10 @@ int main(int argc, char** argv) {
     }
   }
 
-  std::printf("# %d rounds; ns per call: median (min); ratios of medians per joint or vertex; "
-              "target: ossa <= 0.75x the faster ozz build\n", rounds);
+  std::printf(
+      "# %d rounds; ns per call: median (min); ratios of medians per joint or vertex; "
+      "target: ossa <= 0.75x the faster ozz build\n",
+      rounds);
   std::printf("%-17s %-8s %17s %17s %17s %9s %9s %9s  %s\n", "workload", "unit", "ossa", "ozz -O3", "ozz avx2",
               "ossa/O3", "ossa/avx2", "ossa/best", "target");
   for (size_t r = 0; r < kRows; ++r) {
@@ -303,10 +303,8 @@ int main(int argc, char** argv) {
     }
     const double best = side_count == 3 ? std::min(per_unit[1], per_unit[2]) : per_unit[1];
     std::printf(" %9.2f", per_unit[0] / per_unit[1]);
-    if (side_count == 3)
-      std::printf(" %9.2f", per_unit[0] / per_unit[2]);
-    else
-      std::printf(" %9s", "-");
+    if (side_count == 3) std::printf(" %9.2f", per_unit[0] / per_unit[2]);
+    else std::printf(" %9s", "-");
     std::printf(" %9.2f  %s\n", per_unit[0] / best,
                 rows[r].target ? (per_unit[0] / best <= 0.75 ? "met" : "NOT MET") : "-");
   }

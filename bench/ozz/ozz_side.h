@@ -13,13 +13,13 @@ namespace ossa::bench {
 
 /// The workloads, in the order bench_vs_ozz prints them.
 enum AnchorWorkload : uint32_t {
-  kSampleForward,   // walk, forward 60 Hz playback through one sampling context / cache
-  kSampleSeek,      // walk, a random time per call (seek_fraction)
-  kBlend3,          // three perturbed rest poses, weights 0.5 / 0.3 / 0.2
-  kLocalToModel,    // a perturbed rest pose to model space
-  kFrame,           // walk, jog, run at the walk's 60 Hz phase + blend (0.2, 0.5, 0.3) + model + palette
-  kSkinPositions,   // the arnaud mesh, positions, a palette of rotations nudged from the rest pose
-  kSkinNormals,     // the same, positions and normals
+  kSampleForward,  // walk, forward 60 Hz playback through one sampling context / cache
+  kSampleSeek,     // walk, a random time per call (seek_fraction)
+  kBlend3,         // three perturbed rest poses, weights 0.5 / 0.3 / 0.2
+  kLocalToModel,   // a perturbed rest pose to model space
+  kFrame,          // walk, jog, run at the walk's 60 Hz phase + blend (0.2, 0.5, 0.3) + model + palette
+  kSkinPositions,  // the arnaud mesh, positions, a palette of rotations nudged from the rest pose
+  kSkinNormals,    // the same, positions and normals
   kAnchorWorkloads
 };
 
@@ -63,7 +63,7 @@ struct AnchorSide {
   uint32_t vertices = 0;  // skinned vertices (all parts)
   uint32_t palette = 0;   // skinning matrices
   AnchorCall run[kAnchorWorkloads];
-  char error[512] = {};   // set when the media could not be loaded
+  char error[512] = {};  // set when the media could not be loaded
 };
 
 /// ozz-animation as built with its default flags (-O3); `media` is its media/bin folder.

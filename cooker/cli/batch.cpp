@@ -27,7 +27,8 @@ namespace fs = std::filesystem;
 
 bool is_source_extension(const fs::path& path) {
   std::string ext = path.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   return ext == ".fbx" || ext == ".gltf" || ext == ".glb" || ext == ".dae" || ext == ".bvh" || ext == ".obj";
 }
 
@@ -87,9 +88,7 @@ Result<std::vector<BatchItem>> plan_batch(const std::vector<fs::path>& inputs, c
   // Model sources of this batch that share a stem in one folder (skeleton.dae beside skeleton.fbx)
   // keep their extension in the output name, so each gets its own: skeleton.dae.ossa, skeleton.fbx.ossa.
   std::map<std::pair<fs::path, std::string>, std::set<fs::path>> by_stem;  // (folder, stem) -> file names
-  const auto folder_of = [](const fs::path& input) {
-    return fs::absolute(input).lexically_normal().parent_path();
-  };
+  const auto folder_of = [](const fs::path& input) { return fs::absolute(input).lexically_normal().parent_path(); };
   for (const auto& entry : files)
     if (!is_graph_file(entry.first))
       by_stem[{folder_of(entry.first), output_stem(entry.first)}].insert(entry.first.filename());
@@ -98,26 +97,25 @@ Result<std::vector<BatchItem>> plan_batch(const std::vector<fs::path>& inputs, c
   std::map<fs::path, fs::path> claimed;  // output -> first input that maps to it
   std::error_code root_ec;
   if (!root.empty() && !fs::is_directory(root, root_ec))
-    return Error{"--root " + root.string() + ": " + (fs::exists(root, root_ec) ? "is not a directory" : "does not exist")};
+    return Error{"--root " + root.string() + ": " +
+                 (fs::exists(root, root_ec) ? "is not a directory" : "does not exist")};
   const fs::path abs_root = root.empty() ? fs::path() : fs::weakly_canonical(fs::absolute(root));
   for (const auto& [input, tree] : files) {
     fs::path sub;
     if (!root.empty()) {
       const fs::path abs_in = fs::weakly_canonical(fs::absolute(input));
       const fs::path rel = abs_in.lexically_relative(abs_root);
-      if (rel.empty() || *rel.begin() == "..")
-        return Error{input.string() + ": is not inside --root " + root.string()};
+      if (rel.empty() || *rel.begin() == "..") return Error{input.string() + ": is not inside --root " + root.string()};
       sub = rel.parent_path();
     }
-    const bool shared_stem =
-        !is_graph_file(input) && by_stem[{folder_of(input), output_stem(input)}].size() > 1;
+    const bool shared_stem = !is_graph_file(input) && by_stem[{folder_of(input), output_stem(input)}].size() > 1;
     const std::string name = shared_stem ? input.filename().string() : output_stem(input);
     fs::path output = (out_dir / sub / name).concat(".ossa").lexically_normal();
     auto [it, inserted] = claimed.emplace(output, input);
     if (!inserted)
-      return Error{"inputs " + it->second.string() + " and " + input.string() + " would both write " +
-                   output.string() +
-                   (root.empty() ? " (use --root to mirror the source tree)" : " (cook them into separate output directories)")};
+      return Error{
+          "inputs " + it->second.string() + " and " + input.string() + " would both write " + output.string() +
+          (root.empty() ? " (use --root to mirror the source tree)" : " (cook them into separate output directories)")};
     items.push_back({input, output, tree, {}});
   }
   return items;
@@ -144,7 +142,8 @@ std::optional<uint64_t> parse_size(const std::string& text) {
   const auto [unit_at, ec] = std::from_chars(text.data(), end, value, std::chars_format::fixed);
   if (ec != std::errc() || !(value >= 0.0)) return std::nullopt;
   std::string unit(unit_at, end);
-  std::transform(unit.begin(), unit.end(), unit.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  std::transform(unit.begin(), unit.end(), unit.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   double scale = 1.0;
   if (!unit.empty() && unit != "b") {
     const size_t power = std::string_view("kmgt").find(unit[0]);
@@ -314,7 +313,9 @@ struct is_optional : std::false_type {};
 template <class T>
 struct is_optional<std::optional<T>> : std::true_type {};
 
-double ratio(uint64_t raw, uint64_t stored) { return stored > 0 ? static_cast<double>(raw) / static_cast<double>(stored) : 0.0; }
+double ratio(uint64_t raw, uint64_t stored) {
+  return stored > 0 ? static_cast<double>(raw) / static_cast<double>(stored) : 0.0;
+}
 
 /// A clip's compression: its fields, with raw / cooked as "ratio" after the sizes.
 nlohmann::ordered_json clip_json(const ClipRecord& c) {
@@ -400,8 +401,7 @@ nlohmann::ordered_json retarget_json(const RetargetRecord& t) {
 }
 
 template <class Record>
-nlohmann::ordered_json json_list(const std::vector<Record>& records,
-                                 nlohmann::ordered_json (*one)(const Record&)) {
+nlohmann::ordered_json json_list(const std::vector<Record>& records, nlohmann::ordered_json (*one)(const Record&)) {
   nlohmann::ordered_json list = nlohmann::ordered_json::array();
   for (const Record& r : records) list.push_back(one(r));
   return list;

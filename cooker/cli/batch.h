@@ -57,8 +57,7 @@ std::string output_stem(const std::filesystem::path& input);
 /// input outside `root`, or two inputs mapping to one output (both named). Missing inputs are not
 /// errors here: they fail at cook time as their own record. O(inputs log inputs).
 Result<std::vector<BatchItem>> plan_batch(const std::vector<std::filesystem::path>& inputs,
-                                          const std::filesystem::path& out_dir,
-                                          const std::filesystem::path& root);
+                                          const std::filesystem::path& out_dir, const std::filesystem::path& root);
 
 /// What one input may take (--max-memory, --timeout). Not part of CookOptions: limits do not change
 /// the bytes of an output that cooks, so they stay out of options.canonical() and provenance.
@@ -117,9 +116,9 @@ struct CacheTotals {
 };
 CacheTotals cache_totals(const std::vector<CookRecord>& records);
 
-/// The --report document (every string made valid UTF-8: invalid bytes read as Latin-1): schema name and version, cooker version, options, the limits each input
-/// ran under, totals and one record per input. A failed record carries its error and the counts
-/// known before the failure, and no "output" or "cooked_bytes": nothing was written for it.
+/// The --report document (every string made valid UTF-8: invalid bytes read as Latin-1): schema name and version,
+/// cooker version, options, the limits each input ran under, totals and one record per input. A failed record carries
+/// its error and the counts known before the failure, and no "output" or "cooked_bytes": nothing was written for it.
 nlohmann::ordered_json report_json(const std::vector<CookRecord>& records, const CookOptions& options,
                                    const BatchLimits& limits);
 

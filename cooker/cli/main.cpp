@@ -4,7 +4,8 @@
 //   ossa-cook INPUT... -o OUTDIR [--root DIR] [--jobs N] [--max-memory SIZE] [--timeout SECONDS]
 //             [--report FILE.json] [--skeleton REF.ossa] [--retarget-to TARGET.ossa [--map MAP.json]]
 //             [--float-vertices] [--clip-tolerance MM]
-//             [--no-clip-compression] [--root-motion] [--up-axis x|y|z] [--metres-per-unit M] [--force] [--depfile FILE]
+//             [--no-clip-compression] [--root-motion] [--up-axis x|y|z] [--metres-per-unit M] [--force] [--depfile
+//             FILE]
 //             [--list-inputs] [--cache DIR|URL [--cache-mode read|readwrite|off] [--cache-timeout S]]
 //             [-q | -v] [--version] [--help]
 //
@@ -28,7 +29,8 @@
 // warnings (stderr) and a table of what was cooked (stdout). -v adds the options in effect, every
 // input's warnings, time and sizes, one line per clip (frames, error, ratio) and the total time.
 // Warnings are not printed one by one by default: importing the samples alone gives dozens of
-// lines (dropped cameras, matched joint names) that would bury the failures. The --report document is docs/schemas/ossa-cook-report.schema.json (docs/JSON.md).
+// lines (dropped cameras, matched joint names) that would bury the failures. The --report document is
+// docs/schemas/ossa-cook-report.schema.json (docs/JSON.md).
 #include <signal.h>
 #include <sys/ioctl.h>
 #include <unistd.h>
@@ -90,7 +92,8 @@ std::string progress_head(size_t done, size_t total, size_t failed, double elaps
   std::string s = "[" + std::to_string(done) + "/" + std::to_string(total);
   if (failed > 0) s += ", " + std::to_string(failed) + " failed";
   if (done > 0 && done < total) {
-    const auto left = static_cast<long long>(elapsed / static_cast<double>(done) * static_cast<double>(total - done) + 0.5);
+    const auto left =
+        static_cast<long long>(elapsed / static_cast<double>(done) * static_cast<double>(total - done) + 0.5);
     char eta[32];
     std::snprintf(eta, sizeof eta, ", ETA %lld:%02lld", left / 60, left % 60);
     s += eta;
@@ -122,13 +125,16 @@ void print_summary(const std::vector<CookRecord>& records) {
     std::printf("%-*s %7u %7u %9u %6u %12s %12s  %s\n", width, shown(r.output).c_str(), r.joints.value_or(0),
                 r.meshes.value_or(0), r.vertices.value_or(0), r.clips.value_or(0), human_bytes(r.source_bytes).c_str(),
                 human_bytes(r.cooked_bytes).c_str(),
-                r.up_to_date ? "up to date" : r.cache_hit ? "cache_hit" : "cooked");
+                r.up_to_date  ? "up to date"
+                : r.cache_hit ? "cache_hit"
+                              : "cooked");
   }
 }
 
 /// -v: what one input took and what compression achieved on each of its clips.
 void print_details(const CookRecord& r) {
-  std::fprintf(stderr, "  %s: %.1f ms, source %s", shown(r.input).c_str(), r.seconds * 1e3, human_bytes(r.source_bytes).c_str());
+  std::fprintf(stderr, "  %s: %.1f ms, source %s", shown(r.input).c_str(), r.seconds * 1e3,
+               human_bytes(r.source_bytes).c_str());
   if (r.ok) std::fprintf(stderr, ", cooked %s", human_bytes(r.cooked_bytes).c_str());
   std::fprintf(stderr, "\n");
   for (const MorphRecord& m : r.morph_records)
@@ -137,10 +143,10 @@ void print_details(const CookRecord& r) {
                  "%u -> %u bytes (%.1f:1)\n",
                  shown(m.name).c_str(), shown(m.mesh).c_str(), m.vertices, static_cast<double>(m.position_error_mm),
                  static_cast<double>(m.position_bound_mm), static_cast<double>(m.normal_error_deg), m.raw_bytes,
-                 m.stored_bytes,
-                 m.stored_bytes > 0 ? static_cast<double>(m.raw_bytes) / m.stored_bytes : 0.0);
+                 m.stored_bytes, m.stored_bytes > 0 ? static_cast<double>(m.raw_bytes) / m.stored_bytes : 0.0);
   for (const TextureRecord& t : r.texture_records) {
-    std::fprintf(stderr, "    texture '%s' (%s): %u x %u, %s%s, %u mips, %s -> %s (decoded RGBA8 + mips: %s), PSNR %.1f dB",
+    std::fprintf(stderr,
+                 "    texture '%s' (%s): %u x %u, %s%s, %u mips, %s -> %s (decoded RGBA8 + mips: %s), PSNR %.1f dB",
                  shown(t.name).c_str(), t.role.c_str(), t.width, t.height, t.encoding.c_str(), t.srgb ? " sRGB" : "",
                  t.mips, human_bytes(t.source_bytes).c_str(), human_bytes(t.cooked_bytes).c_str(),
                  human_bytes(t.gpu_rgba8_bytes).c_str(), static_cast<double>(t.psnr_db));
@@ -150,24 +156,29 @@ void print_details(const CookRecord& r) {
     std::fprintf(stderr, "\n");
   }
   for (const RetargetRecord& t : r.retarget_records) {
-    std::fprintf(stderr, "    retarget '%s': %u frames, hips ratio %.3f, limbs within %.2f deg, hands %.2f, feet %.2f, "
-                         "%u frames crossing, %u guarded (limbs %.2f deg), %zu contacts", shown(t.clip).c_str(), t.frames,
-                 static_cast<double>(t.hips_ratio), static_cast<double>(t.limb_max_deg), static_cast<double>(t.hand_max_deg),
+    std::fprintf(stderr,
+                 "    retarget '%s': %u frames, hips ratio %.3f, limbs within %.2f deg, hands %.2f, feet %.2f, "
+                 "%u frames crossing, %u guarded (limbs %.2f deg), %zu contacts",
+                 shown(t.clip).c_str(), t.frames, static_cast<double>(t.hips_ratio),
+                 static_cast<double>(t.limb_max_deg), static_cast<double>(t.hand_max_deg),
                  static_cast<double>(t.foot_max_deg), t.crossing_frames, t.guarded_frames,
                  static_cast<double>(t.guard_max_deg), t.contacts.size());
     float held = 0.0f, slide = 0.0f, source = 0.0f;
     for (const RetargetContactRecord& c : t.contacts)
-      held = std::max(held, c.held_mm), slide = std::max(slide, c.slide_mm), source = std::max(source, c.source_slide_mm);
+      held = std::max(held, c.held_mm), slide = std::max(slide, c.slide_mm),
+      source = std::max(source, c.source_slide_mm);
     if (!t.contacts.empty())
-      std::fprintf(stderr, " (held within %.2f mm; feet slide up to %.2f mm, the source's %.2f mm)", static_cast<double>(held),
-                   static_cast<double>(slide), static_cast<double>(source));
+      std::fprintf(stderr, " (held within %.2f mm; feet slide up to %.2f mm, the source's %.2f mm)",
+                   static_cast<double>(held), static_cast<double>(slide), static_cast<double>(source));
     std::fprintf(stderr, "\n");
   }
   for (const ClipRecord& c : r.clip_records)
-    std::fprintf(stderr, "    clip '%s': %u frames, %u joints, max error %.4f mm (mean %.4f mm, at '%s'), %u -> %u bytes (%.1f:1)\n",
-                 shown(c.name).c_str(), c.frames, c.joints, static_cast<double>(c.max_error_mm),
-                 static_cast<double>(c.mean_error_mm), shown(c.worst_joint).c_str(), c.raw_bytes, c.cooked_bytes,
-                 c.cooked_bytes > 0 ? static_cast<double>(c.raw_bytes) / c.cooked_bytes : 0.0);
+    std::fprintf(
+        stderr,
+        "    clip '%s': %u frames, %u joints, max error %.4f mm (mean %.4f mm, at '%s'), %u -> %u bytes (%.1f:1)\n",
+        shown(c.name).c_str(), c.frames, c.joints, static_cast<double>(c.max_error_mm),
+        static_cast<double>(c.mean_error_mm), shown(c.worst_joint).c_str(), c.raw_bytes, c.cooked_bytes,
+        c.cooked_bytes > 0 ? static_cast<double>(c.raw_bytes) / c.cooked_bytes : 0.0);
 }
 
 }  // namespace
@@ -211,10 +222,11 @@ int main(int argc, char** argv) {
                "bytes may lie outside the folders a cook may read)");
   app.add_option("-j,--jobs", jobs, "cook this many files in parallel, each in a worker process of its own")
       ->check(CLI::Range(1u, 256u));
-  CLI::Option* max_memory_option = app.add_option("--max-memory", max_memory_text,
-                 "address space one input may use, e.g. 512M, 4G, 1.5GiB or bytes (K/M/G/T are powers of 1024; "
-                 "0: no limit); past it the input fails alone (default: 0.8 x physical memory, or the cgroup's "
-                 "limit if lower, / the number of workers (--jobs, or the inputs if fewer), at least 1 GiB)");
+  CLI::Option* max_memory_option =
+      app.add_option("--max-memory", max_memory_text,
+                     "address space one input may use, e.g. 512M, 4G, 1.5GiB or bytes (K/M/G/T are powers of 1024; "
+                     "0: no limit); past it the input fails alone (default: 0.8 x physical memory, or the cgroup's "
+                     "limit if lower, / the number of workers (--jobs, or the inputs if fewer), at least 1 GiB)");
   app.add_option("--timeout", timeout_seconds,
                  "seconds one input may take; past it its worker is killed and the input fails alone "
                  "(default 600; 0: no limit)");
@@ -241,7 +253,8 @@ int main(int argc, char** argv) {
   app.add_flag("--root-motion", root_motion, "extract root translation and yaw from clips into a root-motion track");
   app.add_option("--up-axis", up_axis,
                  "the sources' up axis, over what each file states (FBX UpAxis, Collada <up_axis>) or its format's "
-                 "convention (SMD: z); every output is Y-up")->check(CLI::IsMember({"x", "y", "z"}));
+                 "convention (SMD: z); every output is Y-up")
+      ->check(CLI::IsMember({"x", "y", "z"}));
   app.add_option("--metres-per-unit", metres_per_unit,
                  "length of one source unit in metres, for sources that state none (BVH: 1 assumed) or state it "
                  "wrongly; clips cooked with --skeleton are converted into the rig's unit")
@@ -331,7 +344,8 @@ int main(int argc, char** argv) {
   SourceSkeleton retarget_target;
   ossa::tools::HumanoidMapFile map_file;
   if (!map_path.empty() && retarget_path.empty())
-    return command.usage_error("--map is read with --retarget-to (ossa-inspect --humanoid --map shows a rig's mapping)");
+    return command.usage_error(
+        "--map is read with --retarget-to (ossa-inspect --humanoid --map shows a rig's mapping)");
   if (!retarget_path.empty()) {
     auto loaded = load_reference_skeleton(retarget_path, &options.retarget_input);
     if (!loaded) {
@@ -368,8 +382,8 @@ int main(int argc, char** argv) {
   BatchLimits limits;
   limits.timeout_seconds = timeout_seconds;
   // The default share is of the workers that will run: no more than there are inputs.
-  limits.max_memory_bytes = max_memory ? *max_memory
-                                       : default_max_memory(static_cast<unsigned>(std::min<size_t>(jobs, plan->size())));
+  limits.max_memory_bytes =
+      max_memory ? *max_memory : default_max_memory(static_cast<unsigned>(std::min<size_t>(jobs, plan->size())));
   if (verbose)
     std::fprintf(stderr, "ossa-cook: %zu inputs, %u jobs, options %s, limits per input: memory %s%s, time %s\n",
                  plan->size(), jobs, options.canonical().c_str(),
@@ -394,11 +408,11 @@ int main(int argc, char** argv) {
       if (tty)  // one line rewritten in place: it must not wrap, so a long path keeps its tail
         std::fprintf(stderr, "\r\033[K%s %s%s", head.c_str(),
                      fit(shown(r.input), terminal_columns() - head.size() - std::strlen(what) - 2).c_str(), what);
-      else
-        std::fprintf(stderr, "%s %s -> %s%s\n", head.c_str(), shown(r.input).c_str(), shown(r.output).c_str(), what);
+      else std::fprintf(stderr, "%s %s -> %s%s\n", head.c_str(), shown(r.input).c_str(), shown(r.output).c_str(), what);
     }
     if (verbose) {
-      for (const std::string& w : r.warnings) std::fprintf(stderr, "warning: %s: %s\n", shown(r.input).c_str(), shown(w).c_str());
+      for (const std::string& w : r.warnings)
+        std::fprintf(stderr, "warning: %s: %s\n", shown(r.input).c_str(), shown(w).c_str());
       print_details(r);
     }
     if (tty && done == total && !quiet) std::fprintf(stderr, "\n");

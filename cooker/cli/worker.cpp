@@ -55,9 +55,9 @@ struct is_optional<std::optional<T>> : std::true_type {};
 
 /// Records that have a field list (and are sent as objects), as opposed to plain values.
 template <class T>
-constexpr bool kIsRecord = std::is_same_v<T, ClipRecord> || std::is_same_v<T, TextureRecord> ||
-                           std::is_same_v<T, MorphRecord> || std::is_same_v<T, InputFile> ||
-                           std::is_same_v<T, RetargetRecord> || std::is_same_v<T, RetargetContactRecord>;
+constexpr bool kIsRecord =
+    std::is_same_v<T, ClipRecord> || std::is_same_v<T, TextureRecord> || std::is_same_v<T, MorphRecord> ||
+    std::is_same_v<T, InputFile> || std::is_same_v<T, RetargetRecord> || std::is_same_v<T, RetargetContactRecord>;
 
 template <class T>
 struct record_vector : std::false_type {};
@@ -313,8 +313,7 @@ void remove_leftovers(const fs::path& output, const Worker& w) {
     fs::remove(it->path(), ignored);
   }
   struct stat st {};
-  if (::stat(output.c_str(), &st) == 0 &&
-      (!w.had_output || st.st_dev != w.output_dev || st.st_ino != w.output_ino))
+  if (::stat(output.c_str(), &st) == 0 && (!w.had_output || st.st_dev != w.output_dev || st.st_ino != w.output_ino))
     ::unlink(output.c_str());
 }
 

@@ -232,12 +232,12 @@ void compensated_target(const SourceSkeleton& skeleton, const ClipSamples& ref, 
       const glm::dvec3 origin = pr.linear * glm::dvec3(src[f]) + pr.origin;
       out[f] = glm::vec4(glm::vec3(inv * (origin - pd.origin)), 0.0f);
     } else {
-      const glm::dquat q = rotation_of(inv * pr.linear) *
-                           glm::dquat(static_cast<double>(src[f].w), static_cast<double>(src[f].x),
-                                      static_cast<double>(src[f].y), static_cast<double>(src[f].z));
+      const glm::dquat q =
+          rotation_of(inv * pr.linear) * glm::dquat(static_cast<double>(src[f].w), static_cast<double>(src[f].x),
+                                                    static_cast<double>(src[f].y), static_cast<double>(src[f].z));
       const glm::dquat n = glm::normalize(q);
-      out[f] = glm::vec4(static_cast<float>(n.x), static_cast<float>(n.y), static_cast<float>(n.z),
-                         static_cast<float>(n.w));
+      out[f] =
+          glm::vec4(static_cast<float>(n.x), static_cast<float>(n.y), static_cast<float>(n.z), static_cast<float>(n.w));
     }
     if (!std::isfinite(out[f].x + out[f].y + out[f].z + out[f].w)) out[f] = src[f];
   }
@@ -328,9 +328,9 @@ Status pack(const ClipLayout& layout, uint32_t joints, uint32_t frames, Compress
     return Error{"clip '" + out.name + "': compressed keys exceed 4 Gbit"};
   }
   out.key_values = writer.finish();
-  out.cooked_bytes = static_cast<uint32_t>(
-      out.constants.size() * sizeof(fb::ConstantChannel) + out.animated.size() * sizeof(fb::AnimatedChannel) +
-      out.key_frames.size() * sizeof(uint16_t) + out.key_values.size());
+  out.cooked_bytes = static_cast<uint32_t>(out.constants.size() * sizeof(fb::ConstantChannel) +
+                                           out.animated.size() * sizeof(fb::AnimatedChannel) +
+                                           out.key_frames.size() * sizeof(uint16_t) + out.key_values.size());
   return {};
 }
 
@@ -344,7 +344,8 @@ Result<CompressedClip> compress_clip(const SourceClip& clip, const SourceSkeleto
   if (!(std::isfinite(clip.duration) && clip.duration >= 0.0f)) return Error{label + "duration is not a finite time"};
   if (!(std::isfinite(clip.sample_rate) && clip.sample_rate >= 0.0f)) return Error{label + "sample rate is invalid"};
   const double frames_wanted = std::round(static_cast<double>(clip.duration) *
-                                          (clip.sample_rate > 0.0f ? clip.sample_rate : kDefaultSampleRate)) + 1.0;
+                                          (clip.sample_rate > 0.0f ? clip.sample_rate : kDefaultSampleRate)) +
+                               1.0;
   if (frames_wanted > kMaxFrames) {
     char text[160];
     std::snprintf(text, sizeof text, "%.0f frames at %g frames/s, more than the %u a clip can address", frames_wanted,
@@ -355,8 +356,8 @@ Result<CompressedClip> compress_clip(const SourceClip& clip, const SourceSkeleto
   const auto joints = static_cast<uint32_t>(skeleton.joints.size());
   if (joints > std::numeric_limits<uint16_t>::max()) return Error{label + "more joints than a clip can address"};
   for (const SourceTrack& t : clip.tracks) {
-    if (t.joint >= joints) return Error{label + "a track addresses joint " + std::to_string(t.joint) + " of " +
-                                        std::to_string(joints)};
+    if (t.joint >= joints)
+      return Error{label + "a track addresses joint " + std::to_string(t.joint) + " of " + std::to_string(joints)};
   }
   const uint32_t frames = out.grid.frame_count;
   const uint64_t raw = 10ull * sizeof(float) * joints * frames;
@@ -450,7 +451,8 @@ Result<CompressedClip> compress_clip(const SourceClip& clip, const SourceSkeleto
     std::vector<Affine> at(joints);
     for (uint32_t p = 0; p < ref_positions.frame_count; ++p) {
       model_at_frame(skeleton, ref_positions, p, at);
-      for (uint32_t j = 0; j < joints; ++j) ref_position_models[static_cast<size_t>(j) * ref_positions.frame_count + p] = at[j];
+      for (uint32_t j = 0; j < joints; ++j)
+        ref_position_models[static_cast<size_t>(j) * ref_positions.frame_count + p] = at[j];
     }
   }
   ClipError error;
@@ -498,8 +500,8 @@ Result<CompressedClip> compress_clip(const SourceClip& clip, const SourceSkeleto
     }
     if (Status st = pack(layout, joints, frames, out); !st) return st.error();
     decode_clip(out, skeleton, decoded, kErrorSubdivisions);
-    error = measure_clip_error(skeleton, ref_positions, decoded, probe, ref_position_models.empty() ? nullptr : &ref_position_models,
-                               kErrorSubdivisions);
+    error = measure_clip_error(skeleton, ref_positions, decoded, probe,
+                               ref_position_models.empty() ? nullptr : &ref_position_models, kErrorSubdivisions);
     if (error.max <= tolerance || round > kMaxTightening) break;
 
     // Each joint over the tolerance scales the budget of its whole chain; a channel on several
@@ -555,9 +557,9 @@ Result<CompressedClip> compress_clip(const SourceClip& clip, const SourceSkeleto
       }
       if (Status st = pack(layout, joints, frames, out); !st) return st.error();
       decode_clip(out, skeleton, decoded, kErrorSubdivisions);
-      const ClipError shared = measure_clip_error(skeleton, ref_positions, decoded, probe,
-                                                  ref_position_models.empty() ? nullptr : &ref_position_models,
-                                                  kErrorSubdivisions);
+      const ClipError shared =
+          measure_clip_error(skeleton, ref_positions, decoded, probe,
+                             ref_position_models.empty() ? nullptr : &ref_position_models, kErrorSubdivisions);
       kept = shared.max <= tolerance;
       if (kept) {
         error = shared;

@@ -23,15 +23,15 @@ namespace ossa::cook {
 
 struct CompressedConstant {
   uint16_t joint = 0;
-  uint8_t channel = 0;              // fb::Channel
+  uint8_t channel = 0;  // fb::Channel
   float value[4] = {0, 0, 0, 0};
 };
 
 struct CompressedAnimated {
   uint16_t joint = 0;
   uint8_t channel = 0;
-  uint8_t bits = 0;                 // 1..kMaxQuantBits (19) or 32
-  uint8_t dropped = 3;              // rotations: the component not stored (ossa/format/clip_codec.h)
+  uint8_t bits = 0;     // 1..kMaxQuantBits (19) or 32
+  uint8_t dropped = 3;  // rotations: the component not stored (ossa/format/clip_codec.h)
   uint32_t first_key = 0;
   uint32_t key_count = 0;
   uint32_t bit_offset = 0;
@@ -46,24 +46,24 @@ struct CompressedClip {
   std::vector<CompressedConstant> constants;  // sorted by (joint, channel)
   std::vector<CompressedAnimated> animated;   // sorted by (joint, channel)
   std::vector<uint16_t> key_frames;
-  std::vector<uint8_t> key_values;            // padded (ossa/format/clip_codec.h)
+  std::vector<uint8_t> key_values;  // padded (ossa/format/clip_codec.h)
   // What was measured, in source units.
   float tolerance = 0.0f, probe_distance = 0.0f, max_error = 0.0f, mean_error = 0.0f;
   uint16_t worst_joint = 0;
-  uint32_t raw_bytes = 0;                     // 10 floats * joints * frames
-  uint32_t cooked_bytes = 0;                  // the clip's vectors as stored: constants, animated,
-                                              // key_frames, key_values (padding included); tables'
-                                              // overhead excluded
+  uint32_t raw_bytes = 0;     // 10 floats * joints * frames
+  uint32_t cooked_bytes = 0;  // the clip's vectors as stored: constants, animated,
+                              // key_frames, key_values (padding included); tables'
+                              // overhead excluded
   bool has_root_motion = false;
   SourceRootMotion root_motion;
-  std::vector<SourceEvent> events;            // copied from the source clip
+  std::vector<SourceEvent> events;                  // copied from the source clip
   std::vector<CompressedMorphTrack> morph_weights;  // sorted by name (format v5)
 };
 
 /// Compresses one clip of `skeleton`. metres_per_unit converts the tolerances to source units.
 /// Errors name the clip (e.g. more frames than kMaxFrames). Deterministic.
 /// Cost: O(frames * joints * iterations) for the error verification.
-Result<CompressedClip> compress_clip(const SourceClip& clip, const SourceSkeleton& skeleton,
-                                     float metres_per_unit, const ClipCompressionOptions& options);
+Result<CompressedClip> compress_clip(const SourceClip& clip, const SourceSkeleton& skeleton, float metres_per_unit,
+                                     const ClipCompressionOptions& options);
 
 }  // namespace ossa::cook

@@ -34,7 +34,7 @@ double channel_error(const Metric& m, const glm::vec4& reference, const glm::vec
     const glm::dvec4 r = glm::normalize(glm::dvec4(reference));
     glm::dvec4 d = glm::normalize(glm::dvec4(decoded));
     if (glm::dot(r, d) < 0.0) d = -d;
-    const double chord = glm::length(r - d);  // = 2 sin(angle / 4)
+    const double chord = glm::length(r - d);                                              // = 2 sin(angle / 4)
     return 2.0 * chord * std::sqrt(std::max(0.0, 1.0 - 0.25 * chord * chord)) * m.lever;  // 2 sin(angle / 2)
   }
   double worst = 0.0;
@@ -271,8 +271,7 @@ Code encode_quantized(const Metric& m, const glm::vec4& ref, const glm::vec4& st
   for (int adj = 0; adj < 3; ++adj) {
     float xyz[3];
     for (int c = 0; c < 3; ++c) xyz[c] = dequantize(nearest[c], lo[c], extent[c], bits);
-    const auto center = static_cast<int64_t>(quantize(solve_component(xyz, adj, stored.w),
-                                                      lo[adj], extent[adj], bits));
+    const auto center = static_cast<int64_t>(quantize(solve_component(xyz, adj, stored.w), lo[adj], extent[adj], bits));
     const int a = (adj + 1) % 3, b = (adj + 2) % 3;
     for (int64_t d = -2; d <= 2; ++d) {
       for (int64_t da = -1; da <= 1; ++da) {
@@ -420,8 +419,8 @@ ChannelPlan encode_animated(const Metric& m, const glm::vec4* target, uint32_t n
     if (lowest >= best_cost) break;
     bool holds = true;
     for (uint32_t f = 0; f < n && holds; ++f) {
-      codes[f] = encode_quantized(m, target[f], stored[f], plan.dropped, bits, plan.range_min, plan.range_extent,
-                                  tolerance);
+      codes[f] =
+          encode_quantized(m, target[f], stored[f], plan.dropped, bits, plan.range_min, plan.range_extent, tolerance);
       dec[f] = decode_code(m.channel, plan.dropped, bits, plan.range_min, plan.range_extent, codes[f]);
       holds = channel_error(m, target[f], dec[f]) <= tolerance;
     }
@@ -444,8 +443,8 @@ ChannelPlan refit_animated(const Metric& m, const glm::vec4* target, uint32_t n,
   const std::vector<glm::vec4> stored = stored_with_range(m.channel, target, n, plan);
   plan.codes.resize(n);
   for (uint32_t f = 0; f < n; ++f)
-    plan.codes[f] = encode_quantized(m, target[f], stored[f], plan.dropped, bits, plan.range_min, plan.range_extent,
-                                     tolerance);
+    plan.codes[f] =
+        encode_quantized(m, target[f], stored[f], plan.dropped, bits, plan.range_min, plan.range_extent, tolerance);
   return plan;
 }
 
@@ -465,7 +464,8 @@ void decode_plan(const ChannelPlan& plan, uint32_t channel, uint32_t n, const gl
         decode_code(channel, plan.dropped, plan.bits, plan.range_min, plan.range_extent, plan.codes[plan.frames[k]]);
     const uint32_t f0 = plan.frames[k - 1], f1 = plan.frames[k];
     const float inv_length = 1.0f / static_cast<float>(f1 - f0);
-    for (uint32_t f = f0; f <= f1; ++f) out[f] = interpolate_keys(channel, prev, next, static_cast<float>(f - f0) * inv_length);
+    for (uint32_t f = f0; f <= f1; ++f)
+      out[f] = interpolate_keys(channel, prev, next, static_cast<float>(f - f0) * inv_length);
     prev = next;
   }
 }

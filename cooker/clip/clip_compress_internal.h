@@ -49,10 +49,10 @@ using Code = std::array<uint32_t, 3>;
 struct ChannelPlan {
   Kind kind = Kind::Bind;
   glm::vec4 constant{0.0f};
-  uint32_t bits = 0;                 // animated: 1..kMaxQuantBits or 32
-  uint32_t dropped = 0;              // animated rotation: the component not stored (0..3)
-  std::vector<uint16_t> frames;      // animated: kept key frames
-  std::vector<Code> codes;           // animated: every frame's key as it would be stored
+  uint32_t bits = 0;             // animated: 1..kMaxQuantBits or 32
+  uint32_t dropped = 0;          // animated rotation: the component not stored (0..3)
+  std::vector<uint16_t> frames;  // animated: kept key frames
+  std::vector<Code> codes;       // animated: every frame's key as it would be stored
   float range_min[3] = {0, 0, 0}, range_extent[3] = {0, 0, 0};
 };
 

@@ -56,7 +56,7 @@ struct Member {
 struct Group {
   std::vector<uint32_t> members;  // indices into the member list
   std::vector<uint16_t> frames;
-  uint64_t value_bits = 0;        // bits per key over every member
+  uint64_t value_bits = 0;  // bits per key over every member
   bool alive = true;
   uint64_t cost() const { return frames.size() * (kKeyFrameBits + value_bits); }
 };

@@ -80,7 +80,8 @@ ClipSamples between_frames(const ClipSamples& frames) {
       glm::vec4* dst = out.channel(j, ch);
       for (uint32_t p = 0; p < out.frame_count; ++p) {
         const uint32_t f = p / n, k = p % n;
-        dst[p] = k == 0 ? src[f] : interpolate_keys(ch, src[f], src[f + 1], static_cast<float>(k) / static_cast<float>(n));
+        dst[p] =
+            k == 0 ? src[f] : interpolate_keys(ch, src[f], src[f + 1], static_cast<float>(k) / static_cast<float>(n));
       }
     }
   }
@@ -91,11 +92,10 @@ Affine affine_from_trs(const glm::vec4& t, const glm::vec4& r, const glm::vec4& 
   return ossa::affine_from_trs(glm::vec3(t), glm::quat(r.w, r.x, r.y, r.z), glm::vec3(s));
 }
 
-void model_at_frame(const SourceSkeleton& skeleton, const ClipSamples& samples, uint32_t frame,
-                    std::span<Affine> out) {
+void model_at_frame(const SourceSkeleton& skeleton, const ClipSamples& samples, uint32_t frame, std::span<Affine> out) {
   for (uint32_t j = 0; j < samples.joint_count; ++j) {
-    const Affine local = affine_from_trs(samples.channel(j, kTranslation)[frame],
-                                         samples.channel(j, kRotation)[frame], samples.channel(j, kScale)[frame]);
+    const Affine local = affine_from_trs(samples.channel(j, kTranslation)[frame], samples.channel(j, kRotation)[frame],
+                                         samples.channel(j, kScale)[frame]);
     const int parent = skeleton.joints[j].parent;
     if (parent < 0) {
       out[j] = local;
@@ -119,8 +119,8 @@ ClipError measure_clip_error(const SourceSkeleton& skeleton, const ClipSamples& 
     if (reference_models == nullptr) model_at_frame(skeleton, reference, p, ref_model);
     model_at_frame(skeleton, test, p, test_model);
     for (uint32_t j = 0; j < joints; ++j) {
-      const Affine& r = reference_models ? (*reference_models)[static_cast<size_t>(j) * reference.frame_count + p]
-                                         : ref_model[j];
+      const Affine& r =
+          reference_models ? (*reference_models)[static_cast<size_t>(j) * reference.frame_count + p] : ref_model[j];
       const double err = probe_error(r, test_model[j], probe);
       sum += err;
       e.joint_max[j] = std::max(e.joint_max[j], err);

@@ -65,8 +65,8 @@ struct ClipSamples {
 };
 
 /// Positions measured per frame interval (<ossa/anim/pose_error.h>): the frames and the points at
-/// 1/4, 2/4 and 3/4 of the way to the next frame. Position p of a clip is frame position p / kErrorSubdivisions; a clip of F
-/// frames has (F - 1) * kErrorSubdivisions + 1 positions.
+/// 1/4, 2/4 and 3/4 of the way to the next frame. Position p of a clip is frame position p / kErrorSubdivisions; a clip
+/// of F frames has (F - 1) * kErrorSubdivisions + 1 positions.
 inline constexpr uint32_t kErrorSubdivisions = kClipErrorSubdivisions;
 
 /// A channel's bind value as a sample (translation/scale xyz with w = 0, rotation xyzw).
@@ -102,19 +102,18 @@ Affine affine_from_trs(const glm::vec4& t, const glm::vec4& r, const glm::vec4& 
 
 /// Model space of every joint at one frame of `samples` (parents-first skeleton). out.size() ==
 /// joint count.
-void model_at_frame(const SourceSkeleton& skeleton, const ClipSamples& samples, uint32_t frame,
-                    std::span<Affine> out);
+void model_at_frame(const SourceSkeleton& skeleton, const ClipSamples& samples, uint32_t frame, std::span<Affine> out);
 
 /// The largest displacement of the six probe points between two model-space transforms of one
 /// joint: ossa::probe_error (<ossa/anim/pose_error.h>).
 using ossa::probe_error;
 
 struct ClipError {
-  double max = 0.0;             // over every joint at every position
-  double max_at_frames = 0.0;   // ... at the frames only
-  double mean = 0.0;            // of the per-joint, per-position error (largest of its six points)
-  uint16_t worst_joint = 0;     // where max occurs (the first such joint, lowest position first)
-  float worst_frame = 0.0f;     // the frame position where max occurs
+  double max = 0.0;               // over every joint at every position
+  double max_at_frames = 0.0;     // ... at the frames only
+  double mean = 0.0;              // of the per-joint, per-position error (largest of its six points)
+  uint16_t worst_joint = 0;       // where max occurs (the first such joint, lowest position first)
+  float worst_frame = 0.0f;       // the frame position where max occurs
   std::vector<double> joint_max;  // per joint, over positions
 };
 

@@ -39,9 +39,8 @@ bool sample_channel(const std::vector<float>& times, const std::vector<V>& value
     const double t = static_cast<double>(f) / rate;
     while (i < n && static_cast<double>(times[i]) <= t) ++i;
     // The nearest key, when the grid time is on it.
-    const size_t near = (i < n && (i == 0 || static_cast<double>(times[i]) - t < t - static_cast<double>(times[i - 1])))
-                            ? i
-                            : i - 1;
+    const size_t near =
+        (i < n && (i == 0 || static_cast<double>(times[i]) - t < t - static_cast<double>(times[i - 1]))) ? i : i - 1;
     if (std::abs(static_cast<double>(times[near]) - t) * rate <= kSnapFrames) {
       out[f] = to_vec4(values[near]);
     } else if (i == 0) {
@@ -64,8 +63,8 @@ ClipSamples reference_samples(const SourceClip& clip, const SourceSkeleton& skel
   ref.resize(joints, grid.frame_count);
   std::vector<bool> has(static_cast<size_t>(joints) * kChannelsPerJoint, false);
   for (const SourceTrack& t : clip.tracks) {
-    has[t.joint * 3 + kTranslation] = sample_channel(t.translation_times, t.translations, grid,
-                                                     ref.channel(t.joint, kTranslation));
+    has[t.joint * 3 + kTranslation] =
+        sample_channel(t.translation_times, t.translations, grid, ref.channel(t.joint, kTranslation));
     has[t.joint * 3 + kRotation] = sample_channel(t.rotation_times, t.rotations, grid, ref.channel(t.joint, kRotation));
     has[t.joint * 3 + kScale] = sample_channel(t.scale_times, t.scales, grid, ref.channel(t.joint, kScale));
   }

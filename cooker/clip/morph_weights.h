@@ -23,7 +23,7 @@ struct CompressedMorphTrack {
   std::vector<uint16_t> key_frames;  // first 0, last frame_count - 1 (or only 0: constant)
   std::vector<uint16_t> values;      // range_min + range_extent * q / 65535
   float range_min = 0.0f, range_extent = 0.0f;
-  float max_error = 0.0f;            // largest |cooked - source| over every frame
+  float max_error = 0.0f;  // largest |cooked - source| over every frame
 };
 
 /// Compresses one track. tolerance 0 keeps a key at every frame (quantization error only).

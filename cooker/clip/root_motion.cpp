@@ -94,14 +94,13 @@ Status extract_root_motion(SourceClip& clip, const SourceSkeleton& skeleton, uin
   if (up_axis > 2) return Error{where + "up axis must be 0 (x), 1 (y) or 2 (z), not " + std::to_string(up_axis)};
   if (skeleton.joints.empty()) return Error{where + "the file has no skeleton"};
   const SourceJoint& root = skeleton.joints[0];
-  auto track_it = std::find_if(clip.tracks.begin(), clip.tracks.end(),
-                               [](const SourceTrack& t) { return t.joint == 0; });
-  if (track_it == clip.tracks.end())
-    return Error{where + "no track animates the root joint '" + root.name + "'"};
+  auto track_it =
+      std::find_if(clip.tracks.begin(), clip.tracks.end(), [](const SourceTrack& t) { return t.joint == 0; });
+  if (track_it == clip.tracks.end()) return Error{where + "no track animates the root joint '" + root.name + "'"};
   const FrameGrid grid = frame_grid(clip);
   if (grid.frame_count > kMaxFrames)
-    return Error{where + std::to_string(grid.frame_count) + " frames, more than the " +
-                 std::to_string(kMaxFrames) + " a clip may have"};
+    return Error{where + std::to_string(grid.frame_count) + " frames, more than the " + std::to_string(kMaxFrames) +
+                 " a clip may have"};
   SourceTrack& track = *track_it;
 
   glm::dvec3 up(0.0);

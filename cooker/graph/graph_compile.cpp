@@ -43,8 +43,8 @@ std::string number_text(double v) {
 /// compile_graph, so both report the same problems).
 void read_manifest(Checker& check, const Value& root, GraphManifest& out) {
   if (!check.expect(root, Type::Object, "a graph file")) return;
-  check.expect_keys(root, {"ossa_graph", "name", "skeleton", "meshes", "clips", "parameters", "nodes", "root",
-                           "montages"},
+  check.expect_keys(root,
+                    {"ossa_graph", "name", "skeleton", "meshes", "clips", "parameters", "nodes", "root", "montages"},
                     "a graph file");
   const Value* version = root.find("ossa_graph");
   if (!version) {
@@ -62,8 +62,7 @@ void read_manifest(Checker& check, const Value& root, GraphManifest& out) {
       check.expect_keys(*skeleton, {"source", "meshes"}, "\"skeleton\"");
       if (const Value* source = skeleton->find("source"))
         check.expect_name(*source, "\"skeleton\" \"source\" (the rig's source file)", &out.skeleton);
-      else
-        check.error(skeleton->pos, "\"skeleton\" needs a \"source\": the rig's source file");
+      else check.error(skeleton->pos, "\"skeleton\" needs a \"source\": the rig's source file");
       if (const Value* meshes = skeleton->find("meshes"); meshes && check.expect(*meshes, Type::Bool, "\"meshes\""))
         out.skeleton_meshes = meshes->boolean;
     } else {
@@ -108,7 +107,9 @@ void read_manifest(Checker& check, const Value& root, GraphManifest& out) {
   }
 }
 
-void GraphCompiler::warn(Pos pos, const std::string& what) { warnings_.push_back(json::where(check_.doc().file, pos) + what); }
+void GraphCompiler::warn(Pos pos, const std::string& what) {
+  warnings_.push_back(json::where(check_.doc().file, pos) + what);
+}
 
 // ---- small readers -----------------------------------------------------------------------
 bool GraphCompiler::read_float(const Value& v, const std::string& what, float* out, double lo, double hi) {
@@ -169,8 +170,10 @@ int GraphCompiler::clip(const Value& v, const std::string& role) {
     return found->second;
   }
   if (retarget_clip_index_.count(v.string) != 0)
-    return check_.error(v.pos, "clip '" + v.string + "' is a retarget node's clip of another rig; only retarget nodes "
-                               "play it"), -1;
+    return check_.error(v.pos, "clip '" + v.string +
+                                   "' is a retarget node's clip of another rig; only retarget nodes "
+                                   "play it"),
+           -1;
   if (check_.full()) return check_.error(v.pos, "unknown clip '" + v.string + "'"), -1;
   const std::string hint = json::closest_name(v.string, g_.clips);
   check_.error(v.pos, "unknown clip '" + v.string + "'" + (hint.empty() ? "" : " (did you mean '" + hint + "'?)") +
@@ -222,8 +225,7 @@ void GraphCompiler::read_clips(const Value& root, const GraphManifest& manifest)
       const auto w = written.find(entry.name);
       const Value* value = w == written.end() ? nullptr : w->second;
       const Value* list = value && value->is(Type::Object) ? value->find("events") : nullptr;
-      if (list && list->is(Type::Array))
-        read_event_list(check_, *list, duration, "clip '" + entry.name + "'", events);
+      if (list && list->is(Type::Array)) read_event_list(check_, *list, duration, "clip '" + entry.name + "'", events);
       sort_events(events);
     }
     clip_events_.push_back(std::move(events));
@@ -321,7 +323,9 @@ bool GraphCompiler::read_parameter(const Member& m, GraphParameter& p) {
       bool direction = false;
       if (const Value* dir = v.find("direction")) ok &= read_bool(*dir, what + " \"direction\"", &direction);
       Vec3Def d{0.0f, 0.0f, 0.0f};
-      if (def) ok &= read_vec3(*def, what + (direction ? " \"default\"" : " \"default\" (metres)"), direction ? 1.0 : units(), &d);
+      if (def)
+        ok &= read_vec3(*def, what + (direction ? " \"default\"" : " \"default\" (metres)"), direction ? 1.0 : units(),
+                        &d);
       std::copy(d.begin(), d.end(), p.default_vector);
       if (const Value* space = v.find("space")) {
         if (!check_.expect(*space, Type::String, what + " \"space\"")) return false;
@@ -406,7 +410,6 @@ void GraphCompiler::check_unused() {
 using graph_detail::Checker;
 using graph_detail::GraphCompiler;
 using graph_detail::read_manifest;
-
 
 Result<GraphManifest> read_graph_manifest(const json::Document& doc) {
   Checker check(doc);

@@ -140,8 +140,8 @@ int GraphCompiler::machine_node(const Value& v, const std::string& name) {
 }
 
 template <class StateIndex, class UnknownState>
-bool GraphCompiler::transition(const Value& t, const StateIndex& state_index, const UnknownState& unknown_state, TransitionDef& out,
-                long long& priority) {
+bool GraphCompiler::transition(const Value& t, const StateIndex& state_index, const UnknownState& unknown_state,
+                               TransitionDef& out, long long& priority) {
   if (!check_.expect(t, Type::Object, "a transition")) return false;
   check_.expect_keys(t, {"from", "to", "when", "exit_time", "duration", "mode", "priority"}, "a transition");
   bool ok = true;

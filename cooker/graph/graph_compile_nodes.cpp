@@ -34,8 +34,9 @@ int GraphCompiler::node(const Value& v, const std::string& default_name) {
   }
   if (!kind) {
     if (check_.expect_keys(
-            v, {"clip", "blend", "select", "layered", "blend_space", "additive", "state_machine", "morph", "use",
-                "two_bone_ik", "aim", "foot_placement", "foot_lock", "spring", "slot", "retarget", "name"},
+            v,
+            {"clip", "blend", "select", "layered", "blend_space", "additive", "state_machine", "morph", "use",
+             "two_bone_ik", "aim", "foot_placement", "foot_lock", "spring", "slot", "retarget", "name"},
             "a node"))
       check_.error(v.pos,
                    "a node needs one of the keys clip, blend, select, layered, blend_space, additive, "
@@ -317,8 +318,7 @@ int GraphCompiler::joint(const Value& v, const std::string& role) {
   if (!ctx_.skeleton) return -1;
   const auto& joints = ctx_.skeleton->joints;
   if (joint_index_.empty())
-    for (size_t j = joints.size(); j-- > 0;)
-      joint_index_[joints[j].name] = static_cast<int>(j);  // the first of a name
+    for (size_t j = joints.size(); j-- > 0;) joint_index_[joints[j].name] = static_cast<int>(j);  // the first of a name
   if (const auto found = joint_index_.find(v.string); found != joint_index_.end()) return found->second;
   if (check_.full()) return check_.error(v.pos, "unknown joint '" + v.string + "' in " + role), -1;
   std::vector<std::string> names;
@@ -344,9 +344,9 @@ int GraphCompiler::layered_node(const Value& v, const std::string& name) {
       ok = false;
       continue;
     }
-    check_.expect_keys(lv, {"node", "mask", "weight", "weight_parameter", "blend_time", "mesh_space_rotation",
-                            "morph_targets"},
-                       "a layer");
+    check_.expect_keys(
+        lv, {"node", "mask", "weight", "weight_parameter", "blend_time", "mesh_space_rotation", "morph_targets"},
+        "a layer");
     LayerDef layer;
     const Value* n = required(lv, "node", "a layer");
     const int child = n ? node(*n, "") : -1;
@@ -516,7 +516,8 @@ int GraphCompiler::morph_node(const Value& v, const std::string& name) {
   const Value* drives = required(v, "drives", "a morph node");
   if (!drives || !check_.expect(*drives, Type::Array, "\"drives\" ([{\"target\": ..., \"parameter\": ...}, ...])"))
     return -1;
-  if (drives->items.empty()) ok = check_.error(drives->pos, "\"drives\" is empty: a morph node sets at least one target");
+  if (drives->items.empty())
+    ok = check_.error(drives->pos, "\"drives\" is empty: a morph node sets at least one target");
   for (const Value& d : drives->items) {
     if (!check_.expect(d, Type::Object, "a drive ({\"target\": ..., \"parameter\": ...})")) {
       ok = false;

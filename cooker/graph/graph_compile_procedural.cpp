@@ -76,7 +76,8 @@ glm::quat GraphCompiler::bind_rotation(uint32_t j) const {
 
 bool GraphCompiler::ancestor(int a, int b) const {
   if (!ctx_.skeleton || a < 0 || b < 0) return true;  // reported elsewhere
-  for (int j = ctx_.skeleton->joints[static_cast<size_t>(b)].parent; j >= 0; j = ctx_.skeleton->joints[static_cast<size_t>(j)].parent)
+  for (int j = ctx_.skeleton->joints[static_cast<size_t>(b)].parent; j >= 0;
+       j = ctx_.skeleton->joints[static_cast<size_t>(j)].parent)
     if (j == a) return true;
   return false;
 }
@@ -86,7 +87,8 @@ bool GraphCompiler::check_chain(const Value& at, std::initializer_list<int> join
   for (const int& j : joints) {
     if (prev && *prev >= 0 && j >= 0 && !ancestor(*prev, j))
       return check_.error(at.pos, what + ": joint '" + ctx_.skeleton->joints[static_cast<size_t>(*prev)].name +
-                                      "' is not an ancestor of '" + ctx_.skeleton->joints[static_cast<size_t>(j)].name + "'");
+                                      "' is not an ancestor of '" + ctx_.skeleton->joints[static_cast<size_t>(j)].name +
+                                      "'");
     prev = &j;
   }
   return true;
@@ -94,13 +96,15 @@ bool GraphCompiler::check_chain(const Value& at, std::initializer_list<int> join
 
 int GraphCompiler::two_bone_node(const Value& v, const std::string& name) {
   const std::string what = "a two_bone_ik node";
-  check_.expect_keys(v, {"two_bone_ik", "start", "mid", "end", "target", "pole", "mid_axis", "twist", "soften", "weight",
-                         "weight_parameter", "name"},
+  check_.expect_keys(v,
+                     {"two_bone_ik", "start", "mid", "end", "target", "pole", "mid_axis", "twist", "soften", "weight",
+                      "weight_parameter", "name"},
                      what);
   TwoBoneIkDef t;
   const int input = node(*v.find("two_bone_ik"), "");
   bool ok = input >= 0;
-  const int start = joint_member(v, "start", what), mid = joint_member(v, "mid", what), end = joint_member(v, "end", what);
+  const int start = joint_member(v, "start", what), mid = joint_member(v, "mid", what),
+            end = joint_member(v, "end", what);
   ok &= start >= 0 && mid >= 0 && end >= 0 && check_chain(v, {start, mid, end}, what);
   const Value* target = required(v, "target", what);
   const int tp = target ? parameter(*target, {ParamType::Vector}, "\"target\"") : -1;
@@ -132,7 +136,8 @@ int GraphCompiler::two_bone_node(const Value& v, const std::string& name) {
 
 int GraphCompiler::aim_node(const Value& v, const std::string& name) {
   const std::string what = "an aim node";
-  check_.expect_keys(v, {"aim", "chain", "target", "forward", "up", "pole", "weight", "weight_parameter", "name"}, what);
+  check_.expect_keys(v, {"aim", "chain", "target", "forward", "up", "pole", "weight", "weight_parameter", "name"},
+                     what);
   AimDef a;
   const int input = node(*v.find("aim"), "");
   bool ok = input >= 0;
@@ -153,7 +158,8 @@ int GraphCompiler::aim_node(const Value& v, const std::string& name) {
     previous = index;
     j.joint = static_cast<uint16_t>(std::max(index, 0));
     if (const Value* w = e.find("weight")) ok &= read_float(*w, "an aim joint's \"weight\"", &j.weight, 0.0, 1.0);
-    if (const Value* m = e.find("max_angle")) ok &= read_degrees(*m, "an aim joint's \"max_angle\"", &j.max_angle, 0.0, 180.0);
+    if (const Value* m = e.find("max_angle"))
+      ok &= read_degrees(*m, "an aim joint's \"max_angle\"", &j.max_angle, 0.0, 180.0);
     a.chain.push_back(j);
   }
   const Value* target = required(v, "target", what);
@@ -191,7 +197,8 @@ bool GraphCompiler::read_legs(const Value& v, bool lock, std::vector<FootLegDef>
       ok = false;
       continue;
     }
-    if (lock) check_.expect_keys(e, {"hip", "knee", "ankle", "planted", "plant_event", "lift_event"}, "a foot_lock leg");
+    if (lock)
+      check_.expect_keys(e, {"hip", "knee", "ankle", "planted", "plant_event", "lift_event"}, "a foot_lock leg");
     else check_.expect_keys(e, {"hip", "knee", "ankle", "ground", "normal"}, "a foot_placement leg");
     FootLegDef leg;
     const int hip = joint_member(e, "hip", "a leg"), knee = joint_member(e, "knee", "a leg"),
@@ -213,14 +220,17 @@ bool GraphCompiler::read_legs(const Value& v, bool lock, std::vector<FootLegDef>
     for (const char* key : {"plant_event", "lift_event"}) {
       const Value* ev = e.find(key);
       if (!ev) continue;
-      if (!check_.expect(*ev, Type::String, std::string("a leg's \"") + key + "\" (an event name)") || ev->string.empty()) {
-        ok = ok && ev->is(Type::String) ? check_.error(ev->pos, std::string("a leg's \"") + key + "\" is empty") : false;
+      if (!check_.expect(*ev, Type::String, std::string("a leg's \"") + key + "\" (an event name)") ||
+          ev->string.empty()) {
+        ok =
+            ok && ev->is(Type::String) ? check_.error(ev->pos, std::string("a leg's \"") + key + "\" is empty") : false;
         continue;
       }
       (std::string_view(key) == "plant_event" ? leg.plant_event : leg.lift_event) = ev->string;
     }
     if (lock && leg.planted_parameter < 0 && (leg.plant_event.empty() || leg.lift_event.empty()))
-      ok = check_.error(e.pos, "a foot_lock leg needs \"planted\" (a parameter) or both \"plant_event\" and \"lift_event\"");
+      ok = check_.error(e.pos,
+                        "a foot_lock leg needs \"planted\" (a parameter) or both \"plant_event\" and \"lift_event\"");
     out->push_back(std::move(leg));
   }
   return ok;
@@ -229,10 +239,12 @@ bool GraphCompiler::read_legs(const Value& v, bool lock, std::vector<FootLegDef>
 int GraphCompiler::foot_node(const Value& v, const std::string& name, bool lock) {
   const std::string what = lock ? "a foot_lock node" : "a foot_placement node";
   if (lock)
-    check_.expect_keys(v, {"foot_lock", "legs", "release_radius", "blend_time", "weight", "weight_parameter", "name"}, what);
+    check_.expect_keys(v, {"foot_lock", "legs", "release_radius", "blend_time", "weight", "weight_parameter", "name"},
+                       what);
   else
-    check_.expect_keys(v, {"foot_placement", "pelvis", "legs", "up", "max_pelvis_drop", "align", "soften", "weight",
-                           "weight_parameter", "name"},
+    check_.expect_keys(v,
+                       {"foot_placement", "pelvis", "legs", "up", "max_pelvis_drop", "align", "soften", "weight",
+                        "weight_parameter", "name"},
                        what);
   const int input = node(*v.find(lock ? "foot_lock" : "foot_placement"), "");
   bool ok = input >= 0;
@@ -247,7 +259,8 @@ int GraphCompiler::foot_node(const Value& v, const std::string& name, bool lock)
       ok &= read_length(*r, "\"release_radius\"", &f.release_radius);
       if (ok && !(f.release_radius > 0.0f)) ok = check_.error(r->pos, "\"release_radius\" must be above 0");
     }
-    if (const Value* b = v.find("blend_time")) ok &= read_float(*b, "\"blend_time\" (seconds)", &f.blend_time, 0.0, 1e6);
+    if (const Value* b = v.find("blend_time"))
+      ok &= read_float(*b, "\"blend_time\" (seconds)", &f.blend_time, 0.0, 1e6);
     ok &= read_weight(v, &f.weight, &f.weight_parameter);
     if (!ok) return -1;
     f.input = static_cast<uint16_t>(input);
@@ -274,8 +287,8 @@ int GraphCompiler::foot_node(const Value& v, const std::string& name, bool lock)
 
 int GraphCompiler::spring_node(const Value& v, const std::string& name) {
   const std::string what = "a spring node";
-  check_.expect_keys(v, {"spring", "chains", "colliders", "step", "teleport_distance", "weight", "weight_parameter", "name"},
-                     what);
+  check_.expect_keys(
+      v, {"spring", "chains", "colliders", "step", "teleport_distance", "weight", "weight_parameter", "name"}, what);
   SpringDef sp;
   const int input = node(*v.find("spring"), "");
   bool ok = input >= 0;
@@ -316,7 +329,8 @@ int GraphCompiler::spring_node(const Value& v, const std::string& name) {
       const glm::vec3 t = ctx_.skeleton->joints[static_cast<size_t>(previous)].translation;
       chain.tail_length = chain.joints.size() > 1 ? glm::length(t) : static_cast<float>(0.05 * units());
     }
-    if (const Value* x = c.find("stiffness")) ok &= read_float(*x, "\"stiffness\" (per second)", &chain.stiffness, 0.0, 1e4);
+    if (const Value* x = c.find("stiffness"))
+      ok &= read_float(*x, "\"stiffness\" (per second)", &chain.stiffness, 0.0, 1e4);
     if (const Value* x = c.find("drag")) ok &= read_float(*x, "\"drag\"", &chain.drag, 0.0, 1.0);
     if (const Value* x = c.find("gravity")) ok &= read_vec3(*x, "\"gravity\" (m/s^2)", units(), &chain.gravity);
     if (const Value* x = c.find("radius")) ok &= read_length(*x, "\"radius\"", &chain.radius);
@@ -335,16 +349,19 @@ int GraphCompiler::spring_node(const Value& v, const std::string& name) {
       const int j = joint_member(c, "joint", "a collider");
       ok &= j >= 0;
       col.joint = static_cast<uint16_t>(std::max(j, 0));
-      if (const Value* x = c.find("offset")) ok &= read_vec3(*x, "a collider's \"offset\" (metres)", units(), &col.offset);
+      if (const Value* x = c.find("offset"))
+        ok &= read_vec3(*x, "a collider's \"offset\" (metres)", units(), &col.offset);
       col.tail = col.offset;
       if (const Value* x = c.find("tail")) ok &= read_vec3(*x, "a collider's \"tail\" (metres)", units(), &col.tail);
-      if (const Value* r = required(c, "radius", "a collider")) ok &= read_length(*r, "a collider's \"radius\"", &col.radius);
+      if (const Value* r = required(c, "radius", "a collider"))
+        ok &= read_length(*r, "a collider's \"radius\"", &col.radius);
       else ok = false;
       sp.colliders.push_back(col);
     }
   }
   if (const Value* x = v.find("step")) ok &= read_float(*x, "\"step\" (seconds)", &sp.step, 1e-4, 1.0);
-  if (const Value* x = v.find("teleport_distance")) ok &= read_length(*x, "\"teleport_distance\"", &sp.teleport_distance);
+  if (const Value* x = v.find("teleport_distance"))
+    ok &= read_length(*x, "\"teleport_distance\"", &sp.teleport_distance);
   ok &= read_weight(v, &sp.weight, &sp.weight_parameter);
   if (!ok) return -1;
   sp.input = static_cast<uint16_t>(input);

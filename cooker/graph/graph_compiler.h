@@ -32,9 +32,8 @@ using json::Value;
 constexpr double kFloatMax = 3.4e38;      // Parameter.min_value / max_value defaults
 constexpr double kIntLimit = 16777216.0;  // ints are held as floats: exact up to 2^24
 inline const std::vector<std::string_view> kNodeKinds = {
-    "clip",  "blend",      "select",         "layered",   "blend_space", "additive", "state_machine", "morph",
-    "use",   "two_bone_ik", "aim",           "foot_placement", "foot_lock", "spring", "slot",
-    "retarget"};
+    "clip", "blend",       "select", "layered",        "blend_space", "additive", "state_machine", "morph",
+    "use",  "two_bone_ik", "aim",    "foot_placement", "foot_lock",   "spring",   "slot",          "retarget"};
 constexpr double kDegrees = 3.14159265358979323846 / 180.0;
 // The loader's bounds (runtime/loader/validate_graph.cpp). A value past one compiled into a file
 // that failed verification ("internal error, cooked bytes fail verification"): each is refused
@@ -109,7 +108,9 @@ class GraphCompiler {
   bool checking_unused_ = false;  // the node limit then only bounds the work, it is no error
   uint32_t depth_ = 0;            // node() frames on the path, uses included (bounds the recursion)
   uint32_t output_depth_ = 0;     // nodes on the path that are written (uses excluded)
-  MontageCompiler montage_{check_, g_, clip_duration_,
+  MontageCompiler montage_{check_,
+                           g_,
+                           clip_duration_,
                            [this](const Value& v, const std::string& role) { return clip(v, role); },
                            [this](const Value& v, const std::string& role) { return joint(v, role); },
                            [this](const Value& v, const std::string& name) { return node(v, name); },

@@ -24,7 +24,6 @@ bool ident_start(char c) { return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z
 bool ident_char(char c) { return ident_start(c) || (c >= '0' && c <= '9'); }
 bool digit(char c) { return c >= '0' && c <= '9'; }
 
-
 const char* op_text(CondOp op) {
   switch (op) {
     case CondOp::Less: return "<";
@@ -156,10 +155,8 @@ class ConditionParser {
   /// evaluation order): a loader runs conditions on a fixed stack of kMaxConditionStack values.
   void emit(CondOp op, uint16_t parameter = 0, float value = 0.0f) {
     code_.push_back({op, parameter, value});
-    if (op == CondOp::And || op == CondOp::Or)
-      --stack_;
-    else if (op != CondOp::Not)
-      ++stack_;
+    if (op == CondOp::And || op == CondOp::Or) --stack_;
+    else if (op != CondOp::Not) ++stack_;
     if (stack_ > kMaxConditionStack && !too_deep_at_) too_deep_at_ = tok_.offset + 1;  // +1: 0 means "not yet"
   }
 

@@ -163,9 +163,10 @@ void MontageCompiler::montages(const Value* list) {
     if (entry.key.empty()) check.error(entry.key_pos, "a montage name must not be empty");
     const Value& v = entry.value;
     if (!check.expect(v, Type::Object, label)) continue;
-    check.expect_keys(v, {"group", "tracks", "sections", "blend_in", "blend_out", "blend_out_trigger", "rate",
-                          "root_motion", "events"},
-                      label);
+    check.expect_keys(
+        v,
+        {"group", "tracks", "sections", "blend_in", "blend_out", "blend_out_trigger", "rate", "root_motion", "events"},
+        label);
     bool ok = !entry.key.empty();
     m.group = "default";
     if (const Value* g = v.find("group")) ok &= check.expect_name(*g, label + " \"group\"", &m.group);
@@ -174,8 +175,8 @@ void MontageCompiler::montages(const Value* list) {
       double d = 0.0;
       if (!check.expect_number(x, what, &d)) return false;
       if (d < lo || d > hi)
-        return check.error(x.pos, what + " must be within [" + number_text(lo) + ", " + number_text(hi) + "], not " +
-                                      number_text(d));
+        return check.error(
+            x.pos, what + " must be within [" + number_text(lo) + ", " + number_text(hi) + "], not " + number_text(d));
       *out = static_cast<float>(d);
       return true;
     };
@@ -194,13 +195,14 @@ void MontageCompiler::montages(const Value* list) {
         const auto seen = std::find_if(slots.begin(), slots.end(), [&](const SlotSeen& s) { return s.slot == t.key; });
         if (seen == slots.end()) {
           const std::string hint = json::closest_name(t.key, slot_names);
-          tracks_ok = check.error(t.key_pos, "unknown slot '" + t.key + "' in " + label +
-                                                 (hint.empty() ? "" : " (did you mean '" + hint + "'?)") +
-                                                 (slot_names.empty() ? "; the graph has no slot nodes"
-                                                                     : "; slots: " + quoted(slot_names)));
+          tracks_ok = check.error(
+              t.key_pos, "unknown slot '" + t.key + "' in " + label +
+                             (hint.empty() ? "" : " (did you mean '" + hint + "'?)") +
+                             (slot_names.empty() ? "; the graph has no slot nodes" : "; slots: " + quoted(slot_names)));
         } else if (ok && seen->group != m.group) {
-          tracks_ok = check.error(t.key_pos, label + " (group '" + m.group + "') has a track for slot '" + t.key +
-                                                 "' of group '" + seen->group + "'; a montage plays slots of its group");
+          tracks_ok =
+              check.error(t.key_pos, label + " (group '" + m.group + "') has a track for slot '" + t.key +
+                                         "' of group '" + seen->group + "'; a montage plays slots of its group");
         }
         if (!check.expect(t.value, Type::Array, "a track (an array of segments)")) {
           tracks_ok = false;
@@ -229,9 +231,12 @@ void MontageCompiler::montages(const Value* list) {
           const double duration = clip_duration[seg.clip];
           seg.end = static_cast<float>(duration);
           bool seg_ok = true;
-          if (const Value* x = sv.find("start")) seg_ok &= read_number(*x, "a segment's \"start\" (clip seconds)", 0.0, duration, &seg.start);
-          if (const Value* x = sv.find("end")) seg_ok &= read_number(*x, "a segment's \"end\" (clip seconds)", 0.0, duration, &seg.end);
-          if (const Value* x = sv.find("rate")) seg_ok &= read_number(*x, "a segment's \"rate\"", kMinRate, kMaxRate, &seg.rate);
+          if (const Value* x = sv.find("start"))
+            seg_ok &= read_number(*x, "a segment's \"start\" (clip seconds)", 0.0, duration, &seg.start);
+          if (const Value* x = sv.find("end"))
+            seg_ok &= read_number(*x, "a segment's \"end\" (clip seconds)", 0.0, duration, &seg.end);
+          if (const Value* x = sv.find("rate"))
+            seg_ok &= read_number(*x, "a segment's \"rate\"", kMinRate, kMaxRate, &seg.rate);
           if (seg_ok && !(seg.end > seg.start))
             seg_ok = check.error(sv.find("end") ? sv.find("end")->pos : sv.pos,
                                  "a segment's \"end\" (" + number_text(seg.end) + " s) must be after its \"start\" (" +
@@ -323,7 +328,8 @@ void MontageCompiler::montages(const Value* list) {
       if (!check.expect(*b, Type::Object, what + " (seconds, or {\"time\": ..., \"curve\": ...})")) return false;
       check.expect_keys(*b, {"time", "curve"}, what);
       bool fine = true;
-      if (const Value* t = b->find("time")) fine &= read_number(*t, what + " \"time\" (seconds)", 0.0, kMaxSeconds, time);
+      if (const Value* t = b->find("time"))
+        fine &= read_number(*t, what + " \"time\" (seconds)", 0.0, kMaxSeconds, time);
       if (const Value* c = b->find("curve")) {
         static const std::vector<std::string_view> kCurves = {"linear", "cubic", "inertialize"};
         if (!check.expect(*c, Type::String, what + " \"curve\"")) return false;
@@ -341,7 +347,8 @@ void MontageCompiler::montages(const Value* list) {
     ok &= read_blend("blend_in", &m.blend_in, &m.blend_in_curve);
     ok &= read_blend("blend_out", &m.blend_out, &m.blend_out_curve);
     if (const Value* t = v.find("blend_out_trigger"))
-      ok &= read_number(*t, label + " \"blend_out_trigger\" (seconds before the end)", 0.0, kMaxSeconds, &m.blend_out_trigger);
+      ok &= read_number(*t, label + " \"blend_out_trigger\" (seconds before the end)", 0.0, kMaxSeconds,
+                        &m.blend_out_trigger);
     if (const Value* r = v.find("rate")) ok &= read_number(*r, label + " \"rate\"", kMinRate, kMaxRate, &m.rate);
     if (const Value* rm = v.find("root_motion")) {
       if (check.expect(*rm, Type::Bool, label + " \"root_motion\"")) m.root_motion = rm->boolean;
@@ -367,10 +374,12 @@ void MontageCompiler::montages(const Value* list) {
         else ok &= read_number(*tv, "a montage event's \"time\" (timeline seconds)", 0.0, end, &n.time);
         if (const Value* d = e.find("duration")) {
           if (read_number(*d, "a montage event's \"duration\" (seconds)", 0.0, kMaxSeconds, &n.duration)) {
-            if (!(n.duration > 0.0f)) ok = check.error(d->pos, "a montage event's \"duration\" must be above 0 (leave it out for an instant)");
+            if (!(n.duration > 0.0f))
+              ok = check.error(d->pos, "a montage event's \"duration\" must be above 0 (leave it out for an instant)");
             else n.kind = MontageNotifyKindDef::Window;
             if (++windows > kMaxWindows)
-              ok = check.error(d->pos, label + " has more than " + std::to_string(kMaxWindows) + " events with a duration");
+              ok = check.error(d->pos,
+                               label + " has more than " + std::to_string(kMaxWindows) + " events with a duration");
           } else {
             ok = false;
           }

@@ -16,8 +16,8 @@ float mix_value(float a, float b, float t) { return a + (b - a) * t; }
 glm::vec3 mix_value(const glm::vec3& a, const glm::vec3& b, float t) { return a + (b - a) * t; }
 glm::quat mix_value(const glm::quat& a, const glm::quat& b, float t) {
   const glm::quat bb = glm::dot(a, b) < 0.0f ? -b : b;  // the short way, as the compressor blends
-  return glm::normalize(glm::quat(a.w + (bb.w - a.w) * t, a.x + (bb.x - a.x) * t, a.y + (bb.y - a.y) * t,
-                                  a.z + (bb.z - a.z) * t));
+  return glm::normalize(
+      glm::quat(a.w + (bb.w - a.w) * t, a.x + (bb.x - a.x) * t, a.y + (bb.y - a.y) * t, a.z + (bb.z - a.z) * t));
 }
 
 /// The channel's value at `time`: its keys interpolated, held before the first and after the last.
@@ -88,7 +88,8 @@ std::string split_long_clip(SourceClip clip, std::vector<SourceClip>* out) {
     out->push_back(std::move(part));
   }
   char head[160];
-  std::snprintf(head, sizeof head, "%u frames at %g frames/s, more than the %u one clip holds: cooked as %u consecutive clips ",
+  std::snprintf(head, sizeof head,
+                "%u frames at %g frames/s, more than the %u one clip holds: cooked as %u consecutive clips ",
                 grid.frame_count, static_cast<double>(grid.sample_rate), kMaxFrames, parts);
   return "clip '" + clip.name + "' has " + head + described;
 }

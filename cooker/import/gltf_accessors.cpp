@@ -22,8 +22,8 @@ namespace ossa::cook::gltf::detail {
 namespace {
 
 // Accessor component types.
-constexpr uint64_t kByte = 5120, kUnsignedByte = 5121, kShort = 5122, kUnsignedShort = 5123,
-                   kUnsignedInt = 5125, kFloat = 5126;
+constexpr uint64_t kByte = 5120, kUnsignedByte = 5121, kShort = 5122, kUnsignedShort = 5123, kUnsignedInt = 5125,
+                   kFloat = 5126;
 
 /// An accessor without a bufferView is all zeros (then usually sparse); its count is capped so a
 /// hostile file cannot ask for gigabytes of zeros. Animation keys are far below this.
@@ -103,8 +103,8 @@ std::optional<std::vector<uint8_t>> base64_decode(const std::string& s, size_t b
 }  // namespace
 
 uint32_t read_u32(const uint8_t* p) {
-  return static_cast<uint32_t>(p[0]) | static_cast<uint32_t>(p[1]) << 8 |
-         static_cast<uint32_t>(p[2]) << 16 | static_cast<uint32_t>(p[3]) << 24;
+  return static_cast<uint32_t>(p[0]) | static_cast<uint32_t>(p[1]) << 8 | static_cast<uint32_t>(p[2]) << 16 |
+         static_cast<uint32_t>(p[3]) << 24;
 }
 
 /// A non-negative integer member, or nullopt when absent or of another type.
@@ -209,8 +209,7 @@ std::optional<std::span<const uint8_t>> Reader::load(uint64_t index, std::string
     // A scheme ("http:", "file:") is a URI this offline tool will not fetch.
     const size_t colon = uri.find(':');
     const size_t slash = uri.find('/');
-    if (colon != std::string::npos && (slash == std::string::npos || colon < slash) &&
-        colon > 1) {
+    if (colon != std::string::npos && (slash == std::string::npos || colon < slash) && colon > 1) {
       *why = label + " has a URI the cooker cannot read: " + uri;
       return std::nullopt;
     }
@@ -229,8 +228,7 @@ std::optional<std::span<const uint8_t>> Reader::load(uint64_t index, std::string
   }
   if (bytes) span = loaded[index] = std::move(*bytes);
   if (span.size() < *length) {
-    *why = label + " holds " + std::to_string(span.size()) + " bytes, byteLength says " +
-           std::to_string(*length);
+    *why = label + " holds " + std::to_string(span.size()) + " bytes, byteLength says " + std::to_string(*length);
     return std::nullopt;
   }
   return span.first(static_cast<size_t>(*length));  // views are checked against byteLength
@@ -241,16 +239,12 @@ namespace {
 int component_size(uint64_t type) {
   switch (type) {
     case kByte:
-    case kUnsignedByte:
-      return 1;
+    case kUnsignedByte: return 1;
     case kShort:
-    case kUnsignedShort:
-      return 2;
+    case kUnsignedShort: return 2;
     case kUnsignedInt:
-    case kFloat:
-      return 4;
-    default:
-      return 0;
+    case kFloat: return 4;
+    default: return 0;
   }
 }
 
@@ -276,8 +270,7 @@ float decode_component(const uint8_t* p, uint64_t type, bool normalized) {
       const auto c = static_cast<int8_t>(p[0]);
       return normalized ? std::max(static_cast<float>(c) / 127.0f, -1.0f) : static_cast<float>(c);
     }
-    case kUnsignedByte:
-      return normalized ? static_cast<float>(p[0]) / 255.0f : static_cast<float>(p[0]);
+    case kUnsignedByte: return normalized ? static_cast<float>(p[0]) / 255.0f : static_cast<float>(p[0]);
     case kShort: {
       const auto c = static_cast<int16_t>(static_cast<uint16_t>(p[0] | p[1] << 8));
       return normalized ? std::max(static_cast<float>(c) / 32767.0f, -1.0f) : static_cast<float>(c);
@@ -286,10 +279,8 @@ float decode_component(const uint8_t* p, uint64_t type, bool normalized) {
       const auto c = static_cast<uint16_t>(p[0] | p[1] << 8);
       return normalized ? static_cast<float>(c) / 65535.0f : static_cast<float>(c);
     }
-    case kUnsignedInt:
-      return static_cast<float>(read_u32(p));
-    default:
-      return 0.0f;
+    case kUnsignedInt: return static_cast<float>(read_u32(p));
+    default: return 0.0f;
   }
 }
 
@@ -318,8 +309,7 @@ std::optional<ViewBytes> view_bytes(Reader& r, uint64_t index, std::string* why)
   if (!bytes) return std::nullopt;
   if (offset > bytes->size() || *length > bytes->size() - offset) {
     *why = label + " (offset " + std::to_string(offset) + ", length " + std::to_string(*length) +
-           ") lies outside buffer " + std::to_string(*buffer) + " (" +
-           std::to_string(bytes->size()) + " bytes)";
+           ") lies outside buffer " + std::to_string(*buffer) + " (" + std::to_string(bytes->size()) + " bytes)";
     return std::nullopt;
   }
   ViewBytes out;
@@ -331,9 +321,8 @@ std::optional<ViewBytes> view_bytes(Reader& r, uint64_t index, std::string* why)
 
 /// Accessor `index` decoded to floats: count * components values. `want_components` (when not 0)
 /// and `float_only` are what the caller's semantics allow.
-std::optional<std::vector<float>> read_accessor(Reader& r, uint64_t index, int want_components,
-                                                bool float_only, int* components,
-                                                std::string* why) {
+std::optional<std::vector<float>> read_accessor(Reader& r, uint64_t index, int want_components, bool float_only,
+                                                int* components, std::string* why) {
   const std::string label = "accessor " + std::to_string(index);
   const Json* a = element(r.root, "accessors", index);
   if (!a) {
@@ -345,15 +334,13 @@ std::optional<std::vector<float>> read_accessor(Reader& r, uint64_t index, int w
   const int n = component_count(get_string(*a, "type"));
   const int size = type ? component_size(*type) : 0;
   const auto normalized_it = a->find("normalized");
-  const bool normalized =
-      normalized_it != a->end() && normalized_it->is_boolean() && normalized_it->get<bool>();
+  const bool normalized = normalized_it != a->end() && normalized_it->is_boolean() && normalized_it->get<bool>();
   if (!count || size == 0 || n == 0) {
     *why = label + " has no valid count, componentType or type";
     return std::nullopt;
   }
   if (want_components && n != want_components) {
-    *why = label + " has " + std::to_string(n) + " components, " + std::to_string(want_components) +
-           " expected";
+    *why = label + " has " + std::to_string(n) + " components, " + std::to_string(want_components) + " expected";
     return std::nullopt;
   }
   if (float_only && *type != kFloat) {
@@ -373,12 +360,11 @@ std::optional<std::vector<float>> read_accessor(Reader& r, uint64_t index, int w
       return std::nullopt;
     }
     // offset + stride * (count - 1) + element_size <= view size, without overflow.
-    const bool fits =
-        *count == 0 || (offset <= bytes->size && element_size <= bytes->size - offset &&
-                        (*count - 1) <= (bytes->size - offset - element_size) / stride);
+    const bool fits = *count == 0 || (offset <= bytes->size && element_size <= bytes->size - offset &&
+                                      (*count - 1) <= (bytes->size - offset - element_size) / stride);
     if (!fits) {
-      *why = label + " (" + std::to_string(*count) +
-             " elements) reads past the end of bufferView " + std::to_string(*view);
+      *why = label + " (" + std::to_string(*count) + " elements) reads past the end of bufferView " +
+             std::to_string(*view);
       return std::nullopt;
     }
     out.resize(static_cast<size_t>(*count * static_cast<uint64_t>(n)));
@@ -401,14 +387,11 @@ std::optional<std::vector<float>> read_accessor(Reader& r, uint64_t index, int w
     const Json* indices = get_object(*sparse, "indices");
     const Json* values = get_object(*sparse, "values");
     const uint64_t index_type = indices ? get_uint(*indices, "componentType").value_or(0) : 0;
-    const std::optional<uint64_t> index_view =
-        indices ? get_uint(*indices, "bufferView") : std::nullopt;
-    const std::optional<uint64_t> value_view =
-        values ? get_uint(*values, "bufferView") : std::nullopt;
+    const std::optional<uint64_t> index_view = indices ? get_uint(*indices, "bufferView") : std::nullopt;
+    const std::optional<uint64_t> value_view = values ? get_uint(*values, "bufferView") : std::nullopt;
     const int index_size = component_size(index_type);
     if (!sparse_count || !index_view || !value_view ||
-        !(index_type == kUnsignedByte || index_type == kUnsignedShort ||
-          index_type == kUnsignedInt)) {
+        !(index_type == kUnsignedByte || index_type == kUnsignedShort || index_type == kUnsignedInt)) {
       *why = label + " has an incomplete sparse section";
       return std::nullopt;
     }
@@ -435,8 +418,7 @@ std::optional<std::vector<float>> read_accessor(Reader& r, uint64_t index, int w
       }
       for (int c = 0; c < n; ++c) {
         out[static_cast<size_t>(target * static_cast<uint64_t>(n) + static_cast<uint64_t>(c))] =
-            decode_component(vb->data + vo + s * element_size + static_cast<uint64_t>(c * size),
-                             *type, normalized);
+            decode_component(vb->data + vo + s * element_size + static_cast<uint64_t>(c * size), *type, normalized);
       }
     }
   }
@@ -454,11 +436,9 @@ void read_sampler_keys(Reader& r, const Json& sampler, Sampler* s) {
     return;
   }
   int components = 0;
-  std::optional<std::vector<float>> times =
-      read_accessor(r, *input, 1, true, &components, &s->error);
+  std::optional<std::vector<float>> times = read_accessor(r, *input, 1, true, &components, &s->error);
   if (!times) return;
-  std::optional<std::vector<float>> values =
-      read_accessor(r, *output, 0, false, &components, &s->error);
+  std::optional<std::vector<float>> values = read_accessor(r, *output, 0, false, &components, &s->error);
   if (!values) return;
   const std::string in_label = "accessor " + std::to_string(*input);
   const std::string out_label = "accessor " + std::to_string(*output);
@@ -468,8 +448,7 @@ void read_sampler_keys(Reader& r, const Json& sampler, Sampler* s) {
   }
   for (size_t i = 0; i < times->size(); ++i) {
     if (!std::isfinite((*times)[i]) || (i > 0 && !((*times)[i] > (*times)[i - 1]))) {
-      s->error = in_label + ": key times are not finite and strictly increasing (key " +
-                 std::to_string(i) + ")";
+      s->error = in_label + ": key times are not finite and strictly increasing (key " + std::to_string(i) + ")";
       return;
     }
   }
@@ -491,8 +470,7 @@ void read_sampler_keys(Reader& r, const Json& sampler, Sampler* s) {
   const size_t elements = values->size() / static_cast<size_t>(components);
   if (elements != times->size() * per_key) {
     s->error = out_label + " holds " + std::to_string(elements) + " elements, " +
-               std::to_string(times->size() * per_key) + " expected for " +
-               std::to_string(times->size()) + " keys";
+               std::to_string(times->size() * per_key) + " expected for " + std::to_string(times->size()) + " keys";
     return;
   }
   for (float v : *values) {

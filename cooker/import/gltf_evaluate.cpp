@@ -22,14 +22,12 @@ void evaluate(const Sampler& s, double time, double snap, double* out) {
   const size_t n = s.times.size();
   const size_t per_key = s.interpolation == Interpolation::CubicSpline ? 3 : 1;
   // The value element of key k (the middle of the triple for CUBICSPLINE).
-  auto value = [&](size_t k, size_t c) -> double {
-    return s.values[(k * per_key + (per_key == 3 ? 1 : 0)) * w + c];
-  };
+  auto value = [&](size_t k, size_t c) -> double { return s.values[(k * per_key + (per_key == 3 ? 1 : 0)) * w + c]; };
   // Keys reached: times[k] <= time + snap.
-  const size_t reached = static_cast<size_t>(
-      std::upper_bound(s.times.begin(), s.times.end(), time + snap,
-                       [](double t, float key) { return t < static_cast<double>(key); }) -
-      s.times.begin());
+  const size_t reached =
+      static_cast<size_t>(std::upper_bound(s.times.begin(), s.times.end(), time + snap,
+                                           [](double t, float key) { return t < static_cast<double>(key); }) -
+                          s.times.begin());
   if (reached == 0 || reached == n || s.interpolation == Interpolation::Step) {
     const size_t k = reached == 0 ? 0 : reached - 1;
     for (size_t c = 0; c < w; ++c) out[c] = value(k, c);
@@ -42,8 +40,7 @@ void evaluate(const Sampler& s, double time, double snap, double* out) {
       // glTF 2.0, Appendix C: p(u) = (2u³-3u²+1)v_k + (u³-2u²+u)Δ·b_k + (-2u³+3u²)v_k+1 +
       // (u³-u²)Δ·a_k+1, b_k the out-tangent of key k, a_k+1 the in-tangent of key k+1.
       const double u2 = u * u, u3 = u2 * u;
-      const double h00 = 2 * u3 - 3 * u2 + 1, h10 = u3 - 2 * u2 + u, h01 = -2 * u3 + 3 * u2,
-                   h11 = u3 - u2;
+      const double h00 = 2 * u3 - 3 * u2 + 1, h10 = u3 - 2 * u2 + u, h01 = -2 * u3 + 3 * u2, h11 = u3 - u2;
       for (size_t c = 0; c < w; ++c) {
         const double b = s.values[(k * 3 + 2) * w + c];
         const double a = s.values[((k + 1) * 3 + 0) * w + c];
@@ -67,8 +64,7 @@ void evaluate(const Sampler& s, double time, double snap, double* out) {
     }
   }
   if (w == 4 && !s.weights) {
-    const double len =
-        std::sqrt(out[0] * out[0] + out[1] * out[1] + out[2] * out[2] + out[3] * out[3]);
+    const double len = std::sqrt(out[0] * out[0] + out[1] * out[1] + out[2] * out[2] + out[3] * out[3]);
     if (len > 1e-12 && std::isfinite(len)) {
       for (size_t c = 0; c < 4; ++c) out[c] /= len;
     }

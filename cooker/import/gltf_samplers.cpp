@@ -60,7 +60,8 @@ Result<Animations> parse_json(const Json& root, std::optional<std::span<const ui
       const Json* extras = get_object(m, "extras");
       const Json* names = extras ? get_array(*extras, "targetNames") : nullptr;
       for (size_t i = 0; i < count; ++i) {
-        const bool named = names && i < names->size() && (*names)[i].is_string() && !(*names)[i].get<std::string>().empty();
+        const bool named =
+            names && i < names->size() && (*names)[i].is_string() && !(*names)[i].get<std::string>().empty();
         targets.names.push_back(named ? (*names)[i].get<std::string>() : "target" + std::to_string(i));
       }
       out.meshes.push_back(std::move(targets));
@@ -137,8 +138,8 @@ Result<Animations> parse_json(const Json& root, std::optional<std::span<const ui
 
 }  // namespace
 
-Result<Animations> parse_gltf_animations(const std::vector<uint8_t>& bytes,
-                                         const std::string& directory, const std::string& label) {
+Result<Animations> parse_gltf_animations(const std::vector<uint8_t>& bytes, const std::string& directory,
+                                         const std::string& label) {
   try {
     std::optional<std::span<const uint8_t>> glb_bin;
     Json root;

@@ -87,8 +87,8 @@ Result<Animations> read_gltf_animations(const std::string& path);
 
 /// As read_gltf_animations, on bytes already in memory; `directory` resolves relative buffer URIs
 /// and `label` starts every message (the file's path).
-Result<Animations> parse_gltf_animations(const std::vector<uint8_t>& bytes,
-                                         const std::string& directory, const std::string& label);
+Result<Animations> parse_gltf_animations(const std::vector<uint8_t>& bytes, const std::string& directory,
+                                         const std::string& label);
 
 /// The name Assimp 5.2.5 gives the aiNode of glTF node `index`: the node's name, or "nodes[i]"
 /// for an unnamed one (checked against Assimp by tests/cooker/gltf_sampler_test.cpp).

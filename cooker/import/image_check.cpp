@@ -35,7 +35,8 @@ namespace {
 /// The size limit every decode checks from the header first: a "claims W x H pixels" error
 /// when a side is not 1..kMaxImageSide or the area is over kMaxImagePixels.
 Status within_limits(int64_t w, int64_t h) {
-  if (w > 0 && h > 0 && w <= kMaxImageSide && h <= kMaxImageSide && uint64_t(w) * uint64_t(h) <= kMaxImagePixels) return {};
+  if (w > 0 && h > 0 && w <= kMaxImageSide && h <= kMaxImageSide && uint64_t(w) * uint64_t(h) <= kMaxImagePixels)
+    return {};
   return Error{"claims " + std::to_string(w) + " x " + std::to_string(h) + " pixels, over the limit of " +
                std::to_string(kMaxImageSide) + " per side and " + std::to_string(kMaxImagePixels) + " pixels"};
 }
@@ -61,16 +62,18 @@ Result<ImageInfo> check_image(std::span<const uint8_t> bytes) {
   int w = 0, h = 0, channels = 0;
   // A PNG's size is in its first chunk: read it here, so a bomb is named as one even where
   // stb_image would only say "unknown image type".
-  const auto be32 = [&](size_t i) { return uint32_t(at(i)) << 24 | uint32_t(at(i + 1)) << 16 | uint32_t(at(i + 2)) << 8 | at(i + 3); };
-  if (info.mime == "image/png" && bytes.size() >= 24 && at(12) == 'I' && at(13) == 'H' && at(14) == 'D' && at(15) == 'R') {
+  const auto be32 = [&](size_t i) {
+    return uint32_t(at(i)) << 24 | uint32_t(at(i + 1)) << 16 | uint32_t(at(i + 2)) << 8 | at(i + 3);
+  };
+  if (info.mime == "image/png" && bytes.size() >= 24 && at(12) == 'I' && at(13) == 'H' && at(14) == 'D' &&
+      at(15) == 'R') {
     if (Status s = within_limits(be32(16), be32(20)); !s) return s.error();
   }
   if (!stbi_info_from_memory(data, size, &w, &h, &channels))
     return Error{"is not a readable " + info.mime.substr(6) + " image: " + stbi_failure_reason()};
   if (Status s = within_limits(w, h); !s) return s.error();
   stbi_uc* pixels = stbi_load_from_memory(data, size, &w, &h, &channels, 0);
-  if (pixels == nullptr)
-    return Error{"does not decode as " + info.mime.substr(6) + ": " + stbi_failure_reason()};
+  if (pixels == nullptr) return Error{"does not decode as " + info.mime.substr(6) + ": " + stbi_failure_reason()};
   stbi_image_free(pixels);
   info.width = w;
   info.height = h;
@@ -132,7 +135,8 @@ Result<DecodedImage> decode_rgba(std::span<const uint8_t> bytes) {
   const auto* data = reinterpret_cast<const stbi_uc*>(bytes.data());
   const int size = static_cast<int>(bytes.size());
   int w = 0, h = 0, channels = 0;
-  if (!stbi_info_from_memory(data, size, &w, &h, &channels)) return Error{std::string("does not decode: ") + stbi_failure_reason()};
+  if (!stbi_info_from_memory(data, size, &w, &h, &channels))
+    return Error{std::string("does not decode: ") + stbi_failure_reason()};
   if (Status s = within_limits(w, h); !s) return s.error();
   stbi_set_flip_vertically_on_load_thread(1);  // this thread's loads only: the format stores rows bottom-up
   stbi_uc* pixels = stbi_load_from_memory(data, size, &w, &h, &channels, 4);

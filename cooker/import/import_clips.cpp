@@ -42,13 +42,11 @@
 namespace ossa::cook::detail {
 namespace {
 
-bool finite3(const aiVector3D& v) {
-  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
-}
+bool finite3(const aiVector3D& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
 template <class Key, class Value, class Convert>
-void take_keys(const Key* keys, unsigned count, std::vector<double>* times, std::vector<Value>* values,
-               Convert convert, size_t* dropped) {
+void take_keys(const Key* keys, unsigned count, std::vector<double>* times, std::vector<Value>* values, Convert convert,
+               size_t* dropped) {
   std::vector<std::pair<double, Value>> pairs;
   pairs.reserve(count);
   for (unsigned i = 0; keys && i < count; ++i) {
@@ -61,8 +59,7 @@ void take_keys(const Key* keys, unsigned count, std::vector<double>* times, std:
       ++*dropped;
     }
   }
-  std::stable_sort(pairs.begin(), pairs.end(),
-                   [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::stable_sort(pairs.begin(), pairs.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
   for (const auto& [t, v] : pairs) {
     times->push_back(t);
     values->push_back(v);
@@ -169,8 +166,8 @@ RawTrack copy_keys(const NodeKeys& k, const glm::dmat4& prefix) {
   return raw;
 }
 
-RawTrack resample_chain(const NodeGraph& graph, const glm::dmat4& prefix,
-                        const std::vector<int>& chain, const std::vector<const NodeKeys*>& keys_of) {
+RawTrack resample_chain(const NodeGraph& graph, const glm::dmat4& prefix, const std::vector<int>& chain,
+                        const std::vector<const NodeKeys*>& keys_of) {
   std::vector<double> times;
   bool before_zero = false;
   for (size_t i = 0; i < chain.size(); ++i) {
@@ -210,8 +207,8 @@ bool has_negative_time(const NodeKeys& k) {
   return false;
 }
 
-RawTrack joint_keys(const NodeGraph& graph, const glm::dmat4& rig_prefix,
-                    const std::vector<int>& chain, const std::vector<const NodeKeys*>& keys_of) {
+RawTrack joint_keys(const NodeGraph& graph, const glm::dmat4& rig_prefix, const std::vector<int>& chain,
+                    const std::vector<const NodeKeys*>& keys_of) {
   size_t animated = 0;
   for (const auto* k : keys_of) animated += k ? 1 : 0;
   const NodeKeys* last = keys_of.back();
@@ -228,9 +225,8 @@ RawTrack joint_keys(const NodeGraph& graph, const glm::dmat4& rig_prefix,
 
 /// Seconds, strictly increasing in float, inside [0, duration]. Returns keys dropped as duplicates.
 template <class In, class Out, class Convert>
-size_t finish_channel(const std::vector<double>& ticks, const std::vector<In>& values, double tps,
-                      float duration, std::vector<float>* times, std::vector<Out>* out,
-                      Convert convert) {
+size_t finish_channel(const std::vector<double>& ticks, const std::vector<In>& values, double tps, float duration,
+                      std::vector<float>* times, std::vector<Out>* out, Convert convert) {
   size_t duplicates = 0;
   for (size_t i = 0; i < ticks.size(); ++i) {
     const float t = std::clamp(static_cast<float>(ticks[i] / tps), 0.0f, duration);
@@ -244,18 +240,14 @@ size_t finish_channel(const std::vector<double>& ticks, const std::vector<In>& v
   return duplicates;
 }
 
-SourceTrack finish_track(const RawTrack& raw, uint16_t joint, double tps, float duration,
-                         size_t* duplicates) {
+SourceTrack finish_track(const RawTrack& raw, uint16_t joint, double tps, float duration, size_t* duplicates) {
   SourceTrack track;
   track.joint = joint;
   auto vec = [](const glm::dvec3& v) { return glm::vec3(v); };
   auto quat = [](const glm::dquat& q) { return glm::normalize(glm::quat(q)); };
-  *duplicates += finish_channel(raw.tt, raw.tv, tps, duration, &track.translation_times,
-                                &track.translations, vec);
-  *duplicates += finish_channel(raw.rt, raw.rv, tps, duration, &track.rotation_times,
-                                &track.rotations, quat);
-  *duplicates += finish_channel(raw.st, raw.sv, tps, duration, &track.scale_times, &track.scales,
-                                vec);
+  *duplicates += finish_channel(raw.tt, raw.tv, tps, duration, &track.translation_times, &track.translations, vec);
+  *duplicates += finish_channel(raw.rt, raw.rv, tps, duration, &track.rotation_times, &track.rotations, quat);
+  *duplicates += finish_channel(raw.st, raw.sv, tps, duration, &track.scale_times, &track.scales, vec);
   for (size_t i = 1; i < track.rotations.size(); ++i) {
     if (glm::dot(track.rotations[i - 1], track.rotations[i]) < 0.0f) {
       track.rotations[i] = -track.rotations[i];
@@ -368,9 +360,9 @@ bool generic_clip_name(const std::string& name, const NodeGraph& graph) {
   for (char& c : n) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   if (graph.by_name.count(n)) return true;
   // A generic word, then an optional separator and number: "take 001", "take_1", "action.001".
-  static const char* const kWords[] = {"mixamo.com", "take", "unreal take", "default take", "default", "action",
-                                       "armatureaction", "animation", "anim", "clip", "motion", "scene",
-                                       "animstack", "base layer", "globalshape"};
+  static const char* const kWords[] = {"mixamo.com", "take",           "unreal take", "default take", "default",
+                                       "action",     "armatureaction", "animation",   "anim",         "clip",
+                                       "motion",     "scene",          "animstack",   "base layer",   "globalshape"};
   for (const char* word : kWords) {
     const std::string w(word);
     if (n.compare(0, w.size(), w) != 0) continue;
@@ -445,8 +437,8 @@ SourceTrack rest_track(const Rig& rig, uint16_t joint) {
 
 /// One track per joint whose chain carries keys, in joint order (and, where the bind pose is the
 /// skins' and not the node pose, one per other joint holding the node pose).
-std::vector<SourceTrack> joint_tracks(const NodeGraph& graph, const Rig& rig, const ClipKeys& keys,
-                                      double tps, float duration, size_t* duplicates) {
+std::vector<SourceTrack> joint_tracks(const NodeGraph& graph, const Rig& rig, const ClipKeys& keys, double tps,
+                                      float duration, size_t* duplicates) {
   std::vector<SourceTrack> tracks;
   for (size_t j = 0; j < rig.chain.size(); ++j) {
     const auto& chain = rig.chain[j];
@@ -475,14 +467,12 @@ std::vector<SourceTrack> joint_tracks(const NodeGraph& graph, const Rig& rig, co
   return tracks;
 }
 
-SourceClip import_clip(const Context& ctx, const NodeGraph& graph, const Rig& rig,
-                       const aiAnimation& anim, unsigned index, const GltfClip* gltf_clip,
-                       std::set<std::string>* names, ClipSummary* summary) {
+SourceClip import_clip(const Context& ctx, const NodeGraph& graph, const Rig& rig, const aiAnimation& anim,
+                       unsigned index, const GltfClip* gltf_clip, std::set<std::string>* names, ClipSummary* summary) {
   SourceClip clip;
   clip.name = clip_name(anim, index, names);
   if (clip.name != std::string(anim.mName.C_Str()) && anim.mName.length) {
-    ctx.warn("clip name '" + std::string(anim.mName.C_Str()) + "' is used twice, renamed '" +
-             clip.name + "'");
+    ctx.warn("clip name '" + std::string(anim.mName.C_Str()) + "' is used twice, renamed '" + clip.name + "'");
   }
   const double tps = ticks_per_second(ctx, anim);
   ClipKeys keys = collect_keys(graph, anim);
@@ -494,8 +484,7 @@ SourceClip import_clip(const Context& ctx, const NodeGraph& graph, const Rig& ri
   }
   const std::string label = "clip '" + clip.name + "': ";
   bool off_grid = false;
-  clip.sample_rate =
-      clip_sample_rate(key_times(keys.keys, tps), estimate_sample_rate(keys.keys, tps), tps, &off_grid);
+  clip.sample_rate = clip_sample_rate(key_times(keys.keys, tps), estimate_sample_rate(keys.keys, tps), tps, &off_grid);
   if (off_grid) {
     ctx.warn(label + "keys are not on any uniform frame grid; resampled at " + std::to_string(clip.sample_rate) +
              " frames per second");
@@ -514,8 +503,7 @@ SourceClip import_clip(const Context& ctx, const NodeGraph& graph, const Rig& ri
     }
   }
   if (gltf_clip && !gltf_clip->kept.empty()) {
-    ctx.warn(label + "glTF STEP / CUBICSPLINE channels kept as Assimp's linear keys: " +
-             join(gltf_clip->kept));
+    ctx.warn(label + "glTF STEP / CUBICSPLINE channels kept as Assimp's linear keys: " + join(gltf_clip->kept));
   }
   size_t duplicates = 0;
   clip.tracks = joint_tracks(graph, rig, keys, tps, clip.duration, &duplicates);
@@ -556,8 +544,7 @@ std::vector<SourceClip> import_clips(const Context& ctx, const NodeGraph& graph,
   for (unsigned a = 0; a < scene.mNumAnimations; ++a) {
     if (!scene.mAnimations[a]) continue;
     const GltfClip* gltf_clip = gltf_samplers ? &gltf_samplers->clips[a] : nullptr;
-    clips.push_back(
-        import_clip(ctx, graph, rig, *scene.mAnimations[a], a, gltf_clip, &names, &summary));
+    clips.push_back(import_clip(ctx, graph, rig, *scene.mAnimations[a], a, gltf_clip, &names, &summary));
   }
   if (no_joints) {
     const size_t before = clips.size();

@@ -59,16 +59,15 @@ std::vector<double> key_times(const std::vector<NodeKeys>& keys, double tps) {
 /// least kMinResampleRate, so every source key, and so every STEP jump, falls on a frame; when no
 /// rate holds them all, max(estimate, kMinResampleRate). Lowered (keeping a multiple where there is
 /// one) when the clip would need more than kMaxFrames frames, never below the estimate.
-float resampling_rate(const std::vector<NodeKeys>& keys, double tps, float estimated,
-                      float duration) {
+float resampling_rate(const std::vector<NodeKeys>& keys, double tps, float estimated, float duration) {
   const std::vector<double> times = key_times(keys, tps);
   double base = 0.0;
   if (estimated > 0.0f && keys_on_grid(times, estimated)) base = estimated;
   for (size_t i = 0; base == 0.0 && i < std::size(kCommonRates); ++i) {
     if (keys_on_grid(times, kCommonRates[i])) base = kCommonRates[i];
   }
-  double rate = base > 0.0 ? base * std::ceil(kMinResampleRate / base - 1e-9)
-                           : std::max<double>(estimated, kMinResampleRate);
+  double rate =
+      base > 0.0 ? base * std::ceil(kMinResampleRate / base - 1e-9) : std::max<double>(estimated, kMinResampleRate);
   const double fit = duration > 0.0f ? static_cast<double>(kMaxFrames - 1) / duration : rate;
   if (rate > fit) {
     const double lowered = base > 0.0 && fit >= base ? base * std::floor(fit / base) : fit;
@@ -126,14 +125,10 @@ namespace {
 
 const char* path_name(gltf::TargetPath p) {
   switch (p) {
-    case gltf::TargetPath::Translation:
-      return "translation";
-    case gltf::TargetPath::Rotation:
-      return "rotation";
-    case gltf::TargetPath::Scale:
-      return "scale";
-    default:
-      return "other";
+    case gltf::TargetPath::Translation: return "translation";
+    case gltf::TargetPath::Rotation: return "rotation";
+    case gltf::TargetPath::Scale: return "scale";
+    default: return "other";
   }
 }
 
@@ -165,8 +160,7 @@ std::vector<int> match_gltf_nodes(const gltf::Animations& file, const NodeGraph&
     pending.pop_back();
     if (n < 0 || used[g]) continue;
     const gltf::Node& node = file.nodes[static_cast<size_t>(n)];
-    if (graph.nodes[g].name != gltf::assimp_node_name(file, n) ||
-        children[g].size() != node.children.size()) {
+    if (graph.nodes[g].name != gltf::assimp_node_name(file, n) || children[g].size() != node.children.size()) {
       continue;
     }
     used[g] = true;
@@ -182,9 +176,8 @@ std::vector<int> match_gltf_nodes(const gltf::Animations& file, const NodeGraph&
 /// Which channels of one glTF animation to resample. Only channels that move a joint (a node on
 /// some joint's chain), that step or curve in a way Assimp's linear keys do not already give, and
 /// whose keys could be read.
-GltfClip plan_gltf_clip(const gltf::Animations& file, const gltf::Animation& anim,
-                        const std::vector<int>& node_of, const NodeGraph& graph,
-                        const std::vector<bool>& on_chain) {
+GltfClip plan_gltf_clip(const gltf::Animations& file, const gltf::Animation& anim, const std::vector<int>& node_of,
+                        const NodeGraph& graph, const std::vector<bool>& on_chain) {
   GltfClip out;
   // (node, path): a second channel on the same target is ignored.
   std::set<std::pair<int, int>> seen;
@@ -222,8 +215,7 @@ GltfClip plan_gltf_clip(const gltf::Animations& file, const gltf::Animation& ani
       continue;
     }
     if (s.width != (ch.path == gltf::TargetPath::Rotation ? 4 : 3)) {
-      out.kept.push_back(what + " (the sampler's output has " + std::to_string(s.width) +
-                         " components)");
+      out.kept.push_back(what + " (the sampler's output has " + std::to_string(s.width) + " components)");
       continue;
     }
     if (graph.resolve(name) != g) {
@@ -242,8 +234,7 @@ GltfClip plan_gltf_clip(const gltf::Animations& file, const gltf::Animation& ani
 
 /// Reads the glTF file behind the scene and plans every clip; nullopt (with a warning when the
 /// file has STEP or CUBICSPLINE samplers or cannot be read) when nothing is to be resampled.
-std::optional<GltfSamplers> read_gltf_samplers(const Context& ctx, const NodeGraph& graph,
-                                               const Rig& rig) {
+std::optional<GltfSamplers> read_gltf_samplers(const Context& ctx, const NodeGraph& graph, const Rig& rig) {
   Result<gltf::Animations> file = gltf::read_gltf_animations(ctx.path);
   const std::string fallback = ": STEP and CUBICSPLINE samplers, if any, are interpolated linearly";
   if (!file) {
@@ -273,8 +264,7 @@ std::optional<GltfSamplers> read_gltf_samplers(const Context& ctx, const NodeGra
     if (!scene.mAnimations[a]) continue;
     if (anim.name != scene.mAnimations[a]->mName.C_Str()) {
       // Assimp keeps the file's order and names; if not, the animations cannot be paired.
-      out.clips[a].kept.push_back("all (the file's animation " + std::to_string(a) + " is named '" +
-                                  anim.name + "')");
+      out.clips[a].kept.push_back("all (the file's animation " + std::to_string(a) + " is named '" + anim.name + "')");
       continue;
     }
     out.clips[a] = plan_gltf_clip(out.file, anim, node_of, graph, on_chain);
@@ -284,8 +274,7 @@ std::optional<GltfSamplers> read_gltf_samplers(const Context& ctx, const NodeGra
 
 /// Replaces one channel of a node's keys with the sampler evaluated at every frame of the grid and
 /// at its own key times, all inside [0, duration]; times in ticks.
-void resample_gltf_channel(const GltfFix& fix, const FrameGrid& grid, float duration, double tps,
-                           NodeKeys* keys) {
+void resample_gltf_channel(const GltfFix& fix, const FrameGrid& grid, float duration, double tps, NodeKeys* keys) {
   const gltf::Sampler& s = *fix.sampler;
   // A ten-thousandth of a frame: far below any real spacing, far above float rounding of a time.
   const double snap = 1e-4 / grid.sample_rate;
@@ -306,8 +295,7 @@ void resample_gltf_channel(const GltfFix& fix, const FrameGrid& grid, float dura
                                    : fix.path == gltf::TargetPath::Rotation  ? &keys->rt
                                                                              : &keys->st;
   out_times->clear();
-  std::vector<glm::dvec3>* out_vec =
-      fix.path == gltf::TargetPath::Translation ? &keys->tv : &keys->sv;
+  std::vector<glm::dvec3>* out_vec = fix.path == gltf::TargetPath::Translation ? &keys->tv : &keys->sv;
   if (fix.path == gltf::TargetPath::Rotation) {
     keys->rv.clear();
   } else {

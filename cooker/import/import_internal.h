@@ -60,16 +60,16 @@ enum class SourceFormat { Fbx, Gltf, Collada, Bvh, Other };
 struct Node {
   const aiNode* ai = nullptr;
   std::string name;
-  int parent = -1;                 // raw Assimp parent
-  int effective_parent = -1;       // nearest ancestor that is not an `$AssimpFbx$` helper
+  int parent = -1;                      // raw Assimp parent
+  int effective_parent = -1;            // nearest ancestor that is not an `$AssimpFbx$` helper
   std::vector<int> effective_children;  // non-helper nodes whose effective parent is this, in order
   glm::dmat4 local{1.0};
   glm::dmat4 global{1.0};
-  bool helper = false;             // an `$AssimpFbx$` pivot/offset node: never a joint
-  bool has_mesh = false;           // holds at least one mesh that is kept
-  bool subtree_has_mesh = false;   // it or a raw descendant has_mesh
-  bool camera_or_light = false;    // never a joint, its keys are dropped
-  int top = 0;                     // the child of the scene root this node lies under (0 for the root)
+  bool helper = false;            // an `$AssimpFbx$` pivot/offset node: never a joint
+  bool has_mesh = false;          // holds at least one mesh that is kept
+  bool subtree_has_mesh = false;  // it or a raw descendant has_mesh
+  bool camera_or_light = false;   // never a joint, its keys are dropped
+  int top = 0;                    // the child of the scene root this node lies under (0 for the root)
 };
 
 /// Every aiNode flattened depth-first (index 0 = the scene root), so node order, and everything
@@ -93,10 +93,10 @@ struct NodeGraph {
 
 struct Context {
   const aiScene* scene = nullptr;
-  std::string path;                       // as given, for messages and relative texture paths
+  std::string path;  // as given, for messages and relative texture paths
   SourceFormat format = SourceFormat::Other;
   const ImportOptions* options = nullptr;
-  std::vector<bool> mesh_kept;            // per aiMesh: false for dropped (lines, generated skeleton)
+  std::vector<bool> mesh_kept;  // per aiMesh: false for dropped (lines, generated skeleton)
   std::vector<std::string>* warnings = nullptr;
   /// A problem that must fail the import after the stage that found it (a texture that is not the
   /// image it claims to be); the first one is kept.
@@ -160,8 +160,8 @@ std::vector<SourceClip> import_clips(const Context& ctx, const NodeGraph& graph,
 
 /// One SourceMesh per (kept aiMesh, node instance) (import_meshes.cpp). Adds to
 /// *vertices_over_4_influences.
-Result<std::vector<SourceMesh>> import_meshes(const Context& ctx, const NodeGraph& graph,
-                                              const Rig& rig, uint32_t* vertices_over_4_influences);
+Result<std::vector<SourceMesh>> import_meshes(const Context& ctx, const NodeGraph& graph, const Rig& rig,
+                                              uint32_t* vertices_over_4_influences);
 
 /// Whether mesh m is the bone display mesh Assimp builds for files without meshes (BVH, rig-only
 /// Collada), never part of the source (import_meshes.cpp).
@@ -177,8 +177,8 @@ std::vector<SourceMaterial> import_materials(const Context& ctx);
 float metres_per_unit(const Context& ctx);
 
 /// The whole conversion, after Assimp has read the file (import_scene.cpp).
-Result<SourceScene> convert_scene(const aiScene& scene, const std::string& path,
-                                  SourceFormat format, const ImportOptions& options);
+Result<SourceScene> convert_scene(const aiScene& scene, const std::string& path, SourceFormat format,
+                                  const ImportOptions& options);
 
 SourceFormat format_of(const std::string& path);
 

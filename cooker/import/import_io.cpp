@@ -78,7 +78,8 @@ bool LoggedIOSystem::Exists(const char* path) const {
 }
 
 Assimp::IOStream* LoggedIOSystem::Open(const char* path, const char* mode) {
-  if (path == nullptr || (mode != nullptr && (std::strchr(mode, 'w') || std::strchr(mode, 'a') || std::strchr(mode, '+'))))
+  if (path == nullptr ||
+      (mode != nullptr && (std::strchr(mode, 'w') || std::strchr(mode, 'a') || std::strchr(mode, '+'))))
     return nullptr;
   const std::string resolved = resolve(path);
   path = resolved.c_str();

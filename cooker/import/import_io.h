@@ -36,8 +36,8 @@ class LoggedIOSystem : public Assimp::IOSystem {
   /// those a scene names as they are (LightWave's LoadObjectLayer) stay relative.
   std::string resolve(const char* path) const;
 
-  std::string main_;     // absolute, lexically normal
-  std::string folder_;   // main_'s folder
+  std::string main_;    // absolute, lexically normal
+  std::string folder_;  // main_'s folder
   std::string refused_;
 };
 

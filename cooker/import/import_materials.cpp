@@ -50,8 +50,7 @@ bool read_file(const std::filesystem::path& file, std::vector<uint8_t>* bytes, c
 
 /// The texture file a material names: as written relative to the source, then just its file name
 /// next to the source (authoring tools often store absolute paths from another machine).
-bool read_external(const Context& ctx, const std::string& path, std::vector<uint8_t>* bytes,
-                   const std::string& label) {
+bool read_external(const Context& ctx, const std::string& path, std::vector<uint8_t>* bytes, const std::string& label) {
   const std::string reference = label + "'s texture '" + path + "'";
   const std::filesystem::path dir = std::filesystem::path(ctx.path).parent_path();
   const std::filesystem::path as_written(path);
@@ -165,8 +164,8 @@ void import_pbr(const Context& ctx, const aiMaterial& mat, const std::string& la
     out.textures.push_back(std::move(tex));
   }
   tex = {};
-  if (find_texture(ctx, mat, {aiTextureType_AMBIENT_OCCLUSION, aiTextureType_LIGHTMAP}, TextureRole::Occlusion,
-                   label, &tex)) {
+  if (find_texture(ctx, mat, {aiTextureType_AMBIENT_OCCLUSION, aiTextureType_LIGHTMAP}, TextureRole::Occlusion, label,
+                   &tex)) {
     out.textures.push_back(std::move(tex));
   }
   float metallic = 1.0f, roughness = 1.0f;
@@ -185,7 +184,8 @@ void import_pbr(const Context& ctx, const aiMaterial& mat, const std::string& la
   if (!has_metalness_map && !has_roughness_map) return;
   if (ctx.format != SourceFormat::Gltf || !has_metalness_map || !has_roughness_map ||
       std::string(metalness.C_Str()) != rough.C_Str()) {
-    ctx.warn(label + ": separate metalness / roughness maps are not cooked (only glTF's combined metallic-roughness "
+    ctx.warn(label +
+             ": separate metalness / roughness maps are not cooked (only glTF's combined metallic-roughness "
              "texture is)");
     return;
   }
@@ -205,8 +205,7 @@ SourceMaterial import_material(const Context& ctx, const aiMaterial& mat, unsign
   }
   get_color(mat, AI_MATKEY_COLOR_SPECULAR, &out.specular);
   float shininess = 0.0f;
-  if (mat.Get(AI_MATKEY_SHININESS, shininess) == AI_SUCCESS && std::isfinite(shininess) &&
-      shininess > 0.0f) {
+  if (mat.Get(AI_MATKEY_SHININESS, shininess) == AI_SUCCESS && std::isfinite(shininess) && shininess > 0.0f) {
     out.shininess = shininess;
   } else {
     out.shininess = kDefaultShininess;
@@ -217,13 +216,11 @@ SourceMaterial import_material(const Context& ctx, const aiMaterial& mat, unsign
   }
   const std::string label = "material '" + out.name + "' (" + std::to_string(index) + ")";
   SourceTexture tex;
-  if (find_texture(ctx, mat, {aiTextureType_DIFFUSE, aiTextureType_BASE_COLOR}, TextureRole::Diffuse,
-                   label, &tex)) {
+  if (find_texture(ctx, mat, {aiTextureType_DIFFUSE, aiTextureType_BASE_COLOR}, TextureRole::Diffuse, label, &tex)) {
     out.textures.push_back(std::move(tex));
   }
   tex = {};
-  if (find_texture(ctx, mat, {aiTextureType_NORMALS, aiTextureType_NORMAL_CAMERA},
-                   TextureRole::Normal, label, &tex)) {
+  if (find_texture(ctx, mat, {aiTextureType_NORMALS, aiTextureType_NORMAL_CAMERA}, TextureRole::Normal, label, &tex)) {
     out.textures.push_back(std::move(tex));
   }
   tex = {};
@@ -278,8 +275,7 @@ float metres_per_unit(const Context& ctx) {
       ctx.warn("BVH states no length unit: 1 metre per unit assumed");
       return 1.0f;
     case SourceFormat::Gltf:  // glTF is metres by specification
-    case SourceFormat::Other:
-      return 1.0f;
+    case SourceFormat::Other: return 1.0f;
   }
   return 1.0f;
 }

@@ -43,11 +43,8 @@ struct Influence {
 };
 
 /// Largest 4, renormalized, largest first, unused slots (joint 0, weight 0). false when no weight.
-bool cap_influences(std::vector<Influence>* list, std::array<uint16_t, 4>* joints,
-                    glm::vec4* weights, bool* lost) {
-  std::sort(list->begin(), list->end(), [](const Influence& a, const Influence& b) {
-    return a.joint < b.joint;
-  });
+bool cap_influences(std::vector<Influence>* list, std::array<uint16_t, 4>* joints, glm::vec4* weights, bool* lost) {
+  std::sort(list->begin(), list->end(), [](const Influence& a, const Influence& b) { return a.joint < b.joint; });
   std::vector<Influence> merged;  // a joint named by two bones counts once
   for (const Influence& in : *list) {
     if (!merged.empty() && merged.back().joint == in.joint) {
@@ -56,9 +53,8 @@ bool cap_influences(std::vector<Influence>* list, std::array<uint16_t, 4>* joint
       merged.push_back(in);
     }
   }
-  std::stable_sort(merged.begin(), merged.end(), [](const Influence& a, const Influence& b) {
-    return a.weight > b.weight;
-  });
+  std::stable_sort(merged.begin(), merged.end(),
+                   [](const Influence& a, const Influence& b) { return a.weight > b.weight; });
   *lost = merged.size() > 4;
   if (merged.size() > 4) merged.resize(4);
   float sum = 0.0f;
@@ -107,8 +103,7 @@ void repair_normals(SourceMesh* mesh, size_t* repaired) {
   if (!any) return;
   for (size_t i = 0; i + 2 < mesh->indices.size(); i += 3) {
     const uint32_t a = mesh->indices[i], b = mesh->indices[i + 1], c = mesh->indices[i + 2];
-    const glm::vec3 face = glm::cross(mesh->positions[b] - mesh->positions[a],
-                                      mesh->positions[c] - mesh->positions[a]);
+    const glm::vec3 face = glm::cross(mesh->positions[b] - mesh->positions[a], mesh->positions[c] - mesh->positions[a]);
     for (uint32_t v : {a, b, c}) {
       if (bad[v]) mesh->normals[v] += face;
     }
@@ -161,8 +156,8 @@ bool copy_geometry(const aiMesh& in, SourceFormat format, SourceMesh* out, size_
       out->colors.emplace_back(c.r, c.g, c.b, c.a);
       for (int k = 0; k < 4; ++k) all_white = all_white && !(out->colors.back()[k] < kWhite);
     }
-    const bool alpha_lost = format == SourceFormat::Gltf &&
-                            std::all_of(out->colors.begin(), out->colors.end(), [](const glm::vec4& c) { return c.a == 0.0f; });
+    const bool alpha_lost = format == SourceFormat::Gltf && std::all_of(out->colors.begin(), out->colors.end(),
+                                                                        [](const glm::vec4& c) { return c.a == 0.0f; });
     if (alpha_lost) {
       all_white = true;
       for (glm::vec4& c : out->colors) {
@@ -181,8 +176,7 @@ bool copy_geometry(const aiMesh& in, SourceFormat format, SourceMesh* out, size_
   }
   for (unsigned f = 0; f < in.mNumFaces; ++f) {
     const aiFace& face = in.mFaces[f];
-    if (face.mNumIndices != 3 || face.mIndices[0] >= nv || face.mIndices[1] >= nv ||
-        face.mIndices[2] >= nv) {
+    if (face.mNumIndices != 3 || face.mIndices[0] >= nv || face.mIndices[1] >= nv || face.mIndices[2] >= nv) {
       ++*dropped_faces;
       continue;
     }
@@ -267,8 +261,7 @@ struct MeshStats {
 };
 
 /// Influences from the mesh's bones; false when none of its bones is a joint.
-bool skin(const aiMesh& in, const NodeGraph& graph, const Rig& rig, int node, SourceMesh* out,
-          MeshStats* stats) {
+bool skin(const aiMesh& in, const NodeGraph& graph, const Rig& rig, int node, SourceMesh* out, MeshStats* stats) {
   const unsigned nv = in.mNumVertices;
   std::vector<std::vector<Influence>> per_vertex(nv);
   std::map<uint16_t, glm::mat4> bind;  // sorted by joint; a joint named twice keeps its first bone
@@ -322,8 +315,8 @@ bool skin(const aiMesh& in, const NodeGraph& graph, const Rig& rig, int node, So
   return true;
 }
 
-void import_instance(const Context& ctx, const NodeGraph& graph, const Rig& rig, unsigned mesh_index,
-                     int node, std::vector<SourceMesh>* meshes, MeshStats* stats) {
+void import_instance(const Context& ctx, const NodeGraph& graph, const Rig& rig, unsigned mesh_index, int node,
+                     std::vector<SourceMesh>* meshes, MeshStats* stats) {
   const aiMesh& in = *ctx.scene->mMeshes[mesh_index];
   SourceMesh out;
   out.name = in.mName.length ? in.mName.C_Str() : graph.nodes[node].name;
@@ -361,8 +354,7 @@ void report(const Context& ctx, const MeshStats& stats) {
   }
   for (const auto& name : stats.empty) ctx.warn("mesh '" + name + "' has no triangles, dropped");
   if (stats.repaired_normals) {
-    ctx.warn(std::to_string(stats.repaired_normals) +
-             " zero or non-finite normals replaced by their faces' normal");
+    ctx.warn(std::to_string(stats.repaired_normals) + " zero or non-finite normals replaced by their faces' normal");
   }
   if (stats.unweighted) {
     ctx.warn(std::to_string(stats.unweighted) +
@@ -414,8 +406,8 @@ std::vector<bool> select_meshes(const Context& ctx) {
   return kept;
 }
 
-Result<std::vector<SourceMesh>> import_meshes(const Context& ctx, const NodeGraph& graph,
-                                              const Rig& rig, uint32_t* vertices_over_4_influences) {
+Result<std::vector<SourceMesh>> import_meshes(const Context& ctx, const NodeGraph& graph, const Rig& rig,
+                                              uint32_t* vertices_over_4_influences) {
   std::vector<SourceMesh> meshes;
   MeshStats stats;
   for (size_t n = 0; n < graph.nodes.size(); ++n) {

@@ -99,8 +99,7 @@ Seeds find_seeds(const Context& ctx, const NodeGraph& graph) {
     }
   }
   if (!missing_bones.empty()) {
-    ctx.warn("bones name nodes the file does not have, their weights are dropped: " +
-             name_list(missing_bones));
+    ctx.warn("bones name nodes the file does not have, their weights are dropped: " + name_list(missing_bones));
   }
   if (!missing_channels.empty()) {
     ctx.warn("animation channels name nodes the file does not have, their keys are dropped: " +
@@ -169,8 +168,7 @@ std::vector<int> rig_seeds(const Context& ctx, const NodeGraph& graph, const See
     }
   }
   if (!outside.empty()) {
-    ctx.warn("animated nodes outside the skeleton are not joints, their keys are dropped: " +
-             name_list(outside));
+    ctx.warn("animated nodes outside the skeleton are not joints, their keys are dropped: " + name_list(outside));
   }
   return kept;
 }
@@ -214,8 +212,7 @@ int skeleton_root(const NodeGraph& graph, const std::vector<int>& seeds) {
   if (lca == 0) return lca;
   int highest = lca;  // the top-level node, or the joint its `$AssimpFbx$` helpers belong to
   while (graph.nodes[highest].effective_parent > 0) highest = graph.nodes[highest].effective_parent;
-  if (highest != lca && !graph.nodes[highest].camera_or_light &&
-      !graph.nodes[graph.nodes[lca].top].subtree_has_mesh) {
+  if (highest != lca && !graph.nodes[highest].camera_or_light && !graph.nodes[graph.nodes[lca].top].subtree_has_mesh) {
     return highest;
   }
   return lca;
@@ -291,12 +288,13 @@ void fill_bind_pose(const Context& ctx, const NodeGraph& graph, Rig* rig) {
     }
   }
   if (!sheared.empty()) {
-    ctx.warn("bind transforms with shear cannot be held as translation/rotation/scale, these "
-             "joints' model matrices differ from the source: " + name_list(sheared));
+    ctx.warn(
+        "bind transforms with shear cannot be held as translation/rotation/scale, these "
+        "joints' model matrices differ from the source: " +
+        name_list(sheared));
   }
   if (!singular.empty()) {
-    ctx.warn("joints with a singular bind matrix get an identity inverse bind: " +
-             name_list(singular));
+    ctx.warn("joints with a singular bind matrix get an identity inverse bind: " + name_list(singular));
   }
 }
 
@@ -305,8 +303,8 @@ void fill_bind_pose(const Context& ctx, const NodeGraph& graph, Rig* rig) {
 /// the T-pose; the skeleton's bind pose (the viewer's bind pose, additive references, the rest a
 /// game resets to) must be the latter. Bone j of a mesh held by node n was bound at model matrix
 /// global(n) x inverse(offset); the first mesh naming a joint decides (glTF keeps its node pose,
-/// see below). Joints no skin names keep their node-pose local under their (possibly moved) parent. Nothing changes when every bound
-/// matrix agrees with the node pose to kBindTolerance (most files), so those cook as before.
+/// see below). Joints no skin names keep their node-pose local under their (possibly moved) parent. Nothing changes
+/// when every bound matrix agrees with the node pose to kBindTolerance (most files), so those cook as before.
 void adopt_mesh_bind_pose(const Context& ctx, const NodeGraph& graph, Rig* rig) {
   const size_t count = rig->skeleton.joints.size();
   // glTF: the node pose is the rest pose by the specification, and its inverse bind matrices need
@@ -409,8 +407,8 @@ void name_unnamed_joints(const Context& ctx, SourceSkeleton* skeleton) {
     named.push_back(name);
   }
   if (!named.empty()) {
-    ctx.warn(std::to_string(named.size()) + " joints have no name in the source and are named by their index: " +
-             name_list(named));
+    ctx.warn(std::to_string(named.size()) +
+             " joints have no name in the source and are named by their index: " + name_list(named));
   }
 }
 
@@ -435,8 +433,10 @@ void make_names_unique(const Context& ctx, const NodeGraph& graph, Rig* rig) {
     joint.name = name;
   }
   if (!renamed.empty()) {
-    ctx.warn(std::to_string(renamed.size()) + " joints share a name with another joint (several armatures) "
-             "and are renamed: " + name_list(renamed));
+    ctx.warn(std::to_string(renamed.size()) +
+             " joints share a name with another joint (several armatures) "
+             "and are renamed: " +
+             name_list(renamed));
   }
 }
 
@@ -494,8 +494,8 @@ std::vector<int> rig_only_seeds(const Context& ctx, const NodeGraph& graph) {
   for (size_t n = 1; n < graph.nodes.size(); ++n)
     if (graph.nodes[n].top == static_cast<int>(top) && !graph.nodes[n].helper && !graph.nodes[n].camera_or_light)
       seeds.push_back(static_cast<int>(n));
-  ctx.warn("the file holds no mesh and no animation: its node tree under '" + graph.nodes[top].name +
-           "' (" + std::to_string(seeds.size()) + " nodes) is cooked as a skeleton");
+  ctx.warn("the file holds no mesh and no animation: its node tree under '" + graph.nodes[top].name + "' (" +
+           std::to_string(seeds.size()) + " nodes) is cooked as a skeleton");
   return seeds;
 }
 

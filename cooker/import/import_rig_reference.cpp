@@ -38,8 +38,7 @@ std::string loose_name(const std::string& name) {
 bool joinable(const Node& node) { return !node.helper && !node.camera_or_light; }
 
 /// File node per reference joint (-1 when absent): exact names first, then loose ones.
-std::vector<int> match_reference(const Context& ctx, const NodeGraph& graph,
-                                 const SourceSkeleton& ref) {
+std::vector<int> match_reference(const Context& ctx, const NodeGraph& graph, const SourceSkeleton& ref) {
   const size_t count = ref.joints.size();
   std::vector<int> node(count, -1);
   std::vector<bool> taken(graph.nodes.size(), false);
@@ -69,8 +68,7 @@ std::vector<int> match_reference(const Context& ctx, const NodeGraph& graph,
     matched.push_back(graph.nodes[free.front()].name + " -> " + ref.joints[r].name);
   }
   if (!matched.empty()) {
-    ctx.warn("joints matched to the reference by letters and digits only: " +
-             name_list(matched));
+    ctx.warn("joints matched to the reference by letters and digits only: " + name_list(matched));
   }
   return node;
 }
@@ -81,8 +79,8 @@ Status check_reference(const Context& ctx, const SourceSkeleton& ref) {
   for (size_t j = 0; j < ref.joints.size(); ++j) {
     const int p = ref.joints[j].parent;
     if (p >= static_cast<int>(j) || p < -1 || (j > 0 && p < 0) || (j == 0 && p != -1)) {
-      return ctx.error("the reference skeleton is not parents-first with one root (joint '" +
-                       ref.joints[j].name + "')");
+      return ctx.error("the reference skeleton is not parents-first with one root (joint '" + ref.joints[j].name +
+                       "')");
     }
   }
   return {};
@@ -94,8 +92,8 @@ void reference_chains(const Context& ctx, const NodeGraph& graph, Rig* rig) {
   const auto& joints = rig->skeleton.joints;
   std::vector<glm::dmat4> ref_model(joints.size());
   for (size_t r = 0; r < joints.size(); ++r) {
-    const glm::dmat4 local = compose({glm::dvec3(joints[r].translation),
-                                      glm::dquat(joints[r].rotation), glm::dvec3(joints[r].scale)});
+    const glm::dmat4 local =
+        compose({glm::dvec3(joints[r].translation), glm::dquat(joints[r].rotation), glm::dvec3(joints[r].scale)});
     ref_model[r] = joints[r].parent < 0 ? local : ref_model[joints[r].parent] * local;
   }
   std::vector<std::string> moved;
@@ -127,8 +125,7 @@ void reference_chains(const Context& ctx, const NodeGraph& graph, Rig* rig) {
     }
   }
   if (!moved.empty()) {
-    ctx.warn("joints whose parent in the file differs from the reference are not matched: " +
-             name_list(moved));
+    ctx.warn("joints whose parent in the file differs from the reference are not matched: " + name_list(moved));
   }
 }
 
@@ -184,8 +181,7 @@ void check_root_scale(const Context& ctx, const NodeGraph& graph, const Rig& rig
 
 }  // namespace
 
-Result<Rig> reference_rig(const Context& ctx, const NodeGraph& graph, const Seeds& seeds,
-                          const SourceSkeleton& ref) {
+Result<Rig> reference_rig(const Context& ctx, const NodeGraph& graph, const Seeds& seeds, const SourceSkeleton& ref) {
   if (Status s = check_reference(ctx, ref); !s) return s.error();
   Rig rig;
   rig.skeleton = ref;

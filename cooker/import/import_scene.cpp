@@ -79,8 +79,7 @@ Result<SourceScene> convert_scene(const aiScene& scene, const std::string& path,
   Result<Rig> rig = build_rig(ctx, graph);
   if (!rig) return rig.error();
   out.clips = import_clips(ctx, graph, *rig);
-  Result<std::vector<SourceMesh>> meshes =
-      import_meshes(ctx, graph, *rig, &out.vertices_over_4_influences);
+  Result<std::vector<SourceMesh>> meshes = import_meshes(ctx, graph, *rig, &out.vertices_over_4_influences);
   if (!meshes) return meshes.error();
   out.meshes = std::move(*meshes);
   out.materials = import_materials(ctx);
@@ -98,7 +97,8 @@ Result<SourceScene> convert_scene(const aiScene& scene, const std::string& path,
   if (out.skeleton.joints.empty() && out.meshes.empty() && out.clips.empty()) {
     unsigned open_meshes = 0;
     for (unsigned m = 0; m < scene.mNumMeshes; ++m)
-      if (scene.mMeshes[m] && scene.mMeshes[m]->mNumVertices && !(scene.mMeshes[m]->mPrimitiveTypes & aiPrimitiveType_TRIANGLE))
+      if (scene.mMeshes[m] && scene.mMeshes[m]->mNumVertices &&
+          !(scene.mMeshes[m]->mPrimitiveTypes & aiPrimitiveType_TRIANGLE))
         ++open_meshes;
     if (open_meshes != 0 && open_meshes == scene.mNumMeshes) {
       return ctx.error("its " + std::to_string(open_meshes) + (open_meshes == 1 ? " mesh holds" : " meshes hold") +
@@ -131,8 +131,8 @@ bool wants_tangents(const aiScene& scene) {
     if (!mesh || mesh->mTangents || !mesh->mNormals || !mesh->mTextureCoords[0]) continue;
     if (mesh->mMaterialIndex >= scene.mNumMaterials) continue;
     const aiMaterial* mat = scene.mMaterials[mesh->mMaterialIndex];
-    if (mat && (mat->GetTextureCount(aiTextureType_NORMALS) > 0 ||
-                mat->GetTextureCount(aiTextureType_NORMAL_CAMERA) > 0)) {
+    if (mat &&
+        (mat->GetTextureCount(aiTextureType_NORMALS) > 0 || mat->GetTextureCount(aiTextureType_NORMAL_CAMERA) > 0)) {
       return true;
     }
   }

@@ -17,7 +17,9 @@ using Json = nlohmann::json;
 constexpr uint32_t kGlbMagic = 0x46546C67;   // "glTF"
 constexpr uint32_t kChunkJson = 0x4E4F534A;  // "JSON"
 
-uint32_t u32(const uint8_t* p) { return uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24; }
+uint32_t u32(const uint8_t* p) {
+  return uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24;
+}
 void put_u32(std::vector<uint8_t>& out, uint32_t v) {
   for (int i = 0; i < 4; ++i) out.push_back(static_cast<uint8_t>(v >> (8 * i)));
 }
@@ -211,10 +213,8 @@ uint64_t collada_node_depth(std::span<const uint8_t> bytes) {
         state[n] = 1;
         bool cycle = false;
         edges(n, [&](uint32_t c) {
-          if (state[c] == 0)
-            stack.push_back(c);
-          else if (state[c] == 1)
-            cycle = true;
+          if (state[c] == 0) stack.push_back(c);
+          else if (state[c] == 1) cycle = true;
         });
         if (cycle) return uint64_t{kMaxHierarchyDepth} + 1;
         continue;
@@ -297,8 +297,10 @@ bool add_identity_inverse_binds(Json& root) {
       }
     for (const char* key : {"buffers", "bufferViews", "accessors"})
       if (!root.contains(key) || !root[key].is_array()) root[key] = Json::array();
-    const size_t buffer = root["buffers"].size(), view = root["bufferViews"].size(), accessor = root["accessors"].size();
-    root["buffers"].push_back({{"byteLength", bytes.size()}, {"uri", "data:application/octet-stream;base64," + base64(bytes)}});
+    const size_t buffer = root["buffers"].size(), view = root["bufferViews"].size(),
+                 accessor = root["accessors"].size();
+    root["buffers"].push_back(
+        {{"byteLength", bytes.size()}, {"uri", "data:application/octet-stream;base64," + base64(bytes)}});
     root["bufferViews"].push_back({{"buffer", buffer}, {"byteLength", bytes.size()}});
     root["accessors"].push_back({{"bufferView", view}, {"componentType", 5126}, {"count", count}, {"type", "MAT4"}});
     skin["inverseBindMatrices"] = accessor;
@@ -326,7 +328,8 @@ std::optional<Error> check_skins(const Json& root) {
     if (skin.contains("inverseBindMatrices")) {
       const Json& ibm = skin["inverseBindMatrices"];
       if (!ibm.is_number_unsigned() || ibm.get<uint64_t>() >= accessors)
-        return Error{at + ": \"inverseBindMatrices\" is not the index of an accessor (" + ibm.dump().substr(0, 40) + ")"};
+        return Error{at + ": \"inverseBindMatrices\" is not the index of an accessor (" + ibm.dump().substr(0, 40) +
+                     ")"};
     }
   }
   return std::nullopt;
@@ -338,7 +341,8 @@ Result<std::optional<std::vector<uint8_t>>> precheck_gltf(std::span<const uint8_
   if (glb) {
     // Assimp's messages for a broken container are about its consequences ("no meshes"); the
     // container's own story is plain: say it.
-    if (bytes.size() < 20) return Error{"is a GLB file shorter than its 20-byte header (" + std::to_string(bytes.size()) + " bytes)"};
+    if (bytes.size() < 20)
+      return Error{"is a GLB file shorter than its 20-byte header (" + std::to_string(bytes.size()) + " bytes)"};
     const uint32_t declared = u32(bytes.data() + 8);
     if (declared > bytes.size())
       return Error{"is a GLB file that declares " + std::to_string(declared) + " bytes but has " +
@@ -358,7 +362,8 @@ Result<std::optional<std::vector<uint8_t>>> precheck_gltf(std::span<const uint8_
     // Assimp would say "No suitable reader found" for a .gltf that is not JSON.
     std::string what = e.what();
     if (const size_t at = what.find("parse error"); at != std::string::npos) what = what.substr(at);
-    return Error{std::string("is not valid glTF JSON (") + (json_at + e.byte >= bytes.size() ? "truncated? " : "") + what + ")"};
+    return Error{std::string("is not valid glTF JSON (") + (json_at + e.byte >= bytes.size() ? "truncated? " : "") +
+                 what + ")"};
   }
   if (!root.is_object()) return Error{"is not a glTF document (its JSON is not an object)"};
   if (const uint64_t depth = gltf_depth(root); depth > kMaxHierarchyDepth) return too_deep(depth, "node tree");
@@ -366,9 +371,10 @@ Result<std::optional<std::vector<uint8_t>>> precheck_gltf(std::span<const uint8_
   // name joints rather than index them: the 2.0 checks and fix-ups below do not apply (Assimp's
   // glTF 1.0 reader has its own). 1.0 is told by asset.version, or by a file with no "asset" at all.
   const Json* version = root.contains("asset") && root["asset"].is_object() && root["asset"].contains("version")
-                            ? &root["asset"]["version"] : nullptr;
-  const bool gltf1 = !root.contains("asset") ||
-                     (version && version->is_string() && version->get<std::string>().starts_with("1"));
+                            ? &root["asset"]["version"]
+                            : nullptr;
+  const bool gltf1 =
+      !root.contains("asset") || (version && version->is_string() && version->get<std::string>().starts_with("1"));
   if (gltf1) return std::optional<std::vector<uint8_t>>{};
   if (auto bad = check_skins(root)) return *bad;
   if (!add_identity_inverse_binds(root)) return std::optional<std::vector<uint8_t>>{};
@@ -391,7 +397,8 @@ Result<std::optional<std::vector<uint8_t>>> precheck_gltf(std::span<const uint8_
 
 }  // namespace
 
-Result<std::optional<std::vector<uint8_t>>> precheck_source(std::span<const uint8_t> bytes, const std::string& extension) {
+Result<std::optional<std::vector<uint8_t>>> precheck_source(std::span<const uint8_t> bytes,
+                                                            const std::string& extension) {
   try {
     if (extension == ".gltf" || extension == ".glb") return precheck_gltf(bytes);
     if (extension == ".bvh") {
@@ -402,9 +409,11 @@ Result<std::optional<std::vector<uint8_t>>> precheck_source(std::span<const uint
         size_t i = at + 7;
         while (i < text.size() && (text[i] == ' ' || text[i] == '\t')) ++i;
         const bool negative = i < text.size() && text[i] == '-';
-        const bool zero = i < text.size() && text[i] == '0' && (i + 1 >= text.size() || !std::isdigit(static_cast<unsigned char>(text[i + 1])));
+        const bool zero = i < text.size() && text[i] == '0' &&
+                          (i + 1 >= text.size() || !std::isdigit(static_cast<unsigned char>(text[i + 1])));
         if (negative || zero)
-          return Error{"declares \"Frames: " + std::string(text.substr(i, std::min<size_t>(12, text.find_first_of("\r\n", i) - i))) +
+          return Error{"declares \"Frames: " +
+                       std::string(text.substr(i, std::min<size_t>(12, text.find_first_of("\r\n", i) - i))) +
                        "\": a BVH motion needs at least one frame"};
       }
     } else if (extension == ".dae") {
@@ -412,7 +421,8 @@ Result<std::optional<std::vector<uint8_t>>> precheck_source(std::span<const uint
         return too_deep(d, "node tree (nested <node>s and the <instance_node>s they expand)");
     } else if (extension == ".fbx") {
       constexpr std::string_view kBinary = "Kaydara FBX Binary  ";
-      const bool binary = bytes.size() >= kBinary.size() && std::memcmp(bytes.data(), kBinary.data(), kBinary.size()) == 0;
+      const bool binary =
+          bytes.size() >= kBinary.size() && std::memcmp(bytes.data(), kBinary.data(), kBinary.size()) == 0;
       const uint64_t d = binary ? fbx_binary_depth(bytes) : brace_depth(bytes, true);
       if (d > kMaxHierarchyDepth) return too_deep(d, "record tree");
     }

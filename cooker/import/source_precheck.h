@@ -33,6 +33,6 @@ inline constexpr uint32_t kMaxHierarchyDepth = 1000;
 /// Returns the bytes Assimp should read: unchanged (nullopt) or patched. The error names no file
 /// (the caller does). O(file size).
 Result<std::optional<std::vector<uint8_t>>> precheck_source(std::span<const uint8_t> bytes,
-                                                             const std::string& extension);
+                                                            const std::string& extension);
 
 }  // namespace ossa::cook

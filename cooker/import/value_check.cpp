@@ -58,15 +58,18 @@ Status check_scene_values(const SourceScene& scene) {
     const SourceJoint& sj = joints[j];
     if (!bounded(sj.translation))
       return Error{"joint " + joint_name(j) + ": bind translation " + text(sj.translation) + " is unusable" + kBound};
-    if (!bounded(sj.scale)) return Error{"joint " + joint_name(j) + ": bind scale " + text(sj.scale) + " is unusable" + kBound};
+    if (!bounded(sj.scale))
+      return Error{"joint " + joint_name(j) + ": bind scale " + text(sj.scale) + " is unusable" + kBound};
     if (!usable(sj.rotation))
-      return Error{"joint " + joint_name(j) + ": bind rotation " + text(sj.rotation) + " is not a finite, non-zero quaternion"};
+      return Error{"joint " + joint_name(j) + ": bind rotation " + text(sj.rotation) +
+                   " is not a finite, non-zero quaternion"};
     if (!finite(sj.inverse_bind)) return Error{"joint " + joint_name(j) + ": its inverse bind matrix is not finite"};
   }
   for (const SourceMesh& mesh : scene.meshes) {
     const std::string m = "mesh " + quoted(mesh.name);
     for (size_t v = 0; v < mesh.positions.size(); ++v)
-      if (!finite(mesh.positions[v])) return Error{m + ": vertex " + std::to_string(v) + " position " + text(mesh.positions[v]) + " is not finite"};
+      if (!finite(mesh.positions[v]))
+        return Error{m + ": vertex " + std::to_string(v) + " position " + text(mesh.positions[v]) + " is not finite"};
     for (size_t v = 0; v < mesh.normals.size(); ++v)
       if (!finite(mesh.normals[v])) return Error{m + ": vertex " + std::to_string(v) + " normal is not finite"};
     for (size_t v = 0; v < mesh.uv0.size(); ++v)
@@ -74,16 +77,20 @@ Status check_scene_values(const SourceScene& scene) {
         return Error{m + ": vertex " + std::to_string(v) + " texture coordinate is not finite"};
     for (size_t v = 0; v < mesh.colors.size(); ++v)
       for (int k = 0; k < 4; ++k)
-        if (!std::isfinite(mesh.colors[v][k])) return Error{m + ": vertex " + std::to_string(v) + " colour is not finite"};
+        if (!std::isfinite(mesh.colors[v][k]))
+          return Error{m + ": vertex " + std::to_string(v) + " colour is not finite"};
     for (size_t v = 0; v < mesh.weights.size(); ++v)
       for (int k = 0; k < 4; ++k)
-        if (!std::isfinite(mesh.weights[v][k])) return Error{m + ": vertex " + std::to_string(v) + " weight is not finite"};
+        if (!std::isfinite(mesh.weights[v][k]))
+          return Error{m + ": vertex " + std::to_string(v) + " weight is not finite"};
     for (const auto& [joint, matrix] : mesh.bind)
-      if (!finite(matrix)) return Error{m + ": the inverse bind matrix of joint " + joint_name(joint) + " is not finite"};
+      if (!finite(matrix))
+        return Error{m + ": the inverse bind matrix of joint " + joint_name(joint) + " is not finite"};
   }
   for (const SourceClip& clip : scene.clips) {
     const std::string c = "clip " + quoted(clip.name);
-    if (!std::isfinite(clip.duration) || clip.duration < 0.0f) return Error{c + ": its duration is not a finite number >= 0"};
+    if (!std::isfinite(clip.duration) || clip.duration < 0.0f)
+      return Error{c + ": its duration is not a finite number >= 0"};
     for (const SourceTrack& t : clip.tracks) {
       const auto key = [&](const char* what, size_t k, float time, const std::string& value, const char* why) {
         char at[64];

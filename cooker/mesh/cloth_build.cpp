@@ -136,8 +136,10 @@ Result<std::vector<std::vector<glm::vec4>>> cloth_attributes(const SourceScene& 
                        free && backstop > 0.0f ? c.b * backstop : -1.0f, 1.0f);
     }
     if (simulated == 0) {
-      if (warnings) warnings->push_back("mesh '" + m.name + "': its cloth paint (colour set 1) has no red anywhere: "
-                                        "nothing is simulated");
+      if (warnings)
+        warnings->push_back("mesh '" + m.name +
+                            "': its cloth paint (colour set 1) has no red anywhere: "
+                            "nothing is simulated");
       a.clear();
     }
   }

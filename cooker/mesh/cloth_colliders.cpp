@@ -34,8 +34,8 @@ int joint_named(const SourceSkeleton& skeleton, const std::string& name) {
 
 struct Bone {
   int joint = -1, child = -1;
-  glm::vec3 a{0.0f}, b{0.0f};   // model space
-  std::vector<float> distances; // of the body vertices it owns
+  glm::vec3 a{0.0f}, b{0.0f};    // model space
+  std::vector<float> distances;  // of the body vertices it owns
 };
 
 bool is_body_vertex(const SourceScene& scene, const ClothOptions& options, const SourceMesh& m, size_t v) {

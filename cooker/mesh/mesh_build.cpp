@@ -161,7 +161,7 @@ bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y
 // Normals (OpenMesh)
 
 struct NormalTraits : OpenMesh::DefaultTraits {
-  using Point = OpenMesh::Vec3d;   // double: sums of many small cross products stay exact enough
+  using Point = OpenMesh::Vec3d;  // double: sums of many small cross products stay exact enough
   using Normal = OpenMesh::Vec3d;
 };
 using NormalMesh = OpenMesh::TriMesh_ArrayKernelT<NormalTraits>;
@@ -195,8 +195,7 @@ bool can_add_face(const NormalMesh& mesh, const std::array<NormalMesh::VertexHan
 // of the two edges at that corner, |n| = twice the area) to the vertex. A triangle OpenMesh cannot
 // hold (non-manifold) gets private copies of its corners, which still sum into the same source
 // vertex. A vertex no triangle touches gets +z (it is dropped later by the fetch optimizer).
-std::vector<glm::vec3> generate_normals(const std::vector<glm::vec3>& positions,
-                                        const std::vector<uint32_t>& indices) {
+std::vector<glm::vec3> generate_normals(const std::vector<glm::vec3>& positions, const std::vector<uint32_t>& indices) {
   NormalMesh mesh;
   std::vector<uint32_t> source_of;  // OpenMesh vertex -> source vertex
   source_of.reserve(positions.size());
@@ -257,8 +256,8 @@ Status validate_mesh(const SourceScene& scene, size_t index) {
   if (Status s = check_size(m.cloth.size(), "cloth attributes"); !s) return s;
   if (Status s = check_size(m.joints.size(), "joint sets"); !s) return s;
   if (m.weights.size() != m.joints.size())
-    return bad("has " + std::to_string(m.joints.size()) + " joint sets but " +
-               std::to_string(m.weights.size()) + " weight sets");
+    return bad("has " + std::to_string(m.joints.size()) + " joint sets but " + std::to_string(m.weights.size()) +
+               " weight sets");
   if (m.indices.size() % 3 != 0)
     return bad("index count " + std::to_string(m.indices.size()) + " is not a multiple of 3");
   for (size_t i = 0; i < m.indices.size(); ++i) {
@@ -283,7 +282,8 @@ Status validate_mesh(const SourceScene& scene, size_t index) {
       return bad(tl + " has " + std::to_string(t.positions.size()) + " position deltas for " + std::to_string(n) +
                  " vertices");
     if (!t.normals.empty() && t.normals.size() != n) return bad(tl + " has a normal delta count unlike its vertices'");
-    if (!t.tangents.empty() && t.tangents.size() != n) return bad(tl + " has a tangent delta count unlike its vertices'");
+    if (!t.tangents.empty() && t.tangents.size() != n)
+      return bad(tl + " has a tangent delta count unlike its vertices'");
     for (const auto* stream : {&t.positions, &t.normals, &t.tangents})
       for (const glm::vec3& d : *stream)
         if (!finite(d)) return bad(tl + " has a non-finite delta");

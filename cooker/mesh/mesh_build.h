@@ -42,17 +42,17 @@ struct CookedMesh {
   uint32_t vertex_count = 0;
   uint16_t vertex_stride = 0;
   std::vector<fb::VertexAttribute> layout;
-  std::vector<uint8_t> vertices;          // vertex_count * vertex_stride
+  std::vector<uint8_t> vertices;  // vertex_count * vertex_stride
   fb::IndexFormat index_format = fb::IndexFormat::Uint16;
   std::vector<uint8_t> indices;
   std::vector<fb::Submesh> submeshes;
   glm::vec3 bounds_min{0.0f}, bounds_max{0.0f};
   glm::vec3 position_offset{0.0f}, position_scale{1.0f};
-  std::vector<uint16_t> joints;           // skeleton joint per slot
-  std::vector<glm::mat4> inverse_bind;    // per slot
+  std::vector<uint16_t> joints;                  // skeleton joint per slot
+  std::vector<glm::mat4> inverse_bind;           // per slot
   std::vector<CookedMorphTarget> morph_targets;  // names unique, in first-appearance order
-  std::vector<glm::vec4> cloth_attributes;  // per vertex (cloth_build.h), empty without cloth
-  CookedCloth cloth;                        // empty() without cloth
+  std::vector<glm::vec4> cloth_attributes;       // per vertex (cloth_build.h), empty without cloth
+  CookedCloth cloth;                             // empty() without cloth
 };
 
 struct MeshBuildStats {
@@ -61,7 +61,7 @@ struct MeshBuildStats {
   uint32_t triangles = 0;
   uint32_t degenerate_triangles_removed = 0;
   uint32_t meshes_with_generated_normals = 0;
-  float acmr_before = 0.0f;               // average cache miss ratio (meshoptimizer, cache 16)
+  float acmr_before = 0.0f;  // average cache miss ratio (meshoptimizer, cache 16)
   float acmr_after = 0.0f;
 };
 

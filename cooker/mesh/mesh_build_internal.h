@@ -23,8 +23,8 @@ std::string mesh_label(const SourceMesh& mesh, size_t index);
 Error mesh_error(const SourceMesh& mesh, size_t index, const std::string& what);
 
 struct CleanMesh {
-  size_t source = 0;                // index into scene.meshes
-  SourceMesh mesh;                  // welded, degenerate triangles removed, normals present
+  size_t source = 0;  // index into scene.meshes
+  SourceMesh mesh;    // welded, degenerate triangles removed, normals present
 };
 
 struct AttributeSet {
@@ -82,8 +82,7 @@ std::vector<unsigned> influence_class_order(const std::vector<glm::vec4>& weight
 /// Builds the merged mesh of one group. `members` index `cleaned`, in scene order.
 Result<CookedMesh> build_group(const SourceScene& scene, const std::vector<CleanMesh>& cleaned,
                                const std::vector<size_t>& members, const AttributeSet& attrs,
-                               const MeshOptions& options, MeshBuildStats& stats,
-                               std::vector<std::string>& warnings, double& misses_before,
-                               double& misses_after);
+                               const MeshOptions& options, MeshBuildStats& stats, std::vector<std::string>& warnings,
+                               double& misses_before, double& misses_after);
 
 }  // namespace ossa::cook::mesh_detail

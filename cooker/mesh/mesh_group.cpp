@@ -61,9 +61,8 @@ struct Layout {
 // Builds the merged mesh of one group. `members` index `cleaned`, in scene order.
 Result<CookedMesh> build_group(const SourceScene& scene, const std::vector<CleanMesh>& cleaned,
                                const std::vector<size_t>& members, const AttributeSet& attrs,
-                               const MeshOptions& options, MeshBuildStats& stats,
-                               std::vector<std::string>& warnings, double& misses_before,
-                               double& misses_after) {
+                               const MeshOptions& options, MeshBuildStats& stats, std::vector<std::string>& warnings,
+                               double& misses_before, double& misses_after) {
   const size_t joint_count = scene.skeleton.joints.size();
   CookedMesh out;
   out.name = cleaned[members.front()].mesh.name;
@@ -91,8 +90,9 @@ Result<CookedMesh> build_group(const SourceScene& scene, const std::vector<Clean
           if (!(weights[mi][v][k] > 0.0f)) continue;
           const uint16_t joint = m.joints[v][static_cast<size_t>(k)];
           if (joint >= joint_count)
-            return mesh_error(m, si, "vertex " + std::to_string(v) + " references joint " + std::to_string(joint) +
-                                         ", not below the skeleton's joint count " + std::to_string(joint_count));
+            return mesh_error(m, si,
+                              "vertex " + std::to_string(v) + " references joint " + std::to_string(joint) +
+                                  ", not below the skeleton's joint count " + std::to_string(joint_count));
           used[joint] = true;
         }
       }
@@ -147,12 +147,13 @@ Result<CookedMesh> build_group(const SourceScene& scene, const std::vector<Clean
   // stream is present when any member's target of that name has it.
   for (const size_t member : members) {
     for (const SourceMorphTarget& t : cleaned[member].mesh.morph_targets) {
-      auto it = std::find_if(s.targets.begin(), s.targets.end(), [&](const MorphStreams& m) { return m.name == t.name; });
+      auto it =
+          std::find_if(s.targets.begin(), s.targets.end(), [&](const MorphStreams& m) { return m.name == t.name; });
       if (it == s.targets.end()) {
         s.targets.push_back({t.name, t.default_weight, {}, {}, {}});
         it = s.targets.end() - 1;
       }
-      if (!t.normals.empty()) it->normals.resize(1);   // marks the stream present; filled below
+      if (!t.normals.empty()) it->normals.resize(1);  // marks the stream present; filled below
       if (!t.tangents.empty() && attrs.tangents) it->tangents.resize(1);
     }
   }
@@ -305,7 +306,8 @@ Result<CookedMesh> build_group(const SourceScene& scene, const std::vector<Clean
   Layout layout;
   const uint16_t at_position = layout.add(Sem::Position, quantized ? Fmt::Unorm16x4 : Fmt::Float32x3);
   const uint16_t at_normal = layout.add(Sem::Normal, quantized ? Fmt::Snorm16x2 : Fmt::Float32x3);
-  const uint16_t at_tangent = attrs.tangents ? layout.add(Sem::Tangent, quantized ? Fmt::Snorm16x4 : Fmt::Float32x4) : 0;
+  const uint16_t at_tangent =
+      attrs.tangents ? layout.add(Sem::Tangent, quantized ? Fmt::Snorm16x4 : Fmt::Float32x4) : 0;
   const uint16_t at_uv0 = attrs.uv0 ? layout.add(Sem::TexCoord0, quantized ? Fmt::Float16x2 : Fmt::Float32x2) : 0;
   const uint16_t at_color = colored ? layout.add(Sem::Color0, quantized ? Fmt::Unorm8x4 : Fmt::Float32x4) : 0;
   const uint16_t at_joints =
@@ -333,8 +335,7 @@ Result<CookedMesh> build_group(const SourceScene& scene, const std::vector<Clean
         const int16_t sign = t.w < 0.0f ? int16_t{-32767} : int16_t{32767};
         put(dst + at_tangent, std::array<int16_t, 4>{float_to_snorm16(te.x), float_to_snorm16(te.y), sign, 0});
       }
-      if (attrs.uv0)
-        put(dst + at_uv0, std::array<uint16_t, 2>{float_to_half(s.uv0[v].x), float_to_half(s.uv0[v].y)});
+      if (attrs.uv0) put(dst + at_uv0, std::array<uint16_t, 2>{float_to_half(s.uv0[v].x), float_to_half(s.uv0[v].y)});
       if (colored) {
         const glm::vec4& c = s.colors[v];
         put(dst + at_color, std::array<uint8_t, 4>{float_to_unorm8(c.r), float_to_unorm8(c.g), float_to_unorm8(c.b),
@@ -367,7 +368,8 @@ Result<CookedMesh> build_group(const SourceScene& scene, const std::vector<Clean
   std::vector<DenseMorph> dense;
   if (!s.targets.empty()) {
     MorphBounds bounds;
-    const float mpu = scene.metres_per_unit > 0.0f && std::isfinite(scene.metres_per_unit) ? scene.metres_per_unit : 1.0f;
+    const float mpu =
+        scene.metres_per_unit > 0.0f && std::isfinite(scene.metres_per_unit) ? scene.metres_per_unit : 1.0f;
     bounds.position = options.morph_position_bound_m / mpu;
     bounds.angle = options.morph_angle_bound;
     std::vector<glm::vec3> base_tangents;

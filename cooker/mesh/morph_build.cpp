@@ -81,8 +81,8 @@ DenseMorph quantize_morph(const MorphStreams& target, const std::vector<glm::vec
     out.position_error = std::max(out.position_error, glm::length(target.positions[v] - p));
     if (normals) {
       const glm::vec3 d = out.listed[v] ? dequantize(out.normals[v], out.normal_step) : glm::vec3(0.0f);
-      out.normal_error = std::max(out.normal_error, angle_between(base_normals[v] + target.normals[v],
-                                                                  base_normals[v] + d));
+      out.normal_error =
+          std::max(out.normal_error, angle_between(base_normals[v] + target.normals[v], base_normals[v] + d));
     }
   }
   return out;

@@ -42,10 +42,10 @@ struct DenseMorph {
   float default_weight = 0.0f;
   glm::vec3 position_step{0.0f}, normal_step{0.0f}, tangent_step{0.0f};
   std::vector<std::array<int16_t, 3>> positions, normals, tangents;  // normals / tangents may be empty
-  std::vector<uint8_t> listed;       // 1 when the vertex is stored
-  float position_error = 0.0f;       // mesh units
-  float normal_error = 0.0f;         // radians
-  float position_bound = 0.0f;       // mesh units: what position_error is held to (mesh_group.cpp)
+  std::vector<uint8_t> listed;                                       // 1 when the vertex is stored
+  float position_error = 0.0f;                                       // mesh units
+  float normal_error = 0.0f;                                         // radians
+  float position_bound = 0.0f;  // mesh units: what position_error is held to (mesh_group.cpp)
 };
 
 /// The target as stored: listed vertices ascending, three int16 per listed vertex per stream.
@@ -57,7 +57,7 @@ struct CookedMorphTarget {
   glm::vec3 position_step{0.0f}, normal_step{0.0f}, tangent_step{0.0f};
   float position_error = 0.0f, normal_error = 0.0f;
   float position_bound = 0.0f;  // mesh units
-  uint32_t source_bytes = 0;  // the dense float deltas it came from (12 bytes per vertex per stream)
+  uint32_t source_bytes = 0;    // the dense float deltas it came from (12 bytes per vertex per stream)
 };
 
 /// Quantizes one target against `bounds`. base_normals / base_tangents are the vertices' own

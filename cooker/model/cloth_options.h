@@ -12,11 +12,11 @@ namespace ossa::cook {
 
 /// A mesh region named in the settings.
 struct ClothRegion {
-  std::string mesh;                 // a source mesh's name, or
-  std::string material;             // a material's name
+  std::string mesh;                     // a source mesh's name, or
+  std::string material;                 // a material's name
   std::vector<std::string> pin_joints;  // its vertices moved mostly by these stay skinned
-  float pin_within_m = 0.01f;       // ... and those within this of a vertex outside the region
-  float ramp_m = 0.1f;              // weight rises from 0 to 1 over this distance from a pinned one
+  float pin_within_m = 0.01f;           // ... and those within this of a vertex outside the region
+  float ramp_m = 0.1f;                  // weight rises from 0 to 1 over this distance from a pinned one
 };
 
 /// A collider named in the settings: a sphere at `offset` on `joint`, or a capsule from it to
@@ -30,25 +30,25 @@ struct ClothColliderSetting {
 
 /// The "cloth" settings (cloth_settings.h reads them). Lengths in metres, times in seconds.
 struct ClothOptions {
-  bool paint = true;                  // vertex colour set 1 marks cloth
+  bool paint = true;  // vertex colour set 1 marks cloth
   std::vector<ClothRegion> regions;
-  float max_distance_m = 0.0f;        // > 0: green x this; 0: no limit
-  float backstop_m = 0.0f;            // > 0: blue x this; 0: none
+  float max_distance_m = 0.0f;  // > 0: green x this; 0: no limit
+  float backstop_m = 0.0f;      // > 0: blue x this; 0: none
   float thickness_m = 0.01f;
   float stretch_compliance = 0.0f;
   float bend_compliance = 1e-4f;
   float tether_scale = 1.0f;
   float damping = 1.0f;
   float drag = 0.5f;
-  float gravity_ms2 = 9.81f;          // along the model's down axis, -Y (outputs are Y-up)
+  float gravity_ms2 = 9.81f;  // along the model's down axis, -Y (outputs are Y-up)
   float linear_inertia = 1.0f, angular_inertia = 1.0f;
   float teleport_distance_m = 2.0f;
   float max_speed_ms = 30.0f;
-  bool auto_colliders = true;         // fit colliders when none are named
+  bool auto_colliders = true;  // fit colliders when none are named
   std::vector<ClothColliderSetting> colliders;
   uint32_t max_colliders = 6;
-  uint8_t up_axis = 1;                // 0 x, 1 y, 2 z: always 1, outputs are Y-up (import_axes.cpp)
-  bool from_settings = false;         // a settings file gave these (canonical() then records them)
+  uint8_t up_axis = 1;         // 0 x, 1 y, 2 z: always 1, outputs are Y-up (import_axes.cpp)
+  bool from_settings = false;  // a settings file gave these (canonical() then records them)
   /// Canonical text for the cook's options string ("" when there is nothing to say).
   std::string canonical() const;
 };

@@ -132,12 +132,12 @@ std::string ClothOptions::canonical() const {
   // Settings files are inputs of the cook key already; this records the values in the output.
   if (!from_settings) return "";
   char buf[512];
-  std::snprintf(buf, sizeof buf,
-                ";cloth=%d,%zu,%g,%g,%g,%g,%g,%g,%g,%g,%g,%g,%g,%g,%g,%d,%zu,%u", paint ? 1 : 0, regions.size(),
-                double(max_distance_m), double(backstop_m), double(thickness_m), double(stretch_compliance),
-                double(bend_compliance), double(tether_scale), double(damping), double(drag), double(gravity_ms2),
-                double(linear_inertia), double(angular_inertia), double(teleport_distance_m), double(max_speed_ms),
-                auto_colliders ? 1 : 0, colliders.size(), max_colliders);
+  std::snprintf(buf, sizeof buf, ";cloth=%d,%zu,%g,%g,%g,%g,%g,%g,%g,%g,%g,%g,%g,%g,%g,%d,%zu,%u", paint ? 1 : 0,
+                regions.size(), double(max_distance_m), double(backstop_m), double(thickness_m),
+                double(stretch_compliance), double(bend_compliance), double(tether_scale), double(damping),
+                double(drag), double(gravity_ms2), double(linear_inertia), double(angular_inertia),
+                double(teleport_distance_m), double(max_speed_ms), auto_colliders ? 1 : 0, colliders.size(),
+                max_colliders);
   return buf;
 }
 

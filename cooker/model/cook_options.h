@@ -34,10 +34,10 @@ enum class TextureOutput : uint8_t {
 
 /// How clips are compressed (--clip-tolerance, --no-clip-compression; cooker/clip/clip_compress.h).
 struct ClipCompressionOptions {
-  bool enabled = true;              // false: lossless (bind/constant only when bit-equal, every
-                                    // other channel raw floats at every frame)
-  float tolerance_metres = 0.0001f; // 0.1 mm ...
-  float probe_metres = 0.1f;        // ... at 10 cm
+  bool enabled = true;                    // false: lossless (bind/constant only when bit-equal, every
+                                          // other channel raw floats at every frame)
+  float tolerance_metres = 0.0001f;       // 0.1 mm ...
+  float probe_metres = 0.1f;              // ... at 10 cm
   float morph_weight_tolerance = 0.001f;  // largest error of a morph weight at any frame
 };
 
@@ -55,8 +55,8 @@ bool has_folder_rig_name(const std::filesystem::path& path);
 struct CookOptions {
   bool float_vertices = false;
   TextureOutput textures = TextureOutput::Compressed;  // --texture-format
-  ClipCompressionOptions clips;       // --clip-tolerance, --no-clip-compression
-  bool root_motion = false;           // --root-motion: extract root motion from every clip
+  ClipCompressionOptions clips;                        // --clip-tolerance, --no-clip-compression
+  bool root_motion = false;                            // --root-motion: extract root motion from every clip
   /// --up-axis: the sources' up axis (0 x, 1 y, 2 z) over what each file states; -1: the file's.
   /// Every output is Y-up (import_axes.cpp), so root motion and cloth gravity are about Y.
   int up_axis = -1;
@@ -74,11 +74,11 @@ struct CookOptions {
   /// --retarget-to TARGET.ossa: the source's clips are retargeted onto this rig
   /// (cooker/retarget/retarget_clips.h) and cooked as clip-only files of it; null otherwise.
   const SourceSkeleton* retarget_target = nullptr;
-  std::string retarget_name;          // TARGET.ossa's file name
-  InputFile retarget_input;           // TARGET.ossa as read: its hash is in canonical()
+  std::string retarget_name;                             // TARGET.ossa's file name
+  InputFile retarget_input;                              // TARGET.ossa as read: its hash is in canonical()
   const tools::HumanoidMapFile* retarget_map = nullptr;  // --map FILE.json, or null
   std::string retarget_map_name;
-  InputFile retarget_map_input;       // the map file as read: its hash is in canonical()
+  InputFile retarget_map_input;  // the map file as read: its hash is in canonical()
   /// Canonical text of the options that change output bytes, recorded in provenance.
   std::string canonical() const;
 
@@ -96,7 +96,7 @@ struct CookOptions {
   CookCache* cache = nullptr;
   /// The batch looked this input up in the cache already (a miss): the worker only stores.
   bool cache_looked_up = false;
-  bool write = true;   // false (--list-inputs): cook in memory, write nothing
+  bool write = true;  // false (--list-inputs): cook in memory, write nothing
 };
 
 }  // namespace ossa::cook

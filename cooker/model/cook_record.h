@@ -32,50 +32,50 @@ struct ClipRecord {
 /// One morph target as cooked: how many vertices it stores and the error its bounds allowed.
 struct MorphRecord {
   std::string mesh, name;
-  uint32_t vertices = 0;              // listed (stored) vertices
-  uint32_t raw_bytes = 0;             // dense float deltas over the mesh's vertices
-  uint32_t stored_bytes = 0;          // the sparse form in the file
-  float position_error_mm = 0.0f;     // millimetres (via metres_per_unit)
-  float position_bound_mm = 0.0f;     // what that error is held to: 0.02 mm or 2e-5 of the mesh's size
+  uint32_t vertices = 0;           // listed (stored) vertices
+  uint32_t raw_bytes = 0;          // dense float deltas over the mesh's vertices
+  uint32_t stored_bytes = 0;       // the sparse form in the file
+  float position_error_mm = 0.0f;  // millimetres (via metres_per_unit)
+  float position_bound_mm = 0.0f;  // what that error is held to: 0.02 mm or 2e-5 of the mesh's size
   float normal_error_deg = 0.0f;
 };
 
 /// One distinct texture as cooked (a source image used twice for one role is cooked once).
 struct TextureRecord {
-  std::string name;                   // the image's file name, or the embedded image's name
-  std::string role;                   // "diffuse", "normal", "specular"
-  std::string encoding;               // "BC1", "BC3", "BC4", "BC5", "RGBA8", "source"
+  std::string name;      // the image's file name, or the embedded image's name
+  std::string role;      // "diffuse", "normal", "specular"
+  std::string encoding;  // "BC1", "BC3", "BC4", "BC5", "RGBA8", "source"
   bool srgb = false;
   uint32_t width = 0, height = 0, mips = 0;
-  uint64_t source_bytes = 0;          // the encoded image as the source had it
-  uint64_t cooked_bytes = 0;          // what the file stores for it
-  uint64_t gpu_rgba8_bytes = 0;       // RGBA8 + a full mip chain: what decoding the source puts on a GPU
-  float psnr_db = 0.0f;               // level 0 against the source, over the channels kept (99: exact)
+  uint64_t source_bytes = 0;     // the encoded image as the source had it
+  uint64_t cooked_bytes = 0;     // what the file stores for it
+  uint64_t gpu_rgba8_bytes = 0;  // RGBA8 + a full mip chain: what decoding the source puts on a GPU
+  float psnr_db = 0.0f;          // level 0 against the source, over the channels kept (99: exact)
   float normal_mean_deg = 0.0f, normal_max_deg = 0.0f;  // normal maps: angle to the source's normals
 };
 
 /// One contact of a retargeted clip.
 struct RetargetContactRecord {
-  uint32_t foot = 0;                 // 0 left, 1 right
-  float start = 0.0f, end = 0.0f;    // seconds
-  float held_mm = 0.0f;              // the target ankle's largest distance from where the contact holds it
-  float slide_mm = 0.0f;             // the target ankle's largest distance from its mean (how far it slides)
-  float source_slide_mm = 0.0f;      // the source ankle's largest distance from its mean (its own slide)
+  uint32_t foot = 0;               // 0 left, 1 right
+  float start = 0.0f, end = 0.0f;  // seconds
+  float held_mm = 0.0f;            // the target ankle's largest distance from where the contact holds it
+  float slide_mm = 0.0f;           // the target ankle's largest distance from its mean (how far it slides)
+  float source_slide_mm = 0.0f;    // the source ankle's largest distance from its mean (its own slide)
 };
 
 /// What a retarget achieved on one clip (--report "retarget"; docs/RETARGET.md).
 struct RetargetRecord {
   std::string clip;
-  float hips_ratio = 0.0f;           // target hips height / source's, both in metres over the ankles
-  float floor_mm = 0.0f;             // the source clip's floor above its rest pose's (0: none)
+  float hips_ratio = 0.0f;  // target hips height / source's, both in metres over the ankles
+  float floor_mm = 0.0f;    // the source clip's floor above its rest pose's (0: none)
   uint32_t frames = 0;
-  float limb_max_deg = 0.0f;         // upper arm, forearm, thigh, shin: largest angle to the source's,
-                                     // over the limbs the mid-plane guard left alone
-  float guard_max_deg = 0.0f;        // the same over the limbs it swung back (what keeping them on their side cost)
-  float hand_max_deg = 0.0f;         // hands' outward axis, either hand
-  float foot_max_deg = 0.0f;         // feet's forward axis, either foot
-  uint32_t crossing_frames = 0;      // frames with a hand or foot across the mid-plane where the source's is not
-  uint32_t guarded_frames = 0;       // frames where the mid-plane guard swung a limb back
+  float limb_max_deg = 0.0f;     // upper arm, forearm, thigh, shin: largest angle to the source's,
+                                 // over the limbs the mid-plane guard left alone
+  float guard_max_deg = 0.0f;    // the same over the limbs it swung back (what keeping them on their side cost)
+  float hand_max_deg = 0.0f;     // hands' outward axis, either hand
+  float foot_max_deg = 0.0f;     // feet's forward axis, either foot
+  uint32_t crossing_frames = 0;  // frames with a hand or foot across the mid-plane where the source's is not
+  uint32_t guarded_frames = 0;   // frames where the mid-plane guard swung a limb back
   std::vector<RetargetContactRecord> contacts;
 };
 
@@ -89,25 +89,25 @@ struct CookRecord {
   std::string input;
   std::string output;
   bool ok = false;
-  std::string error;                  // when !ok: "<input>: what is wrong"
+  std::string error;  // when !ok: "<input>: what is wrong"
   std::vector<std::string> warnings;
   // Known after import: joints (of the imported rig; when ok, of the file's skeleton: 0 for a
   // clip-only file cooked against --skeleton), clips, materials, textures, vertices over 4 influences.
   std::optional<uint32_t> joints, clips, materials, textures, vertices_over_4_influences;
   // Known once meshes are built.
   std::optional<uint32_t> meshes, submeshes, vertices, triangles;
-  uint64_t source_bytes = 0;          // every file read: the source, its sidecar, a graph's sources
-  uint64_t cooked_bytes = 0;          // the written file (ok only)
+  uint64_t source_bytes = 0;  // every file read: the source, its sidecar, a graph's sources
+  uint64_t cooked_bytes = 0;  // the written file (ok only)
   double seconds = 0.0;
-  std::vector<ClipRecord> clip_records;  // one per clip compressed before any failure
-  std::vector<MorphRecord> morph_records;  // one per morph target, once meshes are built
-  std::vector<TextureRecord> texture_records;  // one per distinct embedded texture, once textures are cooked
+  std::vector<ClipRecord> clip_records;          // one per clip compressed before any failure
+  std::vector<MorphRecord> morph_records;        // one per morph target, once meshes are built
+  std::vector<TextureRecord> texture_records;    // one per distinct embedded texture, once textures are cooked
   std::vector<RetargetRecord> retarget_records;  // --retarget-to: one per clip retargeted
   /// Every file the cook read or looked for (absolute paths, sorted), as far as it got; for an
   /// up-to-date output, the inputs its provenance lists. The depfile and --list-inputs print these.
   std::vector<InputFile> inputs_read;
-  uint64_t cook_key = 0;   // of the written (or up-to-date) output
-  bool up_to_date = false; // ok without cooking: the output's cook key matched (nothing written)
+  uint64_t cook_key = 0;    // of the written (or up-to-date) output
+  bool up_to_date = false;  // ok without cooking: the output's cook key matched (nothing written)
   // The shared cook cache (cooker/cache/cook_cache.h), when the batch has one:
   bool cache_hit = false;            // ok without cooking: the output came from the cache, verified
   std::string cache_note;            // the first trouble the cache gave this input (a miss, never a failure)

@@ -21,8 +21,8 @@ namespace {
 constexpr std::string_view kFolderFile = "ossa.cook.json";
 
 const std::initializer_list<std::string_view> kSettingKeys = {
-    "float_vertices", "clip_compression", "clip_tolerance_mm", "root_motion", "up_axis", "skeleton", "clip_names",
-    "metres_per_unit", "texture_format", "cloth"};
+    "float_vertices", "clip_compression", "clip_tolerance_mm", "root_motion",    "up_axis",
+    "skeleton",       "clip_names",       "metres_per_unit",   "texture_format", "cloth"};
 
 /// One layer of settings, checked; applied in order.
 struct Layer {
@@ -139,8 +139,9 @@ Result<std::vector<Layer>> read_settings(const fs::path& file, bool folder, cons
       }
     }
   } else {
-    check.expect_keys(root, {"ossa_cook", "float_vertices", "clip_compression", "clip_tolerance_mm", "root_motion", "metres_per_unit",
-                             "up_axis", "skeleton", "clip_names", "texture_format", "cloth"},
+    check.expect_keys(root,
+                      {"ossa_cook", "float_vertices", "clip_compression", "clip_tolerance_mm", "root_motion",
+                       "metres_per_unit", "up_axis", "skeleton", "clip_names", "texture_format", "cloth"},
                       "a cook settings file");
     read_layer(check, root, dir, layers.emplace_back());
   }

@@ -28,7 +28,18 @@ struct GraphParameter {
 
 /// Same numbering as fb::ConditionOp.
 enum class CondOp : uint8_t {
-  True = 0, Less, LessEqual, Greater, GreaterEqual, Equal, NotEqual, Bool, Trigger, Not, And, Or
+  True = 0,
+  Less,
+  LessEqual,
+  Greater,
+  GreaterEqual,
+  Equal,
+  NotEqual,
+  Bool,
+  Trigger,
+  Not,
+  And,
+  Or
 };
 
 struct CondInstr {
@@ -189,8 +200,8 @@ struct RetargetNodeDef {
 };
 
 using NodeKind = std::variant<ClipNodeDef, BlendAlphaDef, SelectDef, LayeredDef, BlendSpaceDef, AdditiveDef,
-                              StateMachineRefDef, MorphWeightsDef, TwoBoneIkDef, AimDef, FootPlacementDef,
-                              FootLockDef, SpringDef, SlotDef, RetargetNodeDef>;
+                              StateMachineRefDef, MorphWeightsDef, TwoBoneIkDef, AimDef, FootPlacementDef, FootLockDef,
+                              SpringDef, SlotDef, RetargetNodeDef>;
 
 struct NodeDef {
   std::string name;

@@ -64,8 +64,9 @@ std::vector<InputFile> InputLog::files() const {
   std::vector<InputFile> out = files_;
   // Stable: of two records of one path, the first read is kept.
   std::stable_sort(out.begin(), out.end(), [](const InputFile& a, const InputFile& b) { return a.path < b.path; });
-  out.erase(std::unique(out.begin(), out.end(), [](const InputFile& a, const InputFile& b) { return a.path == b.path; }),
-            out.end());
+  out.erase(
+      std::unique(out.begin(), out.end(), [](const InputFile& a, const InputFile& b) { return a.path == b.path; }),
+      out.end());
   return out;
 }
 
@@ -135,8 +136,7 @@ struct OpenedInput {
 /// (open_beneath.h), then checked on the opened descriptor (regular file, links, size).
 Result<OpenedInput> open_input(const fs::path& path, uint64_t max_bytes, std::string_view reference) {
   // A NUL byte (a JSON "\u0000") would cut the path short for the operating system: another file.
-  if (path.native().find('\0') != std::string::npos)
-    return Error{refuse(path, "contains a NUL byte", reference)};
+  if (path.native().find('\0') != std::string::npos) return Error{refuse(path, "contains a NUL byte", reference)};
   const ReadSandbox* sandbox = t_sandbox;
   const OpenedFile f =
       open_beneath(sandbox ? &sandbox->roots : nullptr, path, true, !sandbox || sandbox->allow_hard_links);
@@ -177,7 +177,8 @@ Result<std::vector<uint8_t>> read_input(const fs::path& path, uint64_t max_bytes
   uint8_t extra = 0;
   const ssize_t more = done == bytes.size() ? ::read(fd, &extra, 1) : 0;
   ::close(fd);
-  if (done != bytes.size() || more != 0) return Error{detail::printable(path.string(), 400) + ": changed while being read"};
+  if (done != bytes.size() || more != 0)
+    return Error{detail::printable(path.string(), 400) + ": changed while being read"};
   if (InputLog* log = current_input_log()) log->add(path, bytes);
   return bytes;
 }

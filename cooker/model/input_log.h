@@ -60,7 +60,8 @@ class InputLog {
   std::vector<InputFile> files() const;
   /// Reads refused by the sandbox (or of files that are not regular files): one message each.
   void add_refusal(std::string message) {
-    if (std::find(refusals_.begin(), refusals_.end(), message) == refusals_.end()) refusals_.push_back(std::move(message));
+    if (std::find(refusals_.begin(), refusals_.end(), message) == refusals_.end())
+      refusals_.push_back(std::move(message));
   }
   const std::vector<std::string>& refusals() const { return refusals_; }
 

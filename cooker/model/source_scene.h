@@ -17,15 +17,15 @@ namespace ossa::cook {
 
 struct SourceJoint {
   std::string name;
-  int parent = -1;                       // < own index; -1 for the root
-  glm::vec3 translation{0.0f};           // bind pose, local to parent
+  int parent = -1;              // < own index; -1 for the root
+  glm::vec3 translation{0.0f};  // bind pose, local to parent
   glm::quat rotation{1.0f, 0.0f, 0.0f, 0.0f};
   glm::vec3 scale{1.0f};
-  glm::mat4 inverse_bind{1.0f};          // inverse of the bind model-space matrix
+  glm::mat4 inverse_bind{1.0f};  // inverse of the bind model-space matrix
 };
 
 struct SourceSkeleton {
-  std::vector<SourceJoint> joints;       // parents first
+  std::vector<SourceJoint> joints;  // parents first
   /// Length of one of its units in metres, when known (a cooked rig's File.metres_per_unit, a
   /// source's unit); 0 when unknown. Clips cooked against it are converted into its units.
   float metres_per_unit = 0.0f;
@@ -35,22 +35,22 @@ struct SourceSkeleton {
 /// added to the base vertex scaled by the target's weight (before skinning). Importers that give
 /// targets as absolute values (Assimp does for glTF and FBX) subtract the base here.
 struct SourceMorphTarget {
-  std::string name;                      // unique within the mesh; binds clips' weight tracks
-  std::vector<glm::vec3> positions;      // one per vertex
-  std::vector<glm::vec3> normals;        // empty or one per vertex
-  std::vector<glm::vec3> tangents;       // empty or one per vertex (direction only)
-  float default_weight = 0.0f;           // glTF mesh.weights
+  std::string name;                  // unique within the mesh; binds clips' weight tracks
+  std::vector<glm::vec3> positions;  // one per vertex
+  std::vector<glm::vec3> normals;    // empty or one per vertex
+  std::vector<glm::vec3> tangents;   // empty or one per vertex (direction only)
+  float default_weight = 0.0f;       // glTF mesh.weights
 };
 
 /// One source mesh (Assimp splits by material, so one material each). Positions etc. are in mesh
 /// space; joints are skeleton joint indices with the matching inverse bind in `bind`.
 struct SourceMesh {
   std::string name;
-  uint32_t material = 0;                 // index into SourceScene::materials
+  uint32_t material = 0;  // index into SourceScene::materials
   std::vector<glm::vec3> positions;
-  std::vector<glm::vec3> normals;        // empty or one per vertex, unit length
-  std::vector<glm::vec4> tangents;       // empty or one per vertex: xyz unit, w = bitangent sign
-  std::vector<glm::vec2> uv0;            // empty or one per vertex
+  std::vector<glm::vec3> normals;   // empty or one per vertex, unit length
+  std::vector<glm::vec4> tangents;  // empty or one per vertex: xyz unit, w = bitangent sign
+  std::vector<glm::vec2> uv0;       // empty or one per vertex
   /// Empty or one per vertex: RGBA as the source stored it (glTF COLOR_0 is linear), the shader
   /// multiplies the material colour by it. The importer leaves it empty when every vertex is
   /// white, which draws exactly as no colours.
@@ -59,7 +59,7 @@ struct SourceMesh {
   /// and joint 0. Empty when the mesh is not skinned (no skeleton in the file).
   std::vector<std::array<uint16_t, 4>> joints;
   std::vector<glm::vec4> weights;
-  std::vector<uint32_t> indices;         // triangle list
+  std::vector<uint32_t> indices;  // triangle list
   /// Skeleton joint -> the inverse bind matrix this mesh's skin uses for it. Sorted by joint,
   /// covering every joint referenced by `joints`.
   std::vector<std::pair<uint16_t, glm::mat4>> bind;
@@ -77,7 +77,7 @@ struct SourceTrack {
   std::vector<float> translation_times;  // seconds, strictly increasing
   std::vector<glm::vec3> translations;
   std::vector<float> rotation_times;
-  std::vector<glm::quat> rotations;      // unit, neighbours on the same hemisphere
+  std::vector<glm::quat> rotations;  // unit, neighbours on the same hemisphere
   std::vector<float> scale_times;
   std::vector<glm::vec3> scales;
 };
@@ -86,22 +86,22 @@ struct SourceTrack {
 /// the clip's frame grid (cooker/model/clip_grid.h), relative to frame 0.
 struct SourceRootMotion {
   std::vector<glm::vec3> translations;
-  std::vector<float> yaws;               // radians about up_axis
-  uint8_t up_axis = 1;                   // 0 x, 1 y, 2 z
+  std::vector<float> yaws;  // radians about up_axis
+  uint8_t up_axis = 1;      // 0 x, 1 y, 2 z
 };
 
 /// A named marker at a time on a clip (sidecar JSON or graph file; see docs/GRAPH.md).
 struct SourceEvent {
   std::string name;
-  float time = 0.0f;                     // seconds, in [0, duration]
+  float time = 0.0f;  // seconds, in [0, duration]
 };
 
 /// One morph target's weight over a clip: keys in seconds, linear between (the importer resamples
 /// STEP and CUBICSPLINE curves onto the clip's frame grid plus its key times).
 struct SourceMorphTrack {
-  std::string name;                      // the targets it drives (SourceMorphTarget::name)
-  std::vector<float> times;              // seconds, strictly increasing, at least one
-  std::vector<float> weights;            // one per time
+  std::string name;            // the targets it drives (SourceMorphTarget::name)
+  std::vector<float> times;    // seconds, strictly increasing, at least one
+  std::vector<float> weights;  // one per time
 };
 
 struct SourceClip {
@@ -110,12 +110,12 @@ struct SourceClip {
   /// generic source name, "mixamo.com" or "Take 001", is named after the file); empty otherwise.
   /// Sidecars, cook settings and graph files may name a clip by either (clip_named).
   std::string source_name;
-  float duration = 0.0f;                 // seconds
-  float sample_rate = 0.0f;              // source keys per second, 0 when unknown
-  std::vector<SourceTrack> tracks;       // sorted by joint, one per animated joint
+  float duration = 0.0f;            // seconds
+  float sample_rate = 0.0f;         // source keys per second, 0 when unknown
+  std::vector<SourceTrack> tracks;  // sorted by joint, one per animated joint
   bool has_root_motion = false;
-  SourceRootMotion root_motion;          // when has_root_motion
-  std::vector<SourceEvent> events;       // sorted by time
+  SourceRootMotion root_motion;                 // when has_root_motion
+  std::vector<SourceEvent> events;              // sorted by time
   std::vector<SourceMorphTrack> morph_weights;  // sorted by name, names unique
 };
 
@@ -124,17 +124,24 @@ inline bool clip_named(const SourceClip& clip, const std::string& name) {
   return clip.name == name || (!clip.source_name.empty() && clip.source_name == name);
 }
 
-enum class TextureRole : uint8_t { Diffuse = 0, Normal = 1, Specular = 2, Occlusion = 3, MetallicRoughness = 4, Emissive = 5 };
+enum class TextureRole : uint8_t {
+  Diffuse = 0,
+  Normal = 1,
+  Specular = 2,
+  Occlusion = 3,
+  MetallicRoughness = 4,
+  Emissive = 5
+};
 
 struct SourceTexture {
   TextureRole role = TextureRole::Diffuse;
-  std::string path;                      // relative to the source file, when external
-  std::string name;                      // for messages and the report: the path, or the embedded image's name
-  std::string mime;                      // "image/png", "image/jpeg" when embedded
-  std::vector<uint8_t> data;             // encoded bytes as the source had them, when embedded;
-                                         // after the texture stage, in `encoding`
+  std::string path;           // relative to the source file, when external
+  std::string name;           // for messages and the report: the path, or the embedded image's name
+  std::string mime;           // "image/png", "image/jpeg" when embedded
+  std::vector<uint8_t> data;  // encoded bytes as the source had them, when embedded;
+                              // after the texture stage, in `encoding`
   // Set by the texture stage (cooker/texture/texture_cook.h); the format's Texture fields.
-  uint8_t encoding = 0;                  // fb::TextureEncoding; 0: Source (data as read)
+  uint8_t encoding = 0;  // fb::TextureEncoding; 0: Source (data as read)
   bool srgb = false;
   uint32_t width = 0, height = 0;
   uint8_t mip_count = 0;
@@ -153,17 +160,17 @@ struct SourceMaterial {
   float opacity = 1.0f;
   std::vector<SourceTexture> textures;
   glm::vec3 emissive{0.0f};
-  bool pbr = false;                      // a PBR source (glTF): metallic and roughness below hold
+  bool pbr = false;  // a PBR source (glTF): metallic and roughness below hold
   float metallic = 1.0f, roughness = 1.0f;
 };
 
 struct SourceScene {
-  SourceSkeleton skeleton;               // empty for a file without joints
+  SourceSkeleton skeleton;  // empty for a file without joints
   std::vector<SourceMesh> meshes;
   std::vector<SourceClip> clips;
   std::vector<SourceMaterial> materials;
-  float metres_per_unit = 1.0f;          // length of one source unit (FBX UnitScaleFactor / 100, ...)
-  std::vector<std::string> warnings;     // human-readable, deterministic order
+  float metres_per_unit = 1.0f;             // length of one source unit (FBX UnitScaleFactor / 100, ...)
+  std::vector<std::string> warnings;        // human-readable, deterministic order
   uint32_t vertices_over_4_influences = 0;  // vertices that lost weight to the 4-influence cap
 };
 

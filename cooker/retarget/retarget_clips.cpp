@@ -23,7 +23,9 @@ namespace {
 
 constexpr double kSnapFrames = 1e-3;  // as the compressor (clip_compress.cpp)
 
-glm::vec3 blend(const glm::vec3& a, const glm::vec3& b, double f) { return glm::vec3(glm::mix(glm::dvec3(a), glm::dvec3(b), f)); }
+glm::vec3 blend(const glm::vec3& a, const glm::vec3& b, double f) {
+  return glm::vec3(glm::mix(glm::dvec3(a), glm::dvec3(b), f));
+}
 glm::quat blend(const glm::quat& a, const glm::quat& b, double f) {
   glm::dquat qa(a), qb(b);
   if (glm::dot(qa, qb) < 0.0) qb = -qb;
@@ -35,9 +37,10 @@ template <class V>
 V at_time(const std::vector<float>& times, const std::vector<V>& values, double t, double rate, const V& fallback) {
   const size_t n = std::min(times.size(), values.size());
   if (n == 0) return fallback;
-  const size_t i = static_cast<size_t>(std::upper_bound(times.begin(), times.begin() + static_cast<std::ptrdiff_t>(n), t,
-                                                        [](double x, float k) { return x < static_cast<double>(k); }) -
-                                       times.begin());
+  const size_t i =
+      static_cast<size_t>(std::upper_bound(times.begin(), times.begin() + static_cast<std::ptrdiff_t>(n), t,
+                                           [](double x, float k) { return x < static_cast<double>(k); }) -
+                          times.begin());
   const size_t near =
       (i < n && (i == 0 || static_cast<double>(times[i]) - t < t - static_cast<double>(times[i - 1]))) ? i : i - 1;
   if (std::abs(static_cast<double>(times[near]) - t) * rate <= kSnapFrames) return values[near];
@@ -114,7 +117,8 @@ float distance_mm(const glm::vec3& a, const glm::vec3& b, float metres_per_unit)
 
 Status retarget_scene(SourceScene& scene, const RetargetTarget& target, const std::string& label,
                       std::vector<RetargetRecord>* records) {
-  if (target.skeleton == nullptr || target.skeleton->joints.empty()) return Error{label + ": no target rig to retarget to"};
+  if (target.skeleton == nullptr || target.skeleton->joints.empty())
+    return Error{label + ": no target rig to retarget to"};
   if (scene.skeleton.joints.empty()) return Error{label + ": has no skeleton to retarget from"};
   if (scene.clips.empty()) return Error{label + ": has no clips to retarget"};
   auto source = make_rig(scene.skeleton, label + " (source rig)", target, "source");
@@ -178,7 +182,8 @@ Status retarget_scene(SourceScene& scene, const RetargetTarget& target, const st
       for (uint32_t f = c.first; f <= c.last; ++f) mean += glm::dvec3(feet[f].source_ankle[c.foot]);
       mean /= static_cast<double>(c.last - c.first + 1);
       for (uint32_t f = c.first; f <= c.last; ++f)
-        cr.source_slide_mm = std::max(cr.source_slide_mm, distance_mm(feet[f].source_ankle[c.foot], glm::vec3(mean), source_mpu));
+        cr.source_slide_mm =
+            std::max(cr.source_slide_mm, distance_mm(feet[f].source_ankle[c.foot], glm::vec3(mean), source_mpu));
       record.contacts.push_back(cr);
     }
     std::vector<glm::dvec3> held_sum(contacts.size(), glm::dvec3(0.0));
@@ -197,7 +202,8 @@ Status retarget_scene(SourceScene& scene, const RetargetTarget& target, const st
         track.translations.push_back(x.translation);
         track.rotation_times.push_back(time);
         glm::quat q = x.rotation;
-        if (!track.rotations.empty() && glm::dot(track.rotations.back(), q) < 0.0f) q = -q;  // neighbours on one hemisphere
+        if (!track.rotations.empty() && glm::dot(track.rotations.back(), q) < 0.0f)
+          q = -q;  // neighbours on one hemisphere
         track.rotations.push_back(q);
         track.scale_times.push_back(time);
         track.scales.push_back(x.scale);
@@ -215,7 +221,8 @@ Status retarget_scene(SourceScene& scene, const RetargetTarget& target, const st
       bool crossing = false;
       for (int p : {kLeftHandPoint, kRightHandPoint, kLeftFootPoint, kRightFootPoint}) {
         const float side = p % 2 == 0 ? 1.0f : -1.0f;
-        crossing |= side * m.source_side[static_cast<size_t>(p)] > 0.05f && side * m.target_side[static_cast<size_t>(p)] < 0.0f;
+        crossing |=
+            side * m.source_side[static_cast<size_t>(p)] > 0.05f && side * m.target_side[static_cast<size_t>(p)] < 0.0f;
       }
       record.crossing_frames += crossing ? 1 : 0;
       record.guarded_frames += (scratch.adjusted & 0x0F) != 0 ? 1 : 0;
@@ -223,7 +230,8 @@ Status retarget_scene(SourceScene& scene, const RetargetTarget& target, const st
         const ContactSpan& c = contacts[k];
         if (f < c.first || f > c.last) continue;
         const glm::vec3 goal = held_ankle(map, scratch, c.foot, held[c.foot], floor);
-        record.contacts[k].held_mm = std::max(record.contacts[k].held_mm, distance_mm(m.target_ankle[c.foot], goal, target_mpu));
+        record.contacts[k].held_mm =
+            std::max(record.contacts[k].held_mm, distance_mm(m.target_ankle[c.foot], goal, target_mpu));
         held_path[k].push_back(m.target_ankle[c.foot]);
         held_sum[k] += glm::dvec3(m.target_ankle[c.foot]);
       }

@@ -27,8 +27,8 @@ namespace ossa::cook {
 
 /// The retarget's inputs besides the scene.
 struct RetargetTarget {
-  const SourceSkeleton* skeleton = nullptr;  // the target rig (from TARGET.ossa)
-  std::string name;                          // TARGET.ossa's file name, for messages
+  const SourceSkeleton* skeleton = nullptr;     // the target rig (from TARGET.ossa)
+  std::string name;                             // TARGET.ossa's file name, for messages
   const tools::HumanoidMapFile* map = nullptr;  // --map, or null
   std::string map_name;
 };

@@ -120,7 +120,8 @@ Result<TextureRecord> cook_one(SourceTexture& t, TextureOutput output) {
   r.source_bytes = t.data.size();
   auto decoded = decode_rgba(t.data);
   if (!decoded) return decoded.error();
-  if (t.role == TextureRole::MetallicRoughness && output != TextureOutput::Source) metallic_roughness_channels(*decoded);
+  if (t.role == TextureRole::MetallicRoughness && output != TextureOutput::Source)
+    metallic_roughness_channels(*decoded);
   const Image& level0 = *decoded;
   r.width = level0.width;
   r.height = level0.height;

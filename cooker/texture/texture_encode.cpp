@@ -132,7 +132,8 @@ Image decode_level(std::span<const uint8_t> bytes, fb::TextureEncoding encoding,
       for (uint32_t y = 0; y < 4; ++y)
         for (uint32_t x = 0; x < 4; ++x) {
           const uint32_t px = bx * 4 + x, py = by * 4 + y;
-          if (px < width && py < height) std::memcpy(&img.rgba[(static_cast<size_t>(py) * width + px) * 4], t[y * 4 + x], 4);
+          if (px < width && py < height)
+            std::memcpy(&img.rgba[(static_cast<size_t>(py) * width + px) * 4], t[y * 4 + x], 4);
         }
     }
   return img;

@@ -14,9 +14,9 @@
 // sharper; the area filter is the one that never rings, and this is the one place it matters
 // that a mip is exactly the mean of what it covers (normal-map lengths, alpha coverage).
 //
-// Level 0 comes from decode_rgba (image_check.h), bottom-up as the format stores rows. Written here rather than taken from
-// stb_image_resize because that one filters in sRGB only with a fixed alpha treatment and has no
-// vector renormalisation; the filter is 60 lines.
+// Level 0 comes from decode_rgba (image_check.h), bottom-up as the format stores rows. Written here rather than taken
+// from stb_image_resize because that one filters in sRGB only with a fixed alpha treatment and has no vector
+// renormalisation; the filter is 60 lines.
 #pragma once
 #include <cstdint>
 #include <span>

@@ -42,8 +42,8 @@ Offset<flatbuffers::Vector<Offset<fb::Montage>>> write_montages(FlatBufferBuilde
     const auto group = fbb.CreateString(m.group);
     const auto tracks_v = fbb.CreateVector(tracks);
     const auto sections_v = fbb.CreateVector(sections);
-    const auto notifies_v = notifies.empty() ? Offset<flatbuffers::Vector<Offset<fb::MontageNotify>>>()
-                                             : fbb.CreateVector(notifies);
+    const auto notifies_v =
+        notifies.empty() ? Offset<flatbuffers::Vector<Offset<fb::MontageNotify>>>() : fbb.CreateVector(notifies);
     out.push_back(fb::CreateMontage(fbb, name, group, tracks_v, sections_v, notifies_v, m.rate, m.blend_in,
                                     static_cast<fb::MontageCurve>(m.blend_in_curve), m.blend_out,
                                     static_cast<fb::MontageCurve>(m.blend_out_curve), m.blend_out_trigger,

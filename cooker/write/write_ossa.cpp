@@ -7,8 +7,8 @@
 //
 // The GPU byte vectors (vertices, indices), embedded texture data and clips' key_values get
 // 16-byte alignment from ForceVectorAlignment right before CreateVector: flatc 2.0.8 accepts
-// force_align on vectors in the schema but generates nothing for it. The builder raises its minimum alignment to 16 with it, and
-// Finish pads the whole buffer to that, so "aligned from the end" is also "aligned from the start".
+// force_align on vectors in the schema but generates nothing for it. The builder raises its minimum alignment to 16
+// with it, and Finish pads the whole buffer to that, so "aligned from the end" is also "aligned from the start".
 #include "cooker/write/write_ossa.h"
 #include "cooker/write/write_montage.h"
 
@@ -110,7 +110,8 @@ Offset<fb::Mesh> write_mesh(FlatBufferBuilder& fbb, const CookedMesh& mesh) {
     const auto target_name = fbb.CreateString(t.name);
     const auto vertices_v = fbb.CreateVector(t.vertices);
     const auto positions_v = fbb.CreateVector(t.position_deltas);
-    const auto normals_v = t.normal_deltas.empty() ? Offset<flatbuffers::Vector<int16_t>>() : fbb.CreateVector(t.normal_deltas);
+    const auto normals_v =
+        t.normal_deltas.empty() ? Offset<flatbuffers::Vector<int16_t>>() : fbb.CreateVector(t.normal_deltas);
     const auto tangents_v =
         t.tangent_deltas.empty() ? Offset<flatbuffers::Vector<int16_t>>() : fbb.CreateVector(t.tangent_deltas);
     const fb::Vec3 ps = vec3(t.position_step), ns = vec3(t.normal_step), ts = vec3(t.tangent_step);
@@ -120,9 +121,8 @@ Offset<fb::Mesh> write_mesh(FlatBufferBuilder& fbb, const CookedMesh& mesh) {
   const auto targets_v =
       targets.empty() ? Offset<flatbuffers::Vector<Offset<fb::MorphTarget>>>() : fbb.CreateVector(targets);
   const Offset<fb::Cloth> cloth = mesh.cloth.empty() ? Offset<fb::Cloth>() : write_cloth(fbb, mesh.cloth);
-  return fb::CreateMesh(fbb, name, mesh.vertex_count, mesh.vertex_stride, layout, vertices, mesh.index_format,
-                        indices, submeshes, &bounds_min, &bounds_max, &offset, &scale, joints, inverse_bind_v, targets_v,
-                        cloth);
+  return fb::CreateMesh(fbb, name, mesh.vertex_count, mesh.vertex_stride, layout, vertices, mesh.index_format, indices,
+                        submeshes, &bounds_min, &bounds_max, &offset, &scale, joints, inverse_bind_v, targets_v, cloth);
 }
 
 Offset<fb::RootMotion> write_root_motion(FlatBufferBuilder& fbb, const SourceRootMotion& rm) {
@@ -173,9 +173,11 @@ Offset<fb::Clip> write_clip(FlatBufferBuilder& fbb, const CompressedClip& clip, 
     const auto track_name = fbb.CreateString(t.name);
     const auto frames_v = fbb.CreateVector(t.key_frames);
     const auto values_v = fbb.CreateVector(t.values);
-    tracks.push_back(fb::CreateMorphTrack(fbb, track_name, frames_v, values_v, t.range_min, t.range_extent, t.max_error));
+    tracks.push_back(
+        fb::CreateMorphTrack(fbb, track_name, frames_v, values_v, t.range_min, t.range_extent, t.max_error));
   }
-  const auto tracks_v = tracks.empty() ? Offset<flatbuffers::Vector<Offset<fb::MorphTrack>>>() : fbb.CreateVector(tracks);
+  const auto tracks_v =
+      tracks.empty() ? Offset<flatbuffers::Vector<Offset<fb::MorphTrack>>>() : fbb.CreateVector(tracks);
   return fb::CreateClip(fbb, name, clip.grid.duration(), clip.grid.sample_rate, clip.grid.frame_count, skeleton_hash,
                         joint_count, constants_v, animated_v, key_frames_v, key_values_v, compression, root_motion,
                         events_v, tracks_v);
@@ -183,7 +185,8 @@ Offset<fb::Clip> write_clip(FlatBufferBuilder& fbb, const CompressedClip& clip, 
 
 fb::Vec3 vec3(const Vec3Def& v) { return fb::Vec3(v[0], v[1], v[2]); }
 
-Offset<flatbuffers::Vector<Offset<fb::FootLeg>>> write_legs(FlatBufferBuilder& fbb, const std::vector<FootLegDef>& legs) {
+Offset<flatbuffers::Vector<Offset<fb::FootLeg>>> write_legs(FlatBufferBuilder& fbb,
+                                                            const std::vector<FootLegDef>& legs) {
   std::vector<Offset<fb::FootLeg>> out;
   for (const FootLegDef& leg : legs) {
     const auto plant = leg.plant_event.empty() ? Offset<flatbuffers::String>() : fbb.CreateString(leg.plant_event);
@@ -217,8 +220,8 @@ Offset<fb::Node> write_node(FlatBufferBuilder& fbb, const NodeDef& node) {
       const auto mask_v = fbb.CreateVectorOfStructs(mask);
       Offset<flatbuffers::Vector<Offset<flatbuffers::String>>> morph_v;
       if (layer.morph_targets) morph_v = fbb.CreateVectorOfStrings(*layer.morph_targets);
-      layers.push_back(fb::CreateLayer(fbb, layer.node, mask_v, layer.weight, layer.weight_parameter,
-                                       layer.blend_time, layer.mesh_space_rotation, morph_v));
+      layers.push_back(fb::CreateLayer(fbb, layer.node, mask_v, layer.weight, layer.weight_parameter, layer.blend_time,
+                                       layer.mesh_space_rotation, morph_v));
     }
     const auto layers_v = fbb.CreateVector(layers);
     data = fb::CreateLayeredBlendNode(fbb, l->base, layers_v).Union();
@@ -355,8 +358,8 @@ Offset<fb::Graph> write_graph(FlatBufferBuilder& fbb, const GraphDef& graph) {
   for (const StateMachineDef& machine : graph.machines) machines.push_back(write_machine(fbb, machine));
   const auto machines_v = fbb.CreateVector(machines);
   const auto montages_v = write_montages(fbb, graph.montages);
-  return fb::CreateGraph(fbb, name, graph.skeleton_hash, graph.joint_count, parameters_v, clips_v, nodes_v,
-                         machines_v, graph.root, montages_v);
+  return fb::CreateGraph(fbb, name, graph.skeleton_hash, graph.joint_count, parameters_v, clips_v, nodes_v, machines_v,
+                         graph.root, montages_v);
 }
 
 /// `written` holds the Texture table of every texture written so far, in the scene's order
@@ -437,8 +440,8 @@ std::vector<uint8_t> write_ossa(const SourceScene& scene, std::span<const Cooked
   for (const GraphDef& graph : options.graphs) graph_offsets.push_back(write_graph(fbb, graph));
   const auto graphs_v = graph_offsets.empty() ? Offset<Vector<Offset<fb::Graph>>>() : fbb.CreateVector(graph_offsets);
 
-  const auto root = fb::CreateFile(fbb, kFormatVersion, scene.metres_per_unit, skeleton, meshes_v, clips_v,
-                                   materials_v, prov, graphs_v);
+  const auto root = fb::CreateFile(fbb, kFormatVersion, scene.metres_per_unit, skeleton, meshes_v, clips_v, materials_v,
+                                   prov, graphs_v);
   fb::FinishFileBuffer(fbb, root);
   return std::vector<uint8_t>(fbb.GetBufferPointer(), fbb.GetBufferPointer() + fbb.GetSize());
 }

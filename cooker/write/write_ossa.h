@@ -19,16 +19,16 @@
 namespace ossa::cook {
 
 struct WriteProvenance {
-  std::string source_name;   // file name only
-  uint64_t source_hash = 0;  // input_hash of the source file
-  std::string options;       // canonical option string
-  std::vector<InputFile> inputs;  // every file read, relative to the input's directory, sorted
-  uint64_t cook_key = 0;     // cook_key(inputs, options)
+  std::string source_name;            // file name only
+  uint64_t source_hash = 0;           // input_hash of the source file
+  std::string options;                // canonical option string
+  std::vector<InputFile> inputs;      // every file read, relative to the input's directory, sorted
+  uint64_t cook_key = 0;              // cook_key(inputs, options)
   std::vector<std::string> warnings;  // the cook's, paths relative to the input's directory
 };
 
 struct WriteOptions {
-  bool include_skeleton = true;  // false for clip-only files cooked against --skeleton
+  bool include_skeleton = true;      // false for clip-only files cooked against --skeleton
   std::span<const GraphDef> graphs;  // animation graphs (a character cooked from a graph file)
 };
 

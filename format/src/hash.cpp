@@ -1,7 +1,6 @@
 // hash.cpp — FNV-1a 64 and the word-wise skeleton hash (see hash.h for why they differ).
 #include <ossa/format/hash.h>
 
-
 namespace ossa {
 uint64_t hash_bytes(const void* data, size_t size, uint64_t state) {
   const auto* p = static_cast<const unsigned char*>(data);

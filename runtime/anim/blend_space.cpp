@@ -86,14 +86,13 @@ double orient(Vec a, Vec b, Vec c) { return cross(b - a, c - a); }
 /// > 0 when d is strictly inside the circumcircle of the counter-clockwise triangle a, b, c.
 double in_circle(Vec a, Vec b, Vec c, Vec d) {
   const Vec ad = a - d, bd = b - d, cd = c - d;
-  return glm::dot(ad, ad) * cross(bd, cd) + glm::dot(bd, bd) * cross(cd, ad) +
-         glm::dot(cd, cd) * cross(ad, bd);
+  return glm::dot(ad, ad) * cross(bd, cd) + glm::dot(bd, bd) * cross(cd, ad) + glm::dot(cd, cd) * cross(ad, bd);
 }
 
 // Tolerances in normalized coordinates (every point inside the unit square).
-constexpr double kSamePoint = 1e-6;   // closer than this on both axes: a duplicate
-constexpr double kCollinear = 1e-9;   // |orient| below this: collinear (twice the triangle area)
-constexpr double kFlip = 1e-12;       // in_circle above this: not Delaunay, flip
+constexpr double kSamePoint = 1e-6;  // closer than this on both axes: a duplicate
+constexpr double kCollinear = 1e-9;  // |orient| below this: collinear (twice the triangle area)
+constexpr double kFlip = 1e-12;      // in_circle above this: not Delaunay, flip
 
 Error error(const std::string& what) { return Error{"blend space: " + what}; }
 
@@ -158,9 +157,8 @@ Result<BlendSpace2D> make_blend_space_2d(std::span<const glm::vec2> points) {
 
   std::vector<uint16_t> order(n);
   std::iota(order.begin(), order.end(), uint16_t{0});
-  std::sort(order.begin(), order.end(), [&](uint16_t a, uint16_t b) {
-    return q[a].x != q[b].x ? q[a].x < q[b].x : q[a].y < q[b].y;
-  });
+  std::sort(order.begin(), order.end(),
+            [&](uint16_t a, uint16_t b) { return q[a].x != q[b].x ? q[a].x < q[b].x : q[a].y < q[b].y; });
 
   // order[0 .. k) lie on one line (sorted along it); order[k] is the first point off it.
   size_t k = 2;

@@ -35,7 +35,7 @@ struct Rows8 {
 };
 
 OSSA_CLOTH_TARGET OSSA_CLOTH_INLINE Rows8 transpose_in(__m128 r0, __m128 r1, __m128 r2, __m128 r3, __m128 r4, __m128 r5,
-                                                 __m128 r6, __m128 r7) {
+                                                       __m128 r6, __m128 r7) {
   const __m256 t0 = _mm256_insertf128_ps(_mm256_castps128_ps256(r0), r4, 1);
   const __m256 t1 = _mm256_insertf128_ps(_mm256_castps128_ps256(r1), r5, 1);
   const __m256 t2 = _mm256_insertf128_ps(_mm256_castps128_ps256(r2), r6, 1);
@@ -181,7 +181,8 @@ OSSA_CLOTH_TARGET void tethers8(glm::vec4* x, const fb::ClothTether* t, size_t c
 
 /// Row `row` of r * p + t for eight points (glm's mat3 * vec3 order: column 0's term, plus column
 /// 1's, plus column 2's; then t).
-OSSA_CLOTH_TARGET OSSA_CLOTH_INLINE __m256 transformed(const Rows8& p, const glm::mat3& r, const glm::vec3& t, int row) {
+OSSA_CLOTH_TARGET OSSA_CLOTH_INLINE __m256 transformed(const Rows8& p, const glm::mat3& r, const glm::vec3& t,
+                                                       int row) {
   return _mm256_add_ps(_mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(_mm256_set1_ps(r[0][row]), p.x),
                                                    _mm256_mul_ps(_mm256_set1_ps(r[1][row]), p.y)),
                                      _mm256_mul_ps(_mm256_set1_ps(r[2][row]), p.z)),
@@ -195,8 +196,7 @@ OSSA_CLOTH_TARGET OSSA_CLOTH_INLINE void transform(Rows8& p, const glm::mat3& r,
   p.z = z;
 }
 
-OSSA_CLOTH_TARGET void carry8(glm::vec4* x, glm::vec4* previous, size_t count, const glm::mat3& r,
-                              const glm::vec3& t) {
+OSSA_CLOTH_TARGET void carry8(glm::vec4* x, glm::vec4* previous, size_t count, const glm::mat3& r, const glm::vec3& t) {
   for (size_t i = 0; i < count; i += 8) {
     Rows8 a = load_block(x + i), b = load_block(previous + i);
     transform(a, r, t);
@@ -240,8 +240,8 @@ OSSA_CLOTH_TARGET uint32_t predict8(glm::vec4* x, glm::vec4* previous, size_t fi
 /// lanes that move) pushed out of each collider of `step` in turn, as cloth_solve.cpp's push_out
 /// pushes one: a collider whose bounding sphere and capsule hold none of the lanes costs a few
 /// operations. Returns the lanes moved.
-OSSA_CLOTH_TARGET OSSA_CLOTH_INLINE __m256 push_out8(__m256& px, __m256& py, __m256& pz, __m256 sx, __m256 sy, __m256 sz,
-                                               __m256 free, const glm::vec4* step, size_t count) {
+OSSA_CLOTH_TARGET OSSA_CLOTH_INLINE __m256 push_out8(__m256& px, __m256& py, __m256& pz, __m256 sx, __m256 sy,
+                                                     __m256 sz, __m256 free, const glm::vec4* step, size_t count) {
   const __m256 zero = _mm256_setzero_ps(), one = splat(1.0f), tiny = splat(1e-12f);
   __m256 moved = zero;
   for (size_t k = 0; k < count; ++k) {
@@ -306,8 +306,7 @@ OSSA_CLOTH_TARGET void push4(glm::vec4* x, const glm::vec4* previous, size_t fir
     if (mask & (1 << l)) x[first + l] = glm::vec4(out[0][l], out[1][l], out[2][l], x[first + l].w);
 }
 
-OSSA_CLOTH_TARGET void push3(glm::vec3* p, const glm::vec4* state, size_t first, const glm::vec4* step,
-                             size_t count) {
+OSSA_CLOTH_TARGET void push3(glm::vec3* p, const glm::vec4* state, size_t first, const glm::vec4* step, size_t count) {
   alignas(32) float in[7][8];
   for (size_t l = 0; l < 8; ++l) {
     in[0][l] = p[first + l].x;
@@ -320,8 +319,8 @@ OSSA_CLOTH_TARGET void push3(glm::vec3* p, const glm::vec4* state, size_t first,
   }
   __m256 px = _mm256_load_ps(in[0]), py = _mm256_load_ps(in[1]), pz = _mm256_load_ps(in[2]);
   const __m256 free = _mm256_cmp_ps(_mm256_load_ps(in[6]), _mm256_setzero_ps(), _CMP_NEQ_UQ);
-  const __m256 moved = push_out8(px, py, pz, _mm256_load_ps(in[3]), _mm256_load_ps(in[4]), _mm256_load_ps(in[5]),
-                                 free, step, count);
+  const __m256 moved =
+      push_out8(px, py, pz, _mm256_load_ps(in[3]), _mm256_load_ps(in[4]), _mm256_load_ps(in[5]), free, step, count);
   if (_mm256_testz_ps(moved, moved)) return;
   _mm256_store_ps(in[0], px);
   _mm256_store_ps(in[1], py);

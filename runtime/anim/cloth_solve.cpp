@@ -95,7 +95,9 @@ glm::vec3 closest_on_segment(const glm::vec3& p, const glm::vec3& a, const glm::
 /// two when there is no older one).
 struct Weights {
   float older = 0.0f, before = 1.0f, now = 0.0f;
-  glm::vec3 of(const glm::vec3& o, const glm::vec3& b, const glm::vec3& n) const { return o * older + b * before + n * now; }
+  glm::vec3 of(const glm::vec3& o, const glm::vec3& b, const glm::vec3& n) const {
+    return o * older + b * before + n * now;
+  }
 };
 
 /// The weights at s seconds into an update of dt seconds that came `gap` seconds after the one
@@ -121,14 +123,14 @@ Weights weights_at(float s, float dt, float gap, bool quadratic) {
 
 /// Everything one substep needs besides the instance.
 struct Step {
-  float h = 0.0f;             // seconds
-  float f = 0.0f;             // where the substep ends between the last update's inputs (0) and this one's (1)
-  Weights w;                  // the inputs at the substep's end
-  glm::vec3 gravity_h2{0.0f}; // model space, displacement per substep from gravity
-  glm::vec3 wind_h{0.0f};     // model space, the air's displacement per substep
-  float keep = 1.0f;          // velocity kept per substep (damping)
-  float drag = 0.0f;          // share of the normal relative velocity taken per substep
-  float max_step = 0.0f;      // > 0: the longest move per substep (max_speed * h)
+  float h = 0.0f;              // seconds
+  float f = 0.0f;              // where the substep ends between the last update's inputs (0) and this one's (1)
+  Weights w;                   // the inputs at the substep's end
+  glm::vec3 gravity_h2{0.0f};  // model space, displacement per substep from gravity
+  glm::vec3 wind_h{0.0f};      // model space, the air's displacement per substep
+  float keep = 1.0f;           // velocity kept per substep (damping)
+  float drag = 0.0f;           // share of the normal relative velocity taken per substep
+  float max_step = 0.0f;       // > 0: the longest move per substep (max_speed * h)
 };
 
 void apply_carry(ClothInstance& c, const Carry& k) {
@@ -191,8 +193,8 @@ void predict(ClothInstance& c, std::span<const glm::vec3> skinned, const Step& s
 #if OSSA_HAVE_VECTOR_CLONES
   if (detail::cloth_kernels_selected() && !(st.drag > 0.0f)) {
     for (; i + 8 <= n; i += 8)
-      for (uint32_t fixed = detail::predict_particles8(c.current.data(), c.previous.data(), i, st.keep,
-                                                       st.gravity_h2, st.max_step);
+      for (uint32_t fixed =
+               detail::predict_particles8(c.current.data(), c.previous.data(), i, st.keep, st.gravity_h2, st.max_step);
            fixed != 0; fixed &= fixed - 1)
         predict_one(c, i + static_cast<size_t>(__builtin_ctz(fixed)), skinned, st);
   }
@@ -549,8 +551,9 @@ Status update_cloth(ClothInstance& c, const ClothInput& in) {
   const Frame now = frame_of(in.model_to_world);
   const Frame before = frame_of(c.world_before);
   const bool jumped =
-      c.started && ((s.teleport_distance > 0.0f && glm::length(now.translation - before.translation) > s.teleport_distance) ||
-                    (s.teleport_angle > 0.0f && rotation_angle(now.rotation, before.rotation) > s.teleport_angle));
+      c.started &&
+      ((s.teleport_distance > 0.0f && glm::length(now.translation - before.translation) > s.teleport_distance) ||
+       (s.teleport_angle > 0.0f && rotation_angle(now.rotation, before.rotation) > s.teleport_angle));
   if (!c.started || jumped) restart(c, in);
   const Frame start = frame_of(c.world_before);
 

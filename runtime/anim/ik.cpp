@@ -164,8 +164,8 @@ bool aim_ik(const AimIkInput& in, AimIkOutput* out) {
   const double limit = std::max(0.0, static_cast<double>(in.max_angle));
   out->reached = angle <= limit + 1e-9;
   if (!out->reached) {
-    const dvec3 axis = glm::length(glm::cross(forward, k)) > 1e-12 ? glm::normalize(glm::cross(forward, k))
-                                                                    : glm::axis(swing);
+    const dvec3 axis =
+        glm::length(glm::cross(forward, k)) > 1e-12 ? glm::normalize(glm::cross(forward, k)) : glm::axis(swing);
     swing = glm::angleAxis(limit, axis);
   }
   const dvec3 facing = swing * forward;

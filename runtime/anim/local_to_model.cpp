@@ -28,7 +28,6 @@
 #include "internal/vector_clones.h"
 #endif
 
-
 namespace ossa {
 
 namespace {
@@ -103,8 +102,7 @@ OSSA_INLINE __m128 combine(const Columns& p, float x, float y, float z) {
 /// 0 0 0 1 by itself. 12 multiplies and 9 adds, 4 wide.
 OSSA_INLINE Columns mul_affine(const Columns& p, const AffineLanes& a, size_t l) {
   return {combine(p, a[0][l], a[1][l], a[2][l]), combine(p, a[3][l], a[4][l], a[5][l]),
-          combine(p, a[6][l], a[7][l], a[8][l]),
-          _mm_add_ps(combine(p, a[9][l], a[10][l], a[11][l]), p.c3)};
+          combine(p, a[6][l], a[7][l], a[8][l]), _mm_add_ps(combine(p, a[9][l], a[10][l], a[11][l]), p.c3)};
 }
 #else
 struct Columns {
@@ -136,7 +134,8 @@ OSSA_INLINE Columns mul_affine(const Columns& p, const AffineLanes& a, size_t l)
 
 }  // namespace
 
-OSSA_INLINE static void local_to_model_body(std::span<const int16_t> parents, ConstPoseSpan local, std::span<glm::mat4> out_model) {
+OSSA_INLINE static void local_to_model_body(std::span<const int16_t> parents, ConstPoseSpan local,
+                                            std::span<glm::mat4> out_model) {
   const detail::FlushDenormals flush;  // internal/float_env.h
   const size_t n = std::min({size_t(local.joint_count), parents.size(), out_model.size()});
   AffineLanes a;
@@ -150,12 +149,9 @@ OSSA_INLINE static void local_to_model_body(std::span<const int16_t> parents, Co
       // Only the parent is chosen per case; a root multiplies the identity (exact), so the local
       // matrix's scalars are read once, after the branches, straight into broadcasts.
       Columns parent;
-      if (p >= 0 && size_t(p) + 1 == i)
-        parent = previous;
-      else if (p >= 0 && size_t(p) < i)
-        parent = load_columns(&out_model[size_t(p)][0][0]);  // 16 contiguous floats
-      else
-        parent = identity_columns();
+      if (p >= 0 && size_t(p) + 1 == i) parent = previous;
+      else if (p >= 0 && size_t(p) < i) parent = load_columns(&out_model[size_t(p)][0][0]);  // 16 contiguous floats
+      else parent = identity_columns();
       const Columns model = mul_affine(parent, a, l);
       store_columns(model, &out_model[i][0][0]);
       previous = model;
@@ -163,6 +159,8 @@ OSSA_INLINE static void local_to_model_body(std::span<const int16_t> parents, Co
   }
 }
 
-OSSA_VECTOR_DISPATCH(local_to_model, (std::span<const int16_t> parents, ConstPoseSpan local, std::span<glm::mat4> out_model), (parents, local, out_model))
+OSSA_VECTOR_DISPATCH(local_to_model,
+                     (std::span<const int16_t> parents, ConstPoseSpan local, std::span<glm::mat4> out_model),
+                     (parents, local, out_model))
 
 }  // namespace ossa

@@ -39,7 +39,6 @@
 #include "internal/float_env.h"
 #include "internal/vector_clones.h"
 
-
 // No-alias promise for GCC's vectorizer (see the comment above). Clang gets none: its loop hint
 // forces vectorization and warns where it cannot (sanitizer builds), and its vectorizer adds its
 // own run-time alias checks anyway.
@@ -95,7 +94,7 @@ OSSA_INLINE void normalize_rotations(float* rx, size_t stride, size_t count) {
   const size_t s1 = stride, s2 = 2 * stride, s3 = 3 * stride;
   for (size_t first = 0; first < count; first += kLanes) {
     float* o = rx + first;
-OSSA_IVDEP
+    OSSA_IVDEP
     for (size_t l = 0; l < kLanes; ++l) {
       const float x = o[l], y = o[l + s1], z = o[l + s2], w = o[l + s3];
       const float inv = rsqrt(x * x + y * y + z * z + w * w);
@@ -109,7 +108,7 @@ OSSA_INLINE void lerp_lanes(const float* a, const float* b, const float* t, floa
   for (size_t first = 0; first < count; first += kLanes) {
     const float *pa = a + first, *pb = b + first, *pt = t + first;
     float* o = out + first;
-OSSA_IVDEP
+    OSSA_IVDEP
     for (size_t l = 0; l < kLanes; ++l) o[l] = pa[l] + pt[l] * (pb[l] - pa[l]);
   }
 }
@@ -124,7 +123,7 @@ OSSA_INLINE void lerp_rotations(const float* a, const float* b, const float* t, 
   for (size_t first = 0; first < count; first += kLanes) {
     const float *pa = a + first, *pb = b + first, *pt = kPerLane ? t + first : t;
     float* o = out + first;
-OSSA_IVDEP
+    OSSA_IVDEP
     for (size_t l = 0; l < kLanes; ++l) {
       const float ax = pa[l], ay = pa[l + s1], az = pa[l + s2], aw = pa[l + s3];
       const float bx = pb[l], by = pb[l + s1], bz = pb[l + s2], bw = pb[l + s3];
@@ -144,7 +143,7 @@ OSSA_INLINE void elementwise(const float* a, const float* b, float* out, size_t 
   for (size_t first = 0; first < count; first += kLanes) {
     const float *pa = a + first, *pb = b + first;
     float* o = out + first;
-OSSA_IVDEP
+    OSSA_IVDEP
     for (size_t l = 0; l < kLanes; ++l) o[l] = f(pa[l], pb[l]);
   }
 }
@@ -169,7 +168,7 @@ OSSA_INLINE void weighted_sum(const float* const (&in)[3], const float (&w)[3], 
   for (size_t first = 0; first < count; first += kLanes) {
     const float *a = in[0] + first, *b = in[K > 1 ? 1 : 0] + first, *c = in[K > 2 ? 2 : 0] + first;
     float* o = out + first;
-OSSA_IVDEP
+    OSSA_IVDEP
     for (size_t l = 0; l < kLanes; ++l) {
       float v = wa * a[l];
       if constexpr (K > 1) v += wb * b[l];
@@ -190,7 +189,7 @@ OSSA_INLINE void weighted_rotation_sum(const float* ref, const float* const (&in
     const float *a = in[0] + first, *b = in[K > 1 ? 1 : 0] + first, *c = in[K > 2 ? 2 : 0] + first;
     const float* f = kRefIsFirst ? a : ref + first;  // one set of loads when they coincide
     float* o = out + first;
-OSSA_IVDEP
+    OSSA_IVDEP
     for (size_t l = 0; l < kLanes; ++l) {
       const float fx = f[l], fy = f[l + s1], fz = f[l + s2], fw = f[l + s3];
       // The three inputs written out: GCC -O2 vectorizes this loop only as straight-line code.
@@ -253,7 +252,8 @@ OSSA_INLINE static void blend_body(ConstPoseSpan a, ConstPoseSpan b, float alpha
 
 OSSA_VECTOR_DISPATCH(blend, (ConstPoseSpan a, ConstPoseSpan b, float alpha, PoseSpan out), (a, b, alpha, out))
 
-OSSA_INLINE static void blend_n_body(std::span<const ConstPoseSpan> poses, std::span<const float> weights, PoseSpan out) {
+OSSA_INLINE static void blend_n_body(std::span<const ConstPoseSpan> poses, std::span<const float> weights,
+                                     PoseSpan out) {
   const detail::FlushDenormals flush;  // internal/float_env.h
   const size_t count = std::min(poses.size(), weights.size());
   if (count == 0) return set_identity(out);
@@ -310,10 +310,11 @@ OSSA_INLINE static void blend_n_body(std::span<const ConstPoseSpan> poses, std::
   reset_padding(out);
 }
 
-OSSA_VECTOR_DISPATCH(blend_n, (std::span<const ConstPoseSpan> poses, std::span<const float> weights, PoseSpan out), (poses, weights, out))
+OSSA_VECTOR_DISPATCH(blend_n, (std::span<const ConstPoseSpan> poses, std::span<const float> weights, PoseSpan out),
+                     (poses, weights, out))
 
-OSSA_INLINE static void blend_layered_body(ConstPoseSpan base, ConstPoseSpan layer, std::span<const float> joint_weights, float weight,
-                   PoseSpan out) {
+OSSA_INLINE static void blend_layered_body(ConstPoseSpan base, ConstPoseSpan layer,
+                                           std::span<const float> joint_weights, float weight, PoseSpan out) {
   const detail::FlushDenormals flush;  // internal/float_env.h
   const size_t stride = common_stride(base, layer, out);
   // Joints past joint_weights (and padding lanes) get weight 0: they keep the base pose.
@@ -338,7 +339,10 @@ OSSA_INLINE static void blend_layered_body(ConstPoseSpan base, ConstPoseSpan lay
   }
 }
 
-OSSA_VECTOR_DISPATCH(blend_layered, (ConstPoseSpan base, ConstPoseSpan layer, std::span<const float> joint_weights, float weight, PoseSpan out), (base, layer, joint_weights, weight, out))
+OSSA_VECTOR_DISPATCH(blend_layered,
+                     (ConstPoseSpan base, ConstPoseSpan layer, std::span<const float> joint_weights, float weight,
+                      PoseSpan out),
+                     (base, layer, joint_weights, weight, out))
 
 void build_joint_mask(std::span<const int16_t> parents, int joint, int depth, std::span<float> out) {
   const size_t n = std::min(parents.size(), out.size());
@@ -380,7 +384,7 @@ OSSA_INLINE static void make_additive_body(ConstPoseSpan pose, ConstPoseSpan ref
   for (size_t first = 0; first < stride; first += kLanes) {
     const float *pq = p + rot + first, *pr = r + rot + first;
     float* po = o + rot + first;
-OSSA_IVDEP
+    OSSA_IVDEP
     for (size_t l = 0; l < kLanes; ++l) {
       const float rx = pr[l], ry = pr[l + s1], rz = pr[l + s2], rw = pr[l + s3];
       const float qx = pq[l], qy = pq[l + s1], qz = pq[l + s2], qw = pq[l + s3];
@@ -392,7 +396,8 @@ OSSA_IVDEP
   }
 }
 
-OSSA_VECTOR_DISPATCH(make_additive, (ConstPoseSpan pose, ConstPoseSpan reference, PoseSpan out_additive), (pose, reference, out_additive))
+OSSA_VECTOR_DISPATCH(make_additive, (ConstPoseSpan pose, ConstPoseSpan reference, PoseSpan out_additive),
+                     (pose, reference, out_additive))
 
 OSSA_INLINE static void add_body(ConstPoseSpan base, ConstPoseSpan additive, float weight, PoseSpan out) {
   const detail::FlushDenormals flush;  // internal/float_env.h
@@ -413,7 +418,7 @@ OSSA_INLINE static void add_body(ConstPoseSpan base, ConstPoseSpan additive, flo
   for (size_t first = 0; first < stride; first += kLanes) {
     const float *pb = b + r + first, *pd = d + r + first;
     float* po = o + r + first;
-OSSA_IVDEP
+    OSSA_IVDEP
     for (size_t l = 0; l < kLanes; ++l) {
       // lerp(identity, delta, w) on the short arc (delta's dot with identity is its w).
       const float dw = pd[l + s3];
@@ -431,6 +436,7 @@ OSSA_IVDEP
   normalize_rotations(o + r, stride, stride);
 }
 
-OSSA_VECTOR_DISPATCH(add, (ConstPoseSpan base, ConstPoseSpan additive, float weight, PoseSpan out), (base, additive, weight, out))
+OSSA_VECTOR_DISPATCH(add, (ConstPoseSpan base, ConstPoseSpan additive, float weight, PoseSpan out),
+                     (base, additive, weight, out))
 
 }  // namespace ossa

@@ -106,9 +106,7 @@ Track track_of(const ClipView& clip) {
 
 }  // namespace
 
-bool has_root_motion(const ClipView& clip) {
-  return clip.fb != nullptr && clip.fb->root_motion() != nullptr;
-}
+bool has_root_motion(const ClipView& clip) { return clip.fb != nullptr && clip.fb->root_motion() != nullptr; }
 
 RootMotionDelta root_motion_delta(const ClipView& clip, double from, double to) {
   const Track track = track_of(clip);

@@ -88,13 +88,13 @@ struct AlignedFloats {
 /// cache creation so the hot path reads one flat record.
 struct Track {
   uint64_t bit_offset = 0;
-  uint32_t bits = 0;                 // 1..19, or 32 (raw floats)
-  float qmax = 0.0f;                 // 2^bits - 1
-  float lo[4] = {0, 0, 0, 0};        // 4 wide (the 4th unused) for one SSE load
+  uint32_t bits = 0;           // 1..19, or 32 (raw floats)
+  float qmax = 0.0f;           // 2^bits - 1
+  float lo[4] = {0, 0, 0, 0};  // 4 wide (the 4th unused) for one SSE load
   float extent[4] = {0, 0, 0, 0};
   bool rotation = false;
-  uint32_t offset[4] = {0, 0, 0, 0}; // where components go in k0 / k1 (offset[3]: a rotation's rebuilt one)
-  uint32_t weight_index = 0;         // kind * stride + joint, into start / inv_length
+  uint32_t offset[4] = {0, 0, 0, 0};  // where components go in k0 / k1 (offset[3]: a rotation's rebuilt one)
+  uint32_t weight_index = 0;          // kind * stride + joint, into start / inv_length
 };
 
 /// Animated channels sharing one key-frame list, and the cursor they share: the pair (cursor,
@@ -113,11 +113,11 @@ struct Run {
 }  // namespace
 
 struct SamplingCache::State {
-  const fb::Clip* clip = nullptr;  // the clip this cache was made for
-  const uint8_t* stream = nullptr; // its key_values
+  const fb::Clip* clip = nullptr;   // the clip this cache was made for
+  const uint8_t* stream = nullptr;  // its key_values
   uint32_t joint_count = 0;
-  uint32_t stride = 0;     // pose_stride(joint_count)
-  float last_frame = 0.0f; // frame_count - 1
+  uint32_t stride = 0;      // pose_stride(joint_count)
+  float last_frame = 0.0f;  // frame_count - 1
 
   // One block: k0[10 * stride], k1[10 * stride], start[3 * stride], inv_length[3 * stride].
   AlignedFloats block;
@@ -196,10 +196,8 @@ Track make_track(const fb::AnimatedChannel& ch, uint32_t stride) {
   const uint32_t dropped = t.rotation ? ch.dropped() : 3;  // validation proved dropped <= 3
   for (uint32_t c = 0, i = 0; c < 4; ++c) {
     const uint32_t at = (kFirstComponent[kind] + c) * stride + ch.joint();
-    if (c == dropped)
-      t.offset[3] = at;
-    else if (i < 3)
-      t.offset[i++] = at;
+    if (c == dropped) t.offset[3] = at;
+    else if (i < 3) t.offset[i++] = at;
   }
   t.weight_index = kind * stride + ch.joint();
   return t;
@@ -221,8 +219,10 @@ inline void decode(const Track& t, const uint8_t* stream, uint32_t key, float* k
     const auto q2 = static_cast<uint32_t>(packed >> (2 * t.bits)) & mask;
 #if defined(__SSE2__)
     // q < 2^19 fits a signed 32-bit lane, so the signed conversion is exact.
-    const __m128 q = _mm_cvtepi32_ps(_mm_setr_epi32(static_cast<int>(q0), static_cast<int>(q1), static_cast<int>(q2), 0));
-    const __m128 r = _mm_add_ps(_mm_loadu_ps(t.lo), _mm_mul_ps(_mm_loadu_ps(t.extent), _mm_div_ps(q, _mm_set1_ps(t.qmax))));
+    const __m128 q =
+        _mm_cvtepi32_ps(_mm_setr_epi32(static_cast<int>(q0), static_cast<int>(q1), static_cast<int>(q2), 0));
+    const __m128 r =
+        _mm_add_ps(_mm_loadu_ps(t.lo), _mm_mul_ps(_mm_loadu_ps(t.extent), _mm_div_ps(q, _mm_set1_ps(t.qmax))));
     _mm_storeu_ps(v, r);
 #else
     const uint32_t q[3] = {q0, q1, q2};
@@ -494,8 +494,8 @@ Result<SamplingCache> make_sampling_cache(const ClipView& clip, const SkeletonVi
   std::vector<uint32_t> run_index(animated.size());
   for (size_t i = 0; i < animated.size(); ++i) {
     const fb::AnimatedChannel& a = animated[i];
-    const auto [it, added] = run_of.emplace(std::make_pair(a.first_key(), a.key_count()),
-                                            static_cast<uint32_t>(runs.size()));
+    const auto [it, added] =
+        run_of.emplace(std::make_pair(a.first_key(), a.key_count()), static_cast<uint32_t>(runs.size()));
     if (added) {
       Run r;
       r.frames = clip.key_frames().data() + a.first_key();
@@ -621,10 +621,8 @@ void sample(const ClipView& clip, float time, const SampleOptions& options, Samp
 
   // Pass 2: every joint.
   const Lanes lanes{s.k0, s.fixed, s.k1, s.start, s.inv_length, s.kinds, out.base, s.stride};
-  if (options.rotation == RotationInterpolation::Slerp)
-    interpolate_slerp(lanes, frame);
-  else
-    interpolate_nlerp(lanes, frame);
+  if (options.rotation == RotationInterpolation::Slerp) interpolate_slerp(lanes, frame);
+  else interpolate_nlerp(lanes, frame);
 }
 
 float advance_time(float time, float dt, float rate, float duration, bool loop, int* loops) {

@@ -30,8 +30,6 @@ glm::mat4 compose(const Transform& t) {
   return m;
 }
 
-
-
 glm::mat4 base_of(const SpringChain& chain, std::span<const int16_t> parents, std::span<const glm::mat4> model) {
   const int16_t p = parents[chain.joints.front()];
   return p >= 0 && static_cast<size_t>(p) < model.size() ? model[static_cast<size_t>(p)] : glm::mat4(1.0f);
@@ -112,7 +110,8 @@ void pass(SpringChain& chain, Pass mode, float h, float ahead, const glm::mat4& 
     }
     // Turn the joint from its animated bone direction onto its tail.
     glm::quat rotation = t.rotation;
-    const glm::vec3 shown = mode == Pass::Pose && ahead > 0.0f ? current + (current - previous) * (ahead / s.step) : current;
+    const glm::vec3 shown =
+        mode == Pass::Pose && ahead > 0.0f ? current + (current - previous) * (ahead / s.step) : current;
     const glm::vec3 to_tail = shown - head;
     const float tl = glm::length(to_tail);
     if (length > 0.0f && tl > 1e-9f) {
@@ -149,8 +148,9 @@ Result<SpringChain> make_spring_chain(std::span<const int16_t> parents, std::spa
   if (!(s.stiffness >= 0.0f) || !std::isfinite(s.stiffness) || !finite3(s.gravity) || !(s.radius >= 0.0f) ||
       !std::isfinite(s.radius) || !(s.teleport_distance >= 0.0f) || !std::isfinite(s.teleport_distance) ||
       !(s.tail_length >= 0.0f) || !std::isfinite(s.tail_length))
-    return Error{"spring chain: stiffness, radius, teleport_distance and tail_length must be finite and >= 0, "
-                 "gravity finite"};
+    return Error{
+        "spring chain: stiffness, radius, teleport_distance and tail_length must be finite and >= 0, "
+        "gravity finite"};
   SpringChain chain;
   chain.joints.assign(joints.begin(), joints.end());
   chain.current.assign(joints.size(), glm::vec3(0.0f));
@@ -174,7 +174,8 @@ void update_spring_chain(SpringChain& chain, float dt, std::span<const int16_t> 
   if (chain.joints.empty()) return;
   const glm::mat4 base = base_of(chain, parents, model);
   const float teleport = chain.settings.teleport_distance;
-  if (!chain.started || (teleport > 0.0f && glm::length(glm::vec3(base[3]) - glm::vec3(chain.base_before[3])) > teleport))
+  if (!chain.started ||
+      (teleport > 0.0f && glm::length(glm::vec3(base[3]) - glm::vec3(chain.base_before[3])) > teleport))
     reset_spring_chain(chain, parents, local, model);
   const float h = chain.settings.step;
   if (std::isfinite(dt) && dt > 0.0f) {

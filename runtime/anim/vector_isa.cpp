@@ -25,7 +25,9 @@ VectorIsa best_vector_isa() {
   return best;
 }
 
-VectorIsa vector_isa() { return avx2_selected().load(std::memory_order_relaxed) ? VectorIsa::Avx2 : VectorIsa::Baseline; }
+VectorIsa vector_isa() {
+  return avx2_selected().load(std::memory_order_relaxed) ? VectorIsa::Avx2 : VectorIsa::Baseline;
+}
 
 bool set_vector_isa(VectorIsa isa) {
   if (isa == VectorIsa::Avx2 && best_vector_isa() != VectorIsa::Avx2) return false;

@@ -17,7 +17,6 @@ using namespace graph_detail;
 
 namespace {
 
-
 const fb::Clip* find_clip(const Asset& asset, std::string_view name) {
   const auto* clips = asset.file().clips();
   if (!clips) return nullptr;
@@ -98,14 +97,12 @@ uint32_t scratch_needed(const GraphDefinition::Impl& def, uint16_t n) {
         need = std::max(need, 1 + scratch_needed(def, st->node()));
       return need;
     }
-    case Kind::Morph:
-      return scratch_needed(def, static_cast<const fb::MorphWeightsNode*>(info.table)->input());
+    case Kind::Morph: return scratch_needed(def, static_cast<const fb::MorphWeightsNode*>(info.table)->input());
     case Kind::TwoBoneIk:
     case Kind::Aim:
     case Kind::FootPlacement:
     case Kind::FootLock:
-    case Kind::Spring:
-      return scratch_needed(def, procedural_input(info));
+    case Kind::Spring: return scratch_needed(def, procedural_input(info));
     case Kind::Slot: {  // the montages' pose and one more, plus the pose before a switch when inertialized
       const SlotInfo& slot = def.slots[info.aux];
       return std::max(scratch_needed(def, slot.input), slot.inertia >= 0 ? 3u : 2u);
@@ -131,11 +128,11 @@ void mark_driven_channels(const GraphDefinition::Impl& d, uint16_t n, std::vecto
   };
   const NodeInfo& info = d.nodes[n];
   switch (info.kind) {
-    case Kind::Clip:
-      return mark_clip(static_cast<const fb::ClipNode*>(info.table)->clip());
+    case Kind::Clip: return mark_clip(static_cast<const fb::ClipNode*>(info.table)->clip());
     case Kind::Retarget: return;  // its clip's weight tracks are not played (graph_retarget.cpp)
     case Kind::BlendSpace:
-      for (const fb::BlendSample* smp : *static_cast<const fb::BlendSpaceNode*>(info.table)->samples()) mark_clip(smp->clip());
+      for (const fb::BlendSample* smp : *static_cast<const fb::BlendSpaceNode*>(info.table)->samples())
+        mark_clip(smp->clip());
       return;
     case Kind::Select:
       for (uint16_t c : *static_cast<const fb::SelectNode*>(info.table)->children()) mark_driven_channels(d, c, mask);
@@ -172,10 +169,8 @@ void mark_driven_channels(const GraphDefinition::Impl& d, uint16_t n, std::vecto
     case Kind::Aim:
     case Kind::FootPlacement:
     case Kind::FootLock:
-    case Kind::Spring:
-      return mark_driven_channels(d, procedural_input(info), mask);
-    case Kind::Slot:
-      return mark_driven_channels(d, d.slots[info.aux].input, mask);
+    case Kind::Spring: return mark_driven_channels(d, procedural_input(info), mask);
+    case Kind::Slot: return mark_driven_channels(d, d.slots[info.aux].input, mask);
   }
 }
 
@@ -188,7 +183,8 @@ Result<GraphDefinition> GraphDefinition::create(const Asset& asset, std::string_
   if (!g) {
     std::string names;
     if (const auto* graphs = asset.file().graphs())
-      for (const fb::Graph* other : *graphs) names += (names.empty() ? "" : ", ") + std::string(flatbuffers::GetStringView(other->name()));
+      for (const fb::Graph* other : *graphs)
+        names += (names.empty() ? "" : ", ") + std::string(flatbuffers::GetStringView(other->name()));
     return Error{asset.name() + ": no graph named '" + std::string(graph_name) + "'" +
                  (names.empty() ? " (the file has no graphs)" : " (graphs: " + names + ")")};
   }
@@ -211,7 +207,8 @@ Result<GraphDefinition> GraphDefinition::create(const Asset& asset, std::string_
       found = find_clip(*more_clips[k], clip_name);
       owner = more_clips[k];
     }
-    if (!found) return Error{where + ": clip '" + std::string(clip_name) + "' not found in the file or the clip files given"};
+    if (!found)
+      return Error{where + ": clip '" + std::string(clip_name) + "' not found in the file or the clip files given"};
     ClipView view{found};
     // A retarget node's clip plays on its source rig (graph_retarget.cpp), any other on the graph's.
     auto rig = graph_detail::retarget_clip_rig(d, static_cast<uint16_t>(d.clips.size()), asset, more_clips, where);
@@ -415,7 +412,8 @@ Result<GraphDefinition> GraphDefinition::create(const Asset& asset, std::string_
           SpringSettings settings;
           settings.stiffness = c->stiffness();
           settings.drag = c->drag();
-          settings.gravity = c->gravity() ? glm::vec3(c->gravity()->x(), c->gravity()->y(), c->gravity()->z()) : glm::vec3(0.0f);
+          settings.gravity =
+              c->gravity() ? glm::vec3(c->gravity()->x(), c->gravity()->y(), c->gravity()->z()) : glm::vec3(0.0f);
           settings.radius = c->radius();
           settings.tail_length = c->tail_length();
           settings.step = t->step();
@@ -438,8 +436,7 @@ Result<GraphDefinition> GraphDefinition::create(const Asset& asset, std::string_
         info.kind = Kind::Slot;
         info.table = node.data_as_SlotNode();
         break;
-      default:
-        return Error{where + ": node " + std::to_string(i) + " has no kind"};  // validation forbids it
+      default: return Error{where + ": node " + std::to_string(i) + " has no kind"};  // validation forbids it
     }
   }
 
@@ -532,7 +529,8 @@ size_t GraphDefinition::state_count(size_t machine) const {
 }
 std::string_view GraphDefinition::state_name(size_t machine, size_t state) const {
   if (state >= state_count(machine)) return {};
-  return flatbuffers::GetStringView(impl_->machines[machine].fb->states()->Get(static_cast<flatbuffers::uoffset_t>(state))->name());
+  return flatbuffers::GetStringView(
+      impl_->machines[machine].fb->states()->Get(static_cast<flatbuffers::uoffset_t>(state))->name());
 }
 size_t GraphDefinition::node_count() const { return impl_->nodes.size(); }
 size_t GraphDefinition::clip_count() const { return impl_->clips.size(); }

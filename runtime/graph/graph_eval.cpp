@@ -39,8 +39,8 @@ void push_event(State& s, const fb::ClipEvent& e, uint16_t clip, uint16_t node) 
 /// way the time playback starts from counts and the time it reaches does not, so consecutive
 /// updates report each crossing once. A wrap passes time 0 (= the end of a looping clip); a clamped
 /// clip that reaches an end includes an event exactly there.
-void collect_events(State& s, const ClipView& clip, uint16_t clip_index, uint16_t node, float t0, float t1,
-                    int loops, bool forward, bool loop) {
+void collect_events(State& s, const ClipView& clip, uint16_t clip_index, uint16_t node, float t0, float t1, int loops,
+                    bool forward, bool loop) {
   const auto* events = clip.fb->events();
   if (!events || events->size() == 0 || (t0 == t1 && loops == 0)) return;
   const float d = clip.duration();
@@ -56,7 +56,8 @@ void collect_events(State& s, const ClipView& clip, uint16_t clip_index, uint16_
     for (flatbuffers::uoffset_t k = events->size(); k-- > 0;) {
       const fb::ClipEvent* e = events->Get(k);
       const float t = e->time();
-      if ((t > lo || (lo_inclusive && t == lo)) && (t < hi || (hi_inclusive && t == hi))) push_event(s, *e, clip_index, node);
+      if ((t > lo || (lo_inclusive && t == lo)) && (t < hi || (hi_inclusive && t == hi)))
+        push_event(s, *e, clip_index, node);
     }
   };
   const int whole = std::min(std::abs(loops) - 1, 4);  // a huge dt would only repeat the same events
@@ -108,8 +109,7 @@ void evaluate_clip(State& s, uint16_t n, const NodeInfo& info, const Advance& ad
   int loops = 0;
   if (advance.synced)
     time = advance_time(time, advance.phase * duration, rate < 0.0f ? -1.0f : 1.0f, duration, c.loop(), &loops);
-  else
-    time = advance_time(time, advance.dt, rate, duration, c.loop(), &loops);
+  else time = advance_time(time, advance.dt, rate, duration, c.loop(), &loops);
   if (dominant) collect_events(s, clip, c.clip(), n, t0, time, loops, rate >= 0.0f, c.loop());
   SampleOptions options;
   options.loop = c.loop();
@@ -227,8 +227,8 @@ uint32_t select_leader(const State& s, const NodeInfo& info, uint32_t n) {
   return leader;
 }
 
-void evaluate_select(State& s, const NodeInfo& info, const Advance& advance, float weight, bool dominant,
-                     PoseSpan out, std::span<float> ow, uint32_t depth) {
+void evaluate_select(State& s, const NodeInfo& info, const Advance& advance, float weight, bool dominant, PoseSpan out,
+                     std::span<float> ow, uint32_t depth) {
   const auto& sel = *static_cast<const fb::SelectNode*>(info.table);
   const uint32_t n = sel.children()->size();
   float* w = &s.floats[info.floats];
@@ -303,8 +303,8 @@ void blend_mesh_space(State& s, const LayerJoints& lj, std::span<const float> ma
 
 namespace {
 
-void evaluate_layered(State& s, const NodeInfo& info, const Advance& advance, float weight, bool dominant,
-                      PoseSpan out, std::span<float> ow, uint32_t depth) {
+void evaluate_layered(State& s, const NodeInfo& info, const Advance& advance, float weight, bool dominant, PoseSpan out,
+                      std::span<float> ow, uint32_t depth) {
   const auto& l = *static_cast<const fb::LayeredBlendNode*>(info.table);
   evaluate(s, l.base(), advance, weight, dominant, out, ow, depth);
   const auto& layers = *l.layers();
@@ -322,17 +322,15 @@ void evaluate_layered(State& s, const NodeInfo& info, const Advance& advance, fl
     const std::vector<float>& morph_mask = s.def->layer_morphs[info.aux + k];
     for (size_t c = 0; c < ow.size(); ++c) ow[c] += (tw[c] - ow[c]) * (current * morph_mask[c]);
     const std::vector<float>& mask = s.def->masks[info.aux + k];
-    if (layer.mesh_space_rotation())
-      blend_mesh_space(s, s.def->layer_joints[info.aux + k], mask, current, tmp, out);
-    else
-      blend_layered(out, tmp, mask, current, out);
+    if (layer.mesh_space_rotation()) blend_mesh_space(s, s.def->layer_joints[info.aux + k], mask, current, tmp, out);
+    else blend_layered(out, tmp, mask, current, out);
   }
 }
 
 // ---- blend by alpha, additive ----
 
-void evaluate_alpha(State& s, const NodeInfo& info, const Advance& advance, float weight, bool dominant,
-                    PoseSpan out, std::span<float> ow, uint32_t depth) {
+void evaluate_alpha(State& s, const NodeInfo& info, const Advance& advance, float weight, bool dominant, PoseSpan out,
+                    std::span<float> ow, uint32_t depth) {
   const auto& a = *static_cast<const fb::BlendAlphaNode*>(info.table);
   const float alpha = clamp01(s.params[a.alpha_parameter()]);
   if (alpha <= 0.0f) return evaluate(s, a.a(), advance, weight, dominant, out, ow, depth);
@@ -363,8 +361,8 @@ void evaluate_additive(State& s, const NodeInfo& info, const Advance& advance, f
 
 // ---- morph weights from parameters ----
 
-void evaluate_morph(State& s, const NodeInfo& info, const Advance& advance, float weight, bool dominant,
-                    PoseSpan out, std::span<float> ow, uint32_t depth) {
+void evaluate_morph(State& s, const NodeInfo& info, const Advance& advance, float weight, bool dominant, PoseSpan out,
+                    std::span<float> ow, uint32_t depth) {
   const auto& m = *static_cast<const fb::MorphWeightsNode*>(info.table);
   evaluate(s, m.input(), advance, weight, dominant, out, ow, depth);
   for (uint32_t k = 0; k < m.drives()->size(); ++k) {
@@ -382,32 +380,21 @@ void evaluate(State& s, uint16_t n, const Advance& advance, float weight, bool d
   const NodeInfo& info = s.def->nodes[n];
   s.node_weights[n] = weight;
   switch (info.kind) {
-    case Kind::Clip:
-      return evaluate_clip(s, n, info, advance, dominant, out, ow);
-    case Kind::Retarget:
-      return evaluate_retarget(s, n, advance, out, ow);
-    case Kind::BlendSpace:
-      return evaluate_blend_space(s, n, info, advance, dominant, out, ow, depth);
-    case Kind::Select:
-      return evaluate_select(s, info, advance, weight, dominant, out, ow, depth);
-    case Kind::Layered:
-      return evaluate_layered(s, info, advance, weight, dominant, out, ow, depth);
-    case Kind::BlendAlpha:
-      return evaluate_alpha(s, info, advance, weight, dominant, out, ow, depth);
-    case Kind::Additive:
-      return evaluate_additive(s, info, advance, weight, dominant, out, ow, depth);
-    case Kind::Machine:
-      return evaluate_machine(s, n, advance, weight, dominant, out, ow, depth);
-    case Kind::Morph:
-      return evaluate_morph(s, info, advance, weight, dominant, out, ow, depth);
+    case Kind::Clip: return evaluate_clip(s, n, info, advance, dominant, out, ow);
+    case Kind::Retarget: return evaluate_retarget(s, n, advance, out, ow);
+    case Kind::BlendSpace: return evaluate_blend_space(s, n, info, advance, dominant, out, ow, depth);
+    case Kind::Select: return evaluate_select(s, info, advance, weight, dominant, out, ow, depth);
+    case Kind::Layered: return evaluate_layered(s, info, advance, weight, dominant, out, ow, depth);
+    case Kind::BlendAlpha: return evaluate_alpha(s, info, advance, weight, dominant, out, ow, depth);
+    case Kind::Additive: return evaluate_additive(s, info, advance, weight, dominant, out, ow, depth);
+    case Kind::Machine: return evaluate_machine(s, n, advance, weight, dominant, out, ow, depth);
+    case Kind::Morph: return evaluate_morph(s, info, advance, weight, dominant, out, ow, depth);
     case Kind::TwoBoneIk:
     case Kind::Aim:
     case Kind::FootPlacement:
     case Kind::FootLock:
-    case Kind::Spring:
-      return evaluate_procedural(s, n, advance, weight, dominant, out, ow, depth);
-    case Kind::Slot:
-      return evaluate_slot(s, n, advance, weight, dominant, out, ow, depth);
+    case Kind::Spring: return evaluate_procedural(s, n, advance, weight, dominant, out, ow, depth);
+    case Kind::Slot: return evaluate_slot(s, n, advance, weight, dominant, out, ow, depth);
   }
 }
 
@@ -454,20 +441,15 @@ void restart(State& s, uint16_t n) {
       restart(s, a.additive());
       return;
     }
-    case Kind::Retarget:
-      return restart_retarget(s, info);
-    case Kind::Machine:
-      return restart_machine(s, info.machine);
-    case Kind::Morph:
-      return restart(s, static_cast<const fb::MorphWeightsNode*>(info.table)->input());
+    case Kind::Retarget: return restart_retarget(s, info);
+    case Kind::Machine: return restart_machine(s, info.machine);
+    case Kind::Morph: return restart(s, static_cast<const fb::MorphWeightsNode*>(info.table)->input());
     case Kind::TwoBoneIk:
     case Kind::Aim:
     case Kind::FootPlacement:
     case Kind::FootLock:
-    case Kind::Spring:
-      return restart_procedural(s, n);
-    case Kind::Slot:
-      return restart(s, s.def->slots[info.aux].input);
+    case Kind::Spring: return restart_procedural(s, n);
+    case Kind::Slot: return restart(s, s.def->slots[info.aux].input);
   }
 }
 
@@ -496,28 +478,21 @@ Cycle cycle(const State& s, uint16_t n) {
       const auto& sel = *static_cast<const fb::SelectNode*>(info.table);
       return cycle(s, sel.children()->Get(select_leader(s, info, sel.children()->size())));
     }
-    case Kind::Layered:
-      return cycle(s, static_cast<const fb::LayeredBlendNode*>(info.table)->base());
+    case Kind::Layered: return cycle(s, static_cast<const fb::LayeredBlendNode*>(info.table)->base());
     case Kind::BlendAlpha: {
       const auto& a = *static_cast<const fb::BlendAlphaNode*>(info.table);
       return cycle(s, s.params[a.alpha_parameter()] < 0.5f ? a.a() : a.b());
     }
-    case Kind::Additive:
-      return cycle(s, static_cast<const fb::AdditiveNode*>(info.table)->base());
-    case Kind::Retarget:
-      return retarget_cycle(s, info);
-    case Kind::Machine:
-      return machine_cycle(s, info.machine);
-    case Kind::Morph:
-      return cycle(s, static_cast<const fb::MorphWeightsNode*>(info.table)->input());
+    case Kind::Additive: return cycle(s, static_cast<const fb::AdditiveNode*>(info.table)->base());
+    case Kind::Retarget: return retarget_cycle(s, info);
+    case Kind::Machine: return machine_cycle(s, info.machine);
+    case Kind::Morph: return cycle(s, static_cast<const fb::MorphWeightsNode*>(info.table)->input());
     case Kind::TwoBoneIk:
     case Kind::Aim:
     case Kind::FootPlacement:
     case Kind::FootLock:
-    case Kind::Spring:
-      return cycle(s, procedural_input(info));
-    case Kind::Slot:
-      return cycle(s, s.def->slots[info.aux].input);
+    case Kind::Spring: return cycle(s, procedural_input(info));
+    case Kind::Slot: return cycle(s, s.def->slots[info.aux].input);
   }
   return {};
 }
@@ -556,20 +531,15 @@ void set_phase(State& s, uint16_t n, float p) {
       set_phase(s, a.additive(), p);
       return;
     }
-    case Kind::Retarget:
-      return set_retarget_phase(s, info, p);
-    case Kind::Machine:
-      return set_machine_phase(s, info.machine, p);
-    case Kind::Morph:
-      return set_phase(s, static_cast<const fb::MorphWeightsNode*>(info.table)->input(), p);
+    case Kind::Retarget: return set_retarget_phase(s, info, p);
+    case Kind::Machine: return set_machine_phase(s, info.machine, p);
+    case Kind::Morph: return set_phase(s, static_cast<const fb::MorphWeightsNode*>(info.table)->input(), p);
     case Kind::TwoBoneIk:
     case Kind::Aim:
     case Kind::FootPlacement:
     case Kind::FootLock:
-    case Kind::Spring:
-      return set_phase(s, procedural_input(info), p);
-    case Kind::Slot:
-      return set_phase(s, s.def->slots[info.aux].input, p);
+    case Kind::Spring: return set_phase(s, procedural_input(info), p);
+    case Kind::Slot: return set_phase(s, s.def->slots[info.aux].input, p);
   }
 }
 

@@ -25,10 +25,21 @@
 namespace ossa::graph_detail {
 
 enum class Kind : uint8_t {
-  Clip, BlendAlpha, Select, Layered, BlendSpace, Additive, Machine, Morph,
-  TwoBoneIk, Aim, FootPlacement, FootLock, Spring,  // procedural: graph_procedural.cpp
-  Slot,                                             // montages: graph_slot.cpp
-  Retarget,                                         // graph_retarget.cpp (format v10)
+  Clip,
+  BlendAlpha,
+  Select,
+  Layered,
+  BlendSpace,
+  Additive,
+  Machine,
+  Morph,
+  TwoBoneIk,
+  Aim,
+  FootPlacement,
+  FootLock,
+  Spring,    // procedural: graph_procedural.cpp
+  Slot,      // montages: graph_slot.cpp
+  Retarget,  // graph_retarget.cpp (format v10)
 };
 
 struct NodeInfo {
@@ -59,8 +70,8 @@ struct TransitionInfo {
 
 struct MachineInfo {
   const fb::StateMachine* fb = nullptr;
-  uint16_t node = 0;                          // the StateMachineNode that plays it
-  std::vector<TransitionInfo> transitions;    // priority order
+  uint16_t node = 0;                        // the StateMachineNode that plays it
+  std::vector<TransitionInfo> transitions;  // priority order
 };
 
 /// A retarget node's data made with the definition (graph_retarget.cpp): the source rig (another
@@ -82,22 +93,22 @@ struct RetargetInstance {
 /// A slot node, decoded (graph_slot.cpp).
 struct SlotInfo {
   uint16_t input = 0;
-  uint16_t slot = 0;       // index into Impl::slot_names
-  uint16_t group = 0;      // index into Impl::groups
-  int32_t mask = -1;       // index into Impl::slot_masks / slot_joints; -1: every joint
-  int32_t inertia = -1;    // index into State::slot_inertia; -1: no montage of its group inertializes
+  uint16_t slot = 0;     // index into Impl::slot_names
+  uint16_t group = 0;    // index into Impl::groups
+  int32_t mask = -1;     // index into Impl::slot_masks / slot_joints; -1: every joint
+  int32_t inertia = -1;  // index into State::slot_inertia; -1: no montage of its group inertializes
   bool additive = false, mesh_space = false;
 };
 
 /// A montage segment placed on its montage's timeline (graph_montage.cpp).
 struct SegmentInfo {
   uint16_t clip = 0;
-  uint32_t cache = 0;                     // index into State::montage_caches
+  uint32_t cache = 0;  // index into State::montage_caches
   float clip_start = 0.0f, clip_end = 0.0f, rate = 1.0f;
-  double begin = 0.0, end = 0.0;          // timeline seconds
+  double begin = 0.0, end = 0.0;  // timeline seconds
 };
 struct TrackInfo {
-  uint16_t slot = 0;                      // index into Impl::slot_names
+  uint16_t slot = 0;  // index into Impl::slot_names
   uint32_t first_segment = 0, segment_count = 0;
   double length = 0.0;
 };
@@ -106,27 +117,27 @@ struct TrackInfo {
 enum class MarkerType : uint8_t { End = 0, Instant = 1, Branch = 2, Begin = 3 };
 struct Marker {
   double time = 0.0;
-  uint16_t notify = 0;                    // index into the montage's notifies
+  uint16_t notify = 0;  // index into the montage's notifies
   MarkerType type = MarkerType::Instant;
-  uint8_t window = 0;                     // Begin / End: the window's bit in MontagePlay::open
+  uint8_t window = 0;  // Begin / End: the window's bit in MontagePlay::open
 };
 struct MontageInfo {
   const fb::Montage* fb = nullptr;
   uint16_t group = 0;
-  double length = 0.0;                    // the longest track
+  double length = 0.0;  // the longest track
   uint32_t first_track = 0, track_count = 0;
   uint32_t first_marker = 0, marker_count = 0;
-  std::vector<double> section_start;      // per section; section k ends where k + 1 starts (the last: length)
-  std::vector<uint16_t> windows;          // per window bit: its notify
-  bool inertial = false;                  // a blend curve is Inertialize
+  std::vector<double> section_start;  // per section; section k ends where k + 1 starts (the last: length)
+  std::vector<uint16_t> windows;      // per window bit: its notify
+  bool inertial = false;              // a blend curve is Inertialize
 };
 
 /// Per-layer joint data for a mesh-space rotation blend: the mask roots (masked joints whose parent
 /// is not masked) and their ancestors, ascending (parents first), whose model rotations the
 /// blend needs.
 struct LayerJoints {
-  std::vector<uint16_t> chain;      // ancestors of mask roots and the roots, ascending
-  std::vector<uint8_t> root;        // per chain entry: 1 when it is a mask root
+  std::vector<uint16_t> chain;  // ancestors of mask roots and the roots, ascending
+  std::vector<uint8_t> root;    // per chain entry: 1 when it is a mask root
 };
 
 }  // namespace ossa::graph_detail
@@ -142,49 +153,49 @@ struct GraphDefinition::Impl {
   std::vector<graph_detail::NodeInfo> nodes;
   std::vector<graph_detail::MachineInfo> machines;
   std::vector<uint16_t> transition_triggers;
-  std::vector<std::vector<float>> masks;               // one per layer (joint weights)
+  std::vector<std::vector<float>> masks;                // one per layer (joint weights)
   std::vector<graph_detail::LayerJoints> layer_joints;  // parallel to masks
   std::vector<BlendSpace2D> spaces;
   std::vector<float> sample_x;         // blend-space sample positions (1D: sorted), per node in order
   std::vector<float> sample_duration;  // their clips' durations
-  Pose bind;                       // the rig's bind pose, for additive deltas
+  Pose bind;                           // the rig's bind pose, for additive deltas
   /// Poses of held clips (rate 0, no rate parameter: a pose that never moves), sampled once here
   /// and shared by every instance instead of being sampled by each, every frame.
   std::vector<Pose> held;
-  uint32_t float_count = 0;        // size of State::floats
-  uint32_t cache_count = 0;        // sampling caches per instance
-  uint32_t scratch_depth = 0;      // scratch poses one evaluation needs at most, plus the root's
+  uint32_t float_count = 0;    // size of State::floats
+  uint32_t cache_count = 0;    // sampling caches per instance
+  uint32_t scratch_depth = 0;  // scratch poses one evaluation needs at most, plus the root's
   // Morph weights (ossa/anim/morph.h): the channels are the distinct target names of the asset's
   // meshes; every pose the graph makes carries one weight per channel beside it.
   std::vector<std::string_view> channels;
-  std::vector<float> default_weights;              // per channel
-  std::vector<std::vector<int32_t>> clip_channels; // per clip: each weight track's channel, or -1
-  std::vector<std::vector<float>> layer_morphs;    // parallel to masks: 1 on channels the layer drives
-  std::vector<int32_t> drive_channels;             // morph nodes' drives, in order: channel or -1
+  std::vector<float> default_weights;               // per channel
+  std::vector<std::vector<int32_t>> clip_channels;  // per clip: each weight track's channel, or -1
+  std::vector<std::vector<float>> layer_morphs;     // parallel to masks: 1 on channels the layer drives
+  std::vector<int32_t> drive_channels;              // morph nodes' drives, in order: channel or -1
   // Procedural nodes: spring chains made (and checked) once, copied into each instance; each spring
   // node's colliders; each foot lock leg's plant and lift event names.
-  std::vector<SpringChain> springs;                   // every spring node's chains, in node order
-  std::vector<std::vector<SpringCollider>> colliders; // per spring node, indexed by NodeInfo::samples
-  std::vector<std::string_view> leg_events;           // per foot lock leg: plant, lift ("" none)
-  bool procedural = false;                            // any procedural node: model matrices needed
+  std::vector<SpringChain> springs;                       // every spring node's chains, in node order
+  std::vector<std::vector<SpringCollider>> colliders;     // per spring node, indexed by NodeInfo::samples
+  std::vector<std::string_view> leg_events;               // per foot lock leg: plant, lift ("" none)
+  bool procedural = false;                                // any procedural node: model matrices needed
   std::vector<graph_detail::RetargetNodeData> retargets;  // one per retarget node, in node order
   // Montages and slots (format v9).
-  std::vector<graph_detail::SlotInfo> slots;          // per slot node, indexed by NodeInfo::aux
+  std::vector<graph_detail::SlotInfo> slots;  // per slot node, indexed by NodeInfo::aux
   std::vector<std::vector<float>> slot_masks;
-  std::vector<graph_detail::LayerJoints> slot_joints; // parallel to slot_masks
+  std::vector<graph_detail::LayerJoints> slot_joints;  // parallel to slot_masks
   /// Parallel to slot_masks: the masked joints as ranges [first, last) (a subtree is contiguous in
   /// depth-first order), so a slot writes exactly those and leaves every other joint's bits alone.
   std::vector<std::vector<std::pair<uint32_t, uint32_t>>> slot_ranges;
-  std::vector<std::string_view> slot_names, groups;   // distinct names
+  std::vector<std::string_view> slot_names, groups;  // distinct names
   std::vector<graph_detail::MontageInfo> montages;
   std::vector<graph_detail::TrackInfo> tracks;
   std::vector<graph_detail::SegmentInfo> segments;
   std::vector<graph_detail::Marker> markers;
-  std::vector<uint16_t> montage_cache_clips;          // per montage sampling cache: its clip
-  std::vector<Pose> track_reference;                  // per track: its first frame (additive slots)
-  Pose identity;                                      // every joint at identity (masked additives)
-  uint32_t max_sections = 0;                          // sections of the largest montage
-  uint32_t inertial_slots = 0;                        // slots with an inertialization state
+  std::vector<uint16_t> montage_cache_clips;  // per montage sampling cache: its clip
+  std::vector<Pose> track_reference;          // per track: its first frame (additive slots)
+  Pose identity;                              // every joint at identity (masked additives)
+  uint32_t max_sections = 0;                  // sections of the largest montage
+  uint32_t inertial_slots = 0;                // slots with an inertialization state
 };
 
 namespace graph_detail {
@@ -197,14 +208,14 @@ struct InertialChannel {
 };
 
 struct MachineState {
-  int current = 0;          // the state being entered / played
-  int source = -1;          // a running crossfade's source state
-  int transition = -1;      // running transition index
+  int current = 0;      // the state being entered / played
+  int source = -1;      // a running crossfade's source state
+  int transition = -1;  // running transition index
   fb::TransitionMode mode = fb::TransitionMode::Crossfade;
   float elapsed = 0.0f, duration = 0.0f;
-  double normalized = 0.0;       // the current state's normalized time since it was entered
+  double normalized = 0.0;         // the current state's normalized time since it was entered
   double normalized_before = 0.0;  // ... at the start of the last update
-  bool looping = true;           // whether the current state's leader loops
+  bool looping = true;             // whether the current state's leader loops
   // Inertialization: the offset kept when the machine switched discontinuously.
   bool inertial = false;
   float inertial_elapsed = 0.0f, inertial_duration = 0.0f;
@@ -215,7 +226,7 @@ struct MachineState {
   std::vector<float> last_weights, weight_offset;
   float last_dt = 0.0f;
   uint64_t last_update = 0, before_last_update = 0;  // update counter stamps; 0 = never
-  bool entered = false;    // false: enter the entry state at the next evaluation
+  bool entered = false;                              // false: enter the entry state at the next evaluation
 };
 
 }  // namespace graph_detail
@@ -240,23 +251,23 @@ inline constexpr uint32_t kMaxMontagePlays = 8;
 
 /// One montage being played (graph_montage.cpp).
 struct MontagePlay {
-  int32_t montage = -1;          // -1: free
-  uint64_t serial = 0;           // play order (later plays are blended over earlier ones)
-  uint32_t revision = 0;         // bumped by jumps, so an advance notices a listener's jump
+  int32_t montage = -1;   // -1: free
+  uint64_t serial = 0;    // play order (later plays are blended over earlier ones)
+  uint32_t revision = 0;  // bumped by jumps, so an advance notices a listener's jump
   uint16_t section = 0;
-  double position = 0.0;         // timeline seconds
-  float rate = 1.0f;             // the host's rate times the montage's
+  double position = 0.0;                      // timeline seconds
+  float rate = 1.0f;                          // the host's rate times the montage's
   float weight = 0.0f, weight_before = 0.0f;  // now, and at the start of the update
   float blend_from = 0.0f, blend_to = 1.0f, blend_time = 0.0f;
-  double blend_elapsed = 0.0;    // seconds (double: a blend's end lands on the frame it should, not one later)
+  double blend_elapsed = 0.0;  // seconds (double: a blend's end lands on the frame it should, not one later)
   fb::MontageCurve curve = fb::MontageCurve::Linear;
-  bool blend_fresh = false;      // the blend began inside this update with blend_elapsed already set
+  bool blend_fresh = false;  // the blend began inside this update with blend_elapsed already set
   bool blending_out = false, interrupted = false, at_end = false, ended = false;
-  uint64_t open = 0;             // open window notifies (bit per window)
-  uint64_t switch_update = 0;    // the update in which an inertialized blend switched it (0: none)
-  float switch_time = 0.0f;      // that blend's time
-  float slot_weight = 0.0f;      // the most weight a slot applied it with in the last update
-  int16_t* next = nullptr;       // per section: the section after it (State::montage_links)
+  uint64_t open = 0;           // open window notifies (bit per window)
+  uint64_t switch_update = 0;  // the update in which an inertialized blend switched it (0: none)
+  float switch_time = 0.0f;    // that blend's time
+  float slot_weight = 0.0f;    // the most weight a slot applied it with in the last update
+  int16_t* next = nullptr;     // per section: the section after it (State::montage_links)
 };
 
 }  // namespace graph_detail
@@ -266,38 +277,38 @@ struct GraphInstance::State {
   const GraphDefinition* owner = nullptr;
   // One allocation for the per-frame scalars (a crowd pays one cache miss for them, not three):
   std::vector<float> values;
-  std::span<float> params;          // parameter values
-  std::span<float> floats;          // node variable state
-  std::span<float> node_weights;    // per node, last update
+  std::span<float> params;        // parameter values
+  std::span<float> floats;        // node variable state
+  std::span<float> node_weights;  // per node, last update
   std::vector<SamplingCache> caches;
   std::unique_ptr<GraphScratch::Buffers> own_scratch;  // null when made to share a GraphScratch
-  GraphScratch::Buffers* scratch = nullptr;  // during update(): the buffers in use
+  GraphScratch::Buffers* scratch = nullptr;            // during update(): the buffers in use
   std::vector<graph_detail::MachineState> machines;
   Pose output;
-  std::vector<float> morph;         // output morph channel weights
-  std::vector<GraphEvent> events;   // capacity reserved; size() = events of the last update
+  std::vector<float> morph;        // output morph channel weights
+  std::vector<GraphEvent> events;  // capacity reserved; size() = events of the last update
   size_t event_capacity = 0;
   size_t dropped = 0;
   uint64_t update_counter = 0;
   // Procedural nodes only, last so that the fields every update reads stay on the lines they had:
-  std::vector<glm::vec3> vectors;   // Vector parameters' values (one slot per parameter)
-  glm::mat4 transform{1.0f};        // model to world, set by the host (set_transform)
+  std::vector<glm::vec3> vectors;  // Vector parameters' values (one slot per parameter)
+  glm::mat4 transform{1.0f};       // model to world, set by the host (set_transform)
   glm::mat4 inverse_transform{1.0f};
-  std::vector<SpringChain> springs; // every spring node's chains' state
+  std::vector<SpringChain> springs;                       // every spring node's chains' state
   std::vector<graph_detail::RetargetInstance> retargets;  // one per retarget node
   // Montages (graph_montage.cpp), last for the same reason: a graph without them reads none of it.
-  std::vector<graph_detail::MontagePlay> plays;   // kMaxMontagePlays when the graph has montages
-  std::vector<int16_t> montage_links;             // plays * max_sections
+  std::vector<graph_detail::MontagePlay> plays;  // kMaxMontagePlays when the graph has montages
+  std::vector<int16_t> montage_links;            // plays * max_sections
   std::vector<SamplingCache> montage_caches;
   std::vector<graph_detail::MachineState> slot_inertia;  // inertialized montage switches per slot
-  std::vector<MontageEvent> montage_events;       // capacity event_capacity
-  size_t montage_events_old = 0;                  // events before this index are dropped by the next update
+  std::vector<MontageEvent> montage_events;              // capacity event_capacity
+  size_t montage_events_old = 0;                         // events before this index are dropped by the next update
   uint64_t play_serial = 0;
-  bool montages_active = false;                   // some play is in use (else updates skip montages)
+  bool montages_active = false;  // some play is in use (else updates skip montages)
   MontageListener listener = nullptr;
   void* listener_user = nullptr;
-  GraphInstance* self = nullptr;                  // handed to the listener
-  RootMotionDelta root_motion;                    // the last update's, from root-motion montages
+  GraphInstance* self = nullptr;  // handed to the listener
+  RootMotionDelta root_motion;    // the last update's, from root-motion montages
   glm::vec3 root_motion_up{0.0f, 1.0f, 0.0f};
 };
 
@@ -313,8 +324,8 @@ struct Advance {
 /// Evaluates node `n` into out, advancing it. weight: its contribution to the output (recorded for
 /// node_weight); dominant: whether its clips may fire events; depth: first free scratch pose.
 /// ow: the output's morph channel weights (empty when the character has none), written beside out.
-void evaluate(GraphInstance::State& s, uint16_t n, const Advance& advance, float weight, bool dominant,
-              PoseSpan out, std::span<float> ow, uint32_t depth);
+void evaluate(GraphInstance::State& s, uint16_t n, const Advance& advance, float weight, bool dominant, PoseSpan out,
+              std::span<float> ow, uint32_t depth);
 /// Puts a subtree back to its start (clip times to start offsets, machines to entry, selection and
 /// layer weights to their targets).
 void restart(GraphInstance::State& s, uint16_t n);

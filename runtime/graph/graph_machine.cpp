@@ -44,8 +44,14 @@ bool condition_holds(const State& s, const fb::Transition& t) {
       case fb::ConditionOp::Bool:
       case fb::ConditionOp::Trigger: stack[sp++] = v != 0.0f; break;
       case fb::ConditionOp::Not: stack[sp - 1] = !stack[sp - 1]; break;
-      case fb::ConditionOp::And: --sp; stack[sp - 1] = stack[sp - 1] && stack[sp]; break;
-      case fb::ConditionOp::Or: --sp; stack[sp - 1] = stack[sp - 1] || stack[sp]; break;
+      case fb::ConditionOp::And:
+        --sp;
+        stack[sp - 1] = stack[sp - 1] && stack[sp];
+        break;
+      case fb::ConditionOp::Or:
+        --sp;
+        stack[sp - 1] = stack[sp - 1] || stack[sp];
+        break;
     }
   }
   return sp > 0 && stack[sp - 1];
@@ -80,7 +86,9 @@ void enter_state(State& s, MachineState& m, const MachineInfo& mi, int state) {
 
 /// Whether the last two outputs are from the previous update (so an offset and its velocity can be
 /// taken from them).
-bool has_last(const State& s, const MachineState& m) { return m.last_update != 0 && m.last_update + 1 == s.update_counter; }
+bool has_last(const State& s, const MachineState& m) {
+  return m.last_update != 0 && m.last_update + 1 == s.update_counter;
+}
 
 }  // namespace
 

@@ -178,8 +178,8 @@ void advance_play(State& s, MontagePlay& p, float dt) {
     const bool final_end = p.next[sec] < 0 && stop >= end;
     const uint32_t revision = p.revision;
     bool jumped = false;
-    const Marker* m = std::lower_bound(markers, markers_end, p.position,
-                                       [](const Marker& k, double t) { return k.time < t; });
+    const Marker* m =
+        std::lower_bound(markers, markers_end, p.position, [](const Marker& k, double t) { return k.time < t; });
     for (; m != markers_end && (m->time < stop || (final_end && m->time == stop)); ++m) {
       if (moves_character) add_root_motion(s, mi, p.position, m->time);
       remaining -= m->time - p.position;
@@ -301,7 +301,8 @@ Status bind_montages(GraphDefinition::Impl& d, const std::string& where) {
         const int p = parents[j];
         if (!(mask[j] > 0.0f) || (p >= 0 && mask[static_cast<size_t>(p)] > 0.0f)) continue;
         is_root[j] = 1;
-        for (int a = static_cast<int>(j); a >= 0 && !on_chain[static_cast<size_t>(a)]; a = parents[static_cast<size_t>(a)])
+        for (int a = static_cast<int>(j); a >= 0 && !on_chain[static_cast<size_t>(a)];
+             a = parents[static_cast<size_t>(a)])
           on_chain[static_cast<size_t>(a)] = 1;
       }
       for (uint32_t j = 0; j < d.joints; ++j) {
@@ -356,7 +357,8 @@ Status bind_montages(GraphDefinition::Impl& d, const std::string& where) {
           si.cache = static_cast<uint32_t>(cached - d.montage_cache_clips.begin());
           if (cached == d.montage_cache_clips.end()) d.montage_cache_clips.push_back(seg->clip());
           si.begin = ti.length;
-          ti.length += (static_cast<double>(seg->end()) - static_cast<double>(seg->start())) / static_cast<double>(seg->rate());
+          ti.length +=
+              (static_cast<double>(seg->end()) - static_cast<double>(seg->start())) / static_cast<double>(seg->rate());
           si.end = ti.length;
           d.segments.push_back(si);
         }
@@ -387,7 +389,9 @@ Status bind_montages(GraphDefinition::Impl& d, const std::string& where) {
               d.markers.push_back({static_cast<double>(n.time()) + n.duration(), notify, MarkerType::End, bit});
               break;
             }
-            case fb::MontageNotifyKind::BranchingPoint: d.markers.push_back({n.time(), notify, MarkerType::Branch, 0}); break;
+            case fb::MontageNotifyKind::BranchingPoint:
+              d.markers.push_back({n.time(), notify, MarkerType::Branch, 0});
+              break;
             default: d.markers.push_back({n.time(), notify, MarkerType::Instant, 0}); break;
           }
         }
@@ -396,14 +400,15 @@ Status bind_montages(GraphDefinition::Impl& d, const std::string& where) {
       std::stable_sort(d.markers.begin() + mi.first_marker, d.markers.end(), [](const Marker& a, const Marker& b) {
         return a.time < b.time || (a.time == b.time && a.type < b.type);
       });
-      mi.inertial = m.blend_in_curve() == fb::MontageCurve::Inertialize ||
-                    m.blend_out_curve() == fb::MontageCurve::Inertialize;
+      mi.inertial =
+          m.blend_in_curve() == fb::MontageCurve::Inertialize || m.blend_out_curve() == fb::MontageCurve::Inertialize;
       d.montages.push_back(std::move(mi));
     }
   }
   for (SlotInfo& slot : d.slots)
     for (const MontageInfo& mi : d.montages)
-      if (mi.group == slot.group && mi.inertial && slot.inertia < 0) slot.inertia = static_cast<int32_t>(d.inertial_slots++);
+      if (mi.group == slot.group && mi.inertial && slot.inertia < 0)
+        slot.inertia = static_cast<int32_t>(d.inertial_slots++);
   d.identity = Pose(d.joints);
   return {};
 }
@@ -412,7 +417,8 @@ void advance_montages(State& s, float dt) {
   // The events of the update before last go; those host calls raised since the last one stay.
   if (s.montage_events_old > 0) {
     s.montage_events.erase(s.montage_events.begin(),
-                           s.montage_events.begin() + static_cast<std::ptrdiff_t>(std::min(s.montage_events_old, s.montage_events.size())));
+                           s.montage_events.begin() +
+                               static_cast<std::ptrdiff_t>(std::min(s.montage_events_old, s.montage_events.size())));
     s.montage_events_old = 0;
   }
   s.root_motion = RootMotionDelta{};
@@ -474,14 +480,16 @@ size_t GraphDefinition::section_count(size_t m) const {
   return m < montage_count() ? impl_->montages[m].section_start.size() : 0;
 }
 std::string_view GraphDefinition::section_name(size_t m, size_t k) const {
-  return k < section_count(m) ? sv(impl_->montages[m].fb->sections()->Get(static_cast<flatbuffers::uoffset_t>(k))->name())
-                              : std::string_view();
+  return k < section_count(m)
+             ? sv(impl_->montages[m].fb->sections()->Get(static_cast<flatbuffers::uoffset_t>(k))->name())
+             : std::string_view();
 }
 float GraphDefinition::section_start(size_t m, size_t k) const {
   return k < section_count(m) ? static_cast<float>(impl_->montages[m].section_start[k]) : 0.0f;
 }
 int GraphDefinition::section_next(size_t m, size_t k) const {
-  return k < section_count(m) ? impl_->montages[m].fb->sections()->Get(static_cast<flatbuffers::uoffset_t>(k))->next() : -1;
+  return k < section_count(m) ? impl_->montages[m].fb->sections()->Get(static_cast<flatbuffers::uoffset_t>(k))->next()
+                              : -1;
 }
 int GraphDefinition::find_section(size_t m, std::string_view name) const {
   for (size_t k = 0; k < section_count(m); ++k)
@@ -495,7 +503,8 @@ bool GraphInstance::play_montage(int montage, float rate, int start_section) {
   State& s = *state_;
   s.self = this;
   const GraphDefinition::Impl& d = *s.def;
-  if (montage < 0 || static_cast<size_t>(montage) >= d.montages.size() || !(rate >= 0.0f && rate <= 1000.0f)) return false;
+  if (montage < 0 || static_cast<size_t>(montage) >= d.montages.size() || !(rate >= 0.0f && rate <= 1000.0f))
+    return false;
   const MontageInfo& mi = d.montages[static_cast<size_t>(montage)];
   const int section = start_section < 0 ? 0 : start_section;
   if (static_cast<size_t>(section) >= mi.section_start.size()) return false;
@@ -523,7 +532,8 @@ bool GraphInstance::play_montage(int montage, float rate, int start_section) {
   slot->section = static_cast<uint16_t>(section);
   slot->position = mi.section_start[static_cast<size_t>(section)];
   slot->rate = rate * fm.rate();
-  for (size_t k = 0; k < mi.section_start.size(); ++k) links[k] = fm.sections()->Get(static_cast<flatbuffers::uoffset_t>(k))->next();
+  for (size_t k = 0; k < mi.section_start.size(); ++k)
+    links[k] = fm.sections()->Get(static_cast<flatbuffers::uoffset_t>(k))->next();
   begin_blend(*slot, 1.0f, fm.blend_in(), fm.blend_in_curve(), 0.0f, false);
   const uint64_t serial = slot->serial;
   raise(s, MontageEventType::Started, *slot, {}, slot->position);

@@ -40,7 +40,8 @@ glm::vec3 vec_or(const fb::Vec3* v, const glm::vec3& fallback) {
 
 /// The node's weight: weight * (weight parameter's value), in [0, 1].
 float node_weight_of(const State& s, const NodeInfo& info) {
-  return clamp01(info.weight * (info.weight_parameter >= 0 ? s.params[static_cast<size_t>(info.weight_parameter)] : 1.0f));
+  return clamp01(info.weight *
+                 (info.weight_parameter >= 0 ? s.params[static_cast<size_t>(info.weight_parameter)] : 1.0f));
 }
 
 /// A Vector parameter as a model-space point / direction.
@@ -64,8 +65,6 @@ glm::mat4 local_matrix(ConstPoseSpan p, uint32_t j) {
   m[3] = glm::vec4(p[kTx][j], p[kTy][j], p[kTz][j], 1.0f);
   return m;
 }
-
-
 
 /// Calls visit(j, parent) for `joint` and each of its descendants, parents first: one forward
 /// sweep over the joints after it (parents come first), marking the subtree in the scratch.
@@ -184,8 +183,8 @@ void two_bone(State& s, const NodeInfo& info, PoseSpan out) {
   float* reached = begin_reaching(s, info, out, w);
   if (reached == nullptr) return;
   const glm::vec3 start(s.scratch->model[t.start()][3]);
-  const glm::vec3 pole = t.pole_parameter() >= 0 ? model_point(s, t.pole_parameter()) - start
-                                                 : vec_or(t.pole(), glm::vec3(0.0f));
+  const glm::vec3 pole =
+      t.pole_parameter() >= 0 ? model_point(s, t.pole_parameter()) - start : vec_or(t.pole(), glm::vec3(0.0f));
   const bool ok = solve_two_bone(s, out, t.start(), t.mid(), t.end(), model_point(s, t.target_parameter()), pole,
                                  vec_or(t.mid_axis(), glm::vec3(0.0f, 0.0f, 1.0f)), t.twist(), t.soften(), w);
   *reached = ok && w >= 1.0f ? 1.0f : 0.0f;
@@ -267,7 +266,8 @@ void foot_placement(State& s, const NodeInfo& info, PoseSpan out) {
     // far as the clip itself stretches it): |target - (hip + up * drop)| <= reach, solved for the
     // highest drop <= 0. Flat ground under the clip's own feet asks for no drop.
     const glm::vec3 hip(model[leg.hip()][3]), knee(model[leg.knee()][3]);
-    const float reach = std::max(0.995f * (glm::length(knee - hip) + glm::length(ankle - knee)), glm::length(ankle - hip));
+    const float reach =
+        std::max(0.995f * (glm::length(knee - hip) + glm::length(ankle - knee)), glm::length(ankle - hip));
     const glm::vec3 d = targets[i].target - hip;
     const float dv = glm::dot(d, up);
     const float dh2 = std::max(0.0f, glm::dot(d, d) - dv * dv);
@@ -336,8 +336,8 @@ void foot_lock(State& s, const NodeInfo& info, const Advance& advance, PoseSpan 
   for (flatbuffers::uoffset_t i = 0; i < legs.size(); ++i) {
     const fb::FootLeg& leg = *legs.Get(i);
     float* st = &s.floats[info.floats + 1 + i * kLockFloats];
-    const bool planted = leg.planted_parameter() >= 0 ? s.params[static_cast<size_t>(leg.planted_parameter())] > 0.5f
-                                                      : st[2] > 0.5f;
+    const bool planted =
+        leg.planted_parameter() >= 0 ? s.params[static_cast<size_t>(leg.planted_parameter())] > 0.5f : st[2] > 0.5f;
     const glm::vec3 ankle(model[leg.ankle()][3]);
     if (planted && st[0] == 0.0f && st[1] <= 0.0f) {  // lands: remember where, in the world
       const glm::vec3 world(s.transform * glm::vec4(ankle, 1.0f));

@@ -134,7 +134,8 @@ void capture(const State& s, MachineState& m, ConstPoseSpan before, ConstPoseSpa
       vt = glm::vec3(last[kTx][j] - older[kTx][j], last[kTy][j] - older[kTy][j], last[kTz][j] - older[kTz][j]) * inv_dt;
       vr = rotation_vector(rotation_at(last, j) * glm::conjugate(rotation_at(older, j))) * inv_dt;
     }
-    const glm::vec3 offset(before[kTx][j] - after[kTx][j], before[kTy][j] - after[kTy][j], before[kTz][j] - after[kTz][j]);
+    const glm::vec3 offset(before[kTx][j] - after[kTx][j], before[kTy][j] - after[kTy][j],
+                           before[kTz][j] - after[kTz][j]);
     init_channel(m.translation[j], offset, vt, duration);
     init_channel(m.rotation[j], rotation_vector(rotation_at(before, j) * glm::conjugate(rotation_at(after, j))), vr,
                  duration);

@@ -36,12 +36,12 @@ Features detect() {
              avx = (r[2] & (1 << 28)) != 0;
   if (!osxsave || !avx) return f;
   const unsigned long long xcr0 = _xgetbv(0);
-  const bool ymm_state = (xcr0 & 0x6) == 0x6;     // XMM + YMM
-  const bool zmm_state = (xcr0 & 0xe6) == 0xe6;   // + opmask, ZMM_Hi256, Hi16_ZMM
+  const bool ymm_state = (xcr0 & 0x6) == 0x6;    // XMM + YMM
+  const bool zmm_state = (xcr0 & 0xe6) == 0xe6;  // + opmask, ZMM_Hi256, Hi16_ZMM
   __cpuidex(r, 7, 0);
   const bool avx2 = (r[1] & (1 << 5)) != 0, bmi1 = (r[1] & (1 << 3)) != 0, bmi2 = (r[1] & (1 << 8)) != 0;
-  const bool avx512f = (r[1] & (1 << 16)) != 0, avx512dq = (r[1] & (1 << 17)) != 0,
-             avx512bw = (r[1] & (1 << 30)) != 0, avx512vl = (r[1] & (1u << 31)) != 0;
+  const bool avx512f = (r[1] & (1 << 16)) != 0, avx512dq = (r[1] & (1 << 17)) != 0, avx512bw = (r[1] & (1 << 30)) != 0,
+             avx512vl = (r[1] & (1u << 31)) != 0;
   f.avx2 = ymm_state && avx2;
   f.avx2_fma = f.avx2 && fma && bmi1 && bmi2 && popcnt;
   f.avx512 = f.avx2_fma && zmm_state && avx512f && avx512vl && avx512bw && avx512dq;

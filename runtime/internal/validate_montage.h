@@ -17,7 +17,7 @@ inline constexpr uint32_t kMaxMontageTracks = 64;
 inline constexpr uint32_t kMaxMontageSegments = 4096;  // per track
 inline constexpr uint32_t kMaxMontageSections = 256;
 inline constexpr uint32_t kMaxMontageNotifies = 4096;
-inline constexpr uint32_t kMaxMontageWindows = 64;     // window notifies per montage (a 64-bit open set)
+inline constexpr uint32_t kMaxMontageWindows = 64;  // window notifies per montage (a 64-bit open set)
 
 /// "" when slot node `node` is sound; otherwise what is wrong, starting "node N (slot ...)".
 /// `budget` is charged for the mask; *over_budget is set when it runs out.

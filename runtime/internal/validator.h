@@ -137,8 +137,7 @@ inline const char* format_name(fb::VertexFormat f) {
 
 class Validator {
  public:
-  Validator(const fb::File& file, std::string_view name, size_t buffer_size)
-      : file_(file), name_(name) {
+  Validator(const fb::File& file, std::string_view name, size_t buffer_size) : file_(file), name_(name) {
     // Every vector element is scanned once in a file without shared vectors, and a few vectors
     // may legitimately be shared (one times vector for several channels); 4x leaves room for
     // that while bounding a crafted DAG. 0 = the caller gave no size: no bound.
@@ -162,14 +161,16 @@ class Validator {
   Error fail(const Where& where, const std::string& what) const { return fail(where.text(), what); }
   Error over_budget(const Where& where) const { return over_budget(where.text()); }
   Error over_budget(const std::string& where) const {
-    return fail(where, "tables reference far more data than the file holds (vectors shared between "
-                       "tables); refusing to scan it");
+    return fail(where,
+                "tables reference far more data than the file holds (vectors shared between "
+                "tables); refusing to scan it");
   }
 
   std::string joint_label(size_t joint) const {
     std::string out = format("joint %zu", joint);
     if (skeleton_ && joint < joint_count_) {
-      const auto name = flatbuffers::GetStringView(skeleton_->joint_names()->Get(static_cast<flatbuffers::uoffset_t>(joint)));
+      const auto name =
+          flatbuffers::GetStringView(skeleton_->joint_names()->Get(static_cast<flatbuffers::uoffset_t>(joint)));
       out += " '" + detail::printable(name) + "'";
     }
     return out;

@@ -43,12 +43,12 @@ bool vector_avx2_selected();
 
 #if OSSA_HAVE_VECTOR_CLONES
 /// Defines `void name params` over `name##_body args`, compiled for AVX2 and the baseline.
-#define OSSA_VECTOR_DISPATCH(name, params, args)                                          \
+#define OSSA_VECTOR_DISPATCH(name, params, args)                                                 \
   __attribute__((target("avx2"), noinline)) static void name##_avx2 params { name##_body args; } \
   __attribute__((noinline)) static void name##_baseline params { name##_body args; }             \
-  void name params {                                                                      \
-    if (::ossa::detail::vector_avx2_selected()) name##_avx2 args;                         \
-    else name##_baseline args;                                                            \
+  void name params {                                                                             \
+    if (::ossa::detail::vector_avx2_selected()) name##_avx2 args;                                \
+    else name##_baseline args;                                                                   \
   }
 #else
 #define OSSA_VECTOR_DISPATCH(name, params, args) \

@@ -9,10 +9,12 @@ namespace ossa {
 namespace {
 
 void* default_allocate(size_t size, size_t alignment, void*) {
-  return ::operator new(size, std::align_val_t{alignment}, std::nothrow);
+  return ::operator new (size, std::align_val_t{alignment}, std::nothrow);
 }
 
-void default_deallocate(void* p, size_t, size_t alignment, void*) { ::operator delete(p, std::align_val_t{alignment}); }
+void default_deallocate(void* p, size_t, size_t alignment, void*) {
+  ::operator delete (p, std::align_val_t{alignment});
+}
 
 constexpr Allocator kDefault{default_allocate, default_deallocate, nullptr};
 Allocator g_allocator = kDefault;

@@ -54,7 +54,6 @@ std::span<const T> scalar_span(const flatbuffers::Vector<T>* v) {
   return {v->data(), v->size()};
 }
 
-
 Error error(std::string_view name, const std::string& what) { return Error{std::string(name) + ": " + what}; }
 
 }  // namespace
@@ -82,13 +81,14 @@ Status verify_buffer(std::span<const uint8_t> bytes, std::string_view name) {
   if (table_limit > options.max_tables) options.max_tables = static_cast<flatbuffers::uoffset_t>(table_limit);
   flatbuffers::Verifier verifier(bytes.data(), bytes.size(), options);
   if (!fb::VerifyFileBuffer(verifier))
-    return error(name, "corrupt: the FlatBuffers verifier rejected it (an offset, size or alignment is "
-                       "outside the buffer, or a required field is missing)");
+    return error(name,
+                 "corrupt: the FlatBuffers verifier rejected it (an offset, size or alignment is "
+                 "outside the buffer, or a required field is missing)");
 
   const fb::File* file = fb::GetFile(bytes.data());
   if (file->version() != kFormatVersion)
-    return error(name, detail::format("format version %u, this build reads %u (re-cook the asset)",
-                                      file->version(), kFormatVersion));
+    return error(name, detail::format("format version %u, this build reads %u (re-cook the asset)", file->version(),
+                                      kFormatVersion));
   return validate_file(*file, name, bytes.size());
 }
 
@@ -124,10 +124,10 @@ Result<Asset> Asset::open(const std::string& path, OpenMode mode) {
   const uint64_t size = file.size();
   if (size == 0) return error(path, "empty file");
   if (size < kMinSize || size >= FLATBUFFERS_MAX_BUFFER_SIZE)
-    return error(path, size < kMinSize
-                           ? detail::format("too small to be an .ossa file (%llu bytes)", static_cast<unsigned long long>(size))
-                           : detail::format("too large for a FlatBuffer (%llu bytes, the limit is 2 GiB)",
-                                            static_cast<unsigned long long>(size)));
+    return error(path, size < kMinSize ? detail::format("too small to be an .ossa file (%llu bytes)",
+                                                        static_cast<unsigned long long>(size))
+                                       : detail::format("too large for a FlatBuffer (%llu bytes, the limit is 2 GiB)",
+                                                        static_cast<unsigned long long>(size)));
   const bool read = mode == OpenMode::kRead || (mode == OpenMode::kAuto && size <= kReadBelow);
   if (read) {
     // Files up to 4 MiB are read into aligned memory: one read() costs less than setting up a
@@ -162,8 +162,9 @@ Result<Asset> Asset::from_bytes(std::span<const uint8_t> bytes, std::string name
 
 Result<Asset> Asset::borrow(std::span<const uint8_t> bytes, std::string name) {
   if (reinterpret_cast<uintptr_t>(bytes.data()) % kAlignment != 0)
-    return error(name, "borrowed bytes are not 16-byte aligned in memory (align them, or copy them with "
-                       "Asset::from_bytes)");
+    return error(name,
+                 "borrowed bytes are not 16-byte aligned in memory (align them, or copy them with "
+                 "Asset::from_bytes)");
   return adopt(std::move(name), bytes.data(), bytes.size(), nullptr, nullptr);
 }
 
@@ -243,7 +244,9 @@ std::string_view SkeletonView::joint_name(size_t joint) const {
   return flatbuffers::GetStringView(fb->joint_names()->Get(static_cast<flatbuffers::uoffset_t>(joint)));
 }
 
-std::span<const int16_t> SkeletonView::parents() const { return fb ? scalar_span(fb->parents()) : std::span<const int16_t>(); }
+std::span<const int16_t> SkeletonView::parents() const {
+  return fb ? scalar_span(fb->parents()) : std::span<const int16_t>();
+}
 std::span<const fb::Vec3> SkeletonView::bind_translations() const {
   return fb ? struct_span(fb->bind_translations()) : std::span<const fb::Vec3>();
 }
@@ -261,7 +264,8 @@ uint64_t SkeletonView::hash() const { return fb ? fb->hash() : 0; }
 int SkeletonView::find_joint(std::string_view name) const {
   const size_t n = joint_count();
   for (size_t i = 0; i < n; ++i)
-    if (flatbuffers::GetStringView(fb->joint_names()->Get(static_cast<flatbuffers::uoffset_t>(i))) == name) return static_cast<int>(i);
+    if (flatbuffers::GetStringView(fb->joint_names()->Get(static_cast<flatbuffers::uoffset_t>(i))) == name)
+      return static_cast<int>(i);
   return -1;
 }
 

@@ -117,7 +117,8 @@ Status check_cloth_settings(const ClothSettings& s) {
   for (const auto& r : ranges)
     if (!within(r.value, r.lo, r.hi))
       return fail(format("setting %s is %g, outside [%g, %g]", r.name, r.value, r.lo, r.hi));
-  if (s.iterations < 1 || s.iterations > 16) return fail(format("setting iterations is %u, outside [1, 16]", s.iterations));
+  if (s.iterations < 1 || s.iterations > 16)
+    return fail(format("setting iterations is %u, outside [1, 16]", s.iterations));
   if (!bounded3(s.gravity)) return fail("setting gravity is not finite or past 1e7");
   if (!bounded3(s.wind)) return fail("setting wind is not finite or past 1e7");
   return {};
@@ -129,7 +130,8 @@ Status check_cloth(const ClothSource& c, uint32_t vertex_count, size_t joint_cou
   if (n > kMaxClothParticles) return fail(format("has %zu particles, more than %u", n, kMaxClothParticles));
   for (size_t i = 0; i < n; ++i)
     if (c.particle_vertices[i] >= vertex_count)
-      return fail(format("particle %zu is driven by vertex %u, the mesh has %u", i, c.particle_vertices[i], vertex_count));
+      return fail(
+          format("particle %zu is driven by vertex %u, the mesh has %u", i, c.particle_vertices[i], vertex_count));
   if (c.inverse_masses.size() != n)
     return fail(format("inverse_masses has %zu entries for %zu particles", c.inverse_masses.size(), n));
   if (Status st = check_per_particle(c.inverse_masses, "inverse_masses", n, kMaxInverseMass); !st) return st;
@@ -137,7 +139,8 @@ Status check_cloth(const ClothSource& c, uint32_t vertex_count, size_t joint_cou
   if (Status st = check_per_particle(c.backstops, "backstops", n, kMaxLength); !st) return st;
 
   if (c.vertex_particles.size() != c.vertices.size())
-    return fail(format("vertex_particles has %zu entries for %zu vertices", c.vertex_particles.size(), c.vertices.size()));
+    return fail(
+        format("vertex_particles has %zu entries for %zu vertices", c.vertex_particles.size(), c.vertices.size()));
   if (!c.flipped.empty() && c.flipped.size() != c.vertices.size())
     return fail(format("flipped has %zu entries for %zu vertices", c.flipped.size(), c.vertices.size()));
   for (size_t k = 0; k < c.vertices.size(); ++k) {
@@ -148,10 +151,12 @@ Status check_cloth(const ClothSource& c, uint32_t vertex_count, size_t joint_cou
                          c.vertices[k - 1]));
     if (c.vertex_particles[k] >= n)
       return fail(format("vertex entry %zu uses particle %u, the cloth has %zu", k, c.vertex_particles[k], n));
-    if (!c.flipped.empty() && c.flipped[k] > 1) return fail(format("flipped entry %zu is %u, not 0 or 1", k, c.flipped[k]));
+    if (!c.flipped.empty() && c.flipped[k] > 1)
+      return fail(format("flipped entry %zu is %u, not 0 or 1", k, c.flipped[k]));
   }
 
-  if (c.triangles.size() % 3 != 0) return fail(format("has %zu triangle indices, not a multiple of 3", c.triangles.size()));
+  if (c.triangles.size() % 3 != 0)
+    return fail(format("has %zu triangle indices, not a multiple of 3", c.triangles.size()));
   for (size_t k = 0; k < c.triangles.size(); ++k)
     if (c.triangles[k] >= n)
       return fail(format("triangle %zu uses particle %u, the cloth has %zu", k / 3, c.triangles[k], n));
@@ -160,7 +165,8 @@ Status check_cloth(const ClothSource& c, uint32_t vertex_count, size_t joint_cou
   for (size_t k = 0; k < c.tethers.size(); ++k) {
     const fb::ClothTether& t = c.tethers[k];
     if (t.particle() >= n || t.anchor() >= n)
-      return fail(format("tether %zu joins particle %u to anchor %u, the cloth has %zu", k, t.particle(), t.anchor(), n));
+      return fail(
+          format("tether %zu joins particle %u to anchor %u, the cloth has %zu", k, t.particle(), t.anchor(), n));
     if (c.inverse_masses[t.anchor()] != 0.0f)
       return fail(format("tether %zu is anchored at particle %u, which is not fixed (inverse mass %g)", k, t.anchor(),
                          c.inverse_masses[t.anchor()]));

@@ -8,13 +8,10 @@ namespace ossa {
 uint32_t texture_block_bytes(fb::TextureEncoding encoding) {
   switch (encoding) {
     case fb::TextureEncoding::Bc1:
-    case fb::TextureEncoding::Bc4:
-      return 8;
+    case fb::TextureEncoding::Bc4: return 8;
     case fb::TextureEncoding::Bc3:
-    case fb::TextureEncoding::Bc5:
-      return 16;
-    default:
-      return 0;
+    case fb::TextureEncoding::Bc5: return 16;
+    default: return 0;
   }
 }
 

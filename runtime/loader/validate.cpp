@@ -93,26 +93,22 @@ Status Validator::check_skeleton(const fb::Skeleton& s) {
     const auto jl = [&] { return format("joint %zu '%s'", i, detail::printable(name).c_str()); };
     const int parent = parents[i];
     if (parent != -1 && (parent < 0 || static_cast<size_t>(parent) >= i)) {
-      if (i == 0)
-        return fail(where, jl() + format(" has parent %d, must be -1 (the first joint is a root)", parent));
+      if (i == 0) return fail(where, jl() + format(" has parent %d, must be -1 (the first joint is a root)", parent));
       return fail(where, jl() + format(" has parent %d, must be -1 or < %zu (parents come first)", parent, i));
     }
     hash_sum += skeleton_hash_joint(i, name, parents[i]);
     if (values_ok) continue;
-    if (!bounded3(*s.bind_translations()->Get(idx)))
-      return fail(where, jl() + ": bind translation is not finite");
+    if (!bounded3(*s.bind_translations()->Get(idx))) return fail(where, jl() + ": bind translation is not finite");
     if (!normalizable(*s.bind_rotations()->Get(idx)))
       return fail(where, jl() + ": bind rotation is not a finite, non-zero quaternion");
     if (!bounded3(*s.bind_scales()->Get(idx))) return fail(where, jl() + ": bind scale is not finite (or beyond 1e7)");
-    if (!finite_matrix(*s.inverse_bind()->Get(idx)))
-      return fail(where, jl() + ": inverse bind matrix is not finite");
+    if (!finite_matrix(*s.inverse_bind()->Get(idx))) return fail(where, jl() + ": inverse bind matrix is not finite");
   }
   const uint64_t computed = skeleton_hash_finish(hash_sum, n);
   if (computed != s.hash())
     return fail(where, format("stored hash %016llx does not match the joints' hash %016llx (names or "
                               "parents changed after cooking)",
-                              static_cast<unsigned long long>(s.hash()),
-                              static_cast<unsigned long long>(computed)));
+                              static_cast<unsigned long long>(s.hash()), static_cast<unsigned long long>(computed)));
   skeleton_ = &s;
   joint_count_ = n;
   return {};
@@ -155,13 +151,14 @@ Status Validator::check_material(const fb::Material& m, size_t material_index) {
     const fb::Vec3* value;
   } colours[] = {{"ambient", m.ambient()}, {"diffuse", m.diffuse()}, {"specular", m.specular()}};
   for (const auto& c : colours)
-    if (c.value && !finite3(*c.value)) return fail(where, format("%s colour %s is not finite", c.field, vec3_text(*c.value).c_str()));
+    if (c.value && !finite3(*c.value))
+      return fail(where, format("%s colour %s is not finite", c.field, vec3_text(*c.value).c_str()));
   if (!std::isfinite(m.shininess())) return fail(where, "shininess is not finite");
   if (!std::isfinite(m.opacity())) return fail(where, "opacity is not finite");
   if (m.emissive() && !finite3(*m.emissive()))
     return fail(where, format("emissive colour %s is not finite", vec3_text(*m.emissive()).c_str()));
-  if (const fb::PbrFactors* p = m.pbr(); p && !(p->metallic() >= 0.0f && p->metallic() <= 1.0f &&
-                                                p->roughness() >= 0.0f && p->roughness() <= 1.0f))
+  if (const fb::PbrFactors* p = m.pbr();
+      p && !(p->metallic() >= 0.0f && p->metallic() <= 1.0f && p->roughness() >= 0.0f && p->roughness() <= 1.0f))
     return fail(where, format("metallic %g / roughness %g outside [0, 1]", static_cast<double>(p->metallic()),
                               static_cast<double>(p->roughness())));
   const auto* textures = m.textures();
@@ -173,11 +170,11 @@ Status Validator::check_material(const fb::Material& m, size_t material_index) {
       return fail(where, format("texture %u has unknown role %u", k, static_cast<unsigned>(t.role())));
     const size_t data_size = count_of(t.data());
     if (data_size == 0 && flatbuffers::GetStringView(t.path()).empty())
-      return fail(where, format("texture %u (%s) has neither embedded data nor a path", k,
-                                fb::EnumNameTextureRole(t.role())));
+      return fail(where,
+                  format("texture %u (%s) has neither embedded data nor a path", k, fb::EnumNameTextureRole(t.role())));
     if (data_size != 0 && reinterpret_cast<uintptr_t>(t.data()->Data()) % 16 != 0)
-      return fail(where, format("texture %u (%s): embedded data is not 16-byte aligned", k,
-                                fb::EnumNameTextureRole(t.role())));
+      return fail(
+          where, format("texture %u (%s): embedded data is not 16-byte aligned", k, fb::EnumNameTextureRole(t.role())));
     if (Status s = check_texture(t, data_size); !s)
       return fail(where, format("texture %u (%s): %s", k, fb::EnumNameTextureRole(t.role()), s.message().c_str()));
   }

@@ -76,7 +76,8 @@ Status Validator::check_clip(const fb::Clip& c, size_t clip_index) {
       const fb::ConstantChannel& prev = *c.constants()->Get(static_cast<flatbuffers::uoffset_t>(k - 1));
       if (channel_key(ch.joint(), ch.channel()) <= channel_key(prev.joint(), prev.channel()))
         return fail(where, cl() + format(" is not after constant channel %zu: channels are sorted by (joint, "
-                                       "channel), each at most once", k - 1));
+                                         "channel), each at most once",
+                                         k - 1));
     }
     if (ch.channel() == fb::Channel::Rotation) {
       if (!normalizable(ch.value())) return fail(where, cl() + ": value is not a finite, non-zero quaternion");
@@ -92,7 +93,8 @@ Status Validator::check_clip(const fb::Clip& c, size_t clip_index) {
   if (!spend(static_cast<uint64_t>(animated_count) * sizeof(fb::AnimatedChannel))) return over_budget(where);
   if (animated_count > 0 && value_bytes < kKeyValuePadding)
     return fail(where, format("key values are %zu bytes, less than the %u padding bytes decoders read past the "
-                              "last key", value_bytes, kKeyValuePadding));
+                              "last key",
+                              value_bytes, kKeyValuePadding));
   const uint64_t value_bits = value_bytes >= kKeyValuePadding ? 8ull * (value_bytes - kKeyValuePadding) : 0;
   const uint16_t* frames = c.key_frames() ? c.key_frames()->data() : nullptr;
   const uint8_t* values = c.key_values() ? c.key_values()->data() : nullptr;
@@ -110,7 +112,8 @@ Status Validator::check_clip(const fb::Clip& c, size_t clip_index) {
       const fb::AnimatedChannel& prev = *c.animated()->Get(static_cast<flatbuffers::uoffset_t>(k - 1));
       if (key <= channel_key(prev.joint(), prev.channel()))
         return fail(where, cl() + format(" is not after animated channel %zu: channels are sorted by (joint, "
-                                       "channel), each at most once", k - 1));
+                                         "channel), each at most once",
+                                         k - 1));
     }
     while (next_constant < constant_count) {
       const fb::ConstantChannel& cc = *c.constants()->Get(static_cast<flatbuffers::uoffset_t>(next_constant));
@@ -125,17 +128,20 @@ Status Validator::check_clip(const fb::Clip& c, size_t clip_index) {
     if (n < 2) return fail(where, cl() + format(" has %u keys; an animated channel has at least 2", n));
     const uint64_t first = ch.first_key();
     if (first + n > frame_total)
-      return fail(where, cl() + format(" uses keys [%llu, %llu), past the %zu key frames", static_cast<unsigned long long>(first),
-                                     static_cast<unsigned long long>(first + n), frame_total));
+      return fail(where, cl() + format(" uses keys [%llu, %llu), past the %zu key frames",
+                                       static_cast<unsigned long long>(first),
+                                       static_cast<unsigned long long>(first + n), frame_total));
     if (!spend(static_cast<uint64_t>(n) * sizeof(uint16_t))) return over_budget(where);
     const uint16_t* f = frames + first;
     if (f[0] != 0) return fail(where, cl() + format(": first key is at frame %u, must be 0", f[0]));
     for (uint32_t i = 1; i < n; ++i)
       if (!(f[i] > f[i - 1]))
         return fail(where, cl() + format(": key %u at frame %u is not after key %u at frame %u (frames must strictly "
-                                       "increase)", i, f[i], i - 1, f[i - 1]));
+                                         "increase)",
+                                         i, f[i], i - 1, f[i - 1]));
     if (f[n - 1] != frame_count - 1)
-      return fail(where, cl() + format(": last key is at frame %u, must be the last frame %u", f[n - 1], frame_count - 1));
+      return fail(where,
+                  cl() + format(": last key is at frame %u, must be the last frame %u", f[n - 1], frame_count - 1));
 
     // Bits: inside key_values, minus the padding.
     const uint32_t bits = ch.bits();
@@ -149,12 +155,12 @@ Status Validator::check_clip(const fb::Clip& c, size_t clip_index) {
     const uint64_t offset = ch.bit_offset();
     if (bits == kRawFloatBits && offset % 8 != 0)
       return fail(where, cl() + format(": raw-float keys start at bit %llu, not on a byte boundary",
-                                     static_cast<unsigned long long>(offset)));
+                                       static_cast<unsigned long long>(offset)));
     const uint64_t end = offset + key_bits(bits) * n;
     if (end > value_bits)
       return fail(where, cl() + format(" needs key value bits [%llu, %llu), the clip has %llu (before padding)",
-                                     static_cast<unsigned long long>(offset), static_cast<unsigned long long>(end),
-                                     static_cast<unsigned long long>(value_bits)));
+                                       static_cast<unsigned long long>(offset), static_cast<unsigned long long>(end),
+                                       static_cast<unsigned long long>(value_bits)));
 
     // Ranges: finite, extents >= 0, and the top of the range finite, so every decoded value
     // (lo + extent * q / max <= lo + extent) is.
@@ -165,10 +171,10 @@ Status Validator::check_clip(const fb::Clip& c, size_t clip_index) {
       for (int i = 0; i < 3; ++i) {
         if (!bounded(los[i]) || !bounded(exs[i]) || !(exs[i] >= 0.0f) || !bounded(los[i] + exs[i]))
           return fail(where, cl() + format(": range min %s extent %s must be finite (within 1e7) with extents >= 0",
-                                         vec3_text(lo).c_str(), vec3_text(ex).c_str()));
+                                           vec3_text(lo).c_str(), vec3_text(ex).c_str()));
         if (rotation && (los[i] < -kRotationComponentLimit || los[i] + exs[i] > kRotationComponentLimit))
           return fail(where, cl() + format(": rotation range min %s extent %s leaves [-1, 1]", vec3_text(lo).c_str(),
-                                         vec3_text(ex).c_str()));
+                                           vec3_text(ex).c_str()));
       }
     } else {
       // Raw floats carry their own values: scan them (O(keys), once, at load).
@@ -190,8 +196,8 @@ Status Validator::check_clip(const fb::Clip& c, size_t clip_index) {
   if (const fb::RootMotion* rm = c.root_motion()) {
     const size_t nt = rm->translations()->size(), ny = rm->yaws()->size();
     if (nt != frame_count || ny != frame_count)
-      return fail(where, format("root motion has %zu translations and %zu yaws, the clip has %u frames", nt, ny,
-                                frame_count));
+      return fail(where,
+                  format("root motion has %zu translations and %zu yaws, the clip has %u frames", nt, ny, frame_count));
     if (rm->up_axis() > 2) return fail(where, format("root motion up axis %u must be 0, 1 or 2", rm->up_axis()));
     if (!spend(static_cast<uint64_t>(frame_count) * 16)) return over_budget(where);
     for (size_t i = 0; i < nt; ++i) {
@@ -212,8 +218,8 @@ Status Validator::check_clip(const fb::Clip& c, size_t clip_index) {
       if (!std::isfinite(t) || t < 0.0f || t > duration)
         return fail(where, format("event %u '%s' at %g s lies outside the clip [0, %g s]", i,
                                   detail::printable(flatbuffers::GetStringView(e.name())).c_str(), t, duration));
-      if (t < previous) return fail(where, format("event %u at %g s comes before event %u's %g s: not sorted", i, t,
-                                                  i - 1, previous));
+      if (t < previous)
+        return fail(where, format("event %u at %g s comes before event %u's %g s: not sorted", i, t, i - 1, previous));
       previous = t;
     }
   }
@@ -246,7 +252,8 @@ Status Validator::check_morph_weights(const fb::Clip& c, const Where& clip_where
     for (size_t i = 1; i < n; ++i)
       if (!(f[i] > f[i - 1]))
         return fail(where, format("key %zu at frame %u is not after key %zu at frame %u (frames must strictly "
-                                  "increase)", i, f[i], i - 1, f[i - 1]));
+                                  "increase)",
+                                  i, f[i], i - 1, f[i - 1]));
     if (n > 1 && f[n - 1] != c.frame_count() - 1)
       return fail(where, format("last key is at frame %u, must be the last frame %u", f[n - 1], c.frame_count() - 1));
     const float lo = track.range_min(), ex = track.range_extent();

@@ -23,13 +23,12 @@ namespace {
 
 using detail::format;
 
-
 class GraphChecker {
  public:
-  GraphChecker(const fb::Graph& g, size_t index, std::string_view name, uint64_t& budget)
-      : g_(g), budget_(budget) {
+  GraphChecker(const fb::Graph& g, size_t index, std::string_view name, uint64_t& budget) : g_(g), budget_(budget) {
     where_ = std::string(name) + ": " + format("graph %zu", index);
-    if (!flatbuffers::GetStringView(g.name()).empty()) where_ += " '" + detail::printable(flatbuffers::GetStringView(g.name())) + "'";
+    if (!flatbuffers::GetStringView(g.name()).empty())
+      where_ += " '" + detail::printable(flatbuffers::GetStringView(g.name())) + "'";
   }
 
   Status run() {
@@ -80,7 +79,8 @@ class GraphChecker {
  private:
   Error fail(const std::string& what) const { return Error{where_ + ": " + what}; }
   Error over_budget() const {
-    return fail("tables reference far more data than the file holds (vectors shared between tables); refusing to scan it");
+    return fail(
+        "tables reference far more data than the file holds (vectors shared between tables); refusing to scan it");
   }
   bool spend(uint64_t bytes) {
     if (bytes > budget_) return false;
@@ -93,7 +93,9 @@ class GraphChecker {
   }
   std::string param_label(size_t p) const {
     return format("parameter %zu '%s'", p,
-                  detail::printable(flatbuffers::GetStringView(g_.parameters()->Get(static_cast<flatbuffers::uoffset_t>(p))->name())).c_str());
+                  detail::printable(
+                      flatbuffers::GetStringView(g_.parameters()->Get(static_cast<flatbuffers::uoffset_t>(p))->name()))
+                      .c_str());
   }
 
   /// A parameter reference of one of the allowed types (optional: -1 allowed).
@@ -150,7 +152,8 @@ class GraphChecker {
   Status child(size_t n, uint32_t c, const char* what) {
     if (c >= n)
       return fail(format("node %zu: %s %u must be an earlier node (nodes are stored children first)", n, what, c));
-    if (++referrers_[c] > 1) return fail(format("node %zu: %s %u is already used by another node or state", n, what, c));
+    if (++referrers_[c] > 1)
+      return fail(format("node %zu: %s %u is already used by another node or state", n, what, c));
     if (depth_[c] + 1 > depth_[n]) depth_[n] = depth_[c] + 1;
     if (depth_[n] > kMaxGraphDepth)
       return fail(format("node %zu: the graph is nested more than %u levels deep", n, kMaxGraphDepth));
@@ -169,7 +172,8 @@ class GraphChecker {
   }
   static bool vector_ok(const fb::Vec3* v) { return !v || vector_ok(*v); }
   Status check_joint(const std::string& at, const char* what, uint32_t j) const {
-    if (j >= g_.joint_count()) return fail(at + format(": %s joint %u is out of range (%u joints)", what, j, g_.joint_count()));
+    if (j >= g_.joint_count())
+      return fail(at + format(": %s joint %u is out of range (%u joints)", what, j, g_.joint_count()));
     return {};
   }
   Status check_weight(const std::string& at, float weight, int16_t parameter) {
@@ -185,8 +189,10 @@ class GraphChecker {
       if (Status st = check_joint(lat, "hip", leg.hip()); !st) return st;
       if (Status st = check_joint(lat, "knee", leg.knee()); !st) return st;
       if (Status st = check_joint(lat, "ankle", leg.ankle()); !st) return st;
-      if (Status st = check_param_ref(lat + " ground", leg.ground_parameter(), true, {fb::ParameterType::Float}); !st) return st;
-      if (Status st = check_param_ref(lat + " normal", leg.normal_parameter(), true, {fb::ParameterType::Vector}); !st) return st;
+      if (Status st = check_param_ref(lat + " ground", leg.ground_parameter(), true, {fb::ParameterType::Float}); !st)
+        return st;
+      if (Status st = check_param_ref(lat + " normal", leg.normal_parameter(), true, {fb::ParameterType::Vector}); !st)
+        return st;
       if (Status st = check_param_ref(lat + " planted", leg.planted_parameter(), true,
                                       {fb::ParameterType::Float, fb::ParameterType::Bool});
           !st)
@@ -251,12 +257,15 @@ class GraphChecker {
     switch (node.data_type()) {
       case fb::NodeData::ClipNode: {
         const auto& c = *node.data_as_ClipNode();
-        if (c.clip() >= clip_count_) return fail(at + format(": clip %u is out of range (%zu clips)", c.clip(), clip_count_));
+        if (c.clip() >= clip_count_)
+          return fail(at + format(": clip %u is out of range (%zu clips)", c.clip(), clip_count_));
         if (retarget_clip_[c.clip()])
           return fail(at + format(": clip %u is played by a retarget node (bound to another rig)", c.clip()));
-        if (!rate_ok(c.rate())) return fail(at + format(": rate %g must be finite and within +-%g", c.rate(), kMaxRate));
+        if (!rate_ok(c.rate()))
+          return fail(at + format(": rate %g must be finite and within +-%g", c.rate(), kMaxRate));
         if (!time_ok(c.start_offset())) return fail(at + ": start offset must be finite and in [0, 1e6] s");
-        return check_param_ref(at + " rate", c.rate_parameter(), true, {fb::ParameterType::Float, fb::ParameterType::Int});
+        return check_param_ref(at + " rate", c.rate_parameter(), true,
+                               {fb::ParameterType::Float, fb::ParameterType::Int});
       }
       case fb::NodeData::RetargetNode: return check_retarget(at, *node.data_as_RetargetNode());
       case fb::NodeData::BlendAlphaNode: {
@@ -289,7 +298,8 @@ class GraphChecker {
           const fb::Layer& layer = *l.layers()->Get(k);
           const std::string lat = at + format(" layer %u", k);
           if (Status st = child(n, layer.node(), "layer"); !st) return st;
-          if (!weight_ok(layer.weight())) return fail(lat + format(": weight must be finite and within +-%g", kMaxWeight));
+          if (!weight_ok(layer.weight()))
+            return fail(lat + format(": weight must be finite and within +-%g", kMaxWeight));
           if (!time_ok(layer.blend_time())) return fail(lat + ": blend time must be finite and in [0, 1e6] s");
           if (Status st = check_param_ref(lat + " weight", layer.weight_parameter(), true,
                                           {fb::ParameterType::Float, fb::ParameterType::Bool});
@@ -316,11 +326,14 @@ class GraphChecker {
         if (samples.size() == 0 || (two_d && samples.size() < 3))
           return fail(at + format(": a %s blend space needs at least %d samples", two_d ? "2D" : "1D", two_d ? 3 : 1));
         if (samples.size() > 1024) return fail(at + ": more than 1024 blend-space samples");
-        if (!rate_ok(b.rate())) return fail(at + format(": rate %g must be finite and within +-%g", b.rate(), kMaxRate));
-        if (Status st = check_param_ref(at + " x", b.x_parameter(), false, {fb::ParameterType::Float, fb::ParameterType::Int});
+        if (!rate_ok(b.rate()))
+          return fail(at + format(": rate %g must be finite and within +-%g", b.rate(), kMaxRate));
+        if (Status st =
+                check_param_ref(at + " x", b.x_parameter(), false, {fb::ParameterType::Float, fb::ParameterType::Int});
             !st)
           return st;
-        if (Status st = check_param_ref(at + " y", b.y_parameter(), true, {fb::ParameterType::Float, fb::ParameterType::Int});
+        if (Status st =
+                check_param_ref(at + " y", b.y_parameter(), true, {fb::ParameterType::Float, fb::ParameterType::Int});
             !st)
           return st;
         for (flatbuffers::uoffset_t k = 0; k < samples.size(); ++k) {
@@ -363,7 +376,8 @@ class GraphChecker {
           const std::string dat = at + format(" drive %u", k);
           if (flatbuffers::GetStringView(d.target()).empty()) return fail(dat + ": empty target name");
           if (!weight_ok(d.scale())) return fail(dat + format(": scale must be finite and within +-%g", kMaxWeight));
-          if (Status st = check_param_ref(dat, d.parameter(), false, {fb::ParameterType::Float, fb::ParameterType::Bool});
+          if (Status st =
+                  check_param_ref(dat, d.parameter(), false, {fb::ParameterType::Float, fb::ParameterType::Bool});
               !st)
             return st;
         }
@@ -375,8 +389,10 @@ class GraphChecker {
         if (Status st = check_joint(at, "start", t.start()); !st) return st;
         if (Status st = check_joint(at, "mid", t.mid()); !st) return st;
         if (Status st = check_joint(at, "end", t.end()); !st) return st;
-        if (Status st = check_param_ref(at + " target", t.target_parameter(), false, {fb::ParameterType::Vector}); !st) return st;
-        if (Status st = check_param_ref(at + " pole", t.pole_parameter(), true, {fb::ParameterType::Vector}); !st) return st;
+        if (Status st = check_param_ref(at + " target", t.target_parameter(), false, {fb::ParameterType::Vector}); !st)
+          return st;
+        if (Status st = check_param_ref(at + " pole", t.pole_parameter(), true, {fb::ParameterType::Vector}); !st)
+          return st;
         if (!vector_ok(t.pole()) || !vector_ok(t.mid_axis()) || !finite(t.twist()) || std::fabs(t.twist()) > 100.0f)
           return fail(at + ": pole, mid axis and twist must be finite and within bounds");
         if (!(t.soften() > 0.0f && t.soften() <= 1.0f)) return fail(at + ": soften must be within (0, 1]");
@@ -395,7 +411,8 @@ class GraphChecker {
           if (!(j.weight() >= 0.0f && j.weight() <= 1.0f) || !(j.max_angle() >= 0.0f && j.max_angle() <= 100.0f))
             return fail(at + format(": aim joint %u: weight must be within [0, 1] and max angle within [0, 100]", k));
         }
-        if (Status st = check_param_ref(at + " target", a.target_parameter(), false, {fb::ParameterType::Vector}); !st) return st;
+        if (Status st = check_param_ref(at + " target", a.target_parameter(), false, {fb::ParameterType::Vector}); !st)
+          return st;
         if (!vector_ok(a.forward()) || !vector_ok(a.up()) || !vector_ok(a.pole()))
           return fail(at + ": forward, up and pole must be finite and within +-1e6");
         return check_weight(at, a.weight(), a.weight_parameter());
@@ -437,7 +454,9 @@ class GraphChecker {
           if (!(c.stiffness() >= 0.0f && c.stiffness() <= 1e4f) || !(c.drag() >= 0.0f && c.drag() <= 1.0f) ||
               !vector_ok(c.gravity()) || !(c.radius() >= 0.0f) || !coordinate_ok(c.radius()) ||
               !(c.tail_length() >= 0.0f) || !coordinate_ok(c.tail_length()))
-            return fail(cat + ": stiffness within [0, 1e4], drag within [0, 1], gravity, radius and tail length finite and not negative");
+            return fail(cat +
+                        ": stiffness within [0, 1e4], drag within [0, 1], gravity, radius and tail length finite and "
+                        "not negative");
         }
         if (const auto* colliders = sp.colliders()) {
           if (!spend(uint64_t(colliders->size()) * 32)) return over_budget();
@@ -455,7 +474,8 @@ class GraphChecker {
       }
       case fb::NodeData::StateMachineNode: {
         const uint16_t m = node.data_as_StateMachineNode()->machine();
-        if (m >= machine_count_) return fail(at + format(": state machine %u is out of range (%zu machines)", m, machine_count_));
+        if (m >= machine_count_)
+          return fail(at + format(": state machine %u is out of range (%zu machines)", m, machine_count_));
         if (machine_player_[m] >= 0)
           return fail(at + format(": state machine %u is already played by node %d", m, machine_player_[m]));
         machine_player_[m] = static_cast<int>(n);
@@ -466,20 +486,21 @@ class GraphChecker {
           if (Status st = child(n, sm.states()->Get(k)->node(), "state"); !st) return st;
         return {};
       }
-      default:
-        return fail(at + format(": unknown node kind %u", static_cast<unsigned>(node.data_type())));
+      default: return fail(at + format(": unknown node kind %u", static_cast<unsigned>(node.data_type())));
     }
   }
 
   Status check_machine(size_t m) {
     const fb::StateMachine& sm = *g_.machines()->Get(static_cast<flatbuffers::uoffset_t>(m));
     std::string at = format("state machine %zu", m);
-    if (!flatbuffers::GetStringView(sm.name()).empty()) at += " '" + detail::printable(flatbuffers::GetStringView(sm.name())) + "'";
+    if (!flatbuffers::GetStringView(sm.name()).empty())
+      at += " '" + detail::printable(flatbuffers::GetStringView(sm.name())) + "'";
     const size_t states = sm.states()->size();
     for (size_t k = 0; k < states; ++k)
       if (flatbuffers::GetStringView(sm.states()->Get(static_cast<flatbuffers::uoffset_t>(k))->name()).empty())
         return fail(at + format(": state %zu has an empty name", k));
-    if (sm.entry() >= states) return fail(at + format(": entry state %u is out of range (%zu states)", sm.entry(), states));
+    if (sm.entry() >= states)
+      return fail(at + format(": entry state %u is out of range (%zu states)", sm.entry(), states));
     const auto* transitions = sm.transitions();
     if (!transitions) return {};
     if (!spend(uint64_t(transitions->size()) * 16)) return over_budget();
@@ -491,7 +512,8 @@ class GraphChecker {
       if (t.to() >= states) return fail(tat + format(": target state %u is out of range", t.to()));
       if (t.from() == t.to()) return fail(tat + ": a state cannot transition to itself");
       if (!time_ok(t.duration())) return fail(tat + ": duration must be finite and in [0, 1e6] s");
-      if (!finite(t.exit_time()) || t.exit_time() > kMaxSeconds) return fail(tat + ": exit time must be finite and <= 1e6");
+      if (!finite(t.exit_time()) || t.exit_time() > kMaxSeconds)
+        return fail(tat + ": exit time must be finite and <= 1e6");
       if (static_cast<unsigned>(t.mode()) > static_cast<unsigned>(fb::TransitionMode::MAX))
         return fail(tat + format(": unknown blend mode %u", static_cast<unsigned>(t.mode())));
       if (Status st = check_condition(t, tat); !st) return st;
@@ -508,9 +530,7 @@ class GraphChecker {
       const fb::ConditionInstr& c = *cond->Get(i);
       const std::string iat = at + format(" condition %u", i);
       switch (c.op()) {
-        case fb::ConditionOp::True:
-          ++depth;
-          break;
+        case fb::ConditionOp::True: ++depth; break;
         case fb::ConditionOp::Less:
         case fb::ConditionOp::LessEqual:
         case fb::ConditionOp::Greater:
@@ -518,9 +538,9 @@ class GraphChecker {
         case fb::ConditionOp::Equal:
         case fb::ConditionOp::NotEqual:
           if (!finite(c.value())) return fail(iat + ": comparison value is not finite");
-          if (Status st = check_param_ref(iat, c.parameter(), false,
-                                          {fb::ParameterType::Float, fb::ParameterType::Int, fb::ParameterType::Bool,
-                                           fb::ParameterType::Enum});
+          if (Status st = check_param_ref(
+                  iat, c.parameter(), false,
+                  {fb::ParameterType::Float, fb::ParameterType::Int, fb::ParameterType::Bool, fb::ParameterType::Enum});
               !st)
             return st;
           ++depth;
@@ -541,8 +561,7 @@ class GraphChecker {
           if (depth < 2) return fail(iat + ": 'and' / 'or' needs two operands");
           --depth;
           break;
-        default:
-          return fail(iat + format(": unknown operation %u", static_cast<unsigned>(c.op())));
+        default: return fail(iat + format(": unknown operation %u", static_cast<unsigned>(c.op())));
       }
       if (depth > 16) return fail(iat + ": the condition needs more than 16 stack entries");
     }

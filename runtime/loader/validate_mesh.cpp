@@ -85,8 +85,8 @@ uint32_t max_joint_slot(const uint8_t* first, size_t n, size_t stride) {
 /// the strided SWAR loop took ~1.6 cycles a 24-byte vertex (~6% of opening Pab's skeleton file).
 /// Compiled for AVX2 and the baseline (SSE2 has the byte max). `masks` holds `period` bytes
 /// (a multiple of 64); bytes past the last whole chunk are left to the caller. O(n * stride).
-OSSA_INLINE static void max_masked_bytes_body(const uint8_t* bytes, size_t chunks, const uint8_t* masks,
-                                              size_t period, uint32_t* out) {
+OSSA_INLINE static void max_masked_bytes_body(const uint8_t* bytes, size_t chunks, const uint8_t* masks, size_t period,
+                                              uint32_t* out) {
   constexpr size_t kChunk = 64;
   uint8_t lanes[kChunk] = {};
   size_t m = 0;
@@ -128,8 +128,7 @@ uint32_t max_u8_joint_slot(const uint8_t* vertices, size_t n, size_t stride, siz
 }
 
 template <class T>
-size_t first_joint_slot_at_least(const uint8_t* first, size_t n, size_t stride, uint32_t limit,
-                                 uint32_t* slot) {
+size_t first_joint_slot_at_least(const uint8_t* first, size_t n, size_t stride, uint32_t limit, uint32_t* slot) {
   for (size_t v = 0; v < n; ++v) {
     T s[4];
     std::memcpy(s, first + v * stride, sizeof s);
@@ -164,8 +163,7 @@ Status Validator::check_mesh(const fb::Mesh& m, size_t mesh_index) {
     const VertexFormatInfo info = vertex_format_info(a.format());
     // Labels are formatted only for a message: a valid file pays for none of them.
     const auto al = [&] { return format("layout attribute %u (%s)", k, semantic_name(a.semantic())); };
-    if (info.size == 0)
-      return fail(where, al() + format(" has unknown format %u", static_cast<unsigned>(a.format())));
+    if (info.size == 0) return fail(where, al() + format(" has unknown format %u", static_cast<unsigned>(a.format())));
     if (by_semantic[sem]) return fail(where, format("layout has two %s attributes", semantic_name(a.semantic())));
     by_semantic[sem] = &a;
     const auto fl = [&] { return al() + format(" %s @%u", format_name(a.format()), a.offset()); };
@@ -193,9 +191,8 @@ Status Validator::check_mesh(const fb::Mesh& m, size_t mesh_index) {
   const auto* vertices = m.vertices();
   const uint64_t expected = static_cast<uint64_t>(vertex_count) * stride;
   if (vertices->size() != expected)
-    return fail(where, format("vertex data is %u bytes, expected vertex_count %u * stride %u = %llu",
-                              vertices->size(), vertex_count, stride,
-                              static_cast<unsigned long long>(expected)));
+    return fail(where, format("vertex data is %u bytes, expected vertex_count %u * stride %u = %llu", vertices->size(),
+                              vertex_count, stride, static_cast<unsigned long long>(expected)));
   if (vertices->size() != 0 && reinterpret_cast<uintptr_t>(vertices->Data()) % 16 != 0)
     return fail(where, "vertex data is not 16-byte aligned");
 
@@ -206,18 +203,16 @@ Status Validator::check_mesh(const fb::Mesh& m, size_t mesh_index) {
     case fb::IndexFormat::Uint16: index_size = 2; break;
     case fb::IndexFormat::Uint32: index_size = 4; break;
   }
-  if (index_size == 0)
-    return fail(where, format("unknown index format %u", static_cast<unsigned>(m.index_format())));
+  if (index_size == 0) return fail(where, format("unknown index format %u", static_cast<unsigned>(m.index_format())));
   const char* index_format = fb::EnumNameIndexFormat(m.index_format());
   if (indices->size() % index_size != 0)
-    return fail(where, format("index data is %u bytes, not a multiple of %zu (%s)", indices->size(), index_size,
-                              index_format));
+    return fail(
+        where, format("index data is %u bytes, not a multiple of %zu (%s)", indices->size(), index_size, index_format));
   const size_t index_count = indices->size() / index_size;
   if (index_count % 3 != 0)
     return fail(where, format("has %zu indices, not a multiple of 3 (triangle list)", index_count));
   if (index_count != 0) {
-    if (reinterpret_cast<uintptr_t>(indices->Data()) % 16 != 0)
-      return fail(where, "index data is not 16-byte aligned");
+    if (reinterpret_cast<uintptr_t>(indices->Data()) % 16 != 0) return fail(where, "index data is not 16-byte aligned");
     if (!spend(indices->size())) return over_budget(where);
     const uint32_t max = index_size == 2 ? max_index<uint16_t>(indices->Data(), index_count)
                                          : max_index<uint32_t>(indices->Data(), index_count);
@@ -245,14 +240,15 @@ Status Validator::check_mesh(const fb::Mesh& m, size_t mesh_index) {
     const fb::Submesh& sm = *submeshes->Get(k);
     const uint64_t end = static_cast<uint64_t>(sm.first_index()) + sm.index_count();
     if (end > index_count)
-      return fail(where, format("submesh %u covers indices [%u, %llu), past the index count %zu", k,
-                                sm.first_index(), static_cast<unsigned long long>(end), index_count));
+      return fail(where, format("submesh %u covers indices [%u, %llu), past the index count %zu", k, sm.first_index(),
+                                static_cast<unsigned long long>(end), index_count));
     if (sm.index_count() % 3 != 0)
       return fail(where, format("submesh %u has %u indices, not a multiple of 3", k, sm.index_count()));
     if (sm.material() >= material_limit)
       return fail(where, material_count_ == 0
                              ? format("submesh %u uses material %u, but the file has no materials (only 0 "
-                                      "is allowed)", k, sm.material())
+                                      "is allowed)",
+                                      k, sm.material())
                              : format("submesh %u uses material %u, the file has %s", k, sm.material(),
                                       count_text(material_count_, "material").c_str()));
   }
@@ -309,13 +305,12 @@ Status Validator::check_mesh(const fb::Mesh& m, size_t mesh_index) {
   for (const auto& v : vectors)
     if (v.value && !finite3(*v.value)) return fail(where, format("%s is not finite", v.field));
   if (const fb::Cloth* cloth = m.cloth()) {  // format v10: ossa/anim/cloth.h's check_cloth
-    const uint64_t bytes = 4 * (count_of(cloth->particle_vertices()) + count_of(cloth->inverse_masses()) +
-                                count_of(cloth->max_distances()) + count_of(cloth->backstops()) +
-                                count_of(cloth->vertices())) +
-                           2 * (count_of(cloth->vertex_particles()) + count_of(cloth->triangles())) +
-                           count_of(cloth->flipped()) +
-                           8 * (count_of(cloth->stretch()) + count_of(cloth->bend()) + count_of(cloth->tethers())) +
-                           32 * count_of(cloth->colliders());
+    const uint64_t bytes =
+        4 * (count_of(cloth->particle_vertices()) + count_of(cloth->inverse_masses()) +
+             count_of(cloth->max_distances()) + count_of(cloth->backstops()) + count_of(cloth->vertices())) +
+        2 * (count_of(cloth->vertex_particles()) + count_of(cloth->triangles())) + count_of(cloth->flipped()) +
+        8 * (count_of(cloth->stretch()) + count_of(cloth->bend()) + count_of(cloth->tethers())) +
+        32 * count_of(cloth->colliders());
     if (!spend(bytes)) return over_budget(where);
     if (Status st = check_cloth(cloth_source(MeshView{&m}), vertex_count, joint_count_); !st)
       return fail(where, st.message());
@@ -357,8 +352,8 @@ Status Validator::check_morph_targets(const fb::Mesh& m, const Where& mesh_where
       if (v[i] >= m.vertex_count())
         return fail(where, format("moves vertex %u (entry %zu), past the vertex count %u", v[i], i, m.vertex_count()));
       if (i > 0 && !(v[i] > v[i - 1]))
-        return fail(where, format("entry %zu names vertex %u after vertex %u: vertices must strictly increase", i,
-                                  v[i], v[i - 1]));
+        return fail(where, format("entry %zu names vertex %u after vertex %u: vertices must strictly increase", i, v[i],
+                                  v[i - 1]));
     }
     const struct {
       const char* field;
@@ -379,8 +374,8 @@ Status Validator::check_morph_targets(const fb::Mesh& m, const Where& mesh_where
                                   st.step ? vec3_text(*st.step).c_str() : "(missing)", kMaxMorphStep));
     }
     if (!std::isfinite(target.default_weight()) || std::fabs(target.default_weight()) > kMaxMorphWeight)
-      return fail(where, format("default weight %g must be finite and within +-%g", target.default_weight(),
-                                kMaxMorphWeight));
+      return fail(where,
+                  format("default weight %g must be finite and within +-%g", target.default_weight(), kMaxMorphWeight));
     if (!(target.position_error() >= 0.0f) || !std::isfinite(target.position_error()) ||
         !(target.normal_error() >= 0.0f) || !std::isfinite(target.normal_error()))
       return fail(where, format("recorded errors %g / %g must be finite and >= 0", target.position_error(),

@@ -64,7 +64,8 @@ std::string check_montage(const fb::Montage& m, size_t index, size_t clip_count,
       const std::string sat = tat + format(" segment %u", k);
       if (s.clip() >= clip_count) return sat + format(": clip %u is out of range (%zu clips)", s.clip(), clip_count);
       if (!seconds_ok(s.start()) || !seconds_ok(s.end()) || !(s.end() > s.start()))
-        return sat + format(": start %g s and end %g s must be within [0, 1e6] with end after start", s.start(), s.end());
+        return sat +
+               format(": start %g s and end %g s must be within [0, 1e6] with end after start", s.start(), s.end());
       if (!rate_ok(s.rate())) return sat + format(": rate %g must be within [%g, %g]", s.rate(), kMinRate, kMaxRate);
     }
     const double l = montage_track_length(track);
@@ -84,7 +85,8 @@ std::string check_montage(const fb::Montage& m, size_t index, size_t clip_count,
       return sat + format(": starts at %g s; the first section starts at 0", s.start());
     if (k > 0 && !(s.start() > sections.Get(k - 1)->start()))
       return sat + format(": starts at %g s, not after the section before it", s.start());
-    if (!(s.start() < length)) return sat + format(": starts at %g s, not before the montage's end (%g s)", s.start(), length);
+    if (!(s.start() < length))
+      return sat + format(": starts at %g s, not before the montage's end (%g s)", s.start(), length);
     if (s.next() < -1 || s.next() >= static_cast<int>(sections.size()))
       return sat + format(": next section %d is out of range (%u sections)", s.next(), sections.size());
   }

@@ -25,8 +25,8 @@ float clip_floor(const RetargetMap& map, std::span<const ContactFrame> frames) {
   return frames.empty() || std::fabs(lowest) <= 0.05f * pose.hips_height ? 0.0f : lowest;
 }
 
-std::vector<ContactSpan> find_foot_contacts(const RetargetMap& map, std::span<const ContactFrame> feet, float sample_rate,
-                                            float floor, const ContactSettings& settings) {
+std::vector<ContactSpan> find_foot_contacts(const RetargetMap& map, std::span<const ContactFrame> feet,
+                                            float sample_rate, float floor, const ContactSettings& settings) {
   std::vector<ContactSpan> out;
   const size_t frames = feet.size();
   if (frames == 0 || !(sample_rate > 0.0f)) return out;
@@ -65,7 +65,8 @@ std::vector<ContactSpan> find_foot_contacts(const RetargetMap& map, std::span<co
         const glm::vec3 mean_error(sum / static_cast<double>(last - f + 1));
         c.offset = back * mean_error / map.scale;
         auto held_minus_free = [&](size_t k) {
-          return back * (map.map_point(feet[k].source_ankle[foot], floor) + mean_error - feet[k].target_ankle[foot]) / map.scale;
+          return back * (map.map_point(feet[k].source_ankle[foot], floor) + mean_error - feet[k].target_ankle[foot]) /
+                 map.scale;
         };
         c.entry_shift = held_minus_free(f);
         c.exit_shift = held_minus_free(last);
@@ -92,7 +93,9 @@ void foot_contacts_at(std::span<const ContactSpan> contacts, float frame, float 
     FootContact& o = out[c.foot];
     if (w > o.weight)
       o = FootContact{outside > 0.0f ? std::min(w, 0.999f) : 1.0f, c.offset,
-                      frame < first ? c.entry_shift : frame > last ? c.exit_shift : glm::vec3(0.0f)};
+                      frame < first  ? c.entry_shift
+                      : frame > last ? c.exit_shift
+                                     : glm::vec3(0.0f)};
   }
 }
 

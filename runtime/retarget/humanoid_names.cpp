@@ -26,15 +26,30 @@ namespace {
 using B = HumanoidBone;
 
 enum class Kind : uint8_t {
-  None, Shoulder, UpperArm, LowerArm, Hand, UpperLeg, LowerLeg, Foot, Toes, Neck, Head, Hips,
-  Thumb, Index, Middle, Ring, Little,
+  None,
+  Shoulder,
+  UpperArm,
+  LowerArm,
+  Hand,
+  UpperLeg,
+  LowerLeg,
+  Foot,
+  Toes,
+  Neck,
+  Head,
+  Hips,
+  Thumb,
+  Index,
+  Middle,
+  Ring,
+  Little,
 };
 
 struct Parsed {
-  int side = 0;            // 0 none, 1 left, 2 right
-  std::string core;        // meaningful words, joined
-  bool helper = false;     // end, nub, twist, ik, ...
-  bool weak = false;       // a synonym that other rigs use for another part ("hip", "palm")
+  int side = 0;         // 0 none, 1 left, 2 right
+  std::string core;     // meaningful words, joined
+  bool helper = false;  // end, nub, twist, ik, ...
+  bool weak = false;    // a synonym that other rigs use for another part ("hip", "palm")
   Kind kind = Kind::None;
 };
 
@@ -118,12 +133,13 @@ Parsed parse(std::string_view name) {
     after_bip = w == "bip";
     if (w == "l" || w == "left") p.side = 1;
     else if (w == "r" || w == "right") p.side = 2;
-    else if (any_of(w, {"end", "nub", "site", "tip", "top", "pole", "target", "twist", "roll", "ik", "ctrl", "control",
-                        "helper", "offset", "adj", "sec", "dummy", "null", "mch", "socket", "attach", "prop", "weapon",
-                        "bend", "corrective", "jiggle", "breast", "bust", "metacarpal", "share", "hair", "eye"}))
+    else if (any_of(w, {"end",        "nub",    "site",   "tip",     "top",        "pole",   "target", "twist",
+                        "roll",       "ik",     "ctrl",   "control", "helper",     "offset", "adj",    "sec",
+                        "dummy",      "null",   "mch",    "socket",  "attach",     "prop",   "weapon", "bend",
+                        "corrective", "jiggle", "breast", "bust",    "metacarpal", "share",  "hair",   "eye"}))
       p.helper = true;
-    else if (!any_of(w, {"j", "bip", "def", "org", "mixamorig", "cc", "base", "skeleton", "joint", "jnt", "bone",
-                         "c", "armature", "rig", "bn", "b", "f"}))
+    else if (!any_of(w, {"j", "bip", "def", "org", "mixamorig", "cc", "base", "skeleton", "joint", "jnt", "bone", "c",
+                         "armature", "rig", "bn", "b", "f"}))
       words.push_back(w);
   }
   for (const std::string& w : words) p.core += w;
@@ -248,7 +264,8 @@ void map_fingers(const Rig& rig, HumanoidMap& map, std::vector<bool>& taken) {
         int j = -1;
         for (int c = 0; c < static_cast<int>(rig.parsed.size()); ++c) {
           const Parsed& p = rig.parsed[static_cast<size_t>(c)];
-          if (p.kind != kFingers[f] || p.side != side || p.helper || taken[static_cast<size_t>(c)] || !rig.below(above, c))
+          if (p.kind != kFingers[f] || p.side != side || p.helper || taken[static_cast<size_t>(c)] ||
+              !rig.below(above, c))
             continue;
           if (j < 0 || rig.depth[static_cast<size_t>(c)] < rig.depth[static_cast<size_t>(j)]) j = c;
         }
@@ -277,15 +294,18 @@ void map_trunk(const Rig& rig, HumanoidMap& map, std::vector<bool>& taken) {
       for (int c = chest + 1; c < static_cast<int>(rig.parsed.size()); ++c) {
         if (rig.parents[static_cast<size_t>(c)] != chest || rig.parsed[static_cast<size_t>(c)].helper) continue;
         if (rig.below(c, map[B::LeftUpperArm]) || rig.below(c, map[B::RightUpperArm])) continue;
-        if (rig.parsed[static_cast<size_t>(c)].kind != Kind::None && rig.parsed[static_cast<size_t>(c)].kind != Kind::Neck)
+        if (rig.parsed[static_cast<size_t>(c)].kind != Kind::None &&
+            rig.parsed[static_cast<size_t>(c)].kind != Kind::Neck)
           continue;
-        if (best < 0 || rig.children[static_cast<size_t>(c)] > best) best = rig.children[static_cast<size_t>(c)], next = c;
+        if (best < 0 || rig.children[static_cast<size_t>(c)] > best)
+          best = rig.children[static_cast<size_t>(c)], next = c;
       }
       int chain = next, first = next;
       while (chain >= 0) {
         int only = -1, count = 0;
         for (int c = chain + 1; c < static_cast<int>(rig.parsed.size()); ++c)
-          if (rig.parents[static_cast<size_t>(c)] == chain && !rig.parsed[static_cast<size_t>(c)].helper) ++count, only = c;
+          if (rig.parents[static_cast<size_t>(c)] == chain && !rig.parsed[static_cast<size_t>(c)].helper)
+            ++count, only = c;
         if (count != 1) break;
         chain = only;
       }

@@ -132,7 +132,8 @@ Status check_humanoid(const HumanoidMap& map, std::span<const int16_t> parents, 
                  " (name them in a map file: docs/RETARGET.md; ossa-inspect prints what was found)"};
   }
   for (size_t j = 0; j < parents.size(); ++j)
-    if (parents[j] >= static_cast<int>(j) || parents[j] < -1) return Error{prefix + "joints are not ordered parents first"};
+    if (parents[j] >= static_cast<int>(j) || parents[j] < -1)
+      return Error{prefix + "joints are not ordered parents first"};
   std::vector<int> used(parents.size(), -1);
   for (size_t i = 0; i < kHumanoidBoneCount; ++i) {
     const int j = map.joints[i];
@@ -142,8 +143,8 @@ Status check_humanoid(const HumanoidMap& map, std::span<const int16_t> parents, 
       return Error{prefix + "humanoid bone " + bone + " names joint " + std::to_string(j) + ", past the rig's " +
                    std::to_string(parents.size()) + " joints"};
     if (used[static_cast<size_t>(j)] >= 0)
-      return Error{prefix + "humanoid bones " + std::string(kBones[used[static_cast<size_t>(j)]].name) + " and " + bone +
-                   " name the same joint"};
+      return Error{prefix + "humanoid bones " + std::string(kBones[used[static_cast<size_t>(j)]].name) + " and " +
+                   bone + " name the same joint"};
     used[static_cast<size_t>(j)] = static_cast<int>(i);
     // The nearest mapped profile ancestor must be a hierarchy ancestor (a foot may hang elsewhere).
     B up = kBones[i].parent;

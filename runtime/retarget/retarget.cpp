@@ -47,7 +47,8 @@ glm::vec3 ratio(const glm::vec3& a, const glm::vec3& b) {
 }
 
 glm::quat delta(const RetargetMap& map, const RetargetScratch& s, int source_joint) {
-  return s.source_rotation[static_cast<size_t>(source_joint)] * map.source_rest_inverse[static_cast<size_t>(source_joint)];
+  return s.source_rotation[static_cast<size_t>(source_joint)] *
+         map.source_rest_inverse[static_cast<size_t>(source_joint)];
 }
 
 }  // namespace
@@ -116,21 +117,27 @@ void evaluate(const RetargetMap& map, const RetargetInput& in, RetargetScratch& 
         }
         if (step.kind == RetargetStep::Hips) {
           const HumanoidMap& sh = map.source_humanoid;
-          const glm::vec3 pelvis = 0.5f * (glm::vec3(s.source_model[static_cast<size_t>(sh[HumanoidBone::LeftUpperLeg])][3]) +
-                                           glm::vec3(s.source_model[static_cast<size_t>(sh[HumanoidBone::RightUpperLeg])][3]));
+          const glm::vec3 pelvis =
+              0.5f * (glm::vec3(s.source_model[static_cast<size_t>(sh[HumanoidBone::LeftUpperLeg])][3]) +
+                      glm::vec3(s.source_model[static_cast<size_t>(sh[HumanoidBone::RightUpperLeg])][3]));
           // What the source's hips move against its own legs (an animated leg root) rides along.
           const auto sj = static_cast<size_t>(step.source_a);
-          const glm::vec3 own = step.same_joint ? glm::vec3(s.source_model[sj][3]) - pelvis -
-                                s.source_rotation[sj] * (map.source_rest_inverse[sj] * map.source_hips_offset) : glm::vec3(0.0f);
+          const glm::vec3 own = step.same_joint
+                                    ? glm::vec3(s.source_model[sj][3]) - pelvis -
+                                          s.source_rotation[sj] * (map.source_rest_inverse[sj] * map.source_hips_offset)
+                                    : glm::vec3(0.0f);
           const glm::vec3 p = map.map_point(pelvis, in.source_floor) + hips_shift + model * step.offset +
                               map.scale * (map.rotation * own);
           t = parent >= 0 ? glm::vec3(glm::inverse(parent_model) * glm::vec4(p, 1.0f)) : p;
         } else if (step.kind == RetargetStep::Anchored) {
           const RetargetMap::Leg& leg = map.legs[step.joint == map.legs[0].foot ? 0 : 1];
           const glm::vec3 own = step.same_joint ? glm::vec3(s.source_model[static_cast<size_t>(leg.source_foot)][3]) -
-                                glm::vec3(s.source_model[static_cast<size_t>(leg.source_lower)] * glm::vec4(leg.source_offset, 1.0f)) : glm::vec3(0.0f);
-          const glm::vec3 p = glm::vec3(s.target_model[static_cast<size_t>(step.anchor)] * glm::vec4(step.offset, 1.0f)) +
-                              map.scale * (map.rotation * own);
+                                                      glm::vec3(s.source_model[static_cast<size_t>(leg.source_lower)] *
+                                                                glm::vec4(leg.source_offset, 1.0f))
+                                                : glm::vec3(0.0f);
+          const glm::vec3 p =
+              glm::vec3(s.target_model[static_cast<size_t>(step.anchor)] * glm::vec4(step.offset, 1.0f)) +
+              map.scale * (map.rotation * own);
           t = parent >= 0 ? glm::vec3(glm::inverse(parent_model) * glm::vec4(p, 1.0f)) : p;
         }
         break;

@@ -13,10 +13,10 @@
 // and hands across the body; the swing costs the limb a few degrees. A hand reaching across the
 // body on the source stays across on the target.
 //
-// Contacts: each planted ankle's error (from where the contact holds it, or an easing shift) is taken by the pelvis first, as the mean over the planted feet, so a single planted
-// foot is held without bending the leg away from the source's (the pelvis path strays from the
-// scaled source's by what the target's proportions make of the pose, a few percent of the hips
-// height); the IK takes the rest: what two planted feet disagree on.
+// Contacts: each planted ankle's error (from where the contact holds it, or an easing shift) is taken by the pelvis
+// first, as the mean over the planted feet, so a single planted foot is held without bending the leg away from the
+// source's (the pelvis path strays from the scaled source's by what the target's proportions make of the pose, a few
+// percent of the hips height); the IK takes the rest: what two planted feet disagree on.
 #include <algorithm>
 #include <array>
 #include <cmath>

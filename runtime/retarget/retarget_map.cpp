@@ -101,7 +101,8 @@ glm::vec3 RetargetMap::map_point(const glm::vec3& p, float floor) const {
   return target_pose.origin + scale * (rotation * (p - source_pose.origin - floor * source_pose.up));
 }
 
-Result<RetargetMap> make_retarget_map(const RetargetRig& source, const RetargetRig& target, const RetargetOptions& options) {
+Result<RetargetMap> make_retarget_map(const RetargetRig& source, const RetargetRig& target,
+                                      const RetargetOptions& options) {
   auto source_pose = make_retarget_pose(source);
   if (!source_pose) return source_pose.error();
   auto target_pose = make_retarget_pose(target);
@@ -135,7 +136,8 @@ Result<RetargetMap> make_retarget_map(const RetargetRig& source, const RetargetR
   std::vector<glm::quat> target_rest(map.target_joint_count);
   for (size_t j = 0; j < target_rest.size(); ++j) {
     const int p = target.parents[j];
-    target_rest[j] = p >= 0 ? glm::normalize(target_rest[static_cast<size_t>(p)] * tp.local[j].rotation) : tp.local[j].rotation;
+    target_rest[j] =
+        p >= 0 ? glm::normalize(target_rest[static_cast<size_t>(p)] * tp.local[j].rotation) : tp.local[j].rotation;
   }
   map.target_rest_inverse.resize(target_rest.size());
   for (size_t j = 0; j < target_rest.size(); ++j) map.target_rest_inverse[j] = glm::inverse(target_rest[j]);
@@ -199,7 +201,8 @@ Result<RetargetMap> make_retarget_map(const RetargetRig& source, const RetargetR
       }
       Chain s;
       s.joints = s_joints;
-      for (size_t i = 0; i < s_joints.size(); ++i) s.at.push_back(static_cast<float>(i) / static_cast<float>(s_joints.size()));
+      for (size_t i = 0; i < s_joints.size(); ++i)
+        s.at.push_back(static_cast<float>(i) / static_cast<float>(s_joints.size()));
       if (s.joints.size() == 1) {
         drive(t_joints[k], s.joints[0]);
         continue;
@@ -212,7 +215,8 @@ Result<RetargetMap> make_retarget_map(const RetargetRig& source, const RetargetR
 
   // Feet hanging elsewhere (IK rigs) follow their shin.
   for (int side = 0; side < 2; ++side) {
-    const int shin = th[side == 0 ? B::LeftLowerLeg : B::RightLowerLeg], foot = th[side == 0 ? B::LeftFoot : B::RightFoot];
+    const int shin = th[side == 0 ? B::LeftLowerLeg : B::RightLowerLeg],
+              foot = th[side == 0 ? B::LeftFoot : B::RightFoot];
     RetargetMap::Leg& leg = map.legs[static_cast<size_t>(side)];
     leg.upper = th[side == 0 ? B::LeftUpperLeg : B::RightUpperLeg];
     leg.lower = static_cast<int16_t>(shin);
@@ -242,7 +246,9 @@ Result<RetargetMap> make_retarget_map(const RetargetRig& source, const RetargetR
       if (it == by_name.end() || source_profile[static_cast<size_t>(it->second)]) continue;
       const int sp_parent = source.parents[static_cast<size_t>(it->second)], tp_parent = target.parents[j];
       if ((sp_parent < 0) != (tp_parent < 0)) continue;
-      if (sp_parent >= 0 && source.names[static_cast<size_t>(sp_parent)] != target.names[static_cast<size_t>(tp_parent)]) continue;
+      if (sp_parent >= 0 &&
+          source.names[static_cast<size_t>(sp_parent)] != target.names[static_cast<size_t>(tp_parent)])
+        continue;
       Step& s = steps[j];
       s.kind = RetargetStep::Copy;
       s.source_a = static_cast<int16_t>(it->second);

@@ -31,9 +31,7 @@ struct Side {
     return rotation[j] * rest_inverse[j];
   }
   /// A profile-space axis carried by bone b's rotation away from the retarget pose.
-  glm::vec3 turned(B b, const glm::vec3& axis) const {
-    return profile(delta(b) * (glm::inverse(pose.frame) * axis));
-  }
+  glm::vec3 turned(B b, const glm::vec3& axis) const { return profile(delta(b) * (glm::inverse(pose.frame) * axis)); }
   float side(B b) const {
     const glm::vec3 left = delta(B::Hips) * (glm::inverse(pose.frame) * glm::vec3(1.0f, 0.0f, 0.0f));
     return glm::dot(at(b) - at(B::Hips), left) / pose.hips_height;
@@ -46,7 +44,7 @@ void measure_retarget(const RetargetMap& map, const RetargetScratch& s, Retarget
   const Side src{s.source_model, s.source_rotation, map.source_rest_inverse, map.source_humanoid, map.source_pose};
   const Side tgt{s.target_model, s.target_rotation, map.target_rest_inverse, map.target_humanoid, map.target_pose};
   static constexpr B kLimbs[kRetargetLimbCount][2] = {
-      {B::LeftUpperArm, B::LeftLowerArm},   {B::LeftLowerArm, B::LeftHand},   {B::LeftUpperLeg, B::LeftLowerLeg},
+      {B::LeftUpperArm, B::LeftLowerArm},   {B::LeftLowerArm, B::LeftHand},       {B::LeftUpperLeg, B::LeftLowerLeg},
       {B::LeftLowerLeg, B::LeftFoot},       {B::RightUpperArm, B::RightLowerArm}, {B::RightLowerArm, B::RightHand},
       {B::RightUpperLeg, B::RightLowerLeg}, {B::RightLowerLeg, B::RightFoot}};
   for (size_t i = 0; i < kRetargetLimbCount; ++i)

@@ -47,7 +47,8 @@ void forward(std::span<const int16_t> parents, const std::vector<Transform>& loc
     const int p = parents[j];
     const glm::mat4 m = trs(local[j]);
     fk.model[j] = p >= 0 ? fk.model[static_cast<size_t>(p)] * m : m;
-    fk.rotation[j] = p >= 0 ? glm::normalize(fk.rotation[static_cast<size_t>(p)] * local[j].rotation) : local[j].rotation;
+    fk.rotation[j] =
+        p >= 0 ? glm::normalize(fk.rotation[static_cast<size_t>(p)] * local[j].rotation) : local[j].rotation;
   }
 }
 
@@ -73,20 +74,26 @@ glm::vec3 snap(const glm::vec3& v) {
 bool bone_end(const RetargetRig& rig, const Fk& fk, B bone, glm::vec3* end) {
   const HumanoidMap& h = rig.humanoid;
   auto at = [&](B b) { return fk.position(h[b]); };
-  const bool left = static_cast<int>(bone) <= static_cast<int>(B::LeftHand) ||
-                    (bone >= B::LeftUpperLeg && bone <= B::LeftToes);
+  const bool left =
+      static_cast<int>(bone) <= static_cast<int>(B::LeftHand) || (bone >= B::LeftUpperLeg && bone <= B::LeftToes);
   switch (bone) {
-    case B::LeftUpperArm: case B::RightUpperArm: *end = at(left ? B::LeftLowerArm : B::RightLowerArm); return true;
-    case B::LeftLowerArm: case B::RightLowerArm: *end = at(left ? B::LeftHand : B::RightHand); return true;
-    case B::LeftUpperLeg: case B::RightUpperLeg: *end = at(left ? B::LeftLowerLeg : B::RightLowerLeg); return true;
-    case B::LeftLowerLeg: case B::RightLowerLeg: *end = at(left ? B::LeftFoot : B::RightFoot); return true;
-    case B::LeftFoot: case B::RightFoot:
+    case B::LeftUpperArm:
+    case B::RightUpperArm: *end = at(left ? B::LeftLowerArm : B::RightLowerArm); return true;
+    case B::LeftLowerArm:
+    case B::RightLowerArm: *end = at(left ? B::LeftHand : B::RightHand); return true;
+    case B::LeftUpperLeg:
+    case B::RightUpperLeg: *end = at(left ? B::LeftLowerLeg : B::RightLowerLeg); return true;
+    case B::LeftLowerLeg:
+    case B::RightLowerLeg: *end = at(left ? B::LeftFoot : B::RightFoot); return true;
+    case B::LeftFoot:
+    case B::RightFoot:
       if (h.has(left ? B::LeftToes : B::RightToes)) {
         *end = at(left ? B::LeftToes : B::RightToes);
         return true;
       }
       break;
-    case B::LeftHand: case B::RightHand: {
+    case B::LeftHand:
+    case B::RightHand: {
       const B middle = left ? B::LeftMiddleProximal : B::RightMiddleProximal;
       if (h.has(middle)) {
         *end = at(middle);
@@ -131,8 +138,8 @@ void turn(std::span<const int16_t> parents, std::vector<Transform>& local, const
 Result<RetargetPose> make_retarget_pose(const RetargetRig& rig) {
   const std::string who(rig.name);
   const size_t n = rig.parents.size();
-  if (rig.bind.size() != n) return Error{who + ": bind pose has " + std::to_string(rig.bind.size()) + " joints, not " +
-                                         std::to_string(n)};
+  if (rig.bind.size() != n)
+    return Error{who + ": bind pose has " + std::to_string(rig.bind.size()) + " joints, not " + std::to_string(n)};
   if (Status st = check_humanoid(rig.humanoid, rig.parents, rig.name); !st) return st.error();
   const HumanoidMap& h = rig.humanoid;
   RetargetPose pose;
@@ -162,7 +169,8 @@ Result<RetargetPose> make_retarget_pose(const RetargetRig& rig) {
   std::array<glm::mat4, 2> foot_offset{};
   for (int s = 0; s < 2; ++s) {
     const int shin = h[s == 0 ? B::LeftLowerLeg : B::RightLowerLeg], foot = h[s == 0 ? B::LeftFoot : B::RightFoot];
-    foot_offset[static_cast<size_t>(s)] = glm::inverse(fk.model[static_cast<size_t>(shin)]) * fk.model[static_cast<size_t>(foot)];
+    foot_offset[static_cast<size_t>(s)] =
+        glm::inverse(fk.model[static_cast<size_t>(shin)]) * fk.model[static_cast<size_t>(foot)];
   }
   auto reanchor_feet = [&] {
     for (int s = 0; s < 2; ++s) {
@@ -201,7 +209,8 @@ Result<RetargetPose> make_retarget_pose(const RetargetRig& rig) {
     }
   }
   for (const RestRotation& r : rig.rest_rotations) {
-    if (r.joint < 0 || static_cast<size_t>(r.joint) >= n) return Error{who + ": rest rotation for a joint out of range"};
+    if (r.joint < 0 || static_cast<size_t>(r.joint) >= n)
+      return Error{who + ": rest rotation for a joint out of range"};
     pose.local[static_cast<size_t>(r.joint)].rotation = glm::normalize(r.rotation);
   }
   forward(rig.parents, pose.local, fk);
@@ -215,8 +224,7 @@ Result<RetargetPose> make_retarget_pose(const RetargetRig& rig) {
         floor = std::min(floor, glm::dot(fk.position(static_cast<int>(j)), up));
   }
   pose.pelvis = 0.5f * (fk.position(h[B::LeftUpperLeg]) + fk.position(h[B::RightUpperLeg]));
-  const float ankles =
-      0.5f * (glm::dot(fk.position(h[B::LeftFoot]), up) + glm::dot(fk.position(h[B::RightFoot]), up));
+  const float ankles = 0.5f * (glm::dot(fk.position(h[B::LeftFoot]), up) + glm::dot(fk.position(h[B::RightFoot]), up));
   pose.ankle_height = ankles - floor;
   pose.hips_height = glm::dot(pose.pelvis, up) - ankles;
   if (!(pose.hips_height > 1e-6f * std::max(1.0f, glm::length(pose.pelvis))) || !std::isfinite(pose.hips_height))

@@ -32,7 +32,8 @@ Status skin_cloth_particles(const ClothSource& source, const MeshView& mesh, std
   if (!pa) return fail("skin_cloth_particles: the mesh has no positions");
   const size_t slots = std::max<size_t>(1, mesh.joints().size());
   if (palette.size() < slots)
-    return fail(format("skin_cloth_particles: the palette has %zu matrices, the mesh needs %zu", palette.size(), slots));
+    return fail(
+        format("skin_cloth_particles: the palette has %zu matrices, the mesh needs %zu", palette.size(), slots));
   // Directions must not see the de-quantization folded into the palette (skinning.h).
   glm::vec3 prescale(1.0f);
   if (pa->format() == fb::VertexFormat::Unorm16x4 && mesh.fb->position_scale()) {
@@ -44,7 +45,8 @@ Status skin_cloth_particles(const ClothSource& source, const MeshView& mesh, std
   for (size_t i = 0; i < n; ++i) {
     const uint32_t v = source.particle_vertices[i];
     if (v >= mesh.vertex_count())
-      return fail(format("skin_cloth_particles: particle %zu's vertex %u is past the mesh's %u", i, v, mesh.vertex_count()));
+      return fail(
+          format("skin_cloth_particles: particle %zu's vertex %u is past the mesh's %u", i, v, mesh.vertex_count()));
     const uint8_t* vb = bytes + static_cast<size_t>(v) * stride;
     glm::mat4 m = palette[0];
     if (ja && wa) {

@@ -66,12 +66,12 @@ struct MeshFacts {
   const fb::VertexAttribute* position = nullptr;
   const fb::VertexAttribute* normal = nullptr;
   const fb::VertexAttribute* tangent = nullptr;
-  const fb::VertexAttribute* joints = nullptr;   // both or neither (validate.cpp)
+  const fb::VertexAttribute* joints = nullptr;  // both or neither (validate.cpp)
   const fb::VertexAttribute* weights = nullptr;
-  size_t slot_count = 0;                         // mesh.joints().size()
-  bool dequantize = false;                       // D applies: a normalized position format
-  glm::vec3 offset{0.0f}, scale{1.0f};           // D
-  glm::vec3 direction_prescale{1.0f};            // 1 / scale (0 on a zero axis)
+  size_t slot_count = 0;                // mesh.joints().size()
+  bool dequantize = false;              // D applies: a normalized position format
+  glm::vec3 offset{0.0f}, scale{1.0f};  // D
+  glm::vec3 direction_prescale{1.0f};   // 1 / scale (0 on a zero axis)
 };
 
 /// Resolves the facts of mesh (skinning.cpp).
@@ -106,7 +106,9 @@ struct Outputs {
 };
 
 /// A transformed direction as the caller asked for it: unit length, or as transformed.
-inline glm::vec3 finish_direction(glm::vec3 v, const Outputs& out) { return out.renormalize ? normalize_or_zero(v) : v; }
+inline glm::vec3 finish_direction(glm::vec3 v, const Outputs& out) {
+  return out.renormalize ? normalize_or_zero(v) : v;
+}
 
 // ---------------------------------------------------------------------------------------------
 // Portable path (skin_portable.cpp): attributes decoded a batch at a time as OpenGL fetches them.
@@ -154,7 +156,7 @@ struct FastMesh {
   uint32_t count, stride;
   uint32_t off_position, off_normal, off_tangent, off_joints, off_weights;
   Slots slots;
-  float prescale[3];     // direction_prescale
+  float prescale[3];  // direction_prescale
 };
 
 /// 256 vertices per batch: lists, classes and decoded directions stay in L1 (~13 KB), and the

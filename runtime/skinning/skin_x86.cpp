@@ -166,11 +166,14 @@ template <int K, bool kCheck, bool kWide, Slots kSlots, bool kPositions, bool kN
     store_xyz<kWide>(at.position_out, transform_dup(a01, a23, p));
   }
   if constexpr (kNormals)
-    store_xyz<kWide>(at.normal_out, transform_dup(a01, a23, _mm256_broadcast_ps(reinterpret_cast<const __m128*>(at.normal))));
+    store_xyz<kWide>(at.normal_out,
+                     transform_dup(a01, a23, _mm256_broadcast_ps(reinterpret_cast<const __m128*>(at.normal))));
   if constexpr (kTangents) {
     const __m128 t = _mm_load_ps(at.tangent);
     // w of t is the sign: transform xyz only, then put the sign back.
-    const __m128 r = transform_dup(a01, a23, _mm256_blend_ps(_mm256_broadcast_ps(reinterpret_cast<const __m128*>(at.tangent)), _mm256_setzero_ps(), 0x88));
+    const __m128 r = transform_dup(
+        a01, a23,
+        _mm256_blend_ps(_mm256_broadcast_ps(reinterpret_cast<const __m128*>(at.tangent)), _mm256_setzero_ps(), 0x88));
     _mm_storeu_ps(at.tangent_out, _mm_blend_ps(r, t, 0x8));
   }
   return kCheck ? outside_class<K>(wb) : 0u;
@@ -191,7 +194,8 @@ OSSA_TARGET_AVX2 void skin_class(const uint32_t* list, uint32_t n, const float* 
                             kPositions ? out.positions + 3 * v : nullptr,
                             kNormals ? out.normals + 3 * v : nullptr,
                             kTangents ? out.tangents + 4 * v : nullptr};
-    skin_vertex<K, false, false, kSlots, kPositions, kNormals, kTangents>(palette, at, off_position, off_joints, off_weights);
+    skin_vertex<K, false, false, kSlots, kPositions, kNormals, kTangents>(palette, at, off_position, off_joints,
+                                                                          off_weights);
   }
 }
 
@@ -215,7 +219,8 @@ OSSA_TARGET_AVX2 uint32_t skin_range(const float* palette, const FastMesh& mesh,
   uint32_t outside = 0;
 #pragma GCC unroll 2
   for (uint32_t i = 0; i < wide; ++i) {
-    outside |= skin_vertex<K, true, true, kSlots, kPositions, kNormals, kTangents>(palette, at, off_position, off_joints, off_weights);
+    outside |= skin_vertex<K, true, true, kSlots, kPositions, kNormals, kTangents>(palette, at, off_position,
+                                                                                   off_joints, off_weights);
     at.vx += stride;
     at.normal += 4;
     at.tangent += 4;
@@ -224,7 +229,8 @@ OSSA_TARGET_AVX2 uint32_t skin_range(const float* palette, const FastMesh& mesh,
     if constexpr (kTangents) at.tangent_out += 4;
   }
   if (wide < b.n)
-    outside |= skin_vertex<K, true, false, kSlots, kPositions, kNormals, kTangents>(palette, at, off_position, off_joints, off_weights);
+    outside |= skin_vertex<K, true, false, kSlots, kPositions, kNormals, kTangents>(palette, at, off_position,
+                                                                                    off_joints, off_weights);
   return outside;
 }
 
@@ -233,11 +239,12 @@ OSSA_TARGET_AVX2 uint32_t skin_range(const float* palette, const FastMesh& mesh,
 /// Returns n, or the index (from first) of the block where a vertex did not belong to the class:
 /// outputs from there on are not written, or wrong.
 template <int K, Slots kSlots, bool kPositions, bool kNormals>
-OSSA_TARGET_AVX2 uint32_t skin_range_soa(const float* palette, const FastMesh& m, uint32_t first, uint32_t n, Outputs out,
-                                          bool avx512) {
+OSSA_TARGET_AVX2 uint32_t skin_range_soa(const float* palette, const FastMesh& m, uint32_t first, uint32_t n,
+                                         Outputs out, bool avx512) {
   constexpr bool kWide = kSlots == Slots::Wide, kPacked = kSlots == Slots::Packed;
-  const soa::Layout l{palette, kWeight.data(), m.stride, m.off_position, m.off_normal, m.off_joints, m.off_weights,
-                      {m.prescale[0], m.prescale[1], m.prescale[2]}, out.renormalize};
+  const soa::Layout l{palette,        kWeight.data(), m.stride,      m.off_position,
+                      m.off_normal,   m.off_joints,   m.off_weights, {m.prescale[0], m.prescale[1], m.prescale[2]},
+                      out.renormalize};
   const uint8_t* vx = m.base + static_cast<size_t>(first) * m.stride;
   const soa::Cursor<kPacked> at{vx + m.off_joints, vx + m.off_weights, vx + m.off_position, vx + m.off_normal};
   float* const p = kPositions ? out.positions + 3 * static_cast<size_t>(first) : nullptr;
@@ -269,7 +276,8 @@ OSSA_TARGET_AVX2 void skin_batch(const float* palette, const FastMesh& m, const 
 
 /// Vertices [first, count) batch by batch, each classified first (any vertex order).
 template <Slots kSlots, bool kPositions, bool kNormals, bool kTangents>
-OSSA_TARGET_AVX2 void skin_classified(const float* palette, const FastMesh& m, Outputs out, bool avx512, uint32_t first) {
+OSSA_TARGET_AVX2 void skin_classified(const float* palette, const FastMesh& m, Outputs out, bool avx512,
+                                      uint32_t first) {
   Batch b;
   for (; first < m.count; first += kBatch) {
     b.first = first;
@@ -335,7 +343,8 @@ OSSA_TARGET_AVX2 void skin_fast(const float* palette, const FastMesh& m, Outputs
     constexpr int K = decltype(k)::value;
     const uint32_t end = K == kClasses - 1 ? m.count : class_end(m, begin, K);
     if constexpr (kNormals && !kTangents) {
-      const uint32_t done = skin_range_soa<K, kSlots, kPositions, kNormals>(palette, m, begin, end - begin, out, avx512);
+      const uint32_t done =
+          skin_range_soa<K, kSlots, kPositions, kNormals>(palette, m, begin, end - begin, out, avx512);
       if (done != end - begin) {
         skin_classified<kSlots, kPositions, kNormals, kTangents>(palette, m, out, avx512, begin + done);
         return false;
@@ -394,9 +403,9 @@ bool fast_layout(const MeshFacts& m, Outputs out, FastMesh* f) {
                 m.tangent != nullptr ? m.tangent->offset() : 0u,
                 m.joints->offset(),
                 m.weights->offset(),
-                m.joints->format() == VertexFormat::Uint16x4                   ? Slots::Wide
+                m.joints->format() == VertexFormat::Uint16x4                            ? Slots::Wide
                 : m.weights->offset() == static_cast<uint32_t>(m.joints->offset()) + 4u ? Slots::Packed
-                                                                                         : Slots::Narrow,
+                                                                                        : Slots::Narrow,
                 {m.direction_prescale.x, m.direction_prescale.y, m.direction_prescale.z}};
   return true;
 }

@@ -58,10 +58,15 @@ OSSA_TARGET_AVX2 void classify_avx2(const FastMesh& m, Batch& b) {
   for (uint32_t c = 0; c < b.n; c += 8) {
     const uint32_t valid = b.n - c >= 8 ? 0xffu : (1u << (b.n - c)) - 1u;
     const __m256i g = _mm256_load_si256(reinterpret_cast<const __m256i*>(words + c));
-    const uint32_t z24 = static_cast<uint32_t>(_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(_mm256_srli_epi32(g, 24), zero))));
-    const uint32_t z16 = static_cast<uint32_t>(_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(_mm256_srli_epi32(g, 16), zero))));
-    const uint32_t z8 = static_cast<uint32_t>(_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(_mm256_srli_epi32(g, 8), zero))));
-    const uint32_t rigid = static_cast<uint32_t>(_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(g, _mm256_set1_epi32(255))))) & valid;
+    const uint32_t z24 = static_cast<uint32_t>(
+        _mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(_mm256_srli_epi32(g, 24), zero))));
+    const uint32_t z16 = static_cast<uint32_t>(
+        _mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(_mm256_srli_epi32(g, 16), zero))));
+    const uint32_t z8 = static_cast<uint32_t>(
+        _mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(_mm256_srli_epi32(g, 8), zero))));
+    const uint32_t rigid =
+        static_cast<uint32_t>(_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(g, _mm256_set1_epi32(255))))) &
+        valid;
     const uint32_t masks[kClasses] = {rigid, valid & z8 & ~rigid, valid & z16 & ~z8, valid & z24 & ~z16, valid & ~z24};
     const __m256i index = _mm256_add_epi32(lane, _mm256_set1_epi32(static_cast<int>(b.first + c)));
     for (int k = 0; k < kClasses; ++k) {
@@ -141,7 +146,8 @@ OSSA_TARGET_AVX2 void decode_directions(const FastMesh& m, Batch& b) {
     normal_words[i] = 0;
     if constexpr (kTangents) tangent_words[i] = tangent_words[kBatch + i] = 0;
   }
-  const __m256 sx = _mm256_set1_ps(m.prescale[0]), sy = _mm256_set1_ps(m.prescale[1]), sz = _mm256_set1_ps(m.prescale[2]);
+  const __m256 sx = _mm256_set1_ps(m.prescale[0]), sy = _mm256_set1_ps(m.prescale[1]),
+               sz = _mm256_set1_ps(m.prescale[2]);
   for (uint32_t c = 0; c < b.n; c += 8) {
     const __m256i gn = _mm256_load_si256(reinterpret_cast<const __m256i*>(normal_words + c));
     __m256 x = snorm16_lanes(gn, false), y = snorm16_lanes(gn, true), z;
@@ -153,8 +159,9 @@ OSSA_TARGET_AVX2 void decode_directions(const FastMesh& m, Batch& b) {
       __m256 tx = snorm16_lanes(gt, false), ty = snorm16_lanes(gt, true), tz;
       unfold_octahedral(tx, ty, tz);
       // Bitangent sign: the sign of the third snorm16 (the low half of the second word).
-      const __m256 sign = _mm256_or_ps(_mm256_set1_ps(1.0f),
-                                       _mm256_castsi256_ps(_mm256_and_si256(_mm256_slli_epi32(gs, 16), _mm256_set1_epi32(INT32_MIN))));
+      const __m256 sign =
+          _mm256_or_ps(_mm256_set1_ps(1.0f),
+                       _mm256_castsi256_ps(_mm256_and_si256(_mm256_slli_epi32(gs, 16), _mm256_set1_epi32(INT32_MIN))));
       store_aos4(_mm256_mul_ps(tx, sx), _mm256_mul_ps(ty, sy), _mm256_mul_ps(tz, sz), sign, b.tangent + c);
     }
   }
@@ -174,15 +181,18 @@ OSSA_TARGET_AVX2 inline void normalize_xyz8(float* p) {
   const __m256 a = _mm256_loadu_ps(p), b = _mm256_loadu_ps(p + 8), c = _mm256_loadu_ps(p + 16);
   const __m256 qa = _mm256_mul_ps(a, a), qb = _mm256_mul_ps(b, b), qc = _mm256_mul_ps(c, c);
   // a = x0 y0 z0 x1 y1 z1 x2 y2 | b = z2 x3 y3 z3 x4 y4 z4 x5 | c = y5 z5 x6 y6 z6 x7 y7 z7
-  const __m256 xx = _mm256_blend_ps(_mm256_blend_ps(_mm256_permutevar8x32_ps(qa, _mm256_setr_epi32(0, 3, 6, 0, 0, 0, 0, 0)),
-                                                    _mm256_permutevar8x32_ps(qb, _mm256_setr_epi32(0, 0, 0, 1, 4, 7, 0, 0)), 0x38),
-                                    _mm256_permutevar8x32_ps(qc, _mm256_setr_epi32(0, 0, 0, 0, 0, 0, 2, 5)), 0xc0);
-  const __m256 yy = _mm256_blend_ps(_mm256_blend_ps(_mm256_permutevar8x32_ps(qa, _mm256_setr_epi32(1, 4, 7, 0, 0, 0, 0, 0)),
-                                                    _mm256_permutevar8x32_ps(qb, _mm256_setr_epi32(0, 0, 0, 2, 5, 0, 0, 0)), 0x18),
-                                    _mm256_permutevar8x32_ps(qc, _mm256_setr_epi32(0, 0, 0, 0, 0, 0, 3, 6)), 0xe0);
-  const __m256 zz = _mm256_blend_ps(_mm256_blend_ps(_mm256_permutevar8x32_ps(qa, _mm256_setr_epi32(2, 5, 0, 0, 0, 0, 0, 0)),
-                                                    _mm256_permutevar8x32_ps(qb, _mm256_setr_epi32(0, 0, 0, 3, 6, 0, 0, 0)), 0x1c),
-                                    _mm256_permutevar8x32_ps(qc, _mm256_setr_epi32(0, 0, 0, 0, 0, 1, 4, 7)), 0xe0);
+  const __m256 xx =
+      _mm256_blend_ps(_mm256_blend_ps(_mm256_permutevar8x32_ps(qa, _mm256_setr_epi32(0, 3, 6, 0, 0, 0, 0, 0)),
+                                      _mm256_permutevar8x32_ps(qb, _mm256_setr_epi32(0, 0, 0, 1, 4, 7, 0, 0)), 0x38),
+                      _mm256_permutevar8x32_ps(qc, _mm256_setr_epi32(0, 0, 0, 0, 0, 0, 2, 5)), 0xc0);
+  const __m256 yy =
+      _mm256_blend_ps(_mm256_blend_ps(_mm256_permutevar8x32_ps(qa, _mm256_setr_epi32(1, 4, 7, 0, 0, 0, 0, 0)),
+                                      _mm256_permutevar8x32_ps(qb, _mm256_setr_epi32(0, 0, 0, 2, 5, 0, 0, 0)), 0x18),
+                      _mm256_permutevar8x32_ps(qc, _mm256_setr_epi32(0, 0, 0, 0, 0, 0, 3, 6)), 0xe0);
+  const __m256 zz =
+      _mm256_blend_ps(_mm256_blend_ps(_mm256_permutevar8x32_ps(qa, _mm256_setr_epi32(2, 5, 0, 0, 0, 0, 0, 0)),
+                                      _mm256_permutevar8x32_ps(qb, _mm256_setr_epi32(0, 0, 0, 3, 6, 0, 0, 0)), 0x1c),
+                      _mm256_permutevar8x32_ps(qc, _mm256_setr_epi32(0, 0, 0, 0, 0, 1, 4, 7)), 0xe0);
   const __m256 inv = inverse_length(_mm256_add_ps(_mm256_add_ps(xx, yy), zz));
   _mm256_storeu_ps(p, _mm256_mul_ps(a, _mm256_permutevar8x32_ps(inv, _mm256_setr_epi32(0, 0, 0, 1, 1, 1, 2, 2))));
   _mm256_storeu_ps(p + 8, _mm256_mul_ps(b, _mm256_permutevar8x32_ps(inv, _mm256_setr_epi32(2, 3, 3, 3, 4, 4, 4, 5))));

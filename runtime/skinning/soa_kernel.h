@@ -40,7 +40,9 @@ namespace ossa::soa {
 
 #define OSSA_SOA_TARGET OSSA_TARGET("avx2,fma,bmi,bmi2,popcnt")
 #if defined(__GNUC__) || defined(__clang__)
-#define OSSA_SOA_INLINE __attribute__((always_inline)) inline  // GNU form: it follows OSSA_TARGET, and Clang takes no [[...]] after __attribute__
+#define OSSA_SOA_INLINE \
+  __attribute__((       \
+      always_inline)) inline  // GNU form: it follows OSSA_TARGET, and Clang takes no [[...]] after __attribute__
 #else
 #define OSSA_SOA_INLINE __forceinline
 #endif
@@ -90,13 +92,15 @@ OSSA_SOA_TARGET OSSA_SOA_INLINE void transpose_columns(const __m256 (&a)[8], __m
 OSSA_SOA_TARGET OSSA_SOA_INLINE void store_xyz8(float* out, __m256 x, __m256 y, __m256 z) {
   // Per lane (vertices 0-3, and 4-7): q0 = x0 y0 z0 x1, q1 = y1 z1 x2 y2, q2 = z2 x3 y3 z3.
   const __m256 xy_lo = _mm256_unpacklo_ps(x, y), xy_hi = _mm256_unpackhi_ps(x, y);  // x0 y0 x1 y1, x2 y2 x3 y3
-  const __m256 q0 = _mm256_shuffle_ps(xy_lo, _mm256_shuffle_ps(z, xy_lo, _MM_SHUFFLE(2, 2, 0, 0)), _MM_SHUFFLE(2, 0, 1, 0));
-  const __m256 q1 = _mm256_shuffle_ps(_mm256_shuffle_ps(xy_lo, z, _MM_SHUFFLE(1, 1, 3, 3)), xy_hi, _MM_SHUFFLE(1, 0, 2, 0));
+  const __m256 q0 =
+      _mm256_shuffle_ps(xy_lo, _mm256_shuffle_ps(z, xy_lo, _MM_SHUFFLE(2, 2, 0, 0)), _MM_SHUFFLE(2, 0, 1, 0));
+  const __m256 q1 =
+      _mm256_shuffle_ps(_mm256_shuffle_ps(xy_lo, z, _MM_SHUFFLE(1, 1, 3, 3)), xy_hi, _MM_SHUFFLE(1, 0, 2, 0));
   const __m256 q2 = _mm256_shuffle_ps(_mm256_shuffle_ps(z, xy_hi, _MM_SHUFFLE(2, 2, 2, 2)),
                                       _mm256_shuffle_ps(xy_hi, z, _MM_SHUFFLE(3, 3, 3, 3)), _MM_SHUFFLE(2, 0, 2, 0));
   _mm256_storeu_ps(out, _mm256_insertf128_ps(q0, _mm256_castps256_ps128(q1), 1));  // q0 | q1 of vertices 0-3
-  _mm256_storeu_ps(out + 8, _mm256_blend_ps(q2, q0, 0xf0));                         // q2 of 0-3 | q0 of 4-7
-  _mm256_storeu_ps(out + 16, _mm256_permute2f128_ps(q1, q2, 0x31));                 // q1 | q2 of 4-7
+  _mm256_storeu_ps(out + 8, _mm256_blend_ps(q2, q0, 0xf0));                        // q2 of 0-3 | q0 of 4-7
+  _mm256_storeu_ps(out + 16, _mm256_permute2f128_ps(q1, q2, 0x31));                // q1 | q2 of 4-7
 }
 
 /// v as it is, hidden from the optimizer: GCC contracts a multiply feeding an add into an FMA
@@ -111,15 +115,17 @@ OSSA_SOA_TARGET OSSA_SOA_INLINE __m256 rounded(__m256 v) {
 /// One component of a point: c0 * x + c1 * y + c2 * z + c3, rounded as skin_x86.cpp's per-vertex
 /// kernel rounds it (fma(c2, z, c0 * x) + (c1 * y + c3)), so that every path of skin_cpu gives
 /// bit-identical outputs whichever streams are asked for.
-OSSA_SOA_TARGET OSSA_SOA_INLINE __m256 transform_point(__m256 c0, __m256 c1, __m256 c2, __m256 c3, __m256 x, __m256 y, __m256 z) {
+OSSA_SOA_TARGET OSSA_SOA_INLINE __m256 transform_point(__m256 c0, __m256 c1, __m256 c2, __m256 c3, __m256 x, __m256 y,
+                                                       __m256 z) {
   return _mm256_add_ps(_mm256_fmadd_ps(c2, z, _mm256_mul_ps(c0, x)), _mm256_add_ps(rounded(_mm256_mul_ps(c1, y)), c3));
 }
 
 /// One component of a direction, c0 * x + c1 * y + c2 * z (+ c3 * 0), rounded likewise, down to
 /// the sign of a zero.
-OSSA_SOA_TARGET OSSA_SOA_INLINE __m256 transform_direction(__m256 c0, __m256 c1, __m256 c2, __m256 c3, __m256 x, __m256 y,
-                                                           __m256 z) {
-  return _mm256_add_ps(_mm256_fmadd_ps(c2, z, _mm256_mul_ps(c0, x)), _mm256_fmadd_ps(c3, _mm256_setzero_ps(), _mm256_mul_ps(c1, y)));
+OSSA_SOA_TARGET OSSA_SOA_INLINE __m256 transform_direction(__m256 c0, __m256 c1, __m256 c2, __m256 c3, __m256 x,
+                                                           __m256 y, __m256 z) {
+  return _mm256_add_ps(_mm256_fmadd_ps(c2, z, _mm256_mul_ps(c0, x)),
+                       _mm256_fmadd_ps(c3, _mm256_setzero_ps(), _mm256_mul_ps(c1, y)));
 }
 
 /// Where the kernel reads and writes.
@@ -140,7 +146,7 @@ struct Cursor {
   const uint8_t* joints;
   const uint8_t* weights_;  // unused when kPacked
   const uint8_t* position;
-  const uint8_t* normal;    // used when the normal does not follow the position (not kFused)
+  const uint8_t* normal;  // used when the normal does not follow the position (not kFused)
   const uint8_t* weights() const { return kPacked ? joints + 4 : weights_; }
   void advance(size_t d) {
     joints += d;
@@ -171,7 +177,8 @@ OSSA_SOA_TARGET OSSA_SOA_INLINE __m128i words_of(const uint8_t* position, const 
 /// Blended matrix of a vertex's first K influences (K = 0: its first slot's matrix as it is), as
 /// columns 0-1 and 2-3; slots and weights read byte by byte (no shifts and masks of a wide word).
 template <int K, bool kWideSlots>
-OSSA_SOA_TARGET OSSA_SOA_INLINE void blend(const uint8_t* j, const uint8_t* w, const Layout& l, __m256& a01, __m256& a23) {
+OSSA_SOA_TARGET OSSA_SOA_INLINE void blend(const uint8_t* j, const uint8_t* w, const Layout& l, __m256& a01,
+                                           __m256& a23) {
   const auto matrix = [&](int k) {
     uint32_t s;
     if constexpr (kWideSlots) {
@@ -249,15 +256,18 @@ OSSA_SOA_TARGET OSSA_SOA_INLINE uint32_t block(Cursor<kPacked> at, uint32_t last
     const __m256 y = _mm256_mul_ps(_mm256_cvtepi32_ps(_mm256_unpackhi_epi16(xy, zero)), unit);
     const __m256 z = _mm256_mul_ps(_mm256_cvtepi32_ps(_mm256_unpacklo_epi16(zw, zero)), unit);
     store_xyz8(position_out, transform_point(c01[0], c01[3], c23[0], c23[3], x, y, z),
-               transform_point(c01[1], c01[4], c23[1], c23[4], x, y, z), transform_point(c01[2], c01[5], c23[2], c23[5], x, y, z));
+               transform_point(c01[1], c01[4], c23[1], c23[4], x, y, z),
+               transform_point(c01[2], c01[5], c23[2], c23[5], x, y, z));
   }
   if constexpr (kNormals) {
     const __m256i t1 = _mm256_unpackhi_epi16(A[0], A[1]), t3 = _mm256_unpackhi_epi16(A[2], A[3]);
     const __m256i n = _mm256_unpacklo_epi32(t1, t3);  // nx0..3 ny0..3 | nx4..7 ny4..7
     // Snorm16 as OpenGL decodes it: max(v / 32767, -1); the word moved to the top, shifted down.
     const __m256 unit = _mm256_set1_ps(1.0f / 32767.0f), minus_one = _mm256_set1_ps(-1.0f);
-    __m256 x = _mm256_max_ps(_mm256_mul_ps(_mm256_cvtepi32_ps(_mm256_srai_epi32(_mm256_unpacklo_epi16(zero, n), 16)), unit), minus_one);
-    __m256 y = _mm256_max_ps(_mm256_mul_ps(_mm256_cvtepi32_ps(_mm256_srai_epi32(_mm256_unpackhi_epi16(zero, n), 16)), unit), minus_one);
+    __m256 x = _mm256_max_ps(
+        _mm256_mul_ps(_mm256_cvtepi32_ps(_mm256_srai_epi32(_mm256_unpacklo_epi16(zero, n), 16)), unit), minus_one);
+    __m256 y = _mm256_max_ps(
+        _mm256_mul_ps(_mm256_cvtepi32_ps(_mm256_srai_epi32(_mm256_unpackhi_epi16(zero, n), 16)), unit), minus_one);
     __m256 z;
     unfold_octahedral(x, y, z);
     x = _mm256_mul_ps(x, _mm256_set1_ps(l.prescale[0]));
@@ -267,7 +277,9 @@ OSSA_SOA_TARGET OSSA_SOA_INLINE uint32_t block(Cursor<kPacked> at, uint32_t last
     __m256 ny = transform_direction(c01[1], c01[4], c23[1], c23[4], x, y, z);
     __m256 nz = transform_direction(c01[2], c01[5], c23[2], c23[5], x, y, z);
     if (l.renormalize) {
-      const __m256 inv = inverse_length(_mm256_add_ps(_mm256_add_ps(rounded(_mm256_mul_ps(nx, nx)), rounded(_mm256_mul_ps(ny, ny))), rounded(_mm256_mul_ps(nz, nz))));
+      const __m256 inv =
+          inverse_length(_mm256_add_ps(_mm256_add_ps(rounded(_mm256_mul_ps(nx, nx)), rounded(_mm256_mul_ps(ny, ny))),
+                                       rounded(_mm256_mul_ps(nz, nz))));
       nx = _mm256_mul_ps(nx, inv);
       ny = _mm256_mul_ps(ny, inv);
       nz = _mm256_mul_ps(nz, inv);
@@ -284,13 +296,13 @@ OSSA_SOA_TARGET OSSA_SOA_INLINE uint32_t block(Cursor<kPacked> at, uint32_t last
 /// vertex of the first block holding a vertex outside the class (its outputs and those after it
 /// are not written, or wrong), or n when every vertex belonged.
 template <int K, bool kWideSlots, bool kPacked, bool kPositions, bool kNormals, bool kFused>
-OSSA_SOA_TARGET OSSA_SOA_INLINE uint32_t range_body(Cursor<kPacked> at, uint32_t n, const Layout& layout, float* position_out,
-                                                    float* normal_out) {
+OSSA_SOA_TARGET OSSA_SOA_INLINE uint32_t range_body(Cursor<kPacked> at, uint32_t n, const Layout& layout,
+                                                    float* position_out, float* normal_out) {
   const Layout l = layout;  // a local copy: its fields stay in registers (the outputs cannot alias them)
   uint32_t i = 0;
   for (; i + 8 <= n; i += 8, at.advance(8 * l.stride)) {
-    if (block<K, kWideSlots, kPacked, kPositions, kNormals, kFused, false>(at, 7, l, kPositions ? position_out + 3 * i : nullptr,
-                                                                          kNormals ? normal_out + 3 * i : nullptr) != 0)
+    if (block<K, kWideSlots, kPacked, kPositions, kNormals, kFused, false>(
+            at, 7, l, kPositions ? position_out + 3 * i : nullptr, kNormals ? normal_out + 3 * i : nullptr) != 0)
       return i;
   }
   if (i < n) {
@@ -305,7 +317,8 @@ OSSA_SOA_TARGET OSSA_SOA_INLINE uint32_t range_body(Cursor<kPacked> at, uint32_t
 /// range_body compiled for AVX2 + FMA, and for AVX-512 (F/VL/BW/DQ: the same 256-bit code, with
 /// 32 vector registers instead of 16).
 template <int K, bool kWideSlots, bool kPacked, bool kPositions, bool kNormals, bool kFused>
-OSSA_SOA_TARGET uint32_t range_avx2(Cursor<kPacked> at, uint32_t n, const Layout& l, float* position_out, float* normal_out) {
+OSSA_SOA_TARGET uint32_t range_avx2(Cursor<kPacked> at, uint32_t n, const Layout& l, float* position_out,
+                                    float* normal_out) {
   return range_body<K, kWideSlots, kPacked, kPositions, kNormals, kFused>(at, n, l, position_out, normal_out);
 }
 template <int K, bool kWideSlots, bool kPacked, bool kPositions, bool kNormals, bool kFused>

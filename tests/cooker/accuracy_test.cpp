@@ -171,7 +171,9 @@ struct Sampled {
 };
 
 template <class Key>
-double key_time(const Key& k) { return k.mTime; }
+double key_time(const Key& k) {
+  return k.mTime;
+}
 
 /// Assimp's channel value at `ticks`, interpolated linearly (slerp for rotations), clamped.
 glm::vec3 eval_vec(const aiVectorKey* keys, unsigned n, double ticks, glm::vec3 fallback) {
@@ -339,11 +341,15 @@ TEST_P(Accuracy, DequantizedVerticesMatchSource) {
         if (bone_nodes.empty()) continue;
         const aiNode* bn = bone_nodes[0];
         for (const aiNode* cand : bone_nodes)
-          if (cand->mNumMeshes == 0) { bn = cand; break; }
+          if (cand->mNumMeshes == 0) {
+            bn = cand;
+            break;
+          }
         const glm::mat4 palette = node_global(bn) * to_glm(bone->mOffsetMatrix);
         for (unsigned w = 0; w < bone->mNumWeights; ++w) {
           const auto& vw = bone->mWeights[w];
-          if (vw.mVertexId < m->mNumVertices && vw.mWeight > 0.0f) influences[vw.mVertexId].push_back({vw.mWeight, palette});
+          if (vw.mVertexId < m->mNumVertices && vw.mWeight > 0.0f)
+            influences[vw.mVertexId].push_back({vw.mWeight, palette});
         }
       }
       // A mesh without bones rides on the joint above it: where the bind pose is the skins', it sits
@@ -410,8 +416,8 @@ TEST_P(Accuracy, DequantizedVerticesMatchSource) {
       } else {
         uint16_t q[3];
         std::memcpy(q, vx + pos->offset(), 6);
-        p = offset + scale * glm::vec3(ossa::unorm16_to_float(q[0]), ossa::unorm16_to_float(q[1]),
-                                       ossa::unorm16_to_float(q[2]));
+        p = offset +
+            scale * glm::vec3(ossa::unorm16_to_float(q[0]), ossa::unorm16_to_float(q[1]), ossa::unorm16_to_float(q[2]));
       }
       worst = std::max(worst, source_points.nearest(p));
       if (jnt != nullptr && wgt != nullptr && !model.empty()) {
@@ -529,9 +535,8 @@ TEST_P(Accuracy, ClipSamplesMatchAssimpAtFirstMiddleLastSourceTimes) {
       const std::vector<glm::vec3> cooked = model_positions(sk, pose);
       for (size_t j = 0; j < sk.joint_count(); ++j) {
         ASSERT_FALSE(source[j].empty()) << "cooked joint " << sk.joint_name(j) << " is no node of the source";
-        EXPECT_LE(error_of(cooked, source[j], j), tol)
-            << "clip '" << clip.name() << "' t=" << t << "s joint " << sk.joint_name(j) << " (max_error " << max_error
-            << ")";
+        EXPECT_LE(error_of(cooked, source[j], j), tol) << "clip '" << clip.name() << "' t=" << t << "s joint "
+                                                       << sk.joint_name(j) << " (max_error " << max_error << ")";
       }
       // Negative control: a pose one frame off must fail the same comparison wherever the clip
       // moves more than twice the tolerance in that frame; otherwise the bound could not catch a
@@ -646,7 +651,8 @@ TEST(TinyValues, EveryRuntimeFloatBelowTheBoundIsFlushedAndNothingElse) {
   for (float* v : high) before.push_back(*v);
   EXPECT_EQ(ossa::cook::flush_tiny_values(scene), low.size());
   for (float* v : low) EXPECT_TRUE(*v == 0.0f && !std::signbit(*v)) << *v;
-  for (size_t i = 0; i < high.size(); ++i) EXPECT_EQ(std::bit_cast<uint32_t>(*high[i]), std::bit_cast<uint32_t>(before[i]));
+  for (size_t i = 0; i < high.size(); ++i)
+    EXPECT_EQ(std::bit_cast<uint32_t>(*high[i]), std::bit_cast<uint32_t>(before[i]));
   EXPECT_EQ(ossa::cook::flush_tiny_values(scene), 0u);  // nothing left to flush
 }
 

@@ -185,8 +185,8 @@ std::vector<std::vector<Trs>> cooked_poses(const CompressedClip& c, const Source
 std::vector<glm::dmat4> model_space(const std::vector<Trs>& pose, const SourceSkeleton& sk) {
   std::vector<glm::dmat4> m(pose.size());
   for (size_t j = 0; j < pose.size(); ++j) {
-    const glm::dmat4 local = glm::translate(glm::dmat4(1.0), pose[j].t) * glm::mat4_cast(pose[j].r) *
-                             glm::scale(glm::dmat4(1.0), pose[j].s);
+    const glm::dmat4 local =
+        glm::translate(glm::dmat4(1.0), pose[j].t) * glm::mat4_cast(pose[j].r) * glm::scale(glm::dmat4(1.0), pose[j].s);
     m[j] = sk.joints[j].parent < 0 ? local : m[static_cast<size_t>(sk.joints[j].parent)] * local;
   }
   return m;
@@ -515,7 +515,8 @@ TEST(ClipCompress, BindAndConstantChannelsAreStoredAsSuch) {
   const auto unit = [](uint32_t) { return glm::vec3(1.0f); };
   std::vector<SourceTrack> tracks;
   // Joint 0: keyed, but every key is the bind pose: nothing stored.
-  tracks.push_back(keyed(0, frames, [](uint32_t) { return glm::vec3(0.0f); }, identity, unit));
+  tracks.push_back(keyed(
+      0, frames, [](uint32_t) { return glm::vec3(0.0f); }, identity, unit));
   // Joint 1: translation held away from bind (constant), rotation swinging (animated), scale bind.
   tracks.push_back(keyed(
       1, frames, [](uint32_t) { return glm::vec3(0.5f, 1.0f, 0.0f); },
@@ -776,7 +777,8 @@ TEST(ClipCompress, ProbePointsSitAtTheProbeDistanceWhateverTheArmatureScale) {
     const SourceSkeleton& sk = rig == 0 ? plain : scaled;
     const float bone = rig == 0 ? 1.0f : 0.01f;
     const auto held = [bone](uint32_t) { return glm::vec3(0.0f, bone, 0.0f); };
-    std::vector<SourceTrack> tracks{keyed(1, frames, held, swing(0.0f), unit), keyed(2, frames, held, swing(1.0f), unit)};
+    std::vector<SourceTrack> tracks{keyed(1, frames, held, swing(0.0f), unit),
+                                    keyed(2, frames, held, swing(1.0f), unit)};
     const SourceClip clip = clip_of("Swing", frames, tracks);
     auto c = compress_clip(clip, sk, 1.0f, {});
     ASSERT_TRUE(c.ok()) << c.error().message;
@@ -938,7 +940,8 @@ TEST(ClipCompressAllAssets, EveryClipCooksAndPlaysWithinTheDefaultTolerance) {
     const fs::path exact = scratch.path() / (std::to_string(i) + "-exact.ossa");
     const std::string label = fs::relative(sources[i], assets).string();
     const CookRecord record = cook_file(sources[i], out, CookOptions{});
-    clips += expect_clips_within_default_tolerance(record, cook_file(sources[i], exact, lossless), out, exact, {}, label);
+    clips +=
+        expect_clips_within_default_tolerance(record, cook_file(sources[i], exact, lossless), out, exact, {}, label);
   }
 
   // Pab's clip files against Pab's cooked rig, as `ossa-cook --skeleton skeleton.ossa` cooks them
@@ -960,8 +963,9 @@ TEST(ClipCompressAllAssets, EveryClipCooksAndPlaysWithinTheDefaultTolerance) {
       const fs::path out = scratch.path() / ("pab-" + source.stem().string() + ".ossa");
       const fs::path exact = scratch.path() / ("pab-" + source.stem().string() + "-exact.ossa");
       const CookRecord record = cook_file(source, out, options);
-      clips += expect_clips_within_default_tolerance(record, cook_file(source, exact, exact_options), out, exact,
-                                                     rig_file, "Pab/" + source.filename().string() + " against skeleton.ossa");
+      clips +=
+          expect_clips_within_default_tolerance(record, cook_file(source, exact, exact_options), out, exact, rig_file,
+                                                "Pab/" + source.filename().string() + " against skeleton.ossa");
     }
   }
   EXPECT_GT(clips, 0u);

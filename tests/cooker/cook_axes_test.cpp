@@ -76,9 +76,11 @@ std::string wall_dae(const std::string& up_axis, int up) {
   }
   return R"(<?xml version="1.0" encoding="utf-8"?>
 <COLLADA xmlns="http://www.collada.org/2005/11/COLLADASchema" version="1.4.1">
-  <asset><unit name="meter" meter="1"/><up_axis>)" + up_axis + R"(</up_axis></asset>
+  <asset><unit name="meter" meter="1"/><up_axis>)" +
+         up_axis + R"(</up_axis></asset>
   <library_geometries><geometry id="g" name="wall"><mesh>
-    <source id="p"><float_array id="pa" count="12">)" + pos + R"(</float_array>
+    <source id="p"><float_array id="pa" count="12">)" +
+         pos + R"(</float_array>
       <technique_common><accessor source="#pa" count="4" stride="3">
         <param name="X" type="float"/><param name="Y" type="float"/><param name="Z" type="float"/>
       </accessor></technique_common></source>
@@ -106,8 +108,7 @@ std::string chain_fbx(int up) {
   for (int i = 0; i < 3; ++i)
     text += "\tModel: " + std::to_string(1000 + i) + ", \"Model::" + names[i] + "\", \"LimbNode\" {\n" +
             "\t\tVersion: 232\n\t\tProperties70:  {\n" +
-            "\t\t\tP: \"Lcl Translation\", \"Lcl Translation\", \"\", \"A\"," + t(i == 0 ? 0.5f : 1) +
-            "\n\t\t}\n\t}\n";
+            "\t\t\tP: \"Lcl Translation\", \"Lcl Translation\", \"\", \"A\"," + t(i == 0 ? 0.5f : 1) + "\n\t\t}\n\t}\n";
   return text + "}\nConnections:  {\n\tC: \"OO\",1000,0\n\tC: \"OO\",1001,1000\n\tC: \"OO\",1002,1001\n}\n";
 }
 

@@ -54,7 +54,7 @@ void write_cape_gltf(const fs::path& file, bool painted) {
                                      static_cast<uint16_t>(v + kColumns + 1)});
     }
   // Inverse bind of Hips (origin) and Spine (y = 1), column-major.
-  const std::vector<float> inverse_bind = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1,
+  const std::vector<float> inverse_bind = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0,  0, 1,
                                            1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, -1, 0, 1};
   std::string bin;
   nlohmann::json views = nlohmann::json::array(), accessors = nlohmann::json::array();
@@ -86,8 +86,10 @@ void write_cape_gltf(const fs::path& file, bool painted) {
       {"asset", {{"version", "2.0"}}},
       {"scene", 0},
       {"scenes", {{{"nodes", {0, 2}}}}},
-      {"nodes", {{{"name", "Hips"}, {"children", {1}}}, {{"name", "Spine"}, {"translation", {0, 1, 0}}},
-                 {{"name", "Cape"}, {"mesh", 0}, {"skin", 0}}}},
+      {"nodes",
+       {{{"name", "Hips"}, {"children", {1}}},
+        {{"name", "Spine"}, {"translation", {0, 1, 0}}},
+        {{"name", "Cape"}, {"mesh", 0}, {"skin", 0}}}},
       {"skins", {{{"joints", {0, 1}}, {"inverseBindMatrices", ibm}}}},
       {"meshes", {{{"name", "Cape"}, {"primitives", {{{"attributes", attributes}, {"indices", idx}}}}}}},
       {"buffers", {{{"uri", bin_file.filename().string()}, {"byteLength", bin.size()}}}},
@@ -286,8 +288,9 @@ SampleRun play_caped(const ossa::Asset& asset, const ossa::ClipView& clip, float
     in.dt = f == 0 ? 0.0f : 1.0f / hz;
     EXPECT_TRUE(ossa::update_cloth(*cloth, in).ok());
     for (const ossa::fb::ClothTether& th : source.tethers)
-      run.worst_tether = std::max(run.worst_tether, glm::distance(cloth->positions()[th.particle()],
-                                                                  cloth->positions()[th.anchor()]) / th.length());
+      run.worst_tether =
+          std::max(run.worst_tether,
+                   glm::distance(cloth->positions()[th.particle()], cloth->positions()[th.anchor()]) / th.length());
     for (size_t i = 0; i < pos.size(); ++i) {
       const glm::vec3 p = cloth->positions()[i];
       run.finite = run.finite && std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
@@ -344,17 +347,18 @@ TEST(CookCloth, CapedManSampleWalks) {
 
 /// The run and sudden turn on the sample: Pab's run cooked onto CapedMan's rig
 /// (--retarget-to; --root-motion takes the hips' travel out of the clip, as a game moving the
-/// character itself would, so the loop does not snap the body back a metre), played while the character runs at 3.5 m/s and turns a quarter left in 0.3 s;
-/// at 30, 60, 144 and 240 Hz the cape swings, never enters a collider, and its tethers hold.
+/// character itself would, so the loop does not snap the body back a metre), played while the character runs at 3.5 m/s
+/// and turns a quarter left in 0.3 s; at 30, 60, 144 and 240 Hz the cape swings, never enters a collider, and its
+/// tethers hold.
 TEST(CookCloth, CapedManSampleRunsAndTurns) {
   const fs::path root = ossa::test::source_dir();
   const fs::path dir = ossa::test::make_temp_dir("cloth-run");
   const std::string cook = (ossa::test::bin_dir() / "ossa-cook").string();
   const auto caped = run_command(cook + " " + q(root / "assets" / "CapedMan" / "CapedMan.glb") + " -o " + q(dir));
   ASSERT_EQ(caped.exit_code, 0) << caped.err;
-  const auto run = run_command(cook + " " + q(root / "assets" / "Pab" / "run.fbx") + " --retarget-to " +
-                               q(dir / "CapedMan.ossa") + " --map " +
-                               q(root / "assets" / "CesiumMan" / "CesiumMan.humanoid.json") + " --root-motion -o " + q(dir));
+  const auto run = run_command(
+      cook + " " + q(root / "assets" / "Pab" / "run.fbx") + " --retarget-to " + q(dir / "CapedMan.ossa") + " --map " +
+      q(root / "assets" / "CesiumMan" / "CesiumMan.humanoid.json") + " --root-motion -o " + q(dir));
   ASSERT_EQ(run.exit_code, 0) << run.err;
   auto asset = ossa::Asset::open((dir / "CapedMan.ossa").string());
   ASSERT_TRUE(asset.ok()) << asset.error().message;

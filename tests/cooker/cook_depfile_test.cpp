@@ -194,10 +194,8 @@ int build_with(const std::string& tool, const NameClass& c, Where where, const f
   // File times come from the kernel's coarse clock (a tick of 1-4 ms): a change made within the
   // tick of the output's write would look no newer to either tool.
   std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  if (where == Where::kTexture)
-    EXPECT_TRUE(ossa::test::write_file(named, ossa::test::tiny_png_with_text("changed")));
-  else
-    EXPECT_TRUE(ossa::test::write_file(src, kObj + "v 0 0 1\n"));
+  if (where == Where::kTexture) EXPECT_TRUE(ossa::test::write_file(named, ossa::test::tiny_png_with_text("changed")));
+  else EXPECT_TRUE(ossa::test::write_file(src, kObj + "v 0 0 1\n"));
   const auto changed = run_command(run);
   wrong += count_of(changed.out, "COOKING") != 1;
   EXPECT_EQ(count_of(changed.out, "COOKING"), 1) << what << ": the named file changed: " << changed.out;

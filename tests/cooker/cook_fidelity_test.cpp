@@ -58,7 +58,8 @@ const char* kRigDae = R"(<?xml version="1.0" encoding="utf-8"?>
 
 /// An ASCII FBX rig: LimbNodes Hips > "" > "", the two below Hips without names (some exporters
 /// write "Model::" and Assimp keeps the empty name).
-const std::string kUnnamedFbx = ossa::test::fbx_ascii_head("\t\tP: \"UnitScaleFactor\", \"double\", \"Number\", \"\",1\n") + R"(Objects:  {
+const std::string kUnnamedFbx =
+    ossa::test::fbx_ascii_head("\t\tP: \"UnitScaleFactor\", \"double\", \"Number\", \"\",1\n") + R"(Objects:  {
 	Model: 1000, "Model::Hips", "LimbNode" {
 		Version: 232
 		Properties70:  {
@@ -175,8 +176,9 @@ TEST(CookFidelity, UnnamedJointsGetStableNamesByIndex) {
 
 TEST(CookFidelity, PointAndLineOnlyMeshesAreSaidToBeSo) {
   const fs::path dir = ossa::test::make_temp_dir("fidelity-lines");
-  for (const auto& [file, text] : {std::pair<std::string, std::string>{"lines.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nl 1 2\nl 2 3\n"},
-                                   {"points.obj", "v 0 0 0\nv 1 0 0\np 1\np 2\n"}}) {
+  for (const auto& [file, text] :
+       {std::pair<std::string, std::string>{"lines.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nl 1 2\nl 2 3\n"},
+        {"points.obj", "v 0 0 0\nv 1 0 0\np 1\np 2\n"}}) {
     const Cooked c = cook(dir, file, text);
     EXPECT_EQ(c.run.exit_code, 1) << file;
     EXPECT_TRUE(contains(c.run.err, file + ": its 1 mesh holds only points or lines")) << c.run.err;
@@ -226,10 +228,10 @@ TEST(CookFidelity, GenericNamesAreRecognisedAndMeaningfulOnesKept) {
     std::string source_name, file_stem, expected;
   };
   const std::vector<Case> cases = {
-      {"mixamo.com", "a1", "a1"},           {"Armature|mixamo.com", "a2", "a2"}, {"Take 001", "a3", "a3"},
-      {"Unreal Take", "a4", "a4"},          {"Armature|Action.001", "a5", "a5"}, {"Bone", "a6", "a6"},
-      {"Wave", "k1", "Wave"},               {"Armature|Wave", "k2", "Armature|Wave"},
-      {"Takeoff", "k3", "Takeoff"},         {"animal", "k4", "animal"}};
+      {"mixamo.com", "a1", "a1"},  {"Armature|mixamo.com", "a2", "a2"},      {"Take 001", "a3", "a3"},
+      {"Unreal Take", "a4", "a4"}, {"Armature|Action.001", "a5", "a5"},      {"Bone", "a6", "a6"},
+      {"Wave", "k1", "Wave"},      {"Armature|Wave", "k2", "Armature|Wave"}, {"Takeoff", "k3", "Takeoff"},
+      {"animal", "k4", "animal"}};
   for (const auto& [name, stem, expected] : cases) {
     doc["animations"][0]["name"] = name;
     const std::string body = doc.dump();
@@ -267,7 +269,8 @@ std::vector<uint8_t> tiny_tga() {
 
 /// An OBJ quad whose material names its diffuse map as `map`.
 void write_obj_with_texture(const fs::path& dir, const std::string& stem, const std::string& map) {
-  const std::string obj = "mtllib " + stem + ".mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
+  const std::string obj = "mtllib " + stem +
+                          ".mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
                           "vn 0 0 1\nusemtl skin\nf 1/1/1 2/2/1 3/3/1\nf 1/1/1 3/3/1 4/4/1\n";
   const std::string mtl = "newmtl skin\nKd 1 1 1\nmap_Kd " + map + "\n";
   ASSERT_TRUE(ossa::test::write_file(dir / (stem + ".obj"), obj));
@@ -285,7 +288,8 @@ TEST(CookFidelity, AbsoluteWindowsTexturePathIsFoundByNameAndTgaEmbeddedAsPng) {
   ASSERT_TRUE(ossa::test::write_file(dir / "skin.tga", tiny_tga()));
   write_obj_with_texture(dir, "quad", "C:\\Users\\artist\\textures\\skin.tga");
   // Kept as source bytes, so the conversion to PNG shows; the default cook is checked below.
-  const auto r = run_command(cook_cmd() + " " + q(dir / "quad.obj") + " -o " + q(dir / "out") + " -v --texture-format source");
+  const auto r =
+      run_command(cook_cmd() + " " + q(dir / "quad.obj") + " -o " + q(dir / "out") + " -v --texture-format source");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(count_of(r.err, "is absolute, looked up as 'skin.tga' next to the source"), 1u) << r.err;
   EXPECT_EQ(count_of(r.err, "is a TGA image, embedded as PNG"), 1u) << r.err;
@@ -368,7 +372,8 @@ TEST(CookFidelity, AClipInOtherUnitsIsConvertedIntoTheRigsUnits) {
   EXPECT_FLOAT_EQ(cooked->file().metres_per_unit(), 1.0f) << "the clip file states the rig's unit";
 
   // The same through a per-asset setting, which also enters the cook key.
-  ASSERT_TRUE(ossa::test::write_file(dir / "cm" / "take.cook.json", std::string(R"({"ossa_cook": 1, "metres_per_unit": 0.01})")));
+  ASSERT_TRUE(ossa::test::write_file(dir / "cm" / "take.cook.json",
+                                     std::string(R"({"ossa_cook": 1, "metres_per_unit": 0.01})")));
   r = run_command(cook_cmd() + " " + q(dir / "cm" / "take.bvh") + " --skeleton " + q(dir / "out" / "actor.ossa") +
                   " -o " + q(dir / "set") + " -v");
   ASSERT_EQ(r.exit_code, 0) << r.err;
@@ -454,10 +459,11 @@ TEST(CookFidelity, TheBindPoseIsThePoseTheSkinWasBoundInNotTheNodePose) {
 /// A BVH capture of `frames` frames at 120 fps: the root walks along x (1 cm a frame) and the
 /// spine sways (frame-dependent z rotation), so every frame is a distinct key.
 std::string long_bvh(uint32_t frames) {
-  std::string text = "HIERARCHY\nROOT Hips\n{\n  OFFSET 0 0 0\n  CHANNELS 6 Xposition Yposition Zposition Zrotation "
-                     "Xrotation Yrotation\n  JOINT Spine\n  {\n    OFFSET 0 10 0\n    CHANNELS 3 Zrotation Xrotation "
-                     "Yrotation\n    End Site\n    {\n      OFFSET 0 10 0\n    }\n  }\n}\nMOTION\nFrames: " +
-                     std::to_string(frames) + "\nFrame Time: 0.0083333333\n";
+  std::string text =
+      "HIERARCHY\nROOT Hips\n{\n  OFFSET 0 0 0\n  CHANNELS 6 Xposition Yposition Zposition Zrotation "
+      "Xrotation Yrotation\n  JOINT Spine\n  {\n    OFFSET 0 10 0\n    CHANNELS 3 Zrotation Xrotation "
+      "Yrotation\n    End Site\n    {\n      OFFSET 0 10 0\n    }\n  }\n}\nMOTION\nFrames: " +
+      std::to_string(frames) + "\nFrame Time: 0.0083333333\n";
   char line[128];
   for (uint32_t f = 0; f < frames; ++f) {
     std::snprintf(line, sizeof line, "%.2f 90 0 0 0 0 %.3f 0 0\n", 0.01 * f, 20.0 * std::sin(0.01 * f));
@@ -472,8 +478,9 @@ TEST(CookFidelity, ALongCaptureIsCookedInConsecutiveClipsNotRefused) {
   constexpr uint32_t kFrames = 100000;
   const Cooked c = cook(dir, "session.bvh", long_bvh(kFrames));
   ASSERT_EQ(c.run.exit_code, 0) << c.run.err.substr(0, 2000);
-  EXPECT_TRUE(contains(c.run.err, "clip 'session' has 100000 frames at 120 frames/s, more than the 65536 one clip holds: "
-                                  "cooked as 2 consecutive clips 'session.part1' (0.000-546.125 s), 'session.part2'"))
+  EXPECT_TRUE(contains(c.run.err,
+                       "clip 'session' has 100000 frames at 120 frames/s, more than the 65536 one clip holds: "
+                       "cooked as 2 consecutive clips 'session.part1' (0.000-546.125 s), 'session.part2'"))
       << c.run.err.substr(0, 2000);
   auto a = open_cooked(c, "session.ossa");
   ASSERT_TRUE(a);
@@ -526,9 +533,10 @@ std::vector<ColouredVertex> coloured_vertices(const ossa::MeshView& mesh) {
     if (pos->format() == fb::VertexFormat::Unorm16x4) {
       uint16_t q[3];
       std::memcpy(q, p + pos->offset(), sizeof q);
-      cv.position = glm::vec3(o->x(), o->y(), o->z()) +
-                    glm::vec3(sc->x(), sc->y(), sc->z()) *
-                        glm::vec3(ossa::unorm16_to_float(q[0]), ossa::unorm16_to_float(q[1]), ossa::unorm16_to_float(q[2]));
+      cv.position =
+          glm::vec3(o->x(), o->y(), o->z()) +
+          glm::vec3(sc->x(), sc->y(), sc->z()) *
+              glm::vec3(ossa::unorm16_to_float(q[0]), ossa::unorm16_to_float(q[1]), ossa::unorm16_to_float(q[2]));
     } else {
       std::memcpy(&cv.position, p + pos->offset(), sizeof cv.position);
     }
@@ -564,7 +572,8 @@ void write_coloured_gltf(const fs::path& dir, const std::string& stem, bool byte
   if (bytes) {
     const uint8_t c[12] = {255, 0, 0, 255, 0, 255, 0, 255, 0, 0, 255, 128};
     bin.append(reinterpret_cast<const char*>(c), sizeof c);
-    colour_accessor = {{"bufferView", 1}, {"componentType", 5121}, {"normalized", true}, {"count", 3}, {"type", "VEC4"}};
+    colour_accessor = {
+        {"bufferView", 1}, {"componentType", 5121}, {"normalized", true}, {"count", 3}, {"type", "VEC4"}};
   } else {
     const float c[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
     bin.append(reinterpret_cast<const char*>(c), sizeof c);
@@ -580,7 +589,12 @@ void write_coloured_gltf(const fs::path& dir, const std::string& stem, bool byte
       {"bufferViews",
        {{{"buffer", 0}, {"byteLength", 36}}, {{"buffer", 0}, {"byteOffset", 36}, {"byteLength", bin.size() - 36}}}},
       {"accessors",
-       {{{"bufferView", 0}, {"componentType", 5126}, {"count", 3}, {"type", "VEC3"}, {"min", {0, 0, 0}}, {"max", {1, 1, 0}}},
+       {{{"bufferView", 0},
+         {"componentType", 5126},
+         {"count", 3},
+         {"type", "VEC3"},
+         {"min", {0, 0, 0}},
+         {"max", {1, 1, 0}}},
         colour_accessor}}};
   ASSERT_TRUE(ossa::test::write_file(dir / (stem + ".bin"), bin));
   ASSERT_TRUE(ossa::test::write_file(dir / (stem + ".gltf"), j.dump()));
@@ -625,9 +639,12 @@ TEST(CookFidelity, ObjVertexColoursAreCarriedClampedOrLeftOutWhenWhite) {
   const fs::path dir = ossa::test::make_temp_dir("fidelity-colour-obj");
   const std::string faces = "f 1 2 3\nf 1 3 4\n";
   // Colours past 1 (an HDR export) are clamped with a warning that names the mesh.
-  ASSERT_TRUE(ossa::test::write_file(dir / "painted.obj", "v 0 0 0 1 0 0\nv 1 0 0 0 1 0\nv 1 1 0 0 0 1\nv 0 1 0 2 0.5 -1\n" + faces));
-  ASSERT_TRUE(ossa::test::write_file(dir / "white.obj", "v 0 0 0 1 1 1\nv 1 0 0 1 1 1\nv 1 1 0 1 1 1\nv 0 1 0 1 1 1\n" + faces));
-  const auto r = run_command(cook_cmd() + " " + q(dir / "painted.obj") + " " + q(dir / "white.obj") + " -o " + q(dir / "out") + " -v");
+  ASSERT_TRUE(ossa::test::write_file(dir / "painted.obj",
+                                     "v 0 0 0 1 0 0\nv 1 0 0 0 1 0\nv 1 1 0 0 0 1\nv 0 1 0 2 0.5 -1\n" + faces));
+  ASSERT_TRUE(ossa::test::write_file(dir / "white.obj",
+                                     "v 0 0 0 1 1 1\nv 1 0 0 1 1 1\nv 1 1 0 1 1 1\nv 0 1 0 1 1 1\n" + faces));
+  const auto r = run_command(cook_cmd() + " " + q(dir / "painted.obj") + " " + q(dir / "white.obj") + " -o " +
+                             q(dir / "out") + " -v");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_TRUE(contains(r.err, "1 vertex colours outside [0, 1] were clamped")) << r.err;
   auto painted = ossa::Asset::open((dir / "out" / "painted.ossa").string());
@@ -635,8 +652,7 @@ TEST(CookFidelity, ObjVertexColoursAreCarriedClampedOrLeftOutWhenWhite) {
   ASSERT_TRUE(painted.ok() && white.ok());
   const auto v = coloured_vertices(painted->mesh(0));
   EXPECT_EQ(colour_at(v, {1, 1, 0}), glm::vec4(0, 0, 1, 1));
-  EXPECT_EQ(colour_at(v, {0, 1, 0}), glm::vec4(1, 128.0f / 255.0f, 0, 1))
-      << "2 -> 1, 0.5 -> 128 / 255, -1 -> 0";
+  EXPECT_EQ(colour_at(v, {0, 1, 0}), glm::vec4(1, 128.0f / 255.0f, 0, 1)) << "2 -> 1, 0.5 -> 128 / 255, -1 -> 0";
   EXPECT_EQ(white->mesh(0).attribute(ossa::fb::VertexSemantic::Color0), nullptr)
       << "all-white colours draw as no colours and cost no bytes";
 }

@@ -54,9 +54,8 @@ std::vector<std::string> files_below(const fs::path& dir) {
 
 template <class T>
 constexpr bool kIsRecord = std::is_same_v<T, ossa::cook::CookRecord> || std::is_same_v<T, ossa::cook::ClipRecord> ||
-                           std::is_same_v<T, ossa::cook::TextureRecord> ||
-                           std::is_same_v<T, ossa::cook::MorphRecord> || std::is_same_v<T, ossa::cook::InputFile> ||
-                           std::is_same_v<T, ossa::cook::RetargetRecord> ||
+                           std::is_same_v<T, ossa::cook::TextureRecord> || std::is_same_v<T, ossa::cook::MorphRecord> ||
+                           std::is_same_v<T, ossa::cook::InputFile> || std::is_same_v<T, ossa::cook::RetargetRecord> ||
                            std::is_same_v<T, ossa::cook::RetargetContactRecord>;
 template <class T>
 struct RecordList : std::false_type {};
@@ -157,8 +156,7 @@ TEST(CookIsolation, BatchAroundFailingWorkersCooksEverythingElseExactly) {
   ASSERT_TRUE(ossa::test::write_file(src / "deep.fbx", deeply_nested_fbx(100000)));
   ASSERT_TRUE(ossa::test::write_file(src / "frames.bvh", bvh_announcing(100000000)));
 
-  const std::string faults =
-      "aborts.glb:abort,crashes.glb:segv,hangs.glb:hang,allocates.glb:alloc,garbles.glb:garble";
+  const std::string faults = "aborts.glb:abort,crashes.glb:segv,hangs.glb:hang,allocates.glb:alloc,garbles.glb:garble";
   // --timeout 20: long enough that no good input reaches it on a loaded machine, short enough that
   // the hang ends soon. No -q: the batch prints a line per input as it ends, in that order.
   const auto r = run_command("OSSA_COOK_TEST_FAULT=" + faults + " " + cook_cmd() + " " + q(src) + " -o " + q(out) +
@@ -209,11 +207,13 @@ TEST(CookIsolation, BatchAroundFailingWorkersCooksEverythingElseExactly) {
     ASSERT_NE(rec, nullptr) << name;
     EXPECT_EQ((*rec)["status"], "ok") << name;
   }
-  const std::vector<std::pair<std::string, std::string>> causes = {
-      {"aborts.glb", "signal 6"},           {"crashes.glb", "signal 11"},
-      {"hangs.glb", "time limit"},          {"allocates.glb", "memory limit"},
-      {"garbles.glb", "unreadable record"}, {"frames.bvh", "memory limit"},
-      {"deep.fbx", "nested over 1000+ levels deep"}};
+  const std::vector<std::pair<std::string, std::string>> causes = {{"aborts.glb", "signal 6"},
+                                                                   {"crashes.glb", "signal 11"},
+                                                                   {"hangs.glb", "time limit"},
+                                                                   {"allocates.glb", "memory limit"},
+                                                                   {"garbles.glb", "unreadable record"},
+                                                                   {"frames.bvh", "memory limit"},
+                                                                   {"deep.fbx", "nested over 1000+ levels deep"}};
   for (const auto& [name, cause] : causes) {
     const nlohmann::json* rec = record_for(report, name);
     ASSERT_NE(rec, nullptr) << name;
@@ -229,9 +229,9 @@ TEST(CookIsolation, BatchAroundFailingWorkersCooksEverythingElseExactly) {
   EXPECT_GE((*hung)["seconds"].get<double>(), 20.0);
   EXPECT_LT((*hung)["seconds"].get<double>(), 60.0);
 
-  const auto check = run_command("/usr/bin/python3 " + q(ossa::test::source_dir() / "tests" / "support" / "json_schema_check.py") +
-                                 " " + q(ossa::test::source_dir() / "docs" / "schemas" / "ossa-cook-report.schema.json") +
-                                 " " + q(report_path));
+  const auto check = run_command(
+      "/usr/bin/python3 " + q(ossa::test::source_dir() / "tests" / "support" / "json_schema_check.py") + " " +
+      q(ossa::test::source_dir() / "docs" / "schemas" / "ossa-cook-report.schema.json") + " " + q(report_path));
   EXPECT_EQ(check.exit_code, 0) << check.out << check.err;
 }
 
@@ -288,8 +288,8 @@ TEST(CookIsolation, JobsOneAndTwoGiveIdenticalBytes) {
 TEST(CookIsolation, LimitOptions) {
   const fs::path dir = ossa::test::make_temp_dir("iso-options");
   const fs::path input = asset("RiggedSimple/RiggedSimple.glb");
-  auto r = run_command(cook_cmd() + " " + q(input) + " -o " + q(dir / "a") + " -q --max-memory 1.5GiB --timeout 0 --report " +
-                       q(dir / "a.json"));
+  auto r = run_command(cook_cmd() + " " + q(input) + " -o " + q(dir / "a") +
+                       " -q --max-memory 1.5GiB --timeout 0 --report " + q(dir / "a.json"));
   ASSERT_EQ(r.exit_code, 0) << r.err;
   nlohmann::json report = read_json(dir / "a.json");
   EXPECT_EQ(report["limits"]["max_memory_bytes"], uint64_t{3} << 29);
@@ -309,11 +309,11 @@ TEST(CookIsolation, LimitOptions) {
     EXPECT_FALSE(fs::exists(dir / "c")) << bad;
   }
   for (const auto& [text, bytes] : std::vector<std::pair<std::string, uint64_t>>{{"512M", 512u << 20},
-                                                                                {"4g", uint64_t{4} << 30},
-                                                                                {"2097152k", uint64_t{2} << 30},
-                                                                                {"3000MB", uint64_t{3000} << 20},
-                                                                                {"1073741824", uint64_t{1} << 30},
-                                                                                {"0", 0}}) {
+                                                                                 {"4g", uint64_t{4} << 30},
+                                                                                 {"2097152k", uint64_t{2} << 30},
+                                                                                 {"3000MB", uint64_t{3000} << 20},
+                                                                                 {"1073741824", uint64_t{1} << 30},
+                                                                                 {"0", 0}}) {
     r = run_command(cook_cmd() + " " + q(input) + " -o " + q(dir / "d") + " -q --max-memory " + text + " --report " +
                     q(dir / "d.json"));
     ASSERT_EQ(r.exit_code, 0) << text << ": " << r.err;
@@ -427,8 +427,8 @@ TEST(CookIsolation, RecordRoundTripsEveryField) {
 
   // Broken: every truncation of the wire bytes, a missing field, a field of another type.
   for (size_t n = 0; n < wire.size(); ++n) {
-    const auto parsed = nlohmann::json::from_cbor(std::vector<uint8_t>(wire.begin(), wire.begin() + static_cast<ptrdiff_t>(n)),
-                                                  true, false);
+    const auto parsed = nlohmann::json::from_cbor(
+        std::vector<uint8_t>(wire.begin(), wire.begin() + static_cast<ptrdiff_t>(n)), true, false);
     EXPECT_TRUE(parsed.is_discarded() || !ossa::cook::record_from_json(parsed)) << "truncated at " << n;
   }
   nlohmann::json missing = ossa::cook::record_to_json(r);

@@ -77,7 +77,8 @@ void read_report(const fs::path& report, const fs::path& out, CookRun& run) {
   run.report = nlohmann::json::parse(*text);
   for (const auto& rec : run.report["records"])
     if (rec.contains("output"))
-      run.up_to_date[fs::relative(rec["output"].get<std::string>(), out).generic_string()] = rec["up_to_date"].get<bool>();
+      run.up_to_date[fs::relative(rec["output"].get<std::string>(), out).generic_string()] =
+          rec["up_to_date"].get<bool>();
 }
 
 /// The three steps of cooking the tree into `out`: the rig, the clip against the cooked rig
@@ -157,7 +158,9 @@ TEST(CookKey, SameTreeElsewhereInAnotherOrderAndJobCountGivesSameBytesAndKeys) {
   const std::string common = " -o " + q(out_b) + " --root " + q(b.root) + " --jobs 2 -q";
   ASSERT_EQ(run_command(cook_cmd() + " " + q(b.root / "pab" / "skeleton.fbx") + common).exit_code, 0);
   ASSERT_EQ(run_command(cook_cmd() + " " + q(b.root / "pab" / "walk.fbx") + " --skeleton " +
-                        q(out_b / "pab" / "skeleton.ossa") + common).exit_code, 0);
+                        q(out_b / "pab" / "skeleton.ossa") + common)
+                .exit_code,
+            0);
   std::string inputs = q(b.root / "chars");
   if (b.has_gltf_bin) inputs = q(b.root / "gltf") + " " + inputs;
   const auto rb = run_command(cook_cmd() + " " + inputs + common);
@@ -229,10 +232,14 @@ TEST(CookKey, ChangingAnyInputRecooksExactlyTheOutputsThatReadIt) {
   // The --skeleton reference's contents (re-cooked with other options, so other bytes): the clip
   // cooked against it is out of date.
   ASSERT_EQ(run_command(cook_cmd() + " " + q(t.root / "pab" / "skeleton.fbx") + " -o " + q(out) + " --root " +
-                        q(t.root) + " -q --float-vertices").exit_code, 0);
+                        q(t.root) + " -q --float-vertices")
+                .exit_code,
+            0);
   const fs::path report = dir / "ref-report.json";
   ASSERT_EQ(run_command(cook_cmd() + " " + q(t.root / "pab" / "walk.fbx") + " -o " + q(out) + " --root " + q(t.root) +
-                        " --skeleton " + q(out / "pab" / "skeleton.ossa") + " --report " + q(report) + " -q").exit_code, 0);
+                        " --skeleton " + q(out / "pab" / "skeleton.ossa") + " --report " + q(report) + " -q")
+                .exit_code,
+            0);
   CookRun ref;
   read_report(report, out, ref);
   EXPECT_EQ(recooked(ref), (Set{"pab/walk.ossa"}));
@@ -256,8 +263,8 @@ TEST(CookKey, DepfileAndListInputsNameEveryFileRead) {
   // --list-inputs: what the cooks read, one absolute path per line, and nothing written.
   const fs::path listed_out = dir / "listed";
   const std::string inputs = q(t.root / "pab" / "walk.fbx") + " --skeleton " + q(out / "pab" / "skeleton.ossa");
-  const auto list = run_command(cook_cmd() + " " + inputs + " -o " + q(listed_out) + " --root " + q(t.root) +
-                                " --list-inputs");
+  const auto list =
+      run_command(cook_cmd() + " " + inputs + " -o " + q(listed_out) + " --root " + q(t.root) + " --list-inputs");
   ASSERT_EQ(list.exit_code, 0) << list.err;
   EXPECT_FALSE(fs::exists(listed_out)) << "--list-inputs writes nothing";
   std::set<std::string> lines;
@@ -274,8 +281,10 @@ TEST(CookKey, DepfileAndListInputsNameEveryFileRead) {
 
   // --depfile: one rule per output naming the same files (absent ones are not prerequisites).
   const fs::path dep = dir / "cook.d";
-  ASSERT_EQ(run_command(cook_cmd() + " " + inputs + " -o " + q(out) + " --root " + q(t.root) + " --depfile " + q(dep) +
-                        " -q").exit_code, 0);
+  ASSERT_EQ(
+      run_command(cook_cmd() + " " + inputs + " -o " + q(out) + " --root " + q(t.root) + " --depfile " + q(dep) + " -q")
+          .exit_code,
+      0);
   auto text = ossa::test::read_text(dep);
   ASSERT_TRUE(text.has_value());
   ASSERT_EQ(text->rfind(canon(out / "pab" / "walk.ossa") + ":", 0), 0u) << *text;
@@ -285,7 +294,9 @@ TEST(CookKey, DepfileAndListInputsNameEveryFileRead) {
   if (!t.has_gltf_bin) GTEST_SKIP() << "../shared/assets not present: no .gltf with an external buffer";
   // A glTF's buffer and texture are prerequisites; its sidecar, looked for and absent, is not.
   ASSERT_EQ(run_command(cook_cmd() + " " + q(t.root / "gltf") + " -o " + q(out) + " --root " + q(t.root) +
-                        " --depfile " + q(dep) + " -q").exit_code, 0);
+                        " --depfile " + q(dep) + " -q")
+                .exit_code,
+            0);
   text = ossa::test::read_text(dep);
   ASSERT_TRUE(text.has_value());
   for (const char* f : {"interpolation_test.gltf", "interpolation_test.bin", "l.jpg"})
@@ -298,8 +309,11 @@ TEST(CookKey, AnInputNamedWithoutAFolderRecordsTheSameRelativeInputs) {
   const Tree t = make_tree(dir / "src");
   const fs::path chars = t.root / "chars";
   ASSERT_EQ(run_command(cook_cmd() + " " + q(chars / "RiggedSimple.glb") + " -o " + q(dir / "a") + " -q").exit_code, 0);
-  ASSERT_EQ(run_command("cd " + q(chars) + " && " + cook_cmd() + " RiggedSimple.glb -o " + q(dir / "b") + " -q").exit_code, 0);
-  const auto a = ossa::test::read_file(dir / "a" / "RiggedSimple.ossa"), b = ossa::test::read_file(dir / "b" / "RiggedSimple.ossa");
+  ASSERT_EQ(
+      run_command("cd " + q(chars) + " && " + cook_cmd() + " RiggedSimple.glb -o " + q(dir / "b") + " -q").exit_code,
+      0);
+  const auto a = ossa::test::read_file(dir / "a" / "RiggedSimple.ossa"),
+             b = ossa::test::read_file(dir / "b" / "RiggedSimple.ossa");
   ASSERT_TRUE(a && b);
   EXPECT_TRUE(*a == *b) << "the same bytes whether the input is named with its folder or from it";
   auto asset = ossa::Asset::open((dir / "b" / "RiggedSimple.ossa").string());

@@ -55,16 +55,16 @@ struct GltfBuilder {
 
 // Six corners of two triangles; 3 repeats 1, 5 repeats 2 (positions, normals, skin all equal).
 const std::vector<glm::vec3> kBase = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
-const std::vector<glm::vec3> kSmile = {{1e-6f, 0, 0}, {0, 0, 0.5f}, {0, 0.25f, 0}, {0, 0, 0}, {0.1f, 0.2f, 0.3f}, {0, 0.25f, 0}};
+const std::vector<glm::vec3> kSmile = {{1e-6f, 0, 0}, {0, 0, 0.5f},       {0, 0.25f, 0},
+                                       {0, 0, 0},     {0.1f, 0.2f, 0.3f}, {0, 0.25f, 0}};
 const std::vector<glm::vec3> kFrown = {{-0.3f, 0, 0}, {0, 0, 0}, {0, 0, 0}, {0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
 const std::vector<glm::vec3> kSmileNormal = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}, {0, 0, 0}, {0.2f, 0, 0}, {0, 0, 0}};
 
 // "talk": CUBICSPLINE at 0, 1, 2 s; per key (in-tangent, value, out-tangent), each 2 weights.
 const std::vector<float> kTalkTimes = {0, 1, 2};
-const std::vector<float> kTalk = {
-    0, 0, /*v*/ 0, -0.5f, /*out*/ 2, 0.5f,     // key 0
-    -1, 0, /*v*/ 1, 0.25f, /*out*/ 0, -1,      // key 1
-    0, 1, /*v*/ 0, -0.5f, /*out*/ 0, 0};       // key 2
+const std::vector<float> kTalk = {0,  0, /*v*/ 0, -0.5f, /*out*/ 2, 0.5f,  // key 0
+                                  -1, 0, /*v*/ 1, 0.25f, /*out*/ 0, -1,    // key 1
+                                  0,  1, /*v*/ 0, -0.5f, /*out*/ 0, 0};    // key 2
 // "blink": LINEAR at 0, 0.5, 1 s.
 const std::vector<float> kBlinkTimes = {0, 0.5f, 1};
 const std::vector<float> kBlink = {0, -0.75f, 1, 0.5f, 0, -0.75f};
@@ -127,7 +127,8 @@ void write_face_gltf(const fs::path& path, float scale = 1.0f) {
        {{{"primitives",
           {{{"attributes", {{"POSITION", a_pos}, {"NORMAL", a_nrm}, {"JOINTS_0", a_joints}, {"WEIGHTS_0", a_weights}}},
             {"indices", a_idx},
-            {"targets", {{{"POSITION", a_smile}, {"NORMAL", a_smile_n}}, {{"POSITION", a_frown}, {"NORMAL", a_frown_n}}}}}}},
+            {"targets",
+             {{{"POSITION", a_smile}, {"NORMAL", a_smile_n}}, {{"POSITION", a_frown}, {"NORMAL", a_frown_n}}}}}}},
          {"weights", {0.5, 0}},
          {"extras", {{"targetNames", {"smile", "frown"}}}}}}},
       {"animations",
@@ -160,9 +161,9 @@ std::vector<glm::vec3> positions_of(const ossa::MeshView& mesh) {
     if (pos->format() == fb::VertexFormat::Unorm16x4) {
       uint16_t qv[3];
       std::memcpy(qv, p, sizeof qv);
-      x = glm::vec3(o->x(), o->y(), o->z()) + glm::vec3(sc->x(), sc->y(), sc->z()) *
-                                                   glm::vec3(ossa::unorm16_to_float(qv[0]), ossa::unorm16_to_float(qv[1]),
-                                                             ossa::unorm16_to_float(qv[2]));
+      x = glm::vec3(o->x(), o->y(), o->z()) +
+          glm::vec3(sc->x(), sc->y(), sc->z()) *
+              glm::vec3(ossa::unorm16_to_float(qv[0]), ossa::unorm16_to_float(qv[1]), ossa::unorm16_to_float(qv[2]));
     } else {
       std::memcpy(&x, p, sizeof x);
     }
@@ -213,7 +214,8 @@ std::vector<glm::vec3> expected_corners(float smile, float frown) {
       return ::testing::AssertionFailure() << "no cooked vertex at (" << e.x << ", " << e.y << ", " << e.z << ")";
   for (const glm::vec3& c : cooked)
     if (!near(c, expected))
-      return ::testing::AssertionFailure() << "cooked vertex (" << c.x << ", " << c.y << ", " << c.z << ") expected nowhere";
+      return ::testing::AssertionFailure()
+             << "cooked vertex (" << c.x << ", " << c.y << ", " << c.z << ") expected nowhere";
   return ::testing::AssertionSuccess();
 }
 
@@ -239,7 +241,8 @@ TEST(CookMorph, TargetsSurviveWeldingAndMorphTheCookedVerticesAsTheSourceDoes) {
     const std::vector<std::string_view> channels = {"smile", "frown"};
     std::vector<int32_t> target_channel(2);
     ASSERT_TRUE(ossa::bind_morph_targets(mesh, channels, target_channel));
-    for (const auto& [smile, frown] : std::vector<std::pair<float, float>>{{0, 0}, {1, 0}, {0, 1}, {1, 1}, {-0.5f, 2}}) {
+    for (const auto& [smile, frown] :
+         std::vector<std::pair<float, float>>{{0, 0}, {1, 0}, {0, 1}, {1, 1}, {-0.5f, 2}}) {
       std::vector<glm::vec3> p = base;
       ASSERT_TRUE(ossa::apply_morphs(mesh, target_channel, std::vector<float>{smile, frown}, p));
       // Base quantization (1 / 65535 of the unit bounds) plus the deltas' bound, per weight.
@@ -318,8 +321,10 @@ TEST(CookMorph, WeightsAtTheSourceKeysEqualTheSourceAndCurvesAreHermite) {
       for (float t : {0.5f, 0.3f, 1.5f, 1.9f}) {
         const size_t k = t < 1.0f ? 0 : 1;
         const float u = t - kTalkTimes[k];
-        const float want_smile = hermite(kTalk[k * 6 + 2], kTalk[k * 6 + 4], kTalk[(k + 1) * 6 + 2], kTalk[(k + 1) * 6 + 0], 1.0f, u);
-        const float want_frown = hermite(kTalk[k * 6 + 3], kTalk[k * 6 + 5], kTalk[(k + 1) * 6 + 3], kTalk[(k + 1) * 6 + 1], 1.0f, u);
+        const float want_smile =
+            hermite(kTalk[k * 6 + 2], kTalk[k * 6 + 4], kTalk[(k + 1) * 6 + 2], kTalk[(k + 1) * 6 + 0], 1.0f, u);
+        const float want_frown =
+            hermite(kTalk[k * 6 + 3], kTalk[k * 6 + 5], kTalk[(k + 1) * 6 + 3], kTalk[(k + 1) * 6 + 1], 1.0f, u);
         EXPECT_NEAR(ossa::sample_morph_track(clip, smile, t), want_smile, tol) << t;
         EXPECT_NEAR(ossa::sample_morph_track(clip, frown, t), want_frown, tol) << t;
       }
@@ -329,7 +334,8 @@ TEST(CookMorph, WeightsAtTheSourceKeysEqualTheSourceAndCurvesAreHermite) {
         const size_t k = t < 0.5f ? 0 : (t < 1.0f ? 1 : 2);
         const float u = k == 2 ? 0.0f : (t - kBlinkTimes[k]) / 0.5f;
         const size_t k1 = std::min<size_t>(k + 1, 2);
-        EXPECT_NEAR(ossa::sample_morph_track(clip, smile, t), kBlink[k * 2] + (kBlink[k1 * 2] - kBlink[k * 2]) * u, tol);
+        EXPECT_NEAR(ossa::sample_morph_track(clip, smile, t), kBlink[k * 2] + (kBlink[k1 * 2] - kBlink[k * 2]) * u,
+                    tol);
         EXPECT_NEAR(ossa::sample_morph_track(clip, frown, t),
                     kBlink[k * 2 + 1] + (kBlink[k1 * 2 + 1] - kBlink[k * 2 + 1]) * u, tol);
       }
@@ -339,8 +345,8 @@ TEST(CookMorph, WeightsAtTheSourceKeysEqualTheSourceAndCurvesAreHermite) {
 
 TEST(CookMorph, InspectReportsEveryTargetAndTrack) {
   const CookedFace c = cook_face("morph-face-inspect");
-  const auto r = run_command((ossa::test::bin_dir() / "ossa-inspect").string() + " --json " +
-                             q(c.dir / "out" / "face.ossa"));
+  const auto r =
+      run_command((ossa::test::bin_dir() / "ossa-inspect").string() + " --json " + q(c.dir / "out" / "face.ossa"));
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const nlohmann::json d = nlohmann::json::parse(r.out);
   const nlohmann::json& targets = d["meshes"][0]["morph_targets"];
@@ -450,10 +456,13 @@ TEST(CookMorph, TheGraphBlendsWeightsLayersOnlyWhatALayerDrivesAndSetsThemFromPa
     return asset->clip(0);
   };
   const ossa::ClipView talk = clip_named("talk"), blink = clip_named("blink");
-  const auto smile_of = [&](const ossa::ClipView& clip, float t) { return ossa::sample_morph_track(clip, clip.morph_track(1), t); };
+  const auto smile_of = [&](const ossa::ClipView& clip, float t) {
+    return ossa::sample_morph_track(clip, clip.morph_track(1), t);
+  };
   // A clip advances only in the updates where it has weight (graph.h): track each one's time.
   float talk_time = 0.0f, blink_time = 0.0f;
-  for (const auto& [m, s, dt] : std::vector<std::tuple<float, float, float>>{{0, 0, 0.25f}, {1, 0, 0.25f}, {0.3f, 0.4f, 0.3f}}) {
+  for (const auto& [m, s, dt] :
+       std::vector<std::tuple<float, float, float>>{{0, 0, 0.25f}, {1, 0, 0.25f}, {0.3f, 0.4f, 0.3f}}) {
     ASSERT_TRUE(inst->set_float(mix, m));
     ASSERT_TRUE(inst->set_float(surprise, s));
     inst->update(dt);

@@ -56,10 +56,8 @@ void swapper(const fs::path& tree, const fs::path& secret_dir, Swap kind, const 
     } else {
       ossa::test::write_file(tmp_file, std::string_view("INSIDE-BYTES"));
       std::rename(tmp_file.c_str(), (tree / "t.bin").c_str());
-      if (kind == Swap::kFileSymlink)
-        ::symlink((secret_dir / "t.bin").c_str(), tmp_link.c_str());
-      else
-        ::link((secret_dir / "t.bin").c_str(), tmp_link.c_str());
+      if (kind == Swap::kFileSymlink) ::symlink((secret_dir / "t.bin").c_str(), tmp_link.c_str());
+      else ::link((secret_dir / "t.bin").c_str(), tmp_link.c_str());
       std::rename(tmp_link.c_str(), (tree / "t.bin").c_str());
     }
     swaps.fetch_add(1, std::memory_order_relaxed);
@@ -93,10 +91,8 @@ RaceCounts race(const fs::path& dir, Swap kind, size_t min_tries) {
         continue;
       }
       const std::string text(bytes->begin(), bytes->end());
-      if (text == "INSIDE-BYTES")
-        ++counts.inside;
-      else
-        ++counts.leaked;
+      if (text == "INSIDE-BYTES") ++counts.inside;
+      else ++counts.leaked;
     }
   }
   stop = true;

@@ -30,17 +30,21 @@ std::string q(const fs::path& p) { return "'" + p.string() + "'"; }
 /// A minimal glTF: one triangle whose positions come from buffer `uri` (36 bytes of floats), with
 /// a material whose base-colour image is `image_uri` (none when empty).
 std::string triangle_gltf(const std::string& uri, const std::string& image_uri = "") {
-  nlohmann::json j = {
-      {"asset", {{"version", "2.0"}}},
-      {"scene", 0},
-      {"scenes", {{{"nodes", {0}}}}},
-      {"nodes", {{{"mesh", 0}}}},
-      {"meshes", {{{"primitives", {{{"attributes", {{"POSITION", 0}}}, {"material", 0}}}}}}},
-      {"materials", {nlohmann::json::object()}},
-      {"buffers", {{{"uri", uri}, {"byteLength", 36}}}},
-      {"bufferViews", {{{"buffer", 0}, {"byteLength", 36}}}},
-      {"accessors", {{{"bufferView", 0}, {"componentType", 5126}, {"count", 3}, {"type", "VEC3"},
-                      {"min", {0, 0, 0}}, {"max", {1, 1, 0}}}}}};
+  nlohmann::json j = {{"asset", {{"version", "2.0"}}},
+                      {"scene", 0},
+                      {"scenes", {{{"nodes", {0}}}}},
+                      {"nodes", {{{"mesh", 0}}}},
+                      {"meshes", {{{"primitives", {{{"attributes", {{"POSITION", 0}}}, {"material", 0}}}}}}},
+                      {"materials", {nlohmann::json::object()}},
+                      {"buffers", {{{"uri", uri}, {"byteLength", 36}}}},
+                      {"bufferViews", {{{"buffer", 0}, {"byteLength", 36}}}},
+                      {"accessors",
+                       {{{"bufferView", 0},
+                         {"componentType", 5126},
+                         {"count", 3},
+                         {"type", "VEC3"},
+                         {"min", {0, 0, 0}},
+                         {"max", {1, 1, 0}}}}}};
   if (!image_uri.empty()) {
     j["images"] = {{{"uri", image_uri}}};
     j["textures"] = {{{"source", 0}}};
@@ -84,7 +88,8 @@ TEST_F(CookSandbox, BufferUriClimbingOutIsRefusedByName) {
   const auto r = cook(tree / "chars" / "evil.gltf", "--report " + q(dir / "report.json"));
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find((secret / "creds.bin").string() + ": refused: outside the folders this cook may read"),
-            std::string::npos) << r.err;
+            std::string::npos)
+      << r.err;
   EXPECT_NE(r.err.find("evil.gltf"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir / "out" / "evil.ossa"));
   // With the secret's folder allowed, the same file cooks: the refusal was the sandbox's doing.
@@ -107,7 +112,8 @@ TEST_F(CookSandbox, SymlinksOutOfTheTreeAreResolvedAndRefused) {
   const auto r = cook(tree / "chars" / "sym.gltf");
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find((secret / "creds.bin").string() + ": refused: outside the folders this cook may read"),
-            std::string::npos) << r.err;
+            std::string::npos)
+      << r.err;
   EXPECT_NE(r.err.find("link.bin'"), std::string::npos) << "names the link as written: " << r.err;
 }
 
@@ -143,8 +149,8 @@ TEST_F(CookSandbox, AnOutsideRefusalNamesTheRootOrAllowDirThatAllowsIt) {
     ASSERT_TRUE(ossa::test::write_file(l.input, triangle_gltf(uri)));
     const auto r = cook(l.input);
     EXPECT_EQ(r.exit_code, 1) << l.input;
-    const std::string proposal = "--root " + l.root.string() + " or --allow-dir " + l.buffer.parent_path().string() +
-                                 " would allow it";
+    const std::string proposal =
+        "--root " + l.root.string() + " or --allow-dir " + l.buffer.parent_path().string() + " would allow it";
     EXPECT_NE(r.err.find(proposal), std::string::npos) << "expected '" << proposal << "' in: " << r.err;
     fs::remove_all(dir / "out");
     const auto rooted = cook(l.input, "--root " + q(l.root));
@@ -174,11 +180,12 @@ TEST_F(CookSandbox, FifosAndDevicesAreRefusedWithoutBeingOpened) {
   // A FIFO as the input itself, and a FIFO as a buffer; /dev/zero as an allowed folder's file.
   // Opening a FIFO would wait for a writer and reading /dev/zero never ends: either would end in
   // the time limit (or the memory limit) instead of the refusals below.
-  const auto r = run_command(cook_cmd() + " " + q(tree / "chars" / "pipe.gltf") + " " + q(tree / "chars" / "fifo.gltf") +
-                             " /dev/zero -o " + q(dir / "out") + " --timeout 120");
+  const auto r = run_command(cook_cmd() + " " + q(tree / "chars" / "pipe.gltf") + " " +
+                             q(tree / "chars" / "fifo.gltf") + " /dev/zero -o " + q(dir / "out") + " --timeout 120");
   EXPECT_EQ(r.exit_code, 1);
-  EXPECT_EQ(r.err.find("exceeded the"), std::string::npos) << "something waited for a writer or read an endless device:\n"
-                                                             << r.err;
+  EXPECT_EQ(r.err.find("exceeded the"), std::string::npos)
+      << "something waited for a writer or read an endless device:\n"
+      << r.err;
   EXPECT_NE(r.err.find("pipe.gltf: refused: is a FIFO, not a regular file"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("pipe.bin: refused: is a FIFO, not a regular file"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("/dev/zero: refused: is a device, not a regular file"), std::string::npos) << r.err;
@@ -312,17 +319,20 @@ TEST_F(CookSandbox, HugeSourceValuesAreNamedAtImport) {
       {"nodes", {{{"name", "hips"}}}},
       {"buffers", {{{"uri", "anim.bin"}, {"byteLength", 32}}}},
       {"bufferViews", {{{"buffer", 0}, {"byteLength", 8}}, {{"buffer", 0}, {"byteOffset", 8}, {"byteLength", 24}}}},
-      {"accessors", {{{"bufferView", 0}, {"componentType", 5126}, {"count", 2}, {"type", "SCALAR"}, {"min", {0}}, {"max", {1}}},
-                     {{"bufferView", 1}, {"componentType", 5126}, {"count", 2}, {"type", "VEC3"}}}},
-      {"animations", {{{"name", "move"},
-                       {"samplers", {{{"input", 0}, {"output", 1}}}},
-                       {"channels", {{{"sampler", 0}, {"target", {{"node", 0}, {"path", "translation"}}}}}}}}}};
+      {"accessors",
+       {{{"bufferView", 0}, {"componentType", 5126}, {"count", 2}, {"type", "SCALAR"}, {"min", {0}}, {"max", {1}}},
+        {{"bufferView", 1}, {"componentType", 5126}, {"count", 2}, {"type", "VEC3"}}}},
+      {"animations",
+       {{{"name", "move"},
+         {"samplers", {{{"input", 0}, {"output", 1}}}},
+         {"channels", {{{"sampler", 0}, {"target", {{"node", 0}, {"path", "translation"}}}}}}}}}};
   ASSERT_TRUE(ossa::test::write_file(tree / "chars" / "huge.gltf", j.dump()));
   const auto r = cook(tree / "chars" / "huge.gltf");
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_EQ(r.err.find("internal error"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("clip 'move', joint 'hips': translation key 0 (at 0 s) (1e+20, 0, 0) is unusable"),
-            std::string::npos) << r.err;
+            std::string::npos)
+      << r.err;
 }
 
 // What Assimp cannot take is handled before it reads the bytes (cooker/import/source_precheck.h).
@@ -334,10 +344,12 @@ TEST_F(CookSandbox, DeepHierarchiesAreRefusedBeforeTheImporterRecurses) {
     if (i + 1 < 20000) node["children"] = {i + 1};
     nodes.push_back(node);
   }
-  const nlohmann::json gltf = {{"asset", {{"version", "2.0"}}}, {"scene", 0}, {"scenes", {{{"nodes", {0}}}}}, {"nodes", nodes}};
+  const nlohmann::json gltf = {
+      {"asset", {{"version", "2.0"}}}, {"scene", 0}, {"scenes", {{{"nodes", {0}}}}}, {"nodes", nodes}};
   ASSERT_TRUE(ossa::test::write_file(tree / "chars" / "chain.gltf", gltf.dump()));
   std::string bvh = "HIERARCHY\nROOT j0\n{\n OFFSET 0 0 0\n CHANNELS 3 Zrotation Xrotation Yrotation\n";
-  for (int i = 1; i < 20000; ++i) bvh += " JOINT j" + std::to_string(i) + "\n {\n OFFSET 0 1 0\n CHANNELS 3 Zrotation Xrotation Yrotation\n";
+  for (int i = 1; i < 20000; ++i)
+    bvh += " JOINT j" + std::to_string(i) + "\n {\n OFFSET 0 1 0\n CHANNELS 3 Zrotation Xrotation Yrotation\n";
   bvh += " End Site\n {\n OFFSET 0 1 0\n }\n";
   for (int i = 0; i < 20000; ++i) bvh += "}\n";
   bvh += "MOTION\nFrames: 1\nFrame Time: 0.033\n";
@@ -418,23 +430,25 @@ TEST_F(CookSandbox, BrokenContainersAreDescribedAsSuch) {
   const auto glb = ossa::test::read_file(asset("RiggedSimple/RiggedSimple.glb"));
   ASSERT_TRUE(glb.has_value());
   ASSERT_TRUE(ossa::test::write_file(tree / "chars" / "cutb.glb", std::span<const uint8_t>(glb->data(), 5000)));
-  ASSERT_TRUE(ossa::test::write_file(tree / "chars" / "zero.bvh", std::string_view(
-      "HIERARCHY\nROOT Hips\n{\n OFFSET 0 0 0\n CHANNELS 3 Zrotation Xrotation Yrotation\n End Site\n {\n"
-      "  OFFSET 0 1 0\n }\n}\nMOTION\nFrames: 0\nFrame Time: 0.033\n")));
+  ASSERT_TRUE(ossa::test::write_file(
+      tree / "chars" / "zero.bvh",
+      std::string_view(
+          "HIERARCHY\nROOT Hips\n{\n OFFSET 0 0 0\n CHANNELS 3 Zrotation Xrotation Yrotation\n End Site\n {\n"
+          "  OFFSET 0 1 0\n }\n}\nMOTION\nFrames: 0\nFrame Time: 0.033\n")));
   const auto r = run_command(cook_cmd() + " " + q(tree / "chars") + " -o " + q(dir / "out") + " --root " + q(tree));
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find("cut.gltf: is not valid glTF JSON (truncated? parse error"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("cutb.glb: is a GLB file that declares " + std::to_string(glb->size()) + " bytes but has 5000"),
-            std::string::npos) << r.err;
-  EXPECT_NE(r.err.find("zero.bvh: declares \"Frames: 0\": a BVH motion needs at least one frame"), std::string::npos) << r.err;
+            std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find("zero.bvh: declares \"Frames: 0\": a BVH motion needs at least one frame"), std::string::npos)
+      << r.err;
 }
 
 /// A minimal binary LightWave object (LWO2): one layer, the four corners of a unit square at
 /// height `y`, two triangles. IFF: big-endian sizes, chunks padded to even length.
 std::string lwo2_square(float y) {
-  const auto be32 = [](uint32_t v) {
-    return std::string{char(v >> 24), char(v >> 16), char(v >> 8), char(v)};
-  };
+  const auto be32 = [](uint32_t v) { return std::string{char(v >> 24), char(v >> 16), char(v >> 8), char(v)}; };
   const auto be16 = [](uint16_t v) { return std::string{char(v >> 8), char(v)}; };
   const auto f32 = [&](float f) {
     uint32_t u = 0;
@@ -482,10 +496,9 @@ TEST_F(CookSandbox, LightWaveScenesCookTheSameFromAnyWorkingDirectory) {
     const char* object;
     float height;  // of the object it must load
   };
-  const Scene scenes[] = {
-      {"beside.lws", "beside.lwo", 1},
-      {"below.lws", "Objects/below.lwo", 2},
-      {"content.lws", "Objects/content.lwo", 3}};
+  const Scene scenes[] = {{"beside.lws", "beside.lwo", 1},
+                          {"below.lws", "Objects/below.lwo", 2},
+                          {"content.lws", "Objects/content.lwo", 3}};
   for (const auto& [scene, object, height] : scenes) {
     SCOPED_TRACE(scene);
     const fs::path input = content / "Scenes" / scene;
@@ -517,7 +530,8 @@ TEST_F(CookSandbox, LightWaveScenesCookTheSameFromAnyWorkingDirectory) {
                                " -o " + q(dir / "out") + " --root " + q(tree));
     EXPECT_EQ(r.exit_code, 1);
     EXPECT_NE(r.err.find((secret / "box.lwo").string() + ": refused: outside the folders this cook may read"),
-              std::string::npos) << r.err;
+              std::string::npos)
+        << r.err;
     EXPECT_NE(r.err.find("out.lws"), std::string::npos) << r.err;
   }
 }

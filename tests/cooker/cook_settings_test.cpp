@@ -102,7 +102,8 @@ TEST_F(CookSettings, RenamesClipsAndSwapsNames) {
 }
 
 TEST_F(CookSettings, ASkeletonSettingCooksAgainstThatRig) {
-  ASSERT_EQ(run_command(cook_cmd() + " " + q(asset("Pab/skeleton.fbx")) + " -o " + q(dir / "rig") + " -q").exit_code, 0);
+  ASSERT_EQ(run_command(cook_cmd() + " " + q(asset("Pab/skeleton.fbx")) + " -o " + q(dir / "rig") + " -q").exit_code,
+            0);
   write("ossa.cook.json", R"({"ossa_cook": 1, "files": [{"match": "*.fbx", "skeleton": "../rig/skeleton.ossa"}]})");
   // The rig lies outside the source folder: the read sandbox refuses it until it is allowed.
   EXPECT_EQ(cook(), 1);
@@ -188,7 +189,8 @@ TEST_F(CookSettings, SettingsFilesAreInputsOfTheCookKey) {
   // A folder file applies to every input of the folder.
   write("ossa.cook.json", R"({"ossa_cook": 1, "files": [{"match": "*.glb", "float_vertices": false}]})");
   ASSERT_EQ(cook(), 0) << err;
-  EXPECT_EQ(fresh(), (std::map<std::string, bool>{{"RiggedSimple.glb", false}, {"run.fbx", false}, {"walk.fbx", false}}));
+  EXPECT_EQ(fresh(),
+            (std::map<std::string, bool>{{"RiggedSimple.glb", false}, {"run.fbx", false}, {"walk.fbx", false}}));
   // Its records list it among the inputs read.
   bool listed = false;
   for (const auto& f : report["records"][0]["inputs_read"]) listed = listed || f["path"] == "ossa.cook.json";

@@ -38,10 +38,10 @@ TEST(CookerCli, BadInputsFailAloneAndTheBatchGoesOn) {
   fs::create_directories(src);
   ASSERT_TRUE(ossa::test::write_file(src / "garbage.fbx", std::string_view("this is not an FBX file\n")));
   ASSERT_TRUE(ossa::test::write_file(src / "empty.glb", std::string_view("")));
-  const auto r = run_command(cook_cmd() + " " + q(src / "garbage.fbx") + " " + q(src / "missing.gltf") + " " +
-                             q(asset("RiggedSimple/RiggedSimple.glb")) + " " + q(src / "empty.glb") + " " +
-                             q(asset("Fox/Fox.glb")) + " -o " + q(out) + " --jobs 2 --report " +
-                             q(dir / "report.json"));
+  const auto r =
+      run_command(cook_cmd() + " " + q(src / "garbage.fbx") + " " + q(src / "missing.gltf") + " " +
+                  q(asset("RiggedSimple/RiggedSimple.glb")) + " " + q(src / "empty.glb") + " " +
+                  q(asset("Fox/Fox.glb")) + " -o " + q(out) + " --jobs 2 --report " + q(dir / "report.json"));
   EXPECT_EQ(r.exit_code, 1);
   // Each failure is named on stderr with its file.
   EXPECT_NE(r.err.find("garbage.fbx"), std::string::npos) << r.err;
@@ -89,15 +89,15 @@ TEST(CookerCli, OutputCollisionRefusedBeforeCooking) {
   fs::create_directories(dir / "b");
   fs::copy_file(asset("RiggedSimple/RiggedSimple.glb"), dir / "a" / "model.glb");
   fs::copy_file(asset("CesiumMan/CesiumMan.glb"), dir / "b" / "model.glb");
-  const auto r = run_command(cook_cmd() + " " + q(dir / "a" / "model.glb") + " " + q(dir / "b" / "model.glb") +
-                             " -o " + q(dir / "out"));
+  const auto r = run_command(cook_cmd() + " " + q(dir / "a" / "model.glb") + " " + q(dir / "b" / "model.glb") + " -o " +
+                             q(dir / "out"));
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("would both write"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir / "out" / "model.ossa"));
 
   // With --root the tree is mirrored and both cook.
-  const auto m = run_command(cook_cmd() + " " + q(dir / "a") + " " + q(dir / "b") + " --root " + q(dir) + " -o " +
-                             q(dir / "out"));
+  const auto m =
+      run_command(cook_cmd() + " " + q(dir / "a") + " " + q(dir / "b") + " --root " + q(dir) + " -o " + q(dir / "out"));
   ASSERT_EQ(m.exit_code, 0) << m.err;
   EXPECT_TRUE(ossa::Asset::open((dir / "out" / "a" / "model.ossa").string()).ok());
   EXPECT_TRUE(ossa::Asset::open((dir / "out" / "b" / "model.ossa").string()).ok());
@@ -108,8 +108,8 @@ std::string generated_bvh(int frames) {
   std::string s =
       "HIERARCHY\nROOT hips\n{\n OFFSET 0 0 0\n CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation "
       "Yrotation\n JOINT spine\n {\n  OFFSET 0 1 0\n  CHANNELS 3 Zrotation Xrotation Yrotation\n"
-      "  End Site\n  {\n   OFFSET 0 1 0\n  }\n }\n}\nMOTION\nFrames: " + std::to_string(frames) +
-      "\nFrame Time: 0.033333\n";
+      "  End Site\n  {\n   OFFSET 0 1 0\n  }\n }\n}\nMOTION\nFrames: " +
+      std::to_string(frames) + "\nFrame Time: 0.033333\n";
   for (int f = 0; f < frames; ++f) s += "0 1 0 0 0 " + std::to_string(f * 3) + " " + std::to_string(f * 2) + " 0 0\n";
   return s;
 }
@@ -140,9 +140,9 @@ TEST(CookerCli, SameStemSourcesOfOneFolderKeepTheirExtension) {
   const std::string cmd = cook_cmd() + " " + q(src) + " --root " + q(src) + " -o " + q(out) + " --jobs 2";
   const auto r = run_command(cmd + " --report " + q(dir / "first.json"));
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  const std::vector<std::string> expected = {"rig/skel.bvh.ossa",   "rig/skel.obj.ossa", "rig/skel.glb.ossa",
-                                             "clips/walk.bvh.ossa", "clips/walk.glb.ossa", "clips/walk.OBJ.ossa",
-                                             "other/skel.ossa",     "lone.ossa"};
+  const std::vector<std::string> expected = {
+      "rig/skel.bvh.ossa",   "rig/skel.obj.ossa",   "rig/skel.glb.ossa", "clips/walk.bvh.ossa",
+      "clips/walk.glb.ossa", "clips/walk.OBJ.ossa", "other/skel.ossa",   "lone.ossa"};
   for (const std::string& name : expected) {
     auto a = ossa::Asset::open((out / name).string());
     EXPECT_TRUE(a.ok()) << name << ": " << (a.ok() ? "" : a.error().message);
@@ -193,11 +193,13 @@ nlohmann::json gltf1_document(const std::string& version, int extra_joints) {
   doc["accessors"]["aidx"] = accessor("vidx", 0, 5123, 3, "SCALAR");
   doc["accessors"]["aibm"] = accessor("vibm", 0, 5126, 2, "MAT4");
   doc["materials"]["mat"] = {{"values", {{"diffuse", {0.8, 0.8, 0.8, 1}}}}};
-  doc["meshes"]["tri"]["primitives"] = J::array(
-      {{{"attributes", {{"POSITION", "apos"}, {"JOINT", "ajnt"}, {"WEIGHT", "awgt"}}}, {"indices", "aidx"},
-        {"material", "mat"}, {"mode", 4}}});
-  doc["skins"]["skin"] = {{"bindShapeMatrix", identity}, {"inverseBindMatrices", "aibm"},
-                          {"jointNames", {"j_root", "j_tip"}}};
+  doc["meshes"]["tri"]["primitives"] =
+      J::array({{{"attributes", {{"POSITION", "apos"}, {"JOINT", "ajnt"}, {"WEIGHT", "awgt"}}},
+                 {"indices", "aidx"},
+                 {"material", "mat"},
+                 {"mode", 4}}});
+  doc["skins"]["skin"] = {
+      {"bindShapeMatrix", identity}, {"inverseBindMatrices", "aibm"}, {"jointNames", {"j_root", "j_tip"}}};
   doc["nodes"]["root"] = {{"children", {"j_root", "body"}}};
   doc["nodes"]["j_root"] = {{"jointName", "j_root"}, {"children", {"j_tip"}}};
   doc["nodes"]["j_tip"] = {{"jointName", "j_tip"}, {"translation", {0, 0.5, 0}}, {"children", J::array()}};
@@ -247,8 +249,8 @@ TEST(CookerCli, NonModelFilesAreNamedAsSuch) {
   const std::vector<std::pair<std::string, std::string>> files = {
       {"README.md", prose + ossa::test::read_text(ossa::test::source_dir() / "README.md").value_or("")},
       {"notes.txt", prose},
-      {"picture.png", std::string(reinterpret_cast<const char*>(ossa::test::tiny_png().data()),
-                                  ossa::test::tiny_png().size())},
+      {"picture.png",
+       std::string(reinterpret_cast<const char*>(ossa::test::tiny_png().data()), ossa::test::tiny_png().size())},
       {"LICENSE", "Permission is hereby granted, \"free of charge\", to any person\n"},
       {"data.csv", "time,x,y\n0,1,2\n"}};
   for (const auto& [name, text] : files) {
@@ -256,7 +258,8 @@ TEST(CookerCli, NonModelFilesAreNamedAsSuch) {
     const auto r = run_command(cook_cmd() + " " + q(dir / name) + " -o " + q(dir / "out"));
     EXPECT_EQ(r.exit_code, 1) << name << ": " << r.err;
     EXPECT_NE(r.err.find(name + ": not a model file ossa-cook can read (FBX, glTF, GLB, DAE, BVH, OBJ"),
-              std::string::npos) << r.err;
+              std::string::npos)
+        << r.err;
     EXPECT_EQ(r.err.find("Tokenize"), std::string::npos) << r.err;
   }
   // Known model extensions with broken content: Assimp's reader says what is wrong.
@@ -270,8 +273,8 @@ TEST(CookerCli, NonModelFilesAreNamedAsSuch) {
 
 TEST(CookerCli, InputOutsideRootIsAnError) {
   const fs::path dir = ossa::test::make_temp_dir("cli-root");
-  const auto r = run_command(cook_cmd() + " " + q(asset("Fox/Fox.glb")) + " --root " + q(dir) + " -o " +
-                             q(dir / "out"));
+  const auto r =
+      run_command(cook_cmd() + " " + q(asset("Fox/Fox.glb")) + " --root " + q(dir) + " -o " + q(dir / "out"));
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("not inside --root"), std::string::npos) << r.err;
 }
@@ -280,8 +283,8 @@ TEST(CookerCli, ClipOnlyFileBindsToItsSkeleton) {
   const fs::path dir = ossa::test::make_temp_dir("cli-skel");
   auto r = run_command(cook_cmd() + " " + q(asset("Pab/skeleton.fbx")) + " -o " + q(dir));
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  r = run_command(cook_cmd() + " " + q(asset("Pab/walk.fbx")) + " --skeleton " + q(dir / "skeleton.ossa") +
-                  " -o " + q(dir / "clips"));
+  r = run_command(cook_cmd() + " " + q(asset("Pab/walk.fbx")) + " --skeleton " + q(dir / "skeleton.ossa") + " -o " +
+                  q(dir / "clips"));
   ASSERT_EQ(r.exit_code, 0) << r.err;
   auto skel = ossa::Asset::open((dir / "skeleton.ossa").string());
   auto walk = ossa::Asset::open((dir / "clips" / "walk.ossa").string());
@@ -389,8 +392,9 @@ namespace {
 
 TEST(CookerCli, ProgressLinesCountFailuresAndEstimateTheRest) {
   const fs::path dir = ossa::test::make_temp_dir("cli-progress");
-  const auto r = run_command(cook_cmd() + " " + q(dir / "missing.fbx") + " " + q(asset("RiggedSimple/RiggedSimple.glb")) +
-                             " " + q(asset("Fox/Fox.glb")) + " -o " + q(dir / "out") + " --jobs 1");
+  const auto r =
+      run_command(cook_cmd() + " " + q(dir / "missing.fbx") + " " + q(asset("RiggedSimple/RiggedSimple.glb")) + " " +
+                  q(asset("Fox/Fox.glb")) + " -o " + q(dir / "out") + " --jobs 1");
   EXPECT_EQ(r.exit_code, 1);
   // Not a terminal: one line per input, done/total, failures so far, and an ETA until the last.
   EXPECT_NE(r.err.find("[1/3, 1 failed, ETA 0:"), std::string::npos) << r.err;
@@ -409,14 +413,15 @@ TEST(CookerCli, Latin1AndControlCharactersInNamesNeitherAbortTheReportNorReachTh
   const fs::path latin1 = dir / "caf\xe9.fbx", escape = dir / "evil\x1b[2Jname.fbx";
   ASSERT_TRUE(ossa::test::write_file(latin1, std::string_view("not an fbx")));
   ASSERT_TRUE(ossa::test::write_file(escape, std::string_view("not an fbx")));
-  const auto r = run_command(cook_cmd() + " " + q(latin1) + " " + q(escape) + " " +
-                             q(asset("RiggedSimple/RiggedSimple.glb")) + " -o " + q(dir / "out") + " --report " +
-                             q(dir / "report.json"));
+  const auto r =
+      run_command(cook_cmd() + " " + q(latin1) + " " + q(escape) + " " + q(asset("RiggedSimple/RiggedSimple.glb")) +
+                  " -o " + q(dir / "out") + " --report " + q(dir / "report.json"));
   EXPECT_EQ(r.exit_code, 1) << r.err;  // not 134: the report is written
   const auto text = ossa::test::read_text(dir / "report.json");
   ASSERT_TRUE(text.has_value());
   const auto report = nlohmann::json::parse(*text);  // valid UTF-8 JSON
-  EXPECT_EQ(report["records"][0]["input"].get<std::string>(), (dir / "caf\xc3\xa9.fbx").string()) << "Latin-1 transcoded";
+  EXPECT_EQ(report["records"][0]["input"].get<std::string>(), (dir / "caf\xc3\xa9.fbx").string())
+      << "Latin-1 transcoded";
   EXPECT_EQ(r.err.find('\x1b'), std::string::npos) << "no raw escape byte reaches stderr";
   EXPECT_NE(r.err.find("evil\\x1b[2Jname.fbx"), std::string::npos) << r.err;
 }
@@ -457,9 +462,11 @@ TEST(CookerCli, ANulByteInAGraphPathIsRefused) {
   fs::copy_file(asset("Pab/skeleton.fbx"), dir / "skeleton.fbx");
   fs::copy_file(asset("Pab/walk.fbx"), dir / "walk.fbx");
   // "skeleton.fbx\u0000.txt" names skeleton.fbx to any C API: it must not be read as that.
-  ASSERT_TRUE(ossa::test::write_file(dir / "g.graph.json", std::string_view(
-      R"({"ossa_graph": 1, "name": "g", "skeleton": "skeleton.fbx\u0000.txt", "clips": {"walk": "walk.fbx"},)"
-      R"( "parameters": {}, "root": {"clip": "walk"}})")));
+  ASSERT_TRUE(ossa::test::write_file(
+      dir / "g.graph.json",
+      std::string_view(
+          R"({"ossa_graph": 1, "name": "g", "skeleton": "skeleton.fbx\u0000.txt", "clips": {"walk": "walk.fbx"},)"
+          R"( "parameters": {}, "root": {"clip": "walk"}})")));
   const auto r = run_command(cook_cmd() + " " + q(dir / "g.graph.json") + " -o " + q(dir / "out"));
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find("refused: contains a NUL byte"), std::string::npos) << r.err;

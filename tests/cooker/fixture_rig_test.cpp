@@ -85,7 +85,8 @@ TEST(FixtureRig, ReadBackEqualsImportAndCompress) {
     auto scene = import_scene((dir / (std::string(name) + ".fbx")).string(), options);
     ASSERT_TRUE(scene) << scene.error().message;
     ASSERT_FALSE(scene->clips.empty());
-    auto clip = compress_clip(scene->clips[0], rig_scene->skeleton, rig_scene->metres_per_unit, ClipCompressionOptions{});
+    auto clip =
+        compress_clip(scene->clips[0], rig_scene->skeleton, rig_scene->metres_per_unit, ClipCompressionOptions{});
     ASSERT_TRUE(clip) << clip.error().message;
     EXPECT_EQ(rig->clips[i].name, name);
     EXPECT_TRUE(rig->clips[i].events.empty()) << "the fixture's events are the tests' to add";

@@ -57,9 +57,7 @@ struct RefChannel {
   std::vector<glm::dvec4> values;  // per element; vec3 channels leave w = 0; rotations (x,y,z,w)
 };
 
-glm::dvec4 ref_value(const RefChannel& c, size_t k) {
-  return c.values[c.mode == Mode::Cubic ? 3 * k + 1 : k];
-}
+glm::dvec4 ref_value(const RefChannel& c, size_t k) { return c.values[c.mode == Mode::Cubic ? 3 * k + 1 : k]; }
 
 glm::dvec4 normalize_if_rotation(const RefChannel& c, glm::dvec4 v) {
   return c.path == Path::R ? v / glm::length(v) : v;
@@ -88,8 +86,8 @@ glm::dvec4 ref_evaluate(const RefChannel& c, double t) {
   const glm::dvec4 vk = c.values[3 * k + 1], bk = c.values[3 * k + 2];
   const glm::dvec4 vk1 = c.values[3 * (k + 1) + 1], ak1 = c.values[3 * (k + 1)];
   const double u2 = u * u, u3 = u2 * u;
-  const glm::dvec4 p = (2 * u3 - 3 * u2 + 1) * vk + (u3 - 2 * u2 + u) * d * bk +
-                       (-2 * u3 + 3 * u2) * vk1 + (u3 - u2) * d * ak1;
+  const glm::dvec4 p =
+      (2 * u3 - 3 * u2 + 1) * vk + (u3 - 2 * u2 + u) * d * bk + (-2 * u3 + 3 * u2) * vk1 + (u3 - u2) * d * ak1;
   return normalize_if_rotation(c, p);
 }
 
@@ -105,12 +103,10 @@ glm::dvec4 ref_linear(const RefChannel& c, double t) {
 // The animated channels of interpolation_test.gltf, copied from the file (its .bin, decoded with
 // Python's struct module). Note the file's quirk: the animation named "Linear Scale" uses a
 // CUBICSPLINE sampler (with zero tangents), and it is tested as what the file says.
-const std::vector<float> kScaleTimes = {0.0416666679084301f, 0.4166666567325592f, 0.875f, 1.25f,
-                                        1.6666666269302368f};
-const std::vector<float> kRotationTimes = {0.0f, 0.4166666567325592f, 0.875f, 1.25f,
-                                           1.7083333730697632f};
-const std::vector<float> kStepTranslationTimes = {0.0f, 0.4583333432674408f, 0.8333333134651184f,
-                                                  1.2916666269302368f, 1.7083333730697632f};
+const std::vector<float> kScaleTimes = {0.0416666679084301f, 0.4166666567325592f, 0.875f, 1.25f, 1.6666666269302368f};
+const std::vector<float> kRotationTimes = {0.0f, 0.4166666567325592f, 0.875f, 1.25f, 1.7083333730697632f};
+const std::vector<float> kStepTranslationTimes = {0.0f, 0.4583333432674408f, 0.8333333134651184f, 1.2916666269302368f,
+                                                  1.7083333730697632f};
 const std::vector<float> kTranslationTimes = {0.0f, 0.4166666567325592f, 0.8333333134651184f, 1.25f,
                                               1.6666666269302368f};
 
@@ -127,20 +123,19 @@ std::vector<glm::dvec4> zero_tangents(const std::vector<glm::dvec4>& values) {
   return out;
 }
 
-const std::vector<glm::dvec4> kScaleValues = {v3(1, 1, 1), v3(0.5, 0.5, 0.5), v3(1, 1, 1),
-                                              v3(0.5, 0.5, 0.5), v3(1, 1, 1)};
-const std::vector<glm::dvec4> kRotationValues = {
-    q4(0, 0, -0.0, 1.0), q4(0, 0, -0.3826834559440613, 0.9238795638084412),
-    q4(0, 0, -0.7071068286895752, 0.7071068286895752),
-    q4(0, 0, -0.9238795042037964, 0.38268348574638367), q4(0, 0, -1.0, -4.371138828673793e-08)};
+const std::vector<glm::dvec4> kScaleValues = {v3(1, 1, 1), v3(0.5, 0.5, 0.5), v3(1, 1, 1), v3(0.5, 0.5, 0.5),
+                                              v3(1, 1, 1)};
+const std::vector<glm::dvec4> kRotationValues = {q4(0, 0, -0.0, 1.0), q4(0, 0, -0.3826834559440613, 0.9238795638084412),
+                                                 q4(0, 0, -0.7071068286895752, 0.7071068286895752),
+                                                 q4(0, 0, -0.9238795042037964, 0.38268348574638367),
+                                                 q4(0, 0, -1.0, -4.371138828673793e-08)};
 
 std::vector<RefChannel> interpolation_test_channels() {
   const double cx = 3.3051798343658447, lx = -3.2975807189941406;
   return {
       {"Step Scale", "Cube", Path::S, Mode::Step, kScaleTimes, kScaleValues},
       {"Linear Scale", "Cube.001", Path::S, Mode::Cubic, kScaleTimes, zero_tangents(kScaleValues)},
-      {"CubicSpline Scale", "Cube.002", Path::S, Mode::Cubic, kScaleTimes,
-       zero_tangents(kScaleValues)},
+      {"CubicSpline Scale", "Cube.002", Path::S, Mode::Cubic, kScaleTimes, zero_tangents(kScaleValues)},
       {"Step Rotation", "Cube.003", Path::R, Mode::Step, kRotationTimes, kRotationValues},
       {"CubicSpline Rotation",
        "Cube.004",
@@ -148,14 +143,10 @@ std::vector<RefChannel> interpolation_test_channels() {
        Mode::Cubic,
        kRotationTimes,
        {q4(0, 0, -0.0, 1.0), q4(0, 0, -0.0, 1.0), q4(0, 0, -0.0, 1.0),
-        q4(0, 0, -0.04789090156555176, 0.9988526701927185),
-        q4(0, 0, -0.3826834559440613, 0.9238795638084412),
-        q4(0, 0, -0.04789090156555176, 0.9988526701927185),
-        q4(0, 0, -0.035464316606521606, 0.9993709921836853),
-        q4(0, 0, -0.7071068286895752, 0.7071068286895752),
-        q4(0, 0, -0.035464316606521606, 0.9993709921836853),
-        q4(0, 0, -0.050318874418735504, 0.9987332224845886),
-        q4(0, 0, -0.9238795042037964, 0.38268348574638367),
+        q4(0, 0, -0.04789090156555176, 0.9988526701927185), q4(0, 0, -0.3826834559440613, 0.9238795638084412),
+        q4(0, 0, -0.04789090156555176, 0.9988526701927185), q4(0, 0, -0.035464316606521606, 0.9993709921836853),
+        q4(0, 0, -0.7071068286895752, 0.7071068286895752), q4(0, 0, -0.035464316606521606, 0.9993709921836853),
+        q4(0, 0, -0.050318874418735504, 0.9987332224845886), q4(0, 0, -0.9238795042037964, 0.38268348574638367),
         q4(0, 0, -0.050318874418735504, 0.9987332224845886), q4(0, 0, -0.0, 1.0),
         q4(0, 0, -1.0, -4.371138828673793e-08), q4(0, 0, -0.0, 1.0)}},
       {"Linear Rotation", "Cube.005", Path::R, Mode::Linear, kRotationTimes, kRotationValues},
@@ -166,8 +157,7 @@ std::vector<RefChannel> interpolation_test_channels() {
        kStepTranslationTimes,
        {v3(0, 6.665226459503174, 0), v3(0, 10, 0), v3(0, 6, 0), v3(0, 10, 0), v3(0, 6, 0)}},
       {"CubicSpline Translation", "Cube.008", Path::T, Mode::Cubic, kTranslationTimes,
-       zero_tangents({v3(cx, 6.640117168426514, 0), v3(cx, 10, 0), v3(cx, 6, 0), v3(cx, 10, 0),
-                      v3(cx, 6, 0)})},
+       zero_tangents({v3(cx, 6.640117168426514, 0), v3(cx, 10, 0), v3(cx, 6, 0), v3(cx, 10, 0), v3(cx, 6, 0)})},
       {"Linear Translation",
        "Cube.009",
        Path::T,
@@ -187,8 +177,7 @@ const SourceClip* find_clip(const SourceScene& scene, const std::string& name) {
   return nullptr;
 }
 
-const SourceTrack* find_track(const SourceScene& scene, const SourceClip& clip,
-                              const std::string& joint) {
+const SourceTrack* find_track(const SourceScene& scene, const SourceClip& clip, const std::string& joint) {
   for (const SourceTrack& t : clip.tracks) {
     if (t.joint < scene.skeleton.joints.size() && scene.skeleton.joints[t.joint].name == joint) {
       return &t;
@@ -228,9 +217,7 @@ int key_at(const TrackChannel& c, double t) {
 
 /// Largest component difference; rotations compared up to sign (q and -q are one rotation).
 double difference(const glm::dvec4& a, const glm::dvec4& b, Path p) {
-  auto max_abs = [](glm::dvec4 v) {
-    return std::max({std::abs(v.x), std::abs(v.y), std::abs(v.z), std::abs(v.w)});
-  };
+  auto max_abs = [](glm::dvec4 v) { return std::max({std::abs(v.x), std::abs(v.y), std::abs(v.z), std::abs(v.w)}); };
   const double d = max_abs(a - b);
   return p == Path::R ? std::min(d, max_abs(a + b)) : d;
 }
@@ -262,8 +249,7 @@ class InterpolationTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     if (fs::exists(ossa::test::shared_assets() / "Khronos_embedded/interpolation_test.gltf")) {
-      scene_ =
-          new std::optional<SourceScene>(import_shared("Khronos_embedded/interpolation_test.gltf"));
+      scene_ = new std::optional<SourceScene>(import_shared("Khronos_embedded/interpolation_test.gltf"));
     }
   }
   static void TearDownTestSuite() {
@@ -292,9 +278,9 @@ class InterpolationTest : public ::testing::Test {
       ASSERT_GE(k, 0) << "no key at frame " << f << " (t = " << t << ")";
       const glm::dvec4 want = ref_evaluate(ref, t);
       EXPECT_LE(difference(ch.values[static_cast<size_t>(k)], want, ref.path), 1e-5)
-          << "frame " << f << " t = " << t << ": got (" << ch.values[k].x << ", " << ch.values[k].y
-          << ", " << ch.values[k].z << ", " << ch.values[k].w << "), want (" << want.x << ", "
-          << want.y << ", " << want.z << ", " << want.w << ")";
+          << "frame " << f << " t = " << t << ": got (" << ch.values[k].x << ", " << ch.values[k].y << ", "
+          << ch.values[k].z << ", " << ch.values[k].w << "), want (" << want.x << ", " << want.y << ", " << want.z
+          << ", " << want.w << ")";
     }
   }
 
@@ -319,12 +305,10 @@ TEST_F(InterpolationTest, ResampledClipsUseAKeyAlignedGridOfAtLeast60Hz) {
     if (c.mode == Mode::Linear) continue;
     const SourceClip* clip = find_clip(scene(), c.clip);
     ASSERT_NE(clip, nullptr) << c.clip;
-    EXPECT_TRUE(clip->sample_rate == 72.0f || clip->sample_rate == 60.0f)
-        << c.clip << ": " << clip->sample_rate;
+    EXPECT_TRUE(clip->sample_rate == 72.0f || clip->sample_rate == 60.0f) << c.clip << ": " << clip->sample_rate;
     for (float t : c.times) {
       const double frame = static_cast<double>(t) * clip->sample_rate;
-      EXPECT_NEAR(frame, std::round(frame), 1e-4)
-          << c.clip << ": key at " << t << " s is off the grid";
+      EXPECT_NEAR(frame, std::round(frame), 1e-4) << c.clip << ": key at " << t << " s is off the grid";
     }
   }
 }
@@ -346,20 +330,16 @@ TEST_F(InterpolationTest, StepHoldsEachValueUntilTheNextKeyTime) {
       const int before = key_at(ch, grid.time(static_cast<uint32_t>(frame) - 1));
       ASSERT_GE(at, 0);
       ASSERT_GE(before, 0);
-      EXPECT_LE(difference(ch.values[at], normalize_if_rotation(ref, ref_value(ref, k)), ref.path),
-                1e-5)
+      EXPECT_LE(difference(ch.values[at], normalize_if_rotation(ref, ref_value(ref, k)), ref.path), 1e-5)
           << name << ": the frame at key " << k;
-      EXPECT_LE(difference(ch.values[before], normalize_if_rotation(ref, ref_value(ref, k - 1)),
-                           ref.path),
-                1e-5)
+      EXPECT_LE(difference(ch.values[before], normalize_if_rotation(ref, ref_value(ref, k - 1)), ref.path), 1e-5)
           << name << ": the frame before key " << k;
     }
   }
 }
 
 TEST_F(InterpolationTest, CubicSplineFollowsTheHermiteCurveNotALine) {
-  for (const char* name :
-       {"CubicSpline Scale", "Linear Scale", "CubicSpline Rotation", "CubicSpline Translation"}) {
+  for (const char* name : {"CubicSpline Scale", "Linear Scale", "CubicSpline Rotation", "CubicSpline Translation"}) {
     const RefChannel ref = channel_named(name);
     expect_frames_match(ref);
     // The curve must differ from the straight line between the keys somewhere on the grid.
@@ -399,8 +379,7 @@ TEST_F(InterpolationTest, LinearChannelsKeepTheirSourceKeys) {
     ASSERT_EQ(ch.times.size(), ref.times.size()) << name;
     for (size_t k = 0; k < ref.times.size(); ++k) {
       EXPECT_NEAR(ch.times[k], ref.times[k], 1e-6) << name << " key " << k;
-      EXPECT_LE(difference(ch.values[k], normalize_if_rotation(ref, ref_value(ref, k)), ref.path),
-                1e-6)
+      EXPECT_LE(difference(ch.values[k], normalize_if_rotation(ref, ref_value(ref, k)), ref.path), 1e-6)
           << name << " key " << k;
     }
   }
@@ -430,12 +409,11 @@ std::optional<TestGlb> read_glb(const fs::path& path) {
     const uint32_t length = u32(at), type = u32(at + 4);
     if (at + 8 + length > bytes->size()) return std::nullopt;
     if (type == 0x4E4F534A) {
-      out.json = Json::parse(bytes->begin() + static_cast<long>(at + 8),
-                             bytes->begin() + static_cast<long>(at + 8 + length));
+      out.json =
+          Json::parse(bytes->begin() + static_cast<long>(at + 8), bytes->begin() + static_cast<long>(at + 8 + length));
     }
     if (type == 0x004E4942) {
-      out.bin.assign(bytes->begin() + static_cast<long>(at + 8),
-                     bytes->begin() + static_cast<long>(at + 8 + length));
+      out.bin.assign(bytes->begin() + static_cast<long>(at + 8), bytes->begin() + static_cast<long>(at + 8 + length));
     }
     at += 8 + length;
   }
@@ -488,18 +466,14 @@ TEST(FoxGlb, LinearKeysAreImportedAsTheFileHasThem) {
       const std::vector<float> times = glb_floats(*glb, sampler["input"].get<size_t>());
       const std::vector<float> values = glb_floats(*glb, sampler["output"].get<size_t>());
       ASSERT_EQ(got.times.size(), times.size()) << clip.name << " " << node << " " << p;
-      const bool root =
-          scene->skeleton.joints[track->joint].parent < 0;  // its keys fold in nodes above
+      const bool root = scene->skeleton.joints[track->joint].parent < 0;  // its keys fold in nodes above
       const size_t w = path_kind == Path::R ? 4 : 3;
       for (size_t k = 0; k < times.size(); ++k) {
         EXPECT_NEAR(got.times[k], times[k], 1e-6);
         if (root) continue;
-        const glm::dvec4 want =
-            w == 4 ? q4(values[4 * k], values[4 * k + 1], values[4 * k + 2], values[4 * k + 3])
-                   : v3(values[3 * k], values[3 * k + 1], values[3 * k + 2]);
-        EXPECT_LE(difference(got.values[k], path_kind == Path::R ? want / glm::length(want) : want,
-                             path_kind),
-                  1e-5)
+        const glm::dvec4 want = w == 4 ? q4(values[4 * k], values[4 * k + 1], values[4 * k + 2], values[4 * k + 3])
+                                       : v3(values[3 * k], values[3 * k + 1], values[3 * k + 2]);
+        EXPECT_LE(difference(got.values[k], path_kind == Path::R ? want / glm::length(want) : want, path_kind), 1e-5)
             << clip.name << " " << node << " " << p << " key " << k;
         ++compared;
       }
@@ -521,8 +495,7 @@ std::string base64(const std::vector<uint8_t>& bytes) {
   static const char* alphabet = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
   std::string out;
   for (size_t i = 0; i < bytes.size(); i += 3) {
-    const uint32_t b = static_cast<uint32_t>(bytes[i]) << 16 |
-                       (i + 1 < bytes.size() ? bytes[i + 1] << 8 : 0) |
+    const uint32_t b = static_cast<uint32_t>(bytes[i]) << 16 | (i + 1 < bytes.size() ? bytes[i + 1] << 8 : 0) |
                        (i + 2 < bytes.size() ? bytes[i + 2] : 0);
     out += alphabet[b >> 18 & 63];
     out += alphabet[b >> 12 & 63];
@@ -556,10 +529,9 @@ std::vector<uint8_t> make_glb(const Json& json, std::vector<uint8_t> bin) {
 // Keys shared by the hand-made files: times 0, 0.5, 1; STEP values; a cubic's (in, value, out).
 const std::vector<float> kTimes = {0.0f, 0.5f, 1.0f};
 const std::vector<float> kStepValues = {0, 0, 0, 1, 2, 3, 4, 5, 6};
-const std::vector<float> kCubicValues = {
-    0,  0, 0, 0, 0, 0, 2, 0, 0,   // key 0: out-tangent (2, 0, 0)
-    0,  0, 0, 1, 1, 1, 0, 0, 0,   // key 1: value (1, 1, 1)
-    -4, 0, 0, 2, 0, 2, 0, 0, 0};  // key 2: in-tangent (-4, 0, 0)
+const std::vector<float> kCubicValues = {0,  0, 0, 0, 0, 0, 2, 0, 0,   // key 0: out-tangent (2, 0, 0)
+                                         0,  0, 0, 1, 1, 1, 0, 0, 0,   // key 1: value (1, 1, 1)
+                                         -4, 0, 0, 2, 0, 2, 0, 0, 0};  // key 2: in-tangent (-4, 0, 0)
 
 /// Buffer: times (12 bytes) | STEP values (36) | cubic values (108) | 16 bytes of padding, so an
 /// accessor that overreads its view by a few bytes still stays inside the buffer for Assimp.
@@ -582,15 +554,14 @@ Json hand_made_json(const Json& buffer) {
       {"bufferViews", Json::array({{{"buffer", 0}, {"byteOffset", 0}, {"byteLength", 12}},
                                    {{"buffer", 0}, {"byteOffset", 12}, {"byteLength", 36}},
                                    {{"buffer", 0}, {"byteOffset", 48}, {"byteLength", 108}}})},
-      {"accessors",
-       Json::array({{{"bufferView", 0},
-                     {"componentType", 5126},
-                     {"count", 3},
-                     {"type", "SCALAR"},
-                     {"min", Json::array({0.0})},
-                     {"max", Json::array({1.0})}},
-                    {{"bufferView", 1}, {"componentType", 5126}, {"count", 3}, {"type", "VEC3"}},
-                    {{"bufferView", 2}, {"componentType", 5126}, {"count", 9}, {"type", "VEC3"}}})},
+      {"accessors", Json::array({{{"bufferView", 0},
+                                  {"componentType", 5126},
+                                  {"count", 3},
+                                  {"type", "SCALAR"},
+                                  {"min", Json::array({0.0})},
+                                  {"max", Json::array({1.0})}},
+                                 {{"bufferView", 1}, {"componentType", 5126}, {"count", 3}, {"type", "VEC3"}},
+                                 {{"bufferView", 2}, {"componentType", 5126}, {"count", 9}, {"type", "VEC3"}}})},
       {"nodes", Json::array({{{"name", "rig"}, {"children", {1, 2, 3}}},
                              Json::object(),
                              {{"name", "A"}},
@@ -599,15 +570,12 @@ Json hand_made_json(const Json& buffer) {
       {"scenes", Json::array({Json{{"nodes", Json::array({0})}}})},
       {"scene", 0},
       {"animations",
-       Json::array(
-           {{{"name", "move"},
-             {"samplers",
-              Json::array({{{"input", 0}, {"output", 1}, {"interpolation", "STEP"}},
-                           {{"input", 0}, {"output", 2}, {"interpolation", "CUBICSPLINE"}}})},
-             {"channels",
-              Json::array({{{"sampler", 0}, {"target", {{"node", 1}, {"path", "translation"}}}},
-                           {{"sampler", 1}, {"target", {{"node", 4}, {"path", "translation"}}}},
-                           {{"sampler", 0}, {"target", {{"node", 3}, {"path", "scale"}}}}})}}})},
+       Json::array({{{"name", "move"},
+                     {"samplers", Json::array({{{"input", 0}, {"output", 1}, {"interpolation", "STEP"}},
+                                               {{"input", 0}, {"output", 2}, {"interpolation", "CUBICSPLINE"}}})},
+                     {"channels", Json::array({{{"sampler", 0}, {"target", {{"node", 1}, {"path", "translation"}}}},
+                                               {{"sampler", 1}, {"target", {{"node", 4}, {"path", "translation"}}}},
+                                               {{"sampler", 0}, {"target", {{"node", 3}, {"path", "scale"}}}}})}}})},
   };
 }
 
@@ -636,8 +604,7 @@ void expect_channel(const SourceScene& scene, const RefChannel& ref) {
   for (uint32_t f = 0; f < grid.frame_count; ++f) {
     const int k = key_at(ch, grid.time(f));
     ASSERT_GE(k, 0) << "frame " << f;
-    EXPECT_LE(difference(ch.values[k], ref_evaluate(ref, grid.time(f)), ref.path), 1e-5)
-        << "frame " << f;
+    EXPECT_LE(difference(ch.values[k], ref_evaluate(ref, grid.time(f)), ref.path), 1e-5) << "frame " << f;
   }
 }
 
@@ -651,16 +618,14 @@ TEST_F(HandMadeFiles, UnnamedNodesAndExternalBuffer) {
   // Assimp 5.2.5 opens a buffer URI as written, without percent-decoding it, so the file must
   // have the encoded name for Assimp to import it; the sampler reader finds it too.
   ASSERT_TRUE(ossa::test::write_file(dir_ / "keys%20data.bin", hand_made_buffer()));
-  const Json json =
-      hand_made_json({{"byteLength", hand_made_buffer().size()}, {"uri", "keys%20data.bin"}});
+  const Json json = hand_made_json({{"byteLength", hand_made_buffer().size()}, {"uri", "keys%20data.bin"}});
   ASSERT_TRUE(ossa::test::write_file(dir_ / "rig.gltf", json.dump()));
   ossa::Result<SourceScene> scene = ossa::cook::import_scene((dir_ / "rig.gltf").string());
   ASSERT_TRUE(scene.ok()) << scene.error().message;
   expect_channel(*scene, hand_made_step());
   expect_channel(*scene, hand_made_cubic());
   // The repeated name "A": Assimp's channel is bound by name, so its keys stay as they were, said.
-  EXPECT_TRUE(mentions(scene->warnings, "'A' scale (the node's name is not unique)"))
-      << all_lines(scene->warnings);
+  EXPECT_TRUE(mentions(scene->warnings, "'A' scale (the node's name is not unique)")) << all_lines(scene->warnings);
 }
 
 TEST_F(HandMadeFiles, GlbWithEmbeddedBinaryChunk) {
@@ -676,15 +641,13 @@ TEST_F(HandMadeFiles, AnAccessorPastItsViewKeepsAssimpKeysWithAWarning) {
   // Assimp 5.2.5 checks an accessor against its view's length without the accessor's offset, so
   // it reads this one (4 bytes past the view, still inside the buffer); the importer refuses it,
   // says so, and keeps Assimp's keys for that channel alone.
-  Json json = hand_made_json(
-      {{"byteLength", hand_made_buffer().size()},
-       {"uri", "data:application/octet-stream;base64," + base64(hand_made_buffer())}});
+  Json json = hand_made_json({{"byteLength", hand_made_buffer().size()},
+                              {"uri", "data:application/octet-stream;base64," + base64(hand_made_buffer())}});
   json["accessors"][1]["byteOffset"] = 4;
   ASSERT_TRUE(ossa::test::write_file(dir_ / "rig.gltf", json.dump()));
   ossa::Result<SourceScene> scene = ossa::cook::import_scene((dir_ / "rig.gltf").string());
   ASSERT_TRUE(scene.ok()) << scene.error().message;
-  EXPECT_TRUE(mentions(scene->warnings, "'nodes[1]' translation (accessor 1"))
-      << all_lines(scene->warnings);
+  EXPECT_TRUE(mentions(scene->warnings, "'nodes[1]' translation (accessor 1")) << all_lines(scene->warnings);
   expect_channel(*scene, hand_made_cubic());  // the other channel is still resampled
   const SourceTrack* track = find_track(*scene, scene->clips[0], "nodes[1]");
   ASSERT_NE(track, nullptr);
@@ -695,16 +658,14 @@ TEST_F(HandMadeFiles, AnAccessorPastItsViewKeepsAssimpKeysWithAWarning) {
 // The reader on malformed input, and the evaluator.
 
 ossa::Result<ossa::cook::gltf::Animations> parse(const std::string& text) {
-  return ossa::cook::gltf::parse_gltf_animations(std::vector<uint8_t>(text.begin(), text.end()), "",
-                                                 "test.gltf");
+  return ossa::cook::gltf::parse_gltf_animations(std::vector<uint8_t>(text.begin(), text.end()), "", "test.gltf");
 }
 
 ossa::Result<ossa::cook::gltf::Animations> parse(const Json& json) { return parse(json.dump()); }
 
 Json data_uri_json() {
-  return hand_made_json(
-      {{"byteLength", hand_made_buffer().size()},
-       {"uri", "data:application/octet-stream;base64," + base64(hand_made_buffer())}});
+  return hand_made_json({{"byteLength", hand_made_buffer().size()},
+                         {"uri", "data:application/octet-stream;base64," + base64(hand_made_buffer())}});
 }
 
 TEST(GltfReader, ReadsStepAndCubicKeysFromADataUri) {
@@ -729,8 +690,7 @@ TEST(GltfReader, MalformedFilesAreErrorsNotCrashes) {
   for (const char* text : {"", "{", "not json", "[1, 2]", "{\"animations\": 3}"}) {
     const auto file = parse(std::string(text));
     if (file.ok()) {
-      EXPECT_TRUE(file->animations.empty())
-          << text;  // valid JSON without animations: nothing to read
+      EXPECT_TRUE(file->animations.empty()) << text;  // valid JSON without animations: nothing to read
     } else {
       EXPECT_EQ(file.error().message.rfind("test.gltf: ", 0), 0u) << file.error().message;
     }
@@ -766,8 +726,7 @@ std::string sampler_error(const Json& json, size_t sampler = 0) {
 TEST(GltfReader, BadAccessorsAreReportedPerSampler) {
   Json j = data_uri_json();
   j["accessors"][1]["count"] = 4;  // past its view
-  EXPECT_NE(sampler_error(j).find("reads past the end of bufferView 1"), std::string::npos)
-      << sampler_error(j);
+  EXPECT_NE(sampler_error(j).find("reads past the end of bufferView 1"), std::string::npos) << sampler_error(j);
 
   j = data_uri_json();
   j["accessors"][1]["count"] = 1000000000000;  // offsets must not overflow
@@ -779,8 +738,7 @@ TEST(GltfReader, BadAccessorsAreReportedPerSampler) {
 
   j = data_uri_json();
   j["animations"][0]["samplers"][1]["output"] = 1;  // CUBICSPLINE with one element per key
-  EXPECT_NE(sampler_error(j, 1).find("9 expected for 3 keys"), std::string::npos)
-      << sampler_error(j, 1);
+  EXPECT_NE(sampler_error(j, 1).find("9 expected for 3 keys"), std::string::npos) << sampler_error(j, 1);
 
   j = data_uri_json();
   j["animations"][0]["samplers"][0]["input"] = 1;  // times must be SCALAR
@@ -809,8 +767,8 @@ TEST(GltfReader, NormalizedAndSparseOutputs) {
   // Rotation as normalized shorts: (0, 0, 32767, 0) and (0, 0, -32768, 0) -> z = 1 and -1
   // (clamped).
   std::vector<uint8_t> bin = float_bytes({0.0f, 1.0f});
-  for (int16_t c : {int16_t{0}, int16_t{0}, int16_t{32767}, int16_t{0}, int16_t{0}, int16_t{0},
-                    int16_t{-32768}, int16_t{0}}) {
+  for (int16_t c :
+       {int16_t{0}, int16_t{0}, int16_t{32767}, int16_t{0}, int16_t{0}, int16_t{0}, int16_t{-32768}, int16_t{0}}) {
     bin.push_back(static_cast<uint8_t>(c & 0xff));
     bin.push_back(static_cast<uint8_t>((c >> 8) & 0xff));
   }
@@ -849,11 +807,10 @@ TEST(GltfReader, NormalizedAndSparseOutputs) {
 TEST(GltfReader, ExternalBufferUrisArePercentDecoded) {
   const fs::path dir = ossa::test::make_temp_dir("gltf-uri");
   ASSERT_TRUE(ossa::test::write_file(dir / "keys data.bin", hand_made_buffer()));
-  const Json j =
-      hand_made_json({{"byteLength", hand_made_buffer().size()}, {"uri", "keys%20data.bin"}});
+  const Json j = hand_made_json({{"byteLength", hand_made_buffer().size()}, {"uri", "keys%20data.bin"}});
   const std::string text = j.dump();
-  const auto file = ossa::cook::gltf::parse_gltf_animations(
-      std::vector<uint8_t>(text.begin(), text.end()), dir.string(), "test.gltf");
+  const auto file = ossa::cook::gltf::parse_gltf_animations(std::vector<uint8_t>(text.begin(), text.end()),
+                                                            dir.string(), "test.gltf");
   ASSERT_TRUE(file.ok()) << file.error().message;
   EXPECT_EQ(file->animations[0].samplers[0].error, "");
   EXPECT_EQ(file->animations[0].samplers[0].values, kStepValues);

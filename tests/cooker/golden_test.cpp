@@ -77,8 +77,8 @@ bool cook_shared_assets(const fs::path& out, int jobs) {
     pab += " " + q(s / "Pab" / (std::string(f) + ".fbx"));
   return cook(others + " --root " + q(s) + " -o " + q(out) + j) &&
          cook(collada + " --root " + q(s) + " -o " + q(out / "collada") + j) &&
-         cook(pab + " --skeleton " + q(out / "Pab" / "skeleton.ossa") + " --root " + q(s) + " -o " +
-              q(out / "bound") + j);
+         cook(pab + " --skeleton " + q(out / "Pab" / "skeleton.ossa") + " --root " + q(s) + " -o " + q(out / "bound") +
+              j);
 }
 
 void expect_goldens(const fs::path& cooked, const fs::path& golden_dir) {

@@ -26,7 +26,8 @@ namespace {
 // Graph files written to temporary folders name the repository's sample sources, which lie outside
 // their read sandbox (input_log.h): every cook here allows the samples folder.
 std::string cook_cmd() {
-  return (ossa::test::bin_dir() / "ossa-cook").string() + " --allow-dir '" + (ossa::test::source_dir() / "assets").string() + "'";
+  return (ossa::test::bin_dir() / "ossa-cook").string() + " --allow-dir '" +
+         (ossa::test::source_dir() / "assets").string() + "'";
 }
 fs::path pab(const char* file) { return ossa::test::source_dir() / "assets" / "Pab" / file; }
 std::string q(const fs::path& p) { return "'" + p.string() + "'"; }

@@ -41,9 +41,16 @@ std::string graph(const std::string& root, const std::string& nodes = "{}", cons
 
 SourceSkeleton make_rig() {
   SourceSkeleton sk;
-  for (auto [name, parent] : std::vector<std::pair<const char*, int>>{
-           {"Hips", -1}, {"Spine", 0}, {"Head", 1}, {"LeftArm", 1}, {"RightArm", 1}, {"LeftLeg", 0},
-           {"LeftKnee", 5}, {"LeftFoot", 6}, {"Tail1", 0}, {"Tail2", 8}}) {
+  for (auto [name, parent] : std::vector<std::pair<const char*, int>>{{"Hips", -1},
+                                                                      {"Spine", 0},
+                                                                      {"Head", 1},
+                                                                      {"LeftArm", 1},
+                                                                      {"RightArm", 1},
+                                                                      {"LeftLeg", 0},
+                                                                      {"LeftKnee", 5},
+                                                                      {"LeftFoot", 6},
+                                                                      {"Tail1", 0},
+                                                                      {"Tail2", 8}}) {
     SourceJoint j;
     j.name = name;
     j.parent = parent;
@@ -301,7 +308,8 @@ TEST_F(GraphCompile, SelectFormsAdditiveAnd2DBlendSpace) {
 }
 
 TEST_F(GraphCompile, MorphNodeDrivesTargetsFromParameters) {
-  const std::string root = R"({"morph": {"clip": "walk"}, "drives": [{"target": "smile", "parameter": "lean", "scale": 0.5},
+  const std::string root =
+      R"({"morph": {"clip": "walk"}, "drives": [{"target": "smile", "parameter": "lean", "scale": 0.5},
     {"target": "blink", "parameter": "crossed"}]})";
   const GraphDef g = ok(graph(root)).graph;
   ASSERT_EQ(g.nodes.size(), 2u);
@@ -321,12 +329,17 @@ TEST_F(GraphCompile, MorphNodeDrivesTargetsFromParameters) {
   EXPECT_HAS(errors(c), "a drive's \"target\" is empty");
   // A layer may name the morph targets it blends.
   const GraphDef layered = ok(graph(R"({"layered": {"clip": "walk"}, "layers": [{"node": {"clip": "wave"},
-    "mask": [{"joint": "Head"}], "morph_targets": ["smile", "blink"]}]})")).graph;
+    "mask": [{"joint": "Head"}], "morph_targets": ["smile", "blink"]}]})"))
+                               .graph;
   const auto& layer = std::get<LayeredDef>(layered.nodes[2].kind).layers[0];
   ASSERT_TRUE(layer.morph_targets.has_value());
   EXPECT_EQ(*layer.morph_targets, (std::vector<std::string>{"smile", "blink"}));
   EXPECT_FALSE(std::get<LayeredDef>(ok(graph(R"({"layered": {"clip": "walk"}, "layers": [{"node": {"clip": "wave"},
-    "mask": [{"joint": "Head"}]}]})")).graph.nodes[2].kind).layers[0].morph_targets.has_value());
+    "mask": [{"joint": "Head"}]}]})"))
+                                        .graph.nodes[2]
+                                        .kind)
+                   .layers[0]
+                   .morph_targets.has_value());
   const std::string d = graph(R"({"layered": {"clip": "walk"}, "layers": [{"node": {"clip": "wave"},
     "mask": [{"joint": "Head"}], "morph_targets": ["smile", ""]}]})");
   EXPECT_HAS(errors(d), "a morph target name is empty");
@@ -541,7 +554,8 @@ TEST_F(GraphCompile, ParameterDeclarations) {
   const std::string i = graph(R"({"clip": "walk"})", "{}", R"({"b": {"type": "bool", "default": 1}})");
   EXPECT_HAS(errors(i), at(i, "1}") + "parameter 'b' \"default\" must be a boolean, not a number");
   const std::string j = graph(R"({"clip": "walk"})", "{}", R"({"s": {"default": 1}})");
-  EXPECT_HAS(errors(j), at(j, "{\"default\"") + "parameter 's' needs a \"type\": float, int, bool, enum, trigger or vector");
+  EXPECT_HAS(errors(j),
+             at(j, "{\"default\"") + "parameter 's' needs a \"type\": float, int, bool, enum, trigger or vector");
 }
 
 TEST_F(GraphCompile, DuplicateNamesAreRefused) {
@@ -938,7 +952,8 @@ TEST_F(GraphCompile, VectorParametersAndProceduralNodesCompileWithUnitsConverted
       "legs": [{"hip": "LeftLeg", "knee": "LeftKnee", "ankle": "LeftFoot", "planted": "planted"}],
       "release_radius": 0.1},
     "chains": [{"joints": ["Tail1", "Tail2"], "radius": 0.02}],
-    "colliders": [{"joint": "Hips", "offset": [0, 0.1, 0], "radius": 0.15}]})", "{}", kVectorParams));
+    "colliders": [{"joint": "Hips", "offset": [0, 0.1, 0], "radius": 0.15}]})",
+                                   "{}", kVectorParams));
   const GraphDef& g = c.graph;
   ASSERT_EQ(g.parameters.size(), 5u);
   EXPECT_EQ(g.parameters[1].type, ParamType::Vector);
@@ -971,23 +986,27 @@ TEST_F(GraphCompile, VectorParametersAndProceduralNodesCompileWithUnitsConverted
 TEST_F(GraphCompile, ProceduralNodeMistakesAreReportedWhereTheyAre) {
   // A chain whose joints are not ancestors in order.
   const std::string a = graph(R"({"two_bone_ik": {"clip": "walk"}, "start": "LeftLeg", "mid": "Spine", "end": "Head",
-    "target": "look"})", "{}", kVectorParams);
+    "target": "look"})",
+                              "{}", kVectorParams);
   EXPECT_HAS(errors(a), "a two_bone_ik node: joint 'LeftLeg' is not an ancestor of 'Spine'");
   // The target must be a vector parameter.
-  const std::string b = graph(R"({"aim": {"clip": "walk"}, "chain": [{"joint": "Head"}], "target": "speed"})", "{}",
-                              kVectorParams);
+  const std::string b =
+      graph(R"({"aim": {"clip": "walk"}, "chain": [{"joint": "Head"}], "target": "speed"})", "{}", kVectorParams);
   EXPECT_HAS(errors(b), "parameter 'speed' is a float; \"target\" needs a vector parameter");
   // A vector parameter cannot be read by a condition.
-  const std::string c = graph(R"({"state_machine": {"name": "m", "entry": "a", "states": {"a": {"node": {"clip": "walk"}},
-    "b": {"node": {"clip": "run"}}}, "transitions": [{"from": "a", "to": "b", "when": "look > 1"}]}})", "{}", kVectorParams);
+  const std::string c =
+      graph(R"({"state_machine": {"name": "m", "entry": "a", "states": {"a": {"node": {"clip": "walk"}},
+    "b": {"node": {"clip": "run"}}}, "transitions": [{"from": "a", "to": "b", "when": "look > 1"}]}})",
+            "{}", kVectorParams);
   EXPECT_HAS(errors(c), "'look' is a vector parameter: conditions cannot read it");
   // A foot lock leg needs a way to know when it is planted.
   const std::string d = graph(R"({"foot_lock": {"clip": "walk"}, "legs": [{"hip": "LeftLeg", "knee": "LeftKnee",
-    "ankle": "LeftFoot"}]})", "{}", kVectorParams);
+    "ankle": "LeftFoot"}]})",
+                              "{}", kVectorParams);
   EXPECT_HAS(errors(d), "a foot_lock leg needs \"planted\" (a parameter) or both \"plant_event\" and \"lift_event\"");
   // A spring chain lists each joint's child next.
-  const std::string e = graph(R"({"spring": {"clip": "walk"}, "chains": [{"joints": ["Tail1", "Head"]}]})", "{}",
-                              kVectorParams);
+  const std::string e =
+      graph(R"({"spring": {"clip": "walk"}, "chains": [{"joints": ["Tail1", "Head"]}]})", "{}", kVectorParams);
   EXPECT_HAS(errors(e), "spring chain joint 'Head' is not a child of 'Tail1'");
   // Vector values need three numbers; an unknown space is named.
   const std::string f = graph(R"({"clip": "walk"})", "{}", R"({"v": {"type": "vector", "default": [1, 2]}})");
@@ -996,7 +1015,8 @@ TEST_F(GraphCompile, ProceduralNodeMistakesAreReportedWhereTheyAre) {
   EXPECT_HAS(errors(h), "\"space\" is 'screen'; spaces: model, world");
   // An unknown joint names the node's role and suggests the right one.
   const std::string k = graph(R"({"two_bone_ik": {"clip": "walk"}, "start": "hips", "mid": "LeftLeg", "end": "LeftFoot",
-    "target": "look"})", "{}", kVectorParams);
+    "target": "look"})",
+                              "{}", kVectorParams);
   EXPECT_HAS(errors(k), "unknown joint 'hips' in a two_bone_ik node \"start\" (did you mean 'Hips'?)");
 }
 

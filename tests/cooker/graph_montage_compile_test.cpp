@@ -34,7 +34,8 @@ std::string graph(const std::string& montages, const std::string& root) {
   return "{\n  \"ossa_graph\": 1,\n  \"name\": \"test\",\n  \"skeleton\": \"rig.fbx\",\n"
          "  \"clips\": {\"walk\": \"walk.fbx\", \"wave\": \"wave.fbx\"},\n"
          "  \"parameters\": {\"lean\": {\"type\": \"float\"}},\n"
-         "  \"montages\": " + montages + ",\n  \"root\": " + root + "\n}\n";
+         "  \"montages\": " +
+         montages + ",\n  \"root\": " + root + "\n}\n";
 }
 
 const std::string kSlot =
@@ -156,18 +157,28 @@ TEST_F(MontageCompile, EveryFieldCompiles) {
 }
 
 TEST_F(MontageCompile, TrackMistakesPointAtTheTrack) {
-  std::string t = graph(R"({"m": {"group": "gestures", "tracks": {"arm": [{"clip": "wave"}]}, "sections": {"all": {"time": 0}}}})", kSlot);
+  std::string t =
+      graph(R"({"m": {"group": "gestures", "tracks": {"arm": [{"clip": "wave"}]}, "sections": {"all": {"time": 0}}}})",
+            kSlot);
   EXPECT_HAS(errors(t), at(t, "\"arm\"") + "unknown slot 'arm' in montage 'm' (did you mean 'arms'?); slots: 'arms'");
-  t = graph(R"({"m": {"group": "other", "tracks": {"arms": [{"clip": "wave"}]}, "sections": {"all": {"time": 0}}}})", kSlot);
-  EXPECT_HAS(errors(t), at(t, "\"arms\"", 0) +
-                            "montage 'm' (group 'other') has a track for slot 'arms' of group 'gestures'");
-  t = graph(R"({"m": {"group": "gestures", "tracks": {"arms": [{"clip": "wav"}]}, "sections": {"all": {"time": 0}}}})", kSlot);
+  t = graph(R"({"m": {"group": "other", "tracks": {"arms": [{"clip": "wave"}]}, "sections": {"all": {"time": 0}}}})",
+            kSlot);
+  EXPECT_HAS(errors(t),
+             at(t, "\"arms\"", 0) + "montage 'm' (group 'other') has a track for slot 'arms' of group 'gestures'");
+  t = graph(R"({"m": {"group": "gestures", "tracks": {"arms": [{"clip": "wav"}]}, "sections": {"all": {"time": 0}}}})",
+            kSlot);
   EXPECT_HAS(errors(t), at(t, "\"wav\"") + "unknown clip 'wav' (did you mean 'wave'?)");
-  t = graph(R"({"m": {"group": "gestures", "tracks": {"arms": [{"clip": "wave", "end": 2.5}]}, "sections": {"all": {"time": 0}}}})", kSlot);
+  t = graph(
+      R"({"m": {"group": "gestures", "tracks": {"arms": [{"clip": "wave", "end": 2.5}]}, "sections": {"all": {"time": 0}}}})",
+      kSlot);
   EXPECT_HAS(errors(t), at(t, "2.5") + "a segment's \"end\" (clip seconds) must be within [0, 2], not 2.5");
-  t = graph(R"({"m": {"group": "gestures", "tracks": {"arms": [{"clip": "wave", "start": 1, "end": 1}]}, "sections": {"all": {"time": 0}}}})", kSlot);
+  t = graph(
+      R"({"m": {"group": "gestures", "tracks": {"arms": [{"clip": "wave", "start": 1, "end": 1}]}, "sections": {"all": {"time": 0}}}})",
+      kSlot);
   EXPECT_HAS(errors(t), at(t, "1}]") + "a segment's \"end\" (1 s) must be after its \"start\" (1 s)");
-  t = graph(R"({"m": {"group": "gestures", "tracks": {"arms": [{"clip": "wave", "rate": 0}]}, "sections": {"all": {"time": 0}}}})", kSlot);
+  t = graph(
+      R"({"m": {"group": "gestures", "tracks": {"arms": [{"clip": "wave", "rate": 0}]}, "sections": {"all": {"time": 0}}}})",
+      kSlot);
   EXPECT_HAS(errors(t), at(t, "0}]") + "a segment's \"rate\" must be within [0.001, 1000], not 0");
   t = graph(R"({"m": {"group": "gestures", "tracks": {"arms": []}, "sections": {"all": {"time": 0}}}})", kSlot);
   EXPECT_HAS(errors(t), at(t, "[]") + "track 'arms' has no segments");
@@ -177,8 +188,8 @@ TEST_F(MontageCompile, TrackMistakesPointAtTheTrack) {
 
 TEST_F(MontageCompile, SectionMistakesPointAtTheSection) {
   auto with_sections = [](const std::string& sections) {
-    return graph(R"({"m": {"group": "gestures", "tracks": {"arms": [{"clip": "wave"}]}, "sections": )" + sections + "}}",
-                 kSlot);
+    return graph(
+        R"({"m": {"group": "gestures", "tracks": {"arms": [{"clip": "wave"}]}, "sections": )" + sections + "}}", kSlot);
   };
   std::string t = with_sections(R"({"a": {"time": 0.5}})");
   EXPECT_HAS(errors(t), at(t, "0.5") + "the first section ('a') must start at time 0");
@@ -244,30 +255,36 @@ TEST_F(MontageCompile, SlotNodeMistakes) {
   EXPECT_HAS(errors(t), at(t, "\"masks\"") + "unknown key \"masks\" in a slot node (did you mean \"mask\"?)");
   // One slot name, one group.
   t = graph(ms, R"({"slot": "arms", "group": "other", "input": )" + kSlot + "}");
-  EXPECT_HAS(errors(t), at(t, "\"arms\"", 1) + "slot 'arms' is in group 'other' here and in group 'gestures' elsewhere");
+  EXPECT_HAS(errors(t),
+             at(t, "\"arms\"", 1) + "slot 'arms' is in group 'other' here and in group 'gestures' elsewhere");
 }
 
 TEST_F(MontageCompile, SlotWhereItWouldPlayNothingIsRefused) {
   // Inside a layer weighted by a parameter: its montages would show only while the parameter is set.
   std::string t = graph(montage(""), R"({"layered": {"clip": "walk"}, "layers": [{"node": )" + kSlot +
-                                          R"(, "mask": [{"joint": "Spine"}], "weight_parameter": "lean"}]})");
-  EXPECT_HAS(errors(t), at(t, "\"arms\"", 1) + "slot 'arms' is inside a layer (or an additive's added input) whose "
-                                               "weight can be 0");
+                                         R"(, "mask": [{"joint": "Spine"}], "weight_parameter": "lean"}]})");
+  EXPECT_HAS(errors(t), at(t, "\"arms\"", 1) +
+                            "slot 'arms' is inside a layer (or an additive's added input) whose "
+                            "weight can be 0");
   t = graph(montage(""), R"({"additive": {"clip": "walk"}, "add": )" + kSlot + R"(, "weight": 0})");
   EXPECT_HAS(errors(t), at(t, "\"arms\"", 1) + "slot 'arms' is inside a layer");
   // Over the layered node, or in a layer of fixed weight, it is fine.
   ok(graph(montage(""), R"({"slot": "arms", "group": "gestures", "input": {"layered": {"clip": "walk"}, "layers": [
         {"node": {"clip": "wave"}, "mask": [{"joint": "Spine"}], "weight_parameter": "lean"}]}})"));
   ok(graph(montage(""), R"({"layered": {"clip": "walk"}, "layers": [{"node": )" + kSlot +
-                             R"(, "mask": [{"joint": "Spine"}], "weight": 1}]})"));
+                            R"(, "mask": [{"joint": "Spine"}], "weight": 1}]})"));
 }
 
 TEST_F(MontageCompile, SlotsOfUnusedNamedNodesDoNotCount) {
   // A named node never used is still checked, but its slot is not a slot of the graph.
-  const std::string t = "{\n  \"ossa_graph\": 1,\n  \"name\": \"test\",\n  \"skeleton\": \"rig.fbx\",\n"
-                        "  \"clips\": {\"walk\": \"walk.fbx\", \"wave\": \"wave.fbx\"},\n"
-                        "  \"nodes\": {\"spare\": " + kSlot + "},\n"
-                        "  \"montages\": " + montage("") + ",\n  \"root\": {\"clip\": \"walk\"}\n}\n";
+  const std::string t =
+      "{\n  \"ossa_graph\": 1,\n  \"name\": \"test\",\n  \"skeleton\": \"rig.fbx\",\n"
+      "  \"clips\": {\"walk\": \"walk.fbx\", \"wave\": \"wave.fbx\"},\n"
+      "  \"nodes\": {\"spare\": " +
+      kSlot +
+      "},\n"
+      "  \"montages\": " +
+      montage("") + ",\n  \"root\": {\"clip\": \"walk\"}\n}\n";
   EXPECT_HAS(errors(t), at(t, "\"arms\"", 1) + "unknown slot 'arms' in montage 'm'; the graph has no slot nodes");
 }
 

@@ -39,10 +39,11 @@ GraphDef events_graph(const test::PabRig& rig) {
   m.tracks.push_back({"body", {{test::kCrossarms, 0.0f, 3.0f, 1.0f}}});
   m.sections = {{"start", 0.0f, 1}, {"loop", 1.0f, 1}, {"end", 2.0f, -1}};
   using K = MontageNotifyKindDef;
-  m.notifies = {{"start", 0.0f, 0.0f, K::Instant},     {"w1", 0.25f, 0.5f, K::Window},    {"half", 0.5f, 0.0f, K::Instant},
-                {"loop_top", 1.0f, 0.0f, K::Instant},  {"b", 1.0f, 0.0f, K::BranchingPoint}, {"wl", 1.25f, 0.5f, K::Window},
-                {"loop_mid", 1.5f, 0.0f, K::Instant},  {"wx", 1.8f, 0.6f, K::Window},    {"near_end", 1.99f, 0.0f, K::Instant},
-                {"end_mid", 2.5f, 0.0f, K::Instant},   {"last", 3.0f, 0.0f, K::Instant}};
+  m.notifies = {
+      {"start", 0.0f, 0.0f, K::Instant},    {"w1", 0.25f, 0.5f, K::Window},       {"half", 0.5f, 0.0f, K::Instant},
+      {"loop_top", 1.0f, 0.0f, K::Instant}, {"b", 1.0f, 0.0f, K::BranchingPoint}, {"wl", 1.25f, 0.5f, K::Window},
+      {"loop_mid", 1.5f, 0.0f, K::Instant}, {"wx", 1.8f, 0.6f, K::Window},        {"near_end", 1.99f, 0.0f, K::Instant},
+      {"end_mid", 2.5f, 0.0f, K::Instant},  {"last", 3.0f, 0.0f, K::Instant}};
   g.montages.push_back(m);
   return g;
 }
@@ -148,11 +149,13 @@ TEST(MontageEvents, EveryEventOnceAtAnyFrameRateAcrossAHitchRateChangesAndJumps)
   for (Scenario scenario : {Scenario::Constant, Scenario::RateChanges, Scenario::Jump, Scenario::ListenerJump}) {
     const std::vector<Seen> reference = run(p, scenario, {1});
     for (const auto& [label, frames] : schedules)
-      EXPECT_TRUE(same_sequence(reference, run(p, scenario, frames))) << label << ", scenario " << static_cast<int>(scenario);
+      EXPECT_TRUE(same_sequence(reference, run(p, scenario, frames)))
+          << label << ", scenario " << static_cast<int>(scenario);
 
     // The reference, by hand. Windows always close as often as they open, in order.
     const auto notifies = count(reference, MontageEventType::Notify);
-    const auto begins = count(reference, MontageEventType::NotifyBegin), ends = count(reference, MontageEventType::NotifyEnd);
+    const auto begins = count(reference, MontageEventType::NotifyBegin),
+               ends = count(reference, MontageEventType::NotifyEnd);
     EXPECT_EQ(begins, ends);
     std::map<std::string, int> open;
     for (const Seen& s : reference) {

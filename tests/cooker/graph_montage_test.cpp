@@ -36,9 +36,10 @@ uint16_t add_slot(GraphDef& g, uint16_t base, std::string slot = "body", std::st
 }
 
 /// A montage of one track on `slot`: the segments laid end to end, the sections given.
-MontageDef make_montage(std::string name, std::vector<MontageSegmentDef> segments, std::vector<MontageSectionDef> sections,
-                        float blend_in = 0.2f, float blend_out = 0.2f, MontageCurveDef curve = MontageCurveDef::Linear,
-                        std::string slot = "body", std::string group = "actions") {
+MontageDef make_montage(std::string name, std::vector<MontageSegmentDef> segments,
+                        std::vector<MontageSectionDef> sections, float blend_in = 0.2f, float blend_out = 0.2f,
+                        MontageCurveDef curve = MontageCurveDef::Linear, std::string slot = "body",
+                        std::string group = "actions") {
   MontageDef m;
   m.name = std::move(name);
   m.group = std::move(group);
@@ -80,7 +81,8 @@ TEST(MontageBlend, WeightsFollowEachCurveInAndOut) {
   for (MontageCurveDef c : {MontageCurveDef::Linear, MontageCurveDef::Cubic, MontageCurveDef::Inertialize}) {
     GraphDef g = test::pab_graph(*rig);
     add_slot(g, test::clip_node(g, test::kWalk));
-    g.montages.push_back(make_montage("m", {{test::kCrossarms, 0.0f, 8.0f, 1.0f}}, {{"all", 0.0f, -1}}, blend_in, blend_out, c));
+    g.montages.push_back(
+        make_montage("m", {{test::kCrossarms, 0.0f, 8.0f, 1.0f}}, {{"all", 0.0f, -1}}, blend_in, blend_out, c));
     Played p = play(*rig, g);
     ASSERT_TRUE(p.inst);
     ASSERT_TRUE(p.inst->play_montage("m"));
@@ -137,7 +139,8 @@ TEST(MontageBlend, AutomaticBlendOutIsTimedInPlayingSecondsAtAnyRate) {
           }
           if (e.type == MontageEventType::Ended) ended = k * dt, ended_at = e.position;
         }
-        if (before < length && p.inst->montage_status(0).position >= length) weight_at_end = p.inst->montage_status(0).weight;
+        if (before < length && p.inst->montage_status(0).position >= length)
+          weight_at_end = p.inst->montage_status(0).weight;
       }
       EXPECT_NEAR(began, starts, dt) << "rate " << rate << " trigger " << trigger;
       EXPECT_NEAR(ended, starts + blend_out, dt) << "rate " << rate << " trigger " << trigger;
@@ -226,7 +229,8 @@ TEST(MontageInterruption, SameGroupTakesOverWithoutAPopAndOtherGroupsPlayOn) {
       // The pair and the times of the graph's own pop test (graph_runtime_test GraphPop): walk, then run.
       const uint16_t body = add_slot(g, test::clip_node(g, test::kJog));
       add_slot(g, body, "head", "looks", rig->joint("Neck"));
-      g.montages.push_back(make_montage("walk", {{test::kWalk, 0.0f, walk_d, 1.0f}}, {{"loop", 0.0f, 0}}, 0.3f, 0.3f, c));
+      g.montages.push_back(
+          make_montage("walk", {{test::kWalk, 0.0f, walk_d, 1.0f}}, {{"loop", 0.0f, 0}}, 0.3f, 0.3f, c));
       g.montages.push_back(make_montage("run", {{test::kRun, 0.0f, run_d, 1.0f}}, {{"loop", 0.0f, 0}}, 0.3f, 0.3f, c));
       g.montages.push_back(make_montage("look", {{test::kCrossarms, 0.0f, 4.0f, 1.0f}}, {{"all", 0.0f, -1}}, 0.3f, 0.3f,
                                         MontageCurveDef::Linear, "head", "looks"));
@@ -276,8 +280,10 @@ TEST(MontageInterruption, SameGroupTakesOverWithoutAPopAndOtherGroupsPlayOn) {
       }
       const float cm = rig->metres_per_unit * 100.0f;
       std::printf("interrupt %-11s at %.2f s: worst step %5.2f cm, plain playback %5.2f cm\n",
-                  c == MontageCurveDef::Linear ? "linear" : c == MontageCurveDef::Cubic ? "cubic" : "inertialize", at,
-                  worst * cm, steady * cm);
+                  c == MontageCurveDef::Linear  ? "linear"
+                  : c == MontageCurveDef::Cubic ? "cubic"
+                                                : "inertialize",
+                  at, worst * cm, steady * cm);
       EXPECT_LE(worst, 1.25f * steady) << "curve " << static_cast<int>(c) << " at " << at;
     }
   }

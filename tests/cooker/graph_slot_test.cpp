@@ -85,7 +85,8 @@ TEST(Slot, NoMontageOrWeightZeroIsTheInputBitForBit) {
         const float dt = u(rng);
         p.inst->update(dt);
         ref.inst->update(dt);
-        ASSERT_TRUE(same_bits(p.inst->pose(), ref.inst->pose())) << "mask " << mask << " additive " << additive << " frame " << f;
+        ASSERT_TRUE(same_bits(p.inst->pose(), ref.inst->pose()))
+            << "mask " << mask << " additive " << additive << " frame " << f;
         EXPECT_EQ(p.inst->montage_status(0).slot_weight, 0.0f);
       }
       // After a masked or additive montage has played and ended, the input (which never stopped) shows again.
@@ -146,7 +147,7 @@ TEST(Slot, MaskedSlotChangesOnlyTheMaskedJoints) {
 
 /// Pab's walk with its root motion taken out (as `ossa-cook --root-motion` does), and as authored.
 struct RootMotionClips {
-  PabRig rig;      // the fixture's, with "walk_rm" added as clip 4
+  PabRig rig;  // the fixture's, with "walk_rm" added as clip 4
   CompressedClip original;
 };
 const RootMotionClips* root_motion_clips() {
@@ -236,7 +237,8 @@ TEST(SlotRootMotion, MovesTheCharacterByTheClipsOwnDisplacementWithoutSinking) {
       EXPECT_LT(sink, 1e-4f) << "the root keeps the clip's height";
       if (root_motion) {
         EXPECT_LT(glm::length(position - glm::vec3(cycle.x, 0.0f, cycle.z)), mm)
-            << "moved " << position.x << " " << position.z << ", the clip " << cycle.x << " " << cycle.z << ", rate " << rate;
+            << "moved " << position.x << " " << position.z << ", the clip " << cycle.x << " " << cycle.z << ", rate "
+            << rate;
         EXPECT_GT(glm::length(position), 100.0f * mm) << "it did move";
       } else {
         EXPECT_EQ(position, glm::vec3(0.0f)) << "root motion off: the host moves the character itself";
@@ -251,7 +253,8 @@ TEST(Slot, UpdatesAndHostCallsAllocateNothing) {
   MontageDef& m = g.montages[0];
   m.sections = {{"start", 0.0f, 1}, {"loop", 1.0f, 1}, {"end", 2.0f, -1}};
   m.blend_in_curve = MontageCurveDef::Inertialize;  // the slot keeps its history and captures offsets too
-  m.notifies = {{"hit", 0.5f, 0.0f, MontageNotifyKindDef::Instant}, {"top", 1.0f, 0.0f, MontageNotifyKindDef::BranchingPoint},
+  m.notifies = {{"hit", 0.5f, 0.0f, MontageNotifyKindDef::Instant},
+                {"top", 1.0f, 0.0f, MontageNotifyKindDef::BranchingPoint},
                 {"swing", 1.2f, 0.5f, MontageNotifyKindDef::Window}};
   MontageDef other = m;
   other.name = "other";
@@ -259,10 +262,12 @@ TEST(Slot, UpdatesAndHostCallsAllocateNothing) {
   Played p = play(*rig, g);
   ASSERT_TRUE(p.inst);
   int heard = 0;
-  p.inst->set_montage_listener([](GraphInstance& inst, const MontageEvent& e, void* user) {
-    ++*static_cast<int*>(user);
-    if (e.type == MontageEventType::BranchingPoint) inst.set_next_section(e.montage, 1, 2);
-  }, &heard);
+  p.inst->set_montage_listener(
+      [](GraphInstance& inst, const MontageEvent& e, void* user) {
+        ++*static_cast<int*>(user);
+        if (e.type == MontageEventType::BranchingPoint) inst.set_next_section(e.montage, 1, 2);
+      },
+      &heard);
   const auto drive = [&](int frames) {
     for (int f = 0; f < frames; ++f) {
       if (f % 97 == 0) p.inst->play_montage(f % 2 ? "other" : "arms", 1.0f + 0.1f * static_cast<float>(f % 5));

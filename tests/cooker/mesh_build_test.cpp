@@ -166,7 +166,7 @@ struct Decoded {
   std::vector<glm::vec4> tangents;
   std::vector<glm::vec2> uv0;
   std::vector<std::array<uint32_t, 4>> slots;
-  std::vector<glm::vec4> weights;             // as floats in [0, 1]
+  std::vector<glm::vec4> weights;                    // as floats in [0, 1]
   std::vector<std::array<uint32_t, 4>> weights_raw;  // Unorm8 values (quantized layout only)
   std::vector<glm::vec4> colors;
   std::vector<uint32_t> indices;
@@ -202,12 +202,14 @@ Decoded decode(const CookedMesh& m) {
           (a.semantic() == fb::VertexSemantic::Position ? d.positions : d.normals).push_back(read<glm::vec3>(p));
           break;
         case fb::VertexFormat::Snorm16x2: {
-          const Float3 n = octahedral_decode({snorm16_to_float(read<int16_t>(p)), snorm16_to_float(read<int16_t>(p + 2))});
+          const Float3 n =
+              octahedral_decode({snorm16_to_float(read<int16_t>(p)), snorm16_to_float(read<int16_t>(p + 2))});
           d.normals.push_back(glm::vec3(n.x, n.y, n.z));
           break;
         }
         case fb::VertexFormat::Snorm16x4: {
-          const Float3 t = octahedral_decode({snorm16_to_float(read<int16_t>(p)), snorm16_to_float(read<int16_t>(p + 2))});
+          const Float3 t =
+              octahedral_decode({snorm16_to_float(read<int16_t>(p)), snorm16_to_float(read<int16_t>(p + 2))});
           d.tangents.push_back(glm::vec4(t.x, t.y, t.z, snorm16_to_float(read<int16_t>(p + 4))));
           break;
         }
@@ -278,8 +280,7 @@ std::vector<CookedMesh> build_ok(const SourceScene& scene, MeshOptions options =
   return r.ok() ? std::move(r.value()) : std::vector<CookedMesh>{};
 }
 
-std::vector<uint8_t> write(const SourceScene& scene, const std::vector<CookedMesh>& meshes,
-                           WriteOptions options = {}) {
+std::vector<uint8_t> write(const SourceScene& scene, const std::vector<CookedMesh>& meshes, WriteOptions options = {}) {
   WriteProvenance prov;
   prov.source_name = "synthetic.glb";
   prov.source_hash = 0x1234567890abcdefull;
@@ -418,8 +419,8 @@ TEST(MeshBuild, WeightsSumTo255ByLargestRemainder) {
       {{0, 1, 2, 3}, {0.25f, 0.25f, 0.25f, 0.25f}},          // 63.75 each
       {{3, 2, 1, 0}, {0.9f, 0.05f, 0.03f, 0.02f}},           // 229.5 12.75 7.65 5.1
   };
-  const std::array<uint32_t, 4> expected[] = {{85, 85, 85, 0}, {128, 127, 0, 0}, {255, 0, 0, 0}, {64, 64, 64, 63},
-                                              {229, 13, 8, 5}};
+  const std::array<uint32_t, 4> expected[] = {
+      {85, 85, 85, 0}, {128, 127, 0, 0}, {255, 0, 0, 0}, {64, 64, 64, 63}, {229, 13, 8, 5}};
   Lcg rng{42};
   while (patterns.size() < src.positions.size()) {
     glm::vec4 w(rng.unit(), rng.unit(), rng.unit(), rng.unit());
@@ -462,11 +463,11 @@ TEST(MeshBuild, DegenerateTrianglesAreRemovedAndCounted) {
   m.positions.push_back({10, 0, 0});  // n: on a line with n+1 and n+2
   m.positions.push_back({11, 0, 0});
   m.positions.push_back({12, 0, 0});
-  m.positions.push_back({0, 0, 0});   // n+3: same position as vertex 0
+  m.positions.push_back({0, 0, 0});  // n+3: same position as vertex 0
   for (int i = 0; i < 4; ++i) m.normals.push_back({0, 0, 1});
-  for (uint32_t i : {0u, 0u, 1u,          // repeated index
-                     n, n + 1, n + 2,     // zero area: collinear
-                     0u, n + 3, 1u})      // zero area: two corners at one position
+  for (uint32_t i : {0u, 0u, 1u,       // repeated index
+                     n, n + 1, n + 2,  // zero area: collinear
+                     0u, n + 3, 1u})   // zero area: two corners at one position
     m.indices.push_back(i);
   MeshBuildStats stats;
   std::vector<std::string> warnings;
@@ -657,7 +658,8 @@ TEST(MeshBuild, MoreThan256SlotsUseUint16Joints) {
       ASSERT_EQ(m.joints.size(), joints);
       const fb::VertexAttribute* attr = find(m, fb::VertexSemantic::Joints);
       ASSERT_NE(attr, nullptr);
-      EXPECT_EQ(attr->format(), joints > 256 || float_vertices ? fb::VertexFormat::Uint16x4 : fb::VertexFormat::Uint8x4);
+      EXPECT_EQ(attr->format(),
+                joints > 256 || float_vertices ? fb::VertexFormat::Uint16x4 : fb::VertexFormat::Uint8x4);
       const Decoded d = decode(m);
       for (size_t v = 0; v < d.positions.size(); ++v) {
         const size_t s = source_vertex(src, {}, d.positions[v], {});
@@ -670,8 +672,8 @@ TEST(MeshBuild, MoreThan256SlotsUseUint16Joints) {
 
 TEST(MeshBuild, IndexFormatFollowsVertexCount) {
   // 255 x 257 = 65535 vertices fit 16-bit indices; 256 x 256 = 65536 need 32-bit.
-  for (const auto& [cols, rows, format] : {std::tuple{255u, 257u, fb::IndexFormat::Uint16},
-                                           std::tuple{256u, 256u, fb::IndexFormat::Uint32}}) {
+  for (const auto& [cols, rows, format] :
+       {std::tuple{255u, 257u, fb::IndexFormat::Uint16}, std::tuple{256u, 256u, fb::IndexFormat::Uint32}}) {
     const auto meshes = build_ok(scene_with({grid(cols, rows)}));
     ASSERT_EQ(meshes.size(), 1u);
     const CookedMesh& m = meshes[0];
@@ -730,7 +732,7 @@ TEST(MeshBuild, FloatVerticesAreExact) {
   EXPECT_EQ(m.position_scale, glm::vec3(1.0f));
   const fb::VertexFormat formats[] = {fb::VertexFormat::Float32x3, fb::VertexFormat::Float32x3,
                                       fb::VertexFormat::Float32x4, fb::VertexFormat::Float32x2,
-                                      fb::VertexFormat::Uint16x4, fb::VertexFormat::Float32x4};
+                                      fb::VertexFormat::Uint16x4,  fb::VertexFormat::Float32x4};
   ASSERT_EQ(m.layout.size(), 6u);
   for (size_t i = 0; i < 6; ++i) EXPECT_EQ(m.layout[i].format(), formats[i]);
   const Decoded d = decode(m);
@@ -801,8 +803,8 @@ TEST(MeshBuild, BadInputIsAnErrorNamingTheMesh) {
 // write_ossa
 
 SourceScene full_scene() {
-  SourceScene scene = scene_with({box_mesh({0, 1, 0}, {0.5f, 1, 0.25f}, true), triangle_soup(3, "Soup")},
-                                 chain_skeleton(3));
+  SourceScene scene =
+      scene_with({box_mesh({0, 1, 0}, {0.5f, 1, 0.25f}, true), triangle_soup(3, "Soup")}, chain_skeleton(3));
   skin(scene.meshes[0], kSkinPatterns, scene.skeleton);
   scene.meshes[1].material = 1;
   scene.metres_per_unit = 0.01f;

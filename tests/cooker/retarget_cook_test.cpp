@@ -80,7 +80,8 @@ Rigs rigs() {
   std::error_code ec;
   const fs::path apose_tool = ossa::test::bin_dir() / "ossa-test-apose";
   if (!fs::exists(r.cowboy_a) || fs::last_write_time(apose_tool, ec) > fs::last_write_time(r.cowboy_a, ec)) {
-    const auto made = run_command(tool("ossa-test-apose") + " " + q(shared("Quaternius_Cowboy/Cowboy.fbx")) + " " + q(r.cowboy_a));
+    const auto made =
+        run_command(tool("ossa-test-apose") + " " + q(shared("Quaternius_Cowboy/Cowboy.fbx")) + " " + q(r.cowboy_a));
     EXPECT_EQ(made.exit_code, 0) << made.err;
   }
   return r;
@@ -121,11 +122,19 @@ TEST(RetargetCook, CrossPairsOfUntunedRigs) {
     std::string name, extra;
   };
   const std::vector<Pair> pairs = {
-      {&pab, r.cowboy, "pab-cowboy", ""},       {&pab, r.cesium, "pab-cesium", map},   {&pab, r.cmu, "pab-cmu", ""},
-      {&cowboy, r.pab, "cowboy-pab", ""},       {&cowboy, r.cesium, "cowboy-cesium", map},
-      {&cowboy, r.cmu, "cowboy-cmu", ""},       {&cesium, r.pab, "cesium-pab", ""},    {&cesium, r.cowboy, "cesium-cowboy", ""},
-      {&cesium, r.cmu, "cesium-cmu", ""},       {&cmu, r.pab, "cmu-pab", ""},          {&cmu, r.cowboy, "cmu-cowboy", ""},
-      {&cmu, r.cesium, "cmu-cesium", map},      {&pab, r.cowboy_a, "pab-cowboy-apose", ""},
+      {&pab, r.cowboy, "pab-cowboy", ""},
+      {&pab, r.cesium, "pab-cesium", map},
+      {&pab, r.cmu, "pab-cmu", ""},
+      {&cowboy, r.pab, "cowboy-pab", ""},
+      {&cowboy, r.cesium, "cowboy-cesium", map},
+      {&cowboy, r.cmu, "cowboy-cmu", ""},
+      {&cesium, r.pab, "cesium-pab", ""},
+      {&cesium, r.cowboy, "cesium-cowboy", ""},
+      {&cesium, r.cmu, "cesium-cmu", ""},
+      {&cmu, r.pab, "cmu-pab", ""},
+      {&cmu, r.cowboy, "cmu-cowboy", ""},
+      {&cmu, r.cesium, "cmu-cesium", map},
+      {&pab, r.cowboy_a, "pab-cowboy-apose", ""},
       {&cowboy, r.cowboy_a, "cowboy-tpose-to-apose", ""},
   };
   std::printf("%-24s %-28s %7s %6s %6s %6s %6s %6s %5s %8s %7s %7s %7s\n", "pair", "clip", "frames", "hips", "limbs",
@@ -162,9 +171,10 @@ TEST(RetargetCook, CrossPairsOfUntunedRigs) {
     }
   }
   // The report of a retarget is valid against its schema.
-  const auto check = run_command("python3 " + q(ossa::test::source_dir() / "tests" / "support" / "json_schema_check.py") + " " +
-                                 q(ossa::test::source_dir() / "docs" / "schemas" / "ossa-cook-report.schema.json") + " " +
-                                 q(cache() / "cmu-cesium.json"));
+  const auto check =
+      run_command("python3 " + q(ossa::test::source_dir() / "tests" / "support" / "json_schema_check.py") + " " +
+                  q(ossa::test::source_dir() / "docs" / "schemas" / "ossa-cook-report.schema.json") + " " +
+                  q(cache() / "cmu-cesium.json"));
   EXPECT_EQ(check.exit_code, 0) << check.out << check.err;
 }
 
@@ -183,7 +193,8 @@ double clip_distance_mm(const ossa::Asset& rig, const ossa::ClipView& a, const o
     ossa::sample(b, t, {false}, *cb, pb);
     ossa::local_to_model(sk.parents(), pa, ma);
     ossa::local_to_model(sk.parents(), pb, mb);
-    for (uint32_t j = 0; j < n; ++j) worst = std::max(worst, static_cast<double>(glm::length(glm::vec3(ma[j][3] - mb[j][3]))));
+    for (uint32_t j = 0; j < n; ++j)
+      worst = std::max(worst, static_cast<double>(glm::length(glm::vec3(ma[j][3] - mb[j][3]))));
   }
   return worst * rig.file().metres_per_unit() * 1000.0;
 }
@@ -212,7 +223,8 @@ TEST(RetargetCook, MissingBonesAndMapMistakesAreNamed) {
   // CesiumMan's joint names say nothing: without its map file, the missing bones are named.
   auto missing = run(q(shared("CesiumMan/CesiumMan.glb")) + " --retarget-to " + q(r.pab));
   EXPECT_EQ(missing.exit_code, 1);
-  EXPECT_NE(missing.err.find("CesiumMan.glb (source rig): missing humanoid bones: hips, spine, head,"), std::string::npos)
+  EXPECT_NE(missing.err.find("CesiumMan.glb (source rig): missing humanoid bones: hips, spine, head,"),
+            std::string::npos)
       << missing.err;
   EXPECT_NE(missing.err.find("rightFoot"), std::string::npos) << missing.err;
   // ... and as a target.
@@ -238,9 +250,11 @@ TEST(RetargetCook, MissingBonesAndMapMistakesAreNamed) {
   auto no_joint = with_map(R"({"ossa_humanoid_map": 1, "source": {"bones": {"hips": "pelvis_joint"}}})");
   EXPECT_EQ(no_joint.exit_code, 1);
   EXPECT_NE(no_joint.err.find("bones.hips: the rig has no joint 'pelvis_joint'"), std::string::npos) << no_joint.err;
-  auto not_unit = with_map(R"({"ossa_humanoid_map": 1, "source": {"rest_rotations": {"leg_joint_L_1": [0, 0, 0, 2]}}})");
+  auto not_unit =
+      with_map(R"({"ossa_humanoid_map": 1, "source": {"rest_rotations": {"leg_joint_L_1": [0, 0, 0, 2]}}})");
   EXPECT_EQ(not_unit.exit_code, 2);
-  EXPECT_NE(not_unit.err.find("rest_rotations.leg_joint_L_1: is not a unit quaternion"), std::string::npos) << not_unit.err;
+  EXPECT_NE(not_unit.err.find("rest_rotations.leg_joint_L_1: is not a unit quaternion"), std::string::npos)
+      << not_unit.err;
   // ossa-inspect --humanoid says the same before any cook.
   const auto inspect = run_command(tool("ossa-inspect") + " " + q(r.cesium) + " --humanoid");
   EXPECT_EQ(inspect.exit_code, 0);

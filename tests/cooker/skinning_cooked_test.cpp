@@ -208,7 +208,8 @@ TEST_P(SkinAsset, NormalsStayUnit) {
       for (ossa::SkinningMethod method : {ossa::SkinningMethod::Linear, ossa::SkinningMethod::DualQuaternion}) {
         const Skinned s = skin(mesh, palette, method);
         double worst = 0.0;
-        for (uint32_t v = 0; v < mesh.vertex_count(); ++v) worst = std::max(worst, std::fabs(glm::length(s.normal(v)) - 1.0));
+        for (uint32_t v = 0; v < mesh.vertex_count(); ++v)
+          worst = std::max(worst, std::fabs(glm::length(s.normal(v)) - 1.0));
         EXPECT_LE(worst, 1e-5) << isa_name(isa) << " method " << int(method);
       }
     }
@@ -232,7 +233,8 @@ TEST_P(SkinAsset, FloatAndQuantizedCooksAgreeWithinQuantization) {
     const glm::dvec3 step(q.fb->position_scale()->x(), q.fb->position_scale()->y(), q.fb->position_scale()->z());
     const double half_step = 0.5 * glm::length(step) / 65535.0;
     std::vector<glm::dmat4> slot_matrix;
-    for (size_t s = 0; s < q.joints().size(); ++s) slot_matrix.push_back(pose.model_d[q.joints()[s]] * inverse_bind_d(q, s));
+    for (size_t s = 0; s < q.joints().size(); ++s)
+      slot_matrix.push_back(pose.model_d[q.joints()[s]] * inverse_bind_d(q, s));
     const RefSkinned ref = skin_reference(f, pose.model_d);
     size_t over = 0;
     for (uint32_t v = 0; v < q.vertex_count(); ++v) {
@@ -292,30 +294,30 @@ TEST_P(SkinAsset, PreparedPaletteEqualsThePaletteDefinition) {
   // every implementation (the AVX2 product with FMA, the SSE one without).
   const Poses pose = make_pose(data_->skeleton(), 0.6f, 11);
   for (size_t mi = 0; mi < data_->asset->mesh_count(); ++mi)
-  for (ossa::SkinningIsa isa : available_isas()) {
-    IsaScope scope(isa);
-    const ossa::MeshView mesh = data_->asset->mesh(mi);
-    ASSERT_FALSE(mesh.joints().empty());
-    std::vector<glm::mat4> bind(mesh.joints().size()), palette(mesh.joints().size());
-    ossa::prepare_bind_matrices(mesh, bind);
-    ossa::skinning_matrices(mesh.joints(), bind, pose.model, palette);
-    const auto& o = *mesh.fb->position_offset();
-    const auto& sc = *mesh.fb->position_scale();
-    const bool quantized = mesh.attribute(ossa::fb::VertexSemantic::Position)->format() ==
-                           ossa::fb::VertexFormat::Unorm16x4;
-    const glm::dmat4 d = quantized ? glm::scale(glm::translate(glm::dmat4(1.0), glm::dvec3(o.x(), o.y(), o.z())),
-                                                glm::dvec3(sc.x(), sc.y(), sc.z()))
-                                   : glm::dmat4(1.0);
-    for (size_t slot = 0; slot < palette.size(); ++slot) {
-      const glm::dmat4 expected = pose.model_d[mesh.joints()[slot]] * inverse_bind_d(mesh, slot) * d;
-      double scale = 0.0;
-      for (int c = 0; c < 4; ++c) scale = std::max(scale, glm::length(expected[c]));
-      for (int c = 0; c < 4; ++c)
-        for (int r = 0; r < 4; ++r)
-          EXPECT_NEAR(palette[slot][c][r], expected[c][r], 1e-5 * scale) << mesh.name() << " slot " << slot << " "
-                                                                         << isa_name(isa);
+    for (ossa::SkinningIsa isa : available_isas()) {
+      IsaScope scope(isa);
+      const ossa::MeshView mesh = data_->asset->mesh(mi);
+      ASSERT_FALSE(mesh.joints().empty());
+      std::vector<glm::mat4> bind(mesh.joints().size()), palette(mesh.joints().size());
+      ossa::prepare_bind_matrices(mesh, bind);
+      ossa::skinning_matrices(mesh.joints(), bind, pose.model, palette);
+      const auto& o = *mesh.fb->position_offset();
+      const auto& sc = *mesh.fb->position_scale();
+      const bool quantized =
+          mesh.attribute(ossa::fb::VertexSemantic::Position)->format() == ossa::fb::VertexFormat::Unorm16x4;
+      const glm::dmat4 d = quantized ? glm::scale(glm::translate(glm::dmat4(1.0), glm::dvec3(o.x(), o.y(), o.z())),
+                                                  glm::dvec3(sc.x(), sc.y(), sc.z()))
+                                     : glm::dmat4(1.0);
+      for (size_t slot = 0; slot < palette.size(); ++slot) {
+        const glm::dmat4 expected = pose.model_d[mesh.joints()[slot]] * inverse_bind_d(mesh, slot) * d;
+        double scale = 0.0;
+        for (int c = 0; c < 4; ++c) scale = std::max(scale, glm::length(expected[c]));
+        for (int c = 0; c < 4; ++c)
+          for (int r = 0; r < 4; ++r)
+            EXPECT_NEAR(palette[slot][c][r], expected[c][r], 1e-5 * scale)
+                << mesh.name() << " slot " << slot << " " << isa_name(isa);
+      }
     }
-  }
 }
 
 }  // namespace

@@ -45,10 +45,13 @@ double srgb_to_linear(double c) { return c <= 0.04045 ? c / 12.92 : std::pow((c 
 
 std::vector<uint8_t> png_of(const Image& img) {
   std::vector<uint8_t> out;
-  stbi_write_png_to_func([](void* ctx, void* data, int size) {
-    auto* o = static_cast<std::vector<uint8_t>*>(ctx);
-    o->insert(o->end(), static_cast<uint8_t*>(data), static_cast<uint8_t*>(data) + size);
-  }, &out, static_cast<int>(img.width), static_cast<int>(img.height), 4, img.rgba.data(), static_cast<int>(img.width) * 4);
+  stbi_write_png_to_func(
+      [](void* ctx, void* data, int size) {
+        auto* o = static_cast<std::vector<uint8_t>*>(ctx);
+        o->insert(o->end(), static_cast<uint8_t*>(data), static_cast<uint8_t*>(data) + size);
+      },
+      &out, static_cast<int>(img.width), static_cast<int>(img.height), 4, img.rgba.data(),
+      static_cast<int>(img.width) * 4);
   return out;
 }
 
@@ -68,7 +71,9 @@ double psnr(const Image& a, const Image& b, int channels) {
 
 TEST(TextureMips, EveryLevelDownToOneByOneAtOddSizes) {
   for (const auto& [w, h] : {std::pair{5u, 3u}, {1u, 7u}, {16u, 16u}, {13u, 1u}, {1024u, 256u}}) {
-    const Image img = make_image(w, h, [](uint32_t x, uint32_t y) { return std::array<uint8_t, 4>{uint8_t(x), uint8_t(y), 0, 255}; });
+    const Image img = make_image(w, h, [](uint32_t x, uint32_t y) {
+      return std::array<uint8_t, 4>{uint8_t(x), uint8_t(y), 0, 255};
+    });
     const std::vector<Image> mips = build_mips(img, TexelKind::Data);
     ASSERT_EQ(mips.size() + 1, texture_full_mip_count(w, h)) << w << "x" << h;
     for (size_t k = 0; k < mips.size(); ++k) {
@@ -90,7 +95,8 @@ TEST(TextureMips, AreaFilterKeepsTheMeanAtEveryLevel) {
     for (const Image& level : build_mips(img, TexelKind::Data)) {
       double mean[4] = {};
       for (size_t i = 0; i < level.rgba.size(); ++i) mean[i % 4] += level.rgba[i];
-      for (int c = 0; c < 4; ++c) EXPECT_NEAR(mean[c] / (double(level.width) * level.height), mean0[c], 0.75) << w << "x" << h;
+      for (int c = 0; c < 4; ++c)
+        EXPECT_NEAR(mean[c] / (double(level.width) * level.height), mean0[c], 0.75) << w << "x" << h;
     }
   }
 }
@@ -128,7 +134,8 @@ TEST(TextureMips, NormalLevelsStayUnitLength) {
   const Image normals = make_image(32, 32, [&](uint32_t, uint32_t) {
     float x = tilt(rng), y = tilt(rng), z = 1.0f;
     const float l = std::sqrt(x * x + y * y + z * z);
-    return std::array<uint8_t, 4>{uint8_t(std::lround((x / l * 0.5f + 0.5f) * 255)), uint8_t(std::lround((y / l * 0.5f + 0.5f) * 255)),
+    return std::array<uint8_t, 4>{uint8_t(std::lround((x / l * 0.5f + 0.5f) * 255)),
+                                  uint8_t(std::lround((y / l * 0.5f + 0.5f) * 255)),
                                   uint8_t(std::lround((z / l * 0.5f + 0.5f) * 255)), 255};
   });
   for (const Image& level : build_mips(normals, TexelKind::Normal))
@@ -143,22 +150,23 @@ TEST(TextureMips, NormalLevelsStayUnitLength) {
 
 TEST(TextureBlocks, DecodersFollowTheSpecification) {
   // BC1 with c0 <= c1: the 3-colour mode, index 3 is transparent black.
-  const uint8_t bc1[8] = {0x00, 0x00, 0xFF, 0xFF, 0xE4, 0xE4, 0xE4, 0xE4};  // c0 black, c1 white; indices 0,1,2,3 per row
+  const uint8_t bc1[8] = {0x00, 0x00, 0xFF, 0xFF,
+                          0xE4, 0xE4, 0xE4, 0xE4};  // c0 black, c1 white; indices 0,1,2,3 per row
   const Image a = decode_level(bc1, fb::TextureEncoding::Bc1, 4, 4);
-  EXPECT_EQ(a.rgba[0], 0);        // index 0: c0
-  EXPECT_EQ(a.rgba[4], 255);      // index 1: c1
-  EXPECT_EQ(a.rgba[8], 127);      // index 2: (c0 + c1) / 2
-  EXPECT_EQ(a.rgba[12 + 3], 0);   // index 3: transparent
+  EXPECT_EQ(a.rgba[0], 0);       // index 0: c0
+  EXPECT_EQ(a.rgba[4], 255);     // index 1: c1
+  EXPECT_EQ(a.rgba[8], 127);     // index 2: (c0 + c1) / 2
+  EXPECT_EQ(a.rgba[12 + 3], 0);  // index 3: transparent
   // BC4 with v0 <= v1: six interpolated values, then 0 and 255.
   uint8_t bc4[8] = {10, 70, 0, 0, 0, 0, 0, 0};
   bc4[2] = 0x88;  // 3 bits per texel, little-endian: texel 0 -> 0b000, texel 1 -> 0b001, texel 2 -> 0b010
   bc4[7] = 0xF8;  // index bits 40..47: texel 14 -> 0b110, texel 15 -> 0b111
   const Image b = decode_level(bc4, fb::TextureEncoding::Bc4, 4, 4);
-  EXPECT_EQ(b.rgba[0], 10);                      // index 0: v0
-  EXPECT_EQ(b.rgba[4], 70);                      // index 1: v1
-  EXPECT_EQ(b.rgba[8], (4 * 10 + 70) / 5);       // index 2: the first of four interpolated values
-  EXPECT_EQ(b.rgba[14 * 4], 0);                  // index 6: 0
-  EXPECT_EQ(b.rgba[15 * 4], 255);                // index 7: 255
+  EXPECT_EQ(b.rgba[0], 10);                 // index 0: v0
+  EXPECT_EQ(b.rgba[4], 70);                 // index 1: v1
+  EXPECT_EQ(b.rgba[8], (4 * 10 + 70) / 5);  // index 2: the first of four interpolated values
+  EXPECT_EQ(b.rgba[14 * 4], 0);             // index 6: 0
+  EXPECT_EQ(b.rgba[15 * 4], 255);           // index 7: 255
 }
 
 TEST(TextureBlocks, RoundTripQualityPerFormat) {
@@ -166,12 +174,15 @@ TEST(TextureBlocks, RoundTripQualityPerFormat) {
   // A smooth colour field with mild noise: what photos and painted textures look like to BC1.
   const Image colour = make_image(64, 64, [&](uint32_t x, uint32_t y) {
     const int n = int(rng() % 9) - 4;
-    return std::array<uint8_t, 4>{uint8_t(std::clamp(int(x * 4) + n, 0, 255)), uint8_t(std::clamp(int(y * 4) + n, 0, 255)),
-                                  uint8_t(std::clamp(128 + n, 0, 255)), uint8_t(std::clamp(int((x + y) * 2), 0, 255))};
+    return std::array<uint8_t, 4>{uint8_t(std::clamp(int(x * 4) + n, 0, 255)),
+                                  uint8_t(std::clamp(int(y * 4) + n, 0, 255)), uint8_t(std::clamp(128 + n, 0, 255)),
+                                  uint8_t(std::clamp(int((x + y) * 2), 0, 255))};
   });
-  for (const auto& [e, channels, floor] : {std::tuple{fb::TextureEncoding::Bc1, 3, 34.0}, {fb::TextureEncoding::Bc3, 4, 34.0},
-                                          {fb::TextureEncoding::Bc4, 1, 40.0}, {fb::TextureEncoding::Bc5, 2, 40.0},
-                                          {fb::TextureEncoding::Rgba8, 4, 99.0}}) {
+  for (const auto& [e, channels, floor] : {std::tuple{fb::TextureEncoding::Bc1, 3, 34.0},
+                                           {fb::TextureEncoding::Bc3, 4, 34.0},
+                                           {fb::TextureEncoding::Bc4, 1, 40.0},
+                                           {fb::TextureEncoding::Bc5, 2, 40.0},
+                                           {fb::TextureEncoding::Rgba8, 4, 99.0}}) {
     std::vector<uint8_t> bytes;
     encode_level(colour, e, bytes);
     ASSERT_EQ(bytes.size(), texture_level_bytes(e, 64, 64));
@@ -201,21 +212,35 @@ SourceTexture texture_of(const Image& img, TextureRole role, const std::string& 
 }
 
 TEST(TextureCook, FormatPerRoleAndContent) {
-  const Image opaque = make_image(16, 8, [](uint32_t x, uint32_t y) { return std::array<uint8_t, 4>{uint8_t(x * 16), uint8_t(y * 30), 50, 255}; });
-  const Image cutout = make_image(16, 8, [](uint32_t x, uint32_t) { return std::array<uint8_t, 4>{200, 100, 50, uint8_t(x < 8 ? 255 : 0)}; });
-  const Image grey = make_image(16, 8, [](uint32_t x, uint32_t) { return std::array<uint8_t, 4>{uint8_t(x * 16), uint8_t(x * 16), uint8_t(x * 16), 255}; });
-  const Image flat_normal = make_image(16, 8, [](uint32_t, uint32_t) { return std::array<uint8_t, 4>{128, 128, 255, 255}; });
+  const Image opaque = make_image(16, 8, [](uint32_t x, uint32_t y) {
+    return std::array<uint8_t, 4>{uint8_t(x * 16), uint8_t(y * 30), 50, 255};
+  });
+  const Image cutout = make_image(16, 8, [](uint32_t x, uint32_t) {
+    return std::array<uint8_t, 4>{200, 100, 50, uint8_t(x < 8 ? 255 : 0)};
+  });
+  const Image grey = make_image(16, 8, [](uint32_t x, uint32_t) {
+    return std::array<uint8_t, 4>{uint8_t(x * 16), uint8_t(x * 16), uint8_t(x * 16), 255};
+  });
+  const Image flat_normal = make_image(16, 8, [](uint32_t, uint32_t) {
+    return std::array<uint8_t, 4>{128, 128, 255, 255};
+  });
   SourceScene scene;
   scene.materials.resize(1);
-  scene.materials[0].textures = {texture_of(opaque, TextureRole::Diffuse, "a"), texture_of(cutout, TextureRole::Diffuse, "b"),
-                                 texture_of(grey, TextureRole::Specular, "c"), texture_of(opaque, TextureRole::Specular, "d"),
-                                 texture_of(flat_normal, TextureRole::Normal, "e")};
+  scene.materials[0].textures = {
+      texture_of(opaque, TextureRole::Diffuse, "a"), texture_of(cutout, TextureRole::Diffuse, "b"),
+      texture_of(grey, TextureRole::Specular, "c"), texture_of(opaque, TextureRole::Specular, "d"),
+      texture_of(flat_normal, TextureRole::Normal, "e")};
   std::vector<TextureRecord> records;
   ASSERT_TRUE(cook_textures(scene, TextureOutput::Compressed, "test", records).ok());
   ASSERT_EQ(records.size(), 5u);
-  const struct { fb::TextureEncoding e; bool srgb; } expected[] = {
-      {fb::TextureEncoding::Bc1, true}, {fb::TextureEncoding::Bc3, true}, {fb::TextureEncoding::Bc4, false},
-      {fb::TextureEncoding::Bc1, false}, {fb::TextureEncoding::Bc5, false}};
+  const struct {
+    fb::TextureEncoding e;
+    bool srgb;
+  } expected[] = {{fb::TextureEncoding::Bc1, true},
+                  {fb::TextureEncoding::Bc3, true},
+                  {fb::TextureEncoding::Bc4, false},
+                  {fb::TextureEncoding::Bc1, false},
+                  {fb::TextureEncoding::Bc5, false}};
   for (size_t i = 0; i < 5; ++i) {
     const SourceTexture& t = scene.materials[0].textures[i];
     EXPECT_EQ(static_cast<fb::TextureEncoding>(t.encoding), expected[i].e) << i;
@@ -239,7 +264,8 @@ TEST(TextureCook, FormatPerRoleAndContent) {
   ASSERT_TRUE(cook_textures(raw, TextureOutput::Rgba8, "test", records).ok());
   EXPECT_EQ(static_cast<fb::TextureEncoding>(raw.materials[0].textures[0].encoding), fb::TextureEncoding::Rgba8);
   EXPECT_TRUE(raw.materials[0].textures[0].srgb);
-  EXPECT_EQ(std::vector<uint8_t>(raw.materials[0].textures[0].data.begin(), raw.materials[0].textures[0].data.begin() + 16 * 8 * 4),
+  EXPECT_EQ(std::vector<uint8_t>(raw.materials[0].textures[0].data.begin(),
+                                 raw.materials[0].textures[0].data.begin() + 16 * 8 * 4),
             decode_rgba(png_of(opaque))->rgba);  // level 0 is the source's texels, bottom row first
   SourceScene source;
   source.materials.resize(1);
@@ -259,7 +285,9 @@ TEST(TextureCook, PbrMapsCookByRoleWithTheirChannels) {
   const Image orm = make_image(16, 16, [](uint32_t x, uint32_t y) {
     return std::array<uint8_t, 4>{uint8_t(x * 16), uint8_t(y * 16), uint8_t(255 - x * 16), 255};
   });
-  const Image glow = make_image(16, 8, [](uint32_t x, uint32_t) { return std::array<uint8_t, 4>{uint8_t(x * 16), 40, 0, 255}; });
+  const Image glow = make_image(16, 8, [](uint32_t x, uint32_t) {
+    return std::array<uint8_t, 4>{uint8_t(x * 16), 40, 0, 255};
+  });
   SourceScene scene;
   scene.materials.resize(1);
   scene.materials[0].textures = {texture_of(orm, TextureRole::Occlusion, "orm"),
@@ -295,11 +323,14 @@ TEST(TextureCook, PbrMapsCookByRoleWithTheirChannels) {
 }
 
 TEST(TextureCook, OneCookedTexturePerImageAndRole) {
-  const Image img = make_image(8, 8, [](uint32_t x, uint32_t y) { return std::array<uint8_t, 4>{uint8_t(x * 30), uint8_t(y * 30), 9, 255}; });
+  const Image img = make_image(8, 8, [](uint32_t x, uint32_t y) {
+    return std::array<uint8_t, 4>{uint8_t(x * 30), uint8_t(y * 30), 9, 255};
+  });
   SourceScene scene;
   scene.materials.resize(3);
   scene.materials[0].textures = {texture_of(img, TextureRole::Diffuse, "skin.png")};
-  scene.materials[1].textures = {texture_of(img, TextureRole::Diffuse, "skin.png"), texture_of(img, TextureRole::Specular, "skin.png")};
+  scene.materials[1].textures = {texture_of(img, TextureRole::Diffuse, "skin.png"),
+                                 texture_of(img, TextureRole::Specular, "skin.png")};
   scene.materials[2].textures = {texture_of(img, TextureRole::Diffuse, "copy.png")};
   std::vector<TextureRecord> records;
   ASSERT_TRUE(cook_textures(scene, TextureOutput::Compressed, "test", records).ok());
@@ -312,7 +343,9 @@ TEST(TextureCook, OneCookedTexturePerImageAndRole) {
 }
 
 TEST(TextureCook, OtherImageFormatsBecomePng) {
-  const Image img = make_image(6, 5, [](uint32_t x, uint32_t y) { return std::array<uint8_t, 4>{uint8_t(x * 40), uint8_t(y * 50), 77, 255}; });
+  const Image img = make_image(6, 5, [](uint32_t x, uint32_t y) {
+    return std::array<uint8_t, 4>{uint8_t(x * 40), uint8_t(y * 50), 77, 255};
+  });
   std::vector<uint8_t> bmp, tga;
   const auto append = [](void* ctx, void* data, int size) {
     auto* o = static_cast<std::vector<uint8_t>*>(ctx);
@@ -323,7 +356,8 @@ TEST(TextureCook, OtherImageFormatsBecomePng) {
   std::string pnm = "P6\n6 5\n255\n";
   for (size_t i = 0; i < img.rgba.size(); i += 4) pnm.append(reinterpret_cast<const char*>(&img.rgba[i]), 3);
   const std::vector<uint8_t> ppm(pnm.begin(), pnm.end());
-  for (const auto& [bytes, kind, named_tga] : {std::tuple{bmp, "BMP", false}, {tga, "TGA", true}, {ppm, "PNM", false}}) {
+  for (const auto& [bytes, kind, named_tga] :
+       {std::tuple{bmp, "BMP", false}, {tga, "TGA", true}, {ppm, "PNM", false}}) {
     ASSERT_STREQ(other_image_format(bytes, named_tga), kind);
     const auto png = other_to_png(bytes, named_tga);
     ASSERT_TRUE(png.ok()) << kind << ": " << png.error().message;

@@ -24,13 +24,15 @@ using Keywords = std::vector<std::vector<std::string>>;  // every group must mat
 
 inline std::string lower(std::string_view s) {
   std::string out(s);
-  std::transform(out.begin(), out.end(), out.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  std::transform(out.begin(), out.end(), out.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   return out;
 }
 
 inline bool contains_any(const std::string& message, const std::vector<std::string>& words) {
   const std::string m = lower(message);
-  return std::any_of(words.begin(), words.end(), [&](const std::string& w) { return m.find(lower(w)) != std::string::npos; });
+  return std::any_of(words.begin(), words.end(),
+                     [&](const std::string& w) { return m.find(lower(w)) != std::string::npos; });
 }
 
 inline std::string join(const std::vector<std::string>& words) {
@@ -40,7 +42,8 @@ inline std::string join(const std::vector<std::string>& words) {
 }
 
 // A message that names the file and says what is wrong.
-inline ::testing::AssertionResult explains(const std::string& message, const std::string& name, const Keywords& groups) {
+inline ::testing::AssertionResult explains(const std::string& message, const std::string& name,
+                                           const Keywords& groups) {
   if (message.empty()) return ::testing::AssertionFailure() << "empty error message";
   if (message.find(name) == std::string::npos)
     return ::testing::AssertionFailure() << "message does not name \"" << name << "\": " << message;
@@ -50,7 +53,8 @@ inline ::testing::AssertionResult explains(const std::string& message, const std
   return ::testing::AssertionSuccess() << message;
 }
 
-inline ::testing::AssertionResult rejected(const Result<Asset>& result, const std::string& name, const Keywords& groups) {
+inline ::testing::AssertionResult rejected(const Result<Asset>& result, const std::string& name,
+                                           const Keywords& groups) {
   if (result.ok()) return ::testing::AssertionFailure() << name << " was accepted";
   return explains(result.error().message, name, groups);
 }

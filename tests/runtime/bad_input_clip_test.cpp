@@ -99,8 +99,7 @@ TEST(Clip, ChannelEnumUnknown) {
 TEST(Clip, ChannelBothConstantAndAnimated) {
   SyntheticSpec spec;
   // spine rotation is animated; also make it constant (constants stay sorted).
-  spec.clips[0].constants.insert(spec.clips[0].constants.begin() + 1,
-                                 {1, fb::Channel::Rotation, fb::Quat(0, 0, 0, 1)});
+  spec.clips[0].constants.insert(spec.clips[0].constants.begin() + 1, {1, fb::Channel::Rotation, fb::Quat(0, 0, 0, 1)});
   EXPECT_TRUE(rejects(spec, with(kClip, {"also constant"})));
 }
 
@@ -202,8 +201,10 @@ TEST(Clip, KeyValuesShorterThanPadding) {
 
 TEST(Clip, RangeNotFiniteOrNegative) {
   const std::pair<fb::Vec3, fb::Vec3> ranges[] = {
-      {fb::Vec3(kNaN, 0, 0), fb::Vec3(1, 1, 1)},     {fb::Vec3(0, 0, 0), fb::Vec3(1, kInf, 1)},
-      {fb::Vec3(0, 0, 0), fb::Vec3(1, 1, -0.5f)},    {fb::Vec3(3e38f, 0, 0), fb::Vec3(3e38f, 0, 0)},  // top overflows
+      {fb::Vec3(kNaN, 0, 0), fb::Vec3(1, 1, 1)},
+      {fb::Vec3(0, 0, 0), fb::Vec3(1, kInf, 1)},
+      {fb::Vec3(0, 0, 0), fb::Vec3(1, 1, -0.5f)},
+      {fb::Vec3(3e38f, 0, 0), fb::Vec3(3e38f, 0, 0)},  // top overflows
   };
   for (const auto& [lo, extent] : ranges) {
     SyntheticSpec spec;

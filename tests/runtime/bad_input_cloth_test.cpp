@@ -110,8 +110,7 @@ TEST(Cloth, ColliderOnAMissingJointOrWithABadShape) {
   spec.meshes[0].cloth->colliders[0] = fb::ClothCollider(40, fb::Vec3(0, 0, 0), fb::Vec3(0, 1, 0), 0.1f);
   EXPECT_TRUE(rejects(spec, cloth_error({"collider 0", "joint 40"})));
   spec = cloth_spec();
-  spec.meshes[0].cloth->colliders[0] =
-      fb::ClothCollider(1, fb::Vec3(std::nanf(""), 0, 0), fb::Vec3(0, 1, 0), 0.1f);
+  spec.meshes[0].cloth->colliders[0] = fb::ClothCollider(1, fb::Vec3(std::nanf(""), 0, 0), fb::Vec3(0, 1, 0), 0.1f);
   EXPECT_TRUE(rejects(spec, cloth_error({"collider 0", "not finite"})));
   spec = cloth_spec();
   spec.meshes[0].cloth->colliders[0] = fb::ClothCollider(1, fb::Vec3(0, 0, 0), fb::Vec3(0, 1, 0), -0.5f);

@@ -56,11 +56,7 @@ TEST(Skeleton, PerJointArrayLengthMismatch) {
   mismatched([](SyntheticSkeleton& s) { s.translations.pop_back(); }, "translation");
   mismatched([](SyntheticSkeleton& s) { s.rotations.pop_back(); }, "rotation");
   mismatched([](SyntheticSkeleton& s) { s.scales.push_back(fb::Vec3(1, 1, 1)); }, "scale");
-  mismatched(
-      [](SyntheticSkeleton& s) {
-        s.inverse_bind = std::vector<fb::Mat4>(3);
-      },
-      "inverse");
+  mismatched([](SyntheticSkeleton& s) { s.inverse_bind = std::vector<fb::Mat4>(3); }, "inverse");
 }
 
 /// The synthetic rig grown to 11 joints (a chain off the head), so the loader's whole-array scans
@@ -145,7 +141,8 @@ TEST(Mesh, InverseBindNotFiniteFoundAtEverySlot) {
       SyntheticSpec spec;
       spec.meshes[0].inverse_bind = std::vector<fb::Mat4>(3, identity_mat4());
       (*spec.meshes[0].inverse_bind)[slot] = identity_with(k, k % 2 ? kInf : kNaN);
-      EXPECT_TRUE(rejects(spec, with(kMesh, {"joint slot " + std::to_string(slot)}, {"inverse bind"}))) << slot << " " << k;
+      EXPECT_TRUE(rejects(spec, with(kMesh, {"joint slot " + std::to_string(slot)}, {"inverse bind"})))
+          << slot << " " << k;
     }
 }
 

@@ -144,7 +144,8 @@ TEST_P(DamagedBytes, EveryTruncationRejected) {
     const Result<Asset> asset = Asset::from_bytes(prefix, name);
     if (asset.ok()) {
       if (n < complete) failures.push_back(name + ": accepted although referenced bytes are missing");
-      else if (const std::string problem = walk_asset(*asset); !problem.empty()) failures.push_back(name + ": " + problem);
+      else if (const std::string problem = walk_asset(*asset); !problem.empty())
+        failures.push_back(name + ": " + problem);
     } else if (auto e = explains(asset.error().message, name, {}); !e) {
       failures.push_back(e.message());
     }
@@ -210,16 +211,16 @@ TEST(DamagedFile, SharedTablesDoNotMultiplyWork) {
   const std::vector<uint8_t> vertices(3 * 12, 0);
   const std::vector<uint8_t> indices(60000 * 2, 0);  // 20000 degenerate triangles over vertex 0
   const std::vector<fb::Submesh> submeshes = {{0, 60000, 0}};
-  const auto mesh = fb::CreateMeshDirect(fbb, "shared", 3, 12, &layout, &vertices, fb::IndexFormat::Uint16,
-                                         &indices, &submeshes);
+  const auto mesh =
+      fb::CreateMeshDirect(fbb, "shared", 3, 12, &layout, &vertices, fb::IndexFormat::Uint16, &indices, &submeshes);
   const std::vector<flatbuffers::Offset<fb::Mesh>> meshes(2000, mesh);
   fb::FinishFileBuffer(fbb, fb::CreateFileDirect(fbb, kFormatVersion, 1.0f, 0, &meshes));
   const std::vector<uint8_t> bytes(fbb.GetBufferPointer(), fbb.GetBufferPointer() + fbb.GetSize());
   EXPECT_TRUE(rejects(bytes, {{"shared", "refusing", "far more"}}));
   // The same mesh referenced once is fine.
   flatbuffers::FlatBufferBuilder once;
-  const auto single = fb::CreateMeshDirect(once, "shared", 3, 12, &layout, &vertices, fb::IndexFormat::Uint16,
-                                           &indices, &submeshes);
+  const auto single =
+      fb::CreateMeshDirect(once, "shared", 3, 12, &layout, &vertices, fb::IndexFormat::Uint16, &indices, &submeshes);
   const std::vector<flatbuffers::Offset<fb::Mesh>> one = {single};
   fb::FinishFileBuffer(once, fb::CreateFileDirect(once, kFormatVersion, 1.0f, 0, &one));
   EXPECT_TRUE(accepts({once.GetBufferPointer(), once.GetBufferPointer() + once.GetSize()}));
@@ -338,25 +339,57 @@ TEST(Montage, HostileFieldsRejectedByName) {
       {"segment end huge", [](SyntheticMontage& m) { m.end = 1e7f; }, {"within [0, 1e6]"}},
       {"segment rate 0", [](SyntheticMontage& m) { m.segment_rate = 0.0f; }, {"segment 0: rate 0"}},
       {"segment rate inf", [=](SyntheticMontage& m) { m.segment_rate = inf; }, {"segment 0: rate inf"}},
-      {"first section", [](SyntheticMontage& m) { m.section_starts = {0.1f, 0.25f}; }, {"first section starts at 0"}},
-      {"section order", [](SyntheticMontage& m) { m.section_starts = {0.0f, 0.0f}; }, {"not after the section before"}},
-      {"section past the end", [](SyntheticMontage& m) { m.section_starts = {0.0f, 5.0f}; }, {"before the montage's end"}},
-      {"section start NaN", [=](SyntheticMontage& m) { m.section_starts = {0.0f, nan}; }, {"section 1"}},
-      {"next section", [](SyntheticMontage& m) { m.section_next = {1, 7}; }, {"next section 7 is out of range"}},
-      {"next section negative", [](SyntheticMontage& m) { m.section_next = {-2, 1}; }, {"next section -2"}},
+      {"first section",
+       [](SyntheticMontage& m) {
+         m.section_starts = {0.1f, 0.25f};
+       },
+       {"first section starts at 0"}},
+      {"section order",
+       [](SyntheticMontage& m) {
+         m.section_starts = {0.0f, 0.0f};
+       },
+       {"not after the section before"}},
+      {"section past the end",
+       [](SyntheticMontage& m) {
+         m.section_starts = {0.0f, 5.0f};
+       },
+       {"before the montage's end"}},
+      {"section start NaN",
+       [=](SyntheticMontage& m) {
+         m.section_starts = {0.0f, nan};
+       },
+       {"section 1"}},
+      {"next section",
+       [](SyntheticMontage& m) {
+         m.section_next = {1, 7};
+       },
+       {"next section 7 is out of range"}},
+      {"next section negative",
+       [](SyntheticMontage& m) {
+         m.section_next = {-2, 1};
+       },
+       {"next section -2"}},
       {"no sections", [](SyntheticMontage& m) { m.section_starts.clear(); }, {"0 sections"}},
-      {"section name", [](SyntheticMontage& m) { m.section_names = {"start", ""}; }, {"section 1: has an empty name"}},
+      {"section name",
+       [](SyntheticMontage& m) {
+         m.section_names = {"start", ""};
+       },
+       {"section 1: has an empty name"}},
       {"notify time", [](SyntheticMontage& m) { m.notify_time = 5.0f; }, {"outside the montage"}},
       {"notify time NaN", [=](SyntheticMontage& m) { m.notify_time = nan; }, {"notify 0: time nan"}},
       {"window duration", [](SyntheticMontage& m) { m.notify_duration = 0.0f; }, {"above 0 for a window"}},
       {"notify duration inf", [=](SyntheticMontage& m) { m.notify_duration = inf; }, {"duration inf"}},
-      {"notify kind", [](SyntheticMontage& m) { m.notify_kind = static_cast<fb::MontageNotifyKind>(9); }, {"unknown kind 9"}},
+      {"notify kind",
+       [](SyntheticMontage& m) { m.notify_kind = static_cast<fb::MontageNotifyKind>(9); },
+       {"unknown kind 9"}},
       {"notify name", [](SyntheticMontage& m) { m.notify.clear(); }, {"notify 0: has an empty name"}},
       {"montage rate", [](SyntheticMontage& m) { m.rate = 0.0f; }, {"'wave': rate 0"}},
       {"montage rate huge", [](SyntheticMontage& m) { m.rate = 1e9f; }, {"rate 1e+09"}},
       {"blend in", [](SyntheticMontage& m) { m.blend_in = -1.0f; }, {"blend in -1"}},
       {"blend out NaN", [=](SyntheticMontage& m) { m.blend_out = nan; }, {"blend out nan"}},
-      {"blend curve", [](SyntheticMontage& m) { m.blend_in_curve = static_cast<fb::MontageCurve>(7); }, {"unknown blend curve 7"}},
+      {"blend curve",
+       [](SyntheticMontage& m) { m.blend_in_curve = static_cast<fb::MontageCurve>(7); },
+       {"unknown blend curve 7"}},
       {"trigger", [=](SyntheticMontage& m) { m.trigger = nan; }, {"trigger nan"}},
       {"trigger huge", [](SyntheticMontage& m) { m.trigger = 1e7f; }, {"trigger 1e+07"}},
       {"track slot", [](SyntheticMontage& m) { m.track_slot.clear(); }, {"track 0: names no slot"}},

@@ -18,7 +18,6 @@
 #include <ossa/anim/blend_space.h>
 #include "allocation_counter.h"
 
-
 namespace ossa {
 namespace {
 
@@ -189,9 +188,8 @@ glm::vec2 blended_point(const BlendSpace2D& s, const std::vector<float>& w) {
 /// Speed (m/s) x direction (degrees): idle, walk and run in 4 directions; plenty of collinear
 /// and co-circular points, and axes in very different units.
 std::vector<glm::vec2> locomotion_points() {
-  return {{0, 0},     {1.5f, -180}, {1.5f, -90}, {1.5f, 0}, {1.5f, 90}, {1.5f, 180},
-          {5, -180},  {5, -90},     {5, 0},      {5, 90},   {5, 180},   {0, -180},
-          {0, 180},   {0, -90},     {0, 90}};
+  return {{0, 0}, {1.5f, -180}, {1.5f, -90}, {1.5f, 0}, {1.5f, 90}, {1.5f, 180}, {5, -180}, {5, -90},
+          {5, 0}, {5, 90},      {5, 180},    {0, -180}, {0, 180},   {0, -90},    {0, 90}};
 }
 
 TEST(BlendSpace2D, TriangulationIsDelaunayOverTheHull) {
@@ -266,7 +264,8 @@ TEST(BlendSpace2D, RandomAndGridSnappedPointSets) {
     std::vector<glm::vec2> pts;
     while (pts.size() < n) {
       glm::vec2 p(next() * 6.0f, next() * 360.0f - 180.0f);
-      if (snap > 0.0f) p = glm::vec2(std::round(p.x / (6.0f * snap)) * 6.0f * snap, std::round(p.y / (360.0f * snap)) * 360.0f * snap);
+      if (snap > 0.0f)
+        p = glm::vec2(std::round(p.x / (6.0f * snap)) * 6.0f * snap, std::round(p.y / (360.0f * snap)) * 360.0f * snap);
       bool dup = false;
       for (const auto& q : pts) dup = dup || q == p;
       if (!dup) pts.push_back(p);
@@ -310,13 +309,15 @@ TEST(BlendSpace2D, DegenerateInputIsAnError) {
 }
 
 TEST(BlendSpace2D, ExactAtEachSample) {
-  for (const auto& pts : {locomotion_points(), std::vector<glm::vec2>{{0, 0}, {1, 0}, {0.3f, 2}, {2, 2}, {1.1f, 0.9f}}}) {
+  for (const auto& pts :
+       {locomotion_points(), std::vector<glm::vec2>{{0, 0}, {1, 0}, {0.3f, 2}, {2, 2}, {1.1f, 0.9f}}}) {
     auto s = make_blend_space_2d(pts);
     ASSERT_TRUE(s) << s.error().message;
     std::vector<float> w(pts.size());
     for (size_t i = 0; i < pts.size(); ++i) {
       blend_space_2d_weights(*s, pts[i], w);
-      for (size_t j = 0; j < w.size(); ++j) EXPECT_EQ(w[j], i == j ? 1.0f : 0.0f) << "at sample " << i << ", weight " << j;
+      for (size_t j = 0; j < w.size(); ++j)
+        EXPECT_EQ(w[j], i == j ? 1.0f : 0.0f) << "at sample " << i << ", weight " << j;
     }
   }
 }

@@ -72,8 +72,8 @@ struct Rig {
     for (int leg = 1; leg <= 2; ++leg) {
       const float side = leg == 1 ? 0.1f : -0.1f;
       const float angle = swing * (leg == 1 ? phase : -phase);
-      model[static_cast<size_t>(leg)] = glm::rotate(glm::translate(glm::mat4(1.0f), glm::vec3(side, 0.95f + bob, 0)),
-                                                    angle, glm::vec3(1, 0, 0));
+      model[static_cast<size_t>(leg)] =
+          glm::rotate(glm::translate(glm::mat4(1.0f), glm::vec3(side, 0.95f + bob, 0)), angle, glm::vec3(1, 0, 0));
     }
   }
   ossa::Status step(double t, float dt, const glm::mat4& world) {
@@ -252,7 +252,8 @@ TEST(Cloth, TeleportAndResetRestartAtRest) {
   ASSERT_TRUE(rig.step(1.0 + 1.0 / 60.0, 1.0f / 60.0f, far).ok());
   EXPECT_EQ(rig.cloth.restarts, restarts + 1);
   EXPECT_LE(rig.kinetic(), before + 1e-3f) << "the jump must not throw the cape";
-  for (size_t i = 0; i < rig.skinned.size(); ++i) EXPECT_LT(glm::distance(rig.cloth.positions()[i], rig.skinned[i]), 0.05f);
+  for (size_t i = 0; i < rig.skinned.size(); ++i)
+    EXPECT_LT(glm::distance(rig.cloth.positions()[i], rig.skinned[i]), 0.05f);
 
   // Without teleport detection the same jump is what the detection prevents: a spike.
   Rig blind(cape());
@@ -379,8 +380,8 @@ TEST(Cloth, UpdatesAllocateNothing) {
 /// iteration count (XPBD's promise; plain PBD gets stiffer with both).
 TEST(Cloth, ComplianceNotStepsSetsTheStiffness) {
   std::vector<float> lengths;
-  for (const auto& [substep, iterations] : {std::pair{1.0f / 120.0f, 1u}, {1.0f / 240.0f, 1u}, {1.0f / 480.0f, 1u},
-                                            {1.0f / 240.0f, 4u}}) {
+  for (const auto& [substep, iterations] :
+       {std::pair{1.0f / 120.0f, 1u}, {1.0f / 240.0f, 1u}, {1.0f / 480.0f, 1u}, {1.0f / 240.0f, 4u}}) {
     GridCloth g = make_grid_cloth(1, 11, 0.1f);
     g.tethers.clear();
     g.settings.stretch_compliance = 2e-4f;

@@ -90,8 +90,7 @@ std::vector<std::pair<std::string, std::function<void()>>> kernels(Fixture& f) {
   out.emplace_back("add", [=] { ossa::add(*pose, *other, 0.5f, *result); });
   out.emplace_back("local_to_model", [=] { ossa::local_to_model(skeleton.parents(), *pose, *model); });
   out.emplace_back("skinning_matrices(mesh)", [=] { ossa::skinning_matrices(mesh, *model, *palette); });
-  out.emplace_back("skinning_matrices(bind)",
-                   [=] { ossa::skinning_matrices(mesh.joints(), *bind, *model, *palette); });
+  out.emplace_back("skinning_matrices(bind)", [=] { ossa::skinning_matrices(mesh.joints(), *bind, *model, *palette); });
   for (ossa::SkinningIsa isa : {ossa::SkinningIsa::Portable, ossa::SkinningIsa::Avx2, ossa::SkinningIsa::Avx512}) {
     out.emplace_back("skin_cpu isa " + std::to_string(int(isa)), [=] {
       const ossa::SkinningIsa before = ossa::skinning_isa();
@@ -116,7 +115,8 @@ TEST(FloatEnvironment, CallersMxcsrIsRestored) {
       run();
       const unsigned after = _mm_getcsr();
       _mm_setcsr(original);
-      EXPECT_EQ(after & ~0x3fu, csr & ~0x3fu) << name << " changed MXCSR's controls " << std::hex << csr << " to " << after;
+      EXPECT_EQ(after & ~0x3fu, csr & ~0x3fu)
+          << name << " changed MXCSR's controls " << std::hex << csr << " to " << after;
     }
   }
 }

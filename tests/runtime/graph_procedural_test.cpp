@@ -27,9 +27,8 @@ namespace {
 using namespace ossa::cook;
 using test::PabRig;
 
-
-using test::Played;
 using test::play;
+using test::Played;
 
 uint16_t vector_param(GraphDef& g, const std::string& name, glm::vec3 value = glm::vec3(0.0f), bool world = false) {
   const uint16_t p = test::add_param(g, name, ParamType::Vector);
@@ -146,11 +145,13 @@ TEST(GraphProcedural, ZeroWeightPassesTheInputThroughUnchanged) {
   f.weight_parameter = static_cast<int16_t>(w);
   n = test::add_node(g, f);
   FootLockDef l;
-  l.input = n, l.legs = {leg}, l.release_radius = 10.0f, l.blend_time = 0.0f, l.weight_parameter = static_cast<int16_t>(w);
+  l.input = n, l.legs = {leg}, l.release_radius = 10.0f, l.blend_time = 0.0f,
+  l.weight_parameter = static_cast<int16_t>(w);
   n = test::add_node(g, l);
   SpringDef s;
   s.input = n, s.weight_parameter = static_cast<int16_t>(w);
-  s.chains = {SpringChainDef{{joint(*rig, "RightArm"), joint(*rig, "RightForeArm")}, 4.0f, 0.4f, {0.0f, -981.0f, 0.0f}, 2.0f, 20.0f}};
+  s.chains = {SpringChainDef{
+      {joint(*rig, "RightArm"), joint(*rig, "RightForeArm")}, 4.0f, 0.4f, {0.0f, -981.0f, 0.0f}, 2.0f, 20.0f}};
   n = test::add_node(g, s);
   g.root = n;
   GraphDef plain = test::pab_graph(*rig);
@@ -167,7 +168,8 @@ TEST(GraphProcedural, ZeroWeightPassesTheInputThroughUnchanged) {
   p.inst->set_float(p.param("w"), 1.0f);
   p.inst->update(1.0f / 60.0f);
   q.inst->update(1.0f / 60.0f);
-  EXPECT_NE(0, std::memcmp(p.inst->pose().base, q.inst->pose().base, sizeof(float) * kPoseComponents * p.inst->pose().stride));
+  EXPECT_NE(0, std::memcmp(p.inst->pose().base, q.inst->pose().base,
+                           sizeof(float) * kPoseComponents * p.inst->pose().stride));
 }
 
 TEST(GraphProcedural, AimChainTurnsTheHeadOntoTheTargetWithinItsLimits) {
@@ -177,12 +179,14 @@ TEST(GraphProcedural, AimChainTurnsTheHeadOntoTheTargetWithinItsLimits) {
     AimDef a;
     a.input = test::clip_node(g, test::kWalk, 0.0f);
     a.target_parameter = vector_param(g, "target");
-    a.chain = {{joint(*rig, "Spine2"), 0.3f, limit}, {joint(*rig, "Neck"), 0.5f, limit}, {joint(*rig, "Head"), 1.0f, limit}};
+    a.chain = {
+        {joint(*rig, "Spine2"), 0.3f, limit}, {joint(*rig, "Neck"), 0.5f, limit}, {joint(*rig, "Head"), 1.0f, limit}};
     // The head's local axes at the bind pose: Pab faces +z, up +y (computed as the compiler does).
     glm::quat bind(1.0f, 0.0f, 0.0f, 0.0f);
     for (int j = rig->joint("Head"); j >= 0; j = rig->skeleton.joints[static_cast<size_t>(j)].parent)
       bind = rig->skeleton.joints[static_cast<size_t>(j)].rotation * bind;
-    const glm::vec3 f = glm::conjugate(bind) * glm::vec3(0.0f, 0.0f, 1.0f), u = glm::conjugate(bind) * glm::vec3(0.0f, 1.0f, 0.0f);
+    const glm::vec3 f = glm::conjugate(bind) * glm::vec3(0.0f, 0.0f, 1.0f),
+                    u = glm::conjugate(bind) * glm::vec3(0.0f, 1.0f, 0.0f);
     a.forward = {f.x, f.y, f.z};
     a.up = {u.x, u.y, u.z};
     a.pole = {0.0f, 1.0f, 0.0f};
@@ -228,12 +232,13 @@ GraphDef feet_graph(const PabRig& rig, uint16_t clip) {
   f.input = test::clip_node(g, clip, 0.0f);
   f.pelvis = joint(rig, "Hips");
   f.max_pelvis_drop = 40.0f;
-  const uint16_t left = test::add_param(g, "left", ParamType::Float), right = test::add_param(g, "right", ParamType::Float);
+  const uint16_t left = test::add_param(g, "left", ParamType::Float),
+                 right = test::add_param(g, "right", ParamType::Float);
   g.parameters[left].min_value = g.parameters[right].min_value = -100.0f;
   g.parameters[left].max_value = g.parameters[right].max_value = 100.0f;
   const uint16_t normal = vector_param(g, "normal", glm::vec3(0.0f, 1.0f, 0.0f));
   for (const auto& [hip, knee, ankle, ground] : {std::tuple{"LeftUpLeg", "LeftLeg", "LeftFoot", left},
-                                                  std::tuple{"RightUpLeg", "RightLeg", "RightFoot", right}}) {
+                                                 std::tuple{"RightUpLeg", "RightLeg", "RightFoot", right}}) {
     FootLegDef leg;
     leg.hip = joint(rig, hip), leg.knee = joint(rig, knee), leg.ankle = joint(rig, ankle);
     leg.ground_parameter = static_cast<int16_t>(ground);
@@ -278,7 +283,8 @@ TEST(GraphProcedural, FootPlacementPutsEachFootOnItsGroundAndLowersThePelvisToRe
   p.inst->set_vector(p.param("normal"), normal);
   p.inst->update(0.0f);
   const glm::mat3 animated(q.model()[static_cast<size_t>(la)]), placed(p.model()[static_cast<size_t>(la)]);
-  const glm::quat turn = glm::normalize(glm::quat_cast(placed)) * glm::conjugate(glm::normalize(glm::quat_cast(animated)));
+  const glm::quat turn =
+      glm::normalize(glm::quat_cast(placed)) * glm::conjugate(glm::normalize(glm::quat_cast(animated)));
   EXPECT_NEAR(glm::angle(turn), angle, 2e-3f);
 }
 
@@ -331,7 +337,11 @@ GraphDef arm_spring_graph(const PabRig& rig, float teleport) {
   SpringDef s;
   s.input = test::clip_node(g, test::kWalk, 0.0f);
   s.chains = {SpringChainDef{{joint(rig, "RightArm"), joint(rig, "RightForeArm"), joint(rig, "RightHand")},
-                             3.0f, 0.2f, {0.0f, -981.0f, 0.0f}, 3.0f, 15.0f}};
+                             3.0f,
+                             0.2f,
+                             {0.0f, -981.0f, 0.0f},
+                             3.0f,
+                             15.0f}};
   s.colliders = {SpringColliderDef{joint(rig, "Spine2"), {0.0f, 0.0f, 0.0f}, {0.0f, 20.0f, 0.0f}, 14.0f}};
   s.teleport_distance = teleport;
   g.root = test::add_node(g, s, "arm");
@@ -339,7 +349,8 @@ GraphDef arm_spring_graph(const PabRig& rig, float teleport) {
 }
 
 glm::mat4 swing(double t) {
-  return glm::translate(glm::mat4(1.0f), glm::vec3(static_cast<float>(40.0 * std::sin(2.0 * 3.14159265358979 * 0.7 * t)), 0.0f, 0.0f));
+  return glm::translate(glm::mat4(1.0f),
+                        glm::vec3(static_cast<float>(40.0 * std::sin(2.0 * 3.14159265358979 * 0.7 * t)), 0.0f, 0.0f));
 }
 
 TEST(GraphProcedural, SpringChainGivesTheSameMotionAtAnyFrameRate) {
@@ -448,7 +459,8 @@ TEST(GraphProcedural, OutOfRangeSettingsAreRefusedByTheLoader) {
   std::get<TwoBoneIkDef>(ik.nodes[ik.root].kind).weight = 2.0f;
   refused(ik, "weight must be within [0, 1]");
   ik = leg_ik_graph(*rig, test::kWalk, 1.0f, false);
-  std::get<TwoBoneIkDef>(ik.nodes[ik.root].kind).target_parameter = static_cast<uint16_t>(std::get<TwoBoneIkDef>(ik.nodes[ik.root].kind).weight_parameter);
+  std::get<TwoBoneIkDef>(ik.nodes[ik.root].kind).target_parameter =
+      static_cast<uint16_t>(std::get<TwoBoneIkDef>(ik.nodes[ik.root].kind).weight_parameter);
   refused(ik, "has type Float, which cannot be used here");
   GraphDef spring = arm_spring_graph(*rig, 0.0f);
   auto& chain = std::get<SpringDef>(spring.nodes[spring.root].kind).chains[0];
@@ -461,7 +473,8 @@ TEST(GraphProcedural, OutOfRangeSettingsAreRefusedByTheLoader) {
   std::get<SpringDef>(spring.nodes[spring.root].kind).step = 0.0f;
   refused(spring, "step must be within [1e-4, 1] s");
   GraphDef feet = feet_graph(*rig, test::kWalk);
-  std::get<FootPlacementDef>(feet.nodes[feet.root].kind).legs.resize(9, std::get<FootPlacementDef>(feet.nodes[feet.root].kind).legs[0]);
+  std::get<FootPlacementDef>(feet.nodes[feet.root].kind)
+      .legs.resize(9, std::get<FootPlacementDef>(feet.nodes[feet.root].kind).legs[0]);
   refused(feet, "9 legs; a foot node needs 1 to 8");
   feet = feet_graph(*rig, test::kWalk);
   std::get<FootPlacementDef>(feet.nodes[feet.root].kind).legs[0].normal_parameter = 0;  // not a vector

@@ -26,9 +26,8 @@ namespace {
 using namespace ossa::cook;
 using test::PabRig;
 
-
-using test::Played;
 using test::play;
+using test::Played;
 
 /// Two states playing clips a and b, a -> b on trigger "go" with the given mode and duration, and
 /// b -> c (if c >= 0) on trigger "next".
@@ -141,7 +140,7 @@ TEST(GraphCrossfade, WeightAfterAnyDtSequenceIsElapsedOverDuration) {
 // ---- no pop at a switch -----------------------------------------------------------------------
 
 struct PopResult {
-  float steady = 0.0f;  // largest per-frame joint displacement of plain playback around the switch
+  float steady = 0.0f;     // largest per-frame joint displacement of plain playback around the switch
   float at_switch = 0.0f;  // largest per-frame displacement over the transition
 };
 
@@ -161,14 +160,16 @@ PopResult measure_pop(const PabRig& rig, TransitionModeDef mode, float duration,
   const int frames_after = static_cast<int>((duration + 0.3f) / dt);
   for (int f = 0; f < frames_before + frames_after; ++f) {
     if (f == frames_before) p.inst->set_trigger(p.param("go"));
-    if (interrupt_to >= 0 && f == frames_before + static_cast<int>(0.4f * duration / dt)) p.inst->set_trigger(p.param("next"));
+    if (interrupt_to >= 0 && f == frames_before + static_cast<int>(0.4f * duration / dt))
+      p.inst->set_trigger(p.param("next"));
     p.inst->update(dt);
     std::vector<glm::vec3> now = positions(p, p.inst->pose());
     if (f >= frames_before) out.at_switch = std::max(out.at_switch, max_step(prev, now));
     prev = std::move(now);
   }
   // Steady: each clip alone over the same frames.
-  for (uint16_t clip : {uint16_t(test::kWalk), uint16_t(test::kRun), uint16_t(interrupt_to >= 0 ? interrupt_to : test::kRun)}) {
+  for (uint16_t clip :
+       {uint16_t(test::kWalk), uint16_t(test::kRun), uint16_t(interrupt_to >= 0 ? interrupt_to : test::kRun)}) {
     ClipPlayer c = player(p, clip);
     std::vector<glm::vec3> last;
     for (int f = 0; f <= frames_before + frames_after; ++f) {
@@ -243,7 +244,8 @@ TEST(GraphSyncCrossfade, TargetStartsAtSourcePhaseAndStaysInStep) {
 
 TEST(GraphInterruption, TransitionOutOfTheTargetTakesOverAndKeepsThePose) {
   NEED_RIG();
-  Played p = play(*rig, two_states(*rig, test::kWalk, test::kRun, TransitionModeDef::Crossfade, 0.5f, test::kCrossarms));
+  Played p =
+      play(*rig, two_states(*rig, test::kWalk, test::kRun, TransitionModeDef::Crossfade, 0.5f, test::kCrossarms));
   ASSERT_TRUE(p.inst);
   for (int f = 0; f < 10; ++f) p.inst->update(1.0f / 60.0f);
   p.inst->set_trigger(p.param("go"));
@@ -490,7 +492,8 @@ void drive(GraphInstance& inst, const GraphDefinition& def, int frames, uint32_t
     if (f % 97 == 0) inst.set_trigger(stop);
     inst.update(1.0f / 60.0f + 0.004f * u(rng));
     const int t = inst.machine_status(0).transition;
-    if (transitions && t >= 0 && static_cast<size_t>(t) < transitions->size()) (*transitions)[static_cast<size_t>(t)] = 1;
+    if (transitions && t >= 0 && static_cast<size_t>(t) < transitions->size())
+      (*transitions)[static_cast<size_t>(t)] = 1;
   }
 }
 
@@ -517,7 +520,7 @@ TEST(GraphInstance, SampleGraphIsDeterministicAndAllocationFree) {
   a.inst = std::make_unique<GraphInstance>(std::move(*first));
   auto b = GraphInstance::create(*a.def);
   ASSERT_TRUE(b.ok());
-  drive(*a.inst, *a.def, 50, 3);  // warm up (first sample decodes keys)
+  drive(*a.inst, *a.def, 50, 3);         // warm up (first sample decodes keys)
   std::vector<char> transitions(16, 0);  // sized before counting: the record must not allocate
   const size_t before = test::allocation_count();
   drive(*a.inst, *a.def, 2000, 5, &transitions);
@@ -692,11 +695,13 @@ TEST(GraphValidation, MalformedGraphTablesAreRejectedWithTheirFault) {
       {"must be an earlier node", [](GraphDef& g) { std::get<BlendAlphaDef>(g.nodes[2].kind).b = 2; }},
       {"already used", [](GraphDef& g) { std::get<BlendAlphaDef>(g.nodes[2].kind).b = 0; }},
       {"cannot be used here", [](GraphDef& g) { std::get<BlendAlphaDef>(g.nodes[2].kind).alpha_parameter = 1; }},
-      {"parameter 7 is out of range", [](GraphDef& g) { std::get<BlendAlphaDef>(g.nodes[2].kind).alpha_parameter = 7; }},
+      {"parameter 7 is out of range",
+       [](GraphDef& g) { std::get<BlendAlphaDef>(g.nodes[2].kind).alpha_parameter = 7; }},
       {"clip 9 is out of range", [](GraphDef& g) { std::get<ClipNodeDef>(g.nodes[0].kind).clip = 9; }},
       {"root 5 is not a node", [](GraphDef& g) { g.root = 5; }},
       {"start offset", [](GraphDef& g) { std::get<ClipNodeDef>(g.nodes[0].kind).start_offset = -1.0f; }},
-      {"default 9 lies outside", [](GraphDef& g) {
+      {"default 9 lies outside",
+       [](GraphDef& g) {
          g.parameters[0].max_value = 1.0f;
          g.parameters[0].default_value = 9.0f;
        }},

@@ -47,7 +47,8 @@ struct Chain {
   }
   /// Multiplies the corrections into the local pose and recomputes model space.
   void apply(const ossa::TwoBoneIkOutput& out) {
-    for (const auto& [joint, correction] : {std::pair{kStart, out.start_correction}, std::pair{kMid, out.mid_correction}}) {
+    for (const auto& [joint, correction] :
+         {std::pair{kStart, out.start_correction}, std::pair{kMid, out.mid_correction}}) {
       Transform t = ossa::get_transform(local, joint);
       t.rotation = glm::normalize(t.rotation * correction);
       ossa::set_transform(local, joint, t);
@@ -342,7 +343,9 @@ struct Head {
   std::vector<glm::mat4> model = std::vector<glm::mat4>(3);
   static constexpr std::array<int16_t, 3> kHeadParents{-1, 0, 1};
   void update() { ossa::local_to_model(kHeadParents, local, model); }
-  glm::vec3 axis(glm::vec3 local_axis) const { return glm::normalize(glm::vec3(model[2] * glm::vec4(local_axis, 0.0f))); }
+  glm::vec3 axis(glm::vec3 local_axis) const {
+    return glm::normalize(glm::vec3(model[2] * glm::vec4(local_axis, 0.0f)));
+  }
   glm::vec3 position() const { return glm::vec3(model[2][3]); }
   void apply(const glm::quat& correction) {
     Transform t = ossa::get_transform(local, 2);

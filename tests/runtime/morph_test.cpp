@@ -91,8 +91,8 @@ TEST(Morph, ApplyAddsWeightedDeltasToListedVerticesOnly) {
   ASSERT_TRUE(apply_morphs(mesh, target_channel, weights, p, normals));
   // Expected from the spec's integers: smile (w 0.5, step 1e-4) lifts 4 by 0.05 and 5 by 0.1;
   // frown (w 2, step 1e-4) moves 2 by -0.1 in x, 3 by +0.1 in x, 4 by -0.06 in y.
-  const std::vector<glm::vec3> expected_delta = {{0, 0, 0}, {0, 0, 0}, {-0.1f, 0, 0}, {0.1f, 0, 0},
-                                                 {0, 0.05f - 0.06f, 0}, {0, 0.1f, 0}};
+  const std::vector<glm::vec3> expected_delta = {
+      {0, 0, 0}, {0, 0, 0}, {-0.1f, 0, 0}, {0.1f, 0, 0}, {0, 0.05f - 0.06f, 0}, {0, 0.1f, 0}};
   for (size_t v = 0; v < n; ++v)
     for (int a = 0; a < 3; ++a) EXPECT_NEAR(p[v][a] - base[v][a], expected_delta[v][a], 1e-5f) << v << " " << a;
   // Normals: frown's deltas (w 2, step 1e-3): +0.2 z on 2, -0.2 z on 3; smile has none.

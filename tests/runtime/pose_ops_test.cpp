@@ -252,8 +252,8 @@ TEST(Pose, BindPoseFromSkeleton) {
   for (uint32_t j = 0; j < p.joint_count(); ++j) {
     const Transform t = ossa::get_transform(p, j);
     EXPECT_EQ(t.translation, glm::vec3(spec.translations[j].x(), spec.translations[j].y(), spec.translations[j].z()));
-    EXPECT_EQ(t.rotation, glm::quat(spec.rotations[j].w(), spec.rotations[j].x(), spec.rotations[j].y(),
-                                     spec.rotations[j].z()));
+    EXPECT_EQ(t.rotation,
+              glm::quat(spec.rotations[j].w(), spec.rotations[j].x(), spec.rotations[j].y(), spec.rotations[j].z()));
     EXPECT_EQ(t.scale, glm::vec3(spec.scales[j].x(), spec.scales[j].y(), spec.scales[j].z()));
   }
   expect_padding_identity(p);
@@ -385,9 +385,9 @@ TEST(BlendN, ManyPosesMatchPerJointReference) {
   std::vector<Pose> inputs;
   for (size_t i = 0; i < kCount; ++i) inputs.push_back(random_pose(kJoints, uint32_t(80 + i)));
   std::vector<ConstPoseSpan> poses(inputs.begin(), inputs.end());
-  for (const std::vector<float>& weights : {std::vector<float>{1, 2, 3, 4, 5, 6, 7, 8},
-                                            std::vector<float>{0, 0.5f, 0, 1, 2, 0, 0.25f, 0},
-                                            std::vector<float>{3, 1, 4, 1, 5, 9, 2}}) {
+  for (const std::vector<float>& weights :
+       {std::vector<float>{1, 2, 3, 4, 5, 6, 7, 8}, std::vector<float>{0, 0.5f, 0, 1, 2, 0, 0.25f, 0},
+        std::vector<float>{3, 1, 4, 1, 5, 9, 2}}) {
     const size_t n = std::min(poses.size(), weights.size());
     Pose out(kJoints);
     ossa::blend_n(std::span(poses.data(), n), std::span(weights.data(), n), out);
@@ -503,8 +503,8 @@ TEST(JointMask, PabUpperBody) {
   std::set<std::string> masked;
   for (size_t j = 0; j < m.size(); ++j)
     if (m[j] == 1.0f) masked.insert(std::string(sk.joint_name(j)));
-  for (const char* name : {"Spine1", "Spine3", "Head", "LeftArm", "Lefthand", "LeftHandIndex3", "RightArm",
-                           "RightHand", "RightHandPinky3"})
+  for (const char* name : {"Spine1", "Spine3", "Head", "LeftArm", "Lefthand", "LeftHandIndex3", "RightArm", "RightHand",
+                           "RightHandPinky3"})
     EXPECT_TRUE(masked.count(name)) << name;
   for (const char* name : {"Hips", "Pelvis", "Spine", "LeftUpLeg", "LeftFoot", "RightUpLeg", "RightFoot"})
     EXPECT_FALSE(masked.count(name)) << name;

@@ -29,8 +29,9 @@ using ossa::test::SyntheticRig;
 using B = HumanoidBone;
 
 std::vector<HumanoidNames> conventions() {
-  return {test::mixamo_names(), test::unreal_names(), test::unity_names(),  test::vroid_names(), test::rigify_names(),
-          test::metarig_names(), test::cmu_names(),   test::biped_names(), test::quaternius_names()};
+  return {test::mixamo_names(), test::unreal_names(), test::unity_names(),
+          test::vroid_names(),  test::rigify_names(), test::metarig_names(),
+          test::cmu_names(),    test::biped_names(),  test::quaternius_names()};
 }
 
 TEST(HumanoidProfile, NamesAndParents) {
@@ -72,7 +73,8 @@ TEST(HumanoidMapping, MissingBonesAreNamed) {
   const HumanoidMap map = map_humanoid(rig.views, rig.parents);
   const Status st = check_humanoid(map, rig.parents, "handless.ossa");
   ASSERT_FALSE(st.ok());
-  EXPECT_NE(st.message().find("handless.ossa: missing humanoid bones: leftHand, rightHand"), std::string::npos) << st.message();
+  EXPECT_NE(st.message().find("handless.ossa: missing humanoid bones: leftHand, rightHand"), std::string::npos)
+      << st.message();
   const SyntheticRig other = test::make_humanoid(test::unity_names(), RigShape{});
   RetargetRig source = rig.rig("handless.ossa");
   auto built = make_retarget_map(source, other.rig("unity.ossa"));
@@ -123,7 +125,8 @@ Worst run(const SyntheticRig& source, const SyntheticRig& target, const Retarget
     for (float d : m.foot_degrees) w.foot = std::max(w.foot, d);
     for (int p : {kLeftHandPoint, kRightHandPoint, kLeftFootPoint, kRightFootPoint}) {
       const float side = p % 2 == 0 ? 1.0f : -1.0f;
-      if (side * m.source_side[static_cast<size_t>(p)] > 0.05f && side * m.target_side[static_cast<size_t>(p)] < 0.0f) ++w.crossings;
+      if (side * m.source_side[static_cast<size_t>(p)] > 0.05f && side * m.target_side[static_cast<size_t>(p)] < 0.0f)
+        ++w.crossings;
     }
   }
   return w;
@@ -133,8 +136,13 @@ TEST(Retarget, APoseRigMeetsTPoseRig) {
   // Mixamo T-pose, Y-up, metres -> an Unreal A-pose rig, Z-up, centimetres, other proportions,
   // every joint frame turned at random; and back.
   const SyntheticRig t_pose = test::make_humanoid(test::mixamo_names(), RigShape{.frame_seed = 3});
-  RigShape a_shape{.arm_down_degrees = 45.0f, .thigh = 0.5f, .shin = 0.47f, .upper_arm = 0.31f, .forearm = 0.27f,
-                   .orientation = glm::angleAxis(glm::radians(90.0f), glm::vec3(1, 0, 0)), .units_per_metre = 100.0f,
+  RigShape a_shape{.arm_down_degrees = 45.0f,
+                   .thigh = 0.5f,
+                   .shin = 0.47f,
+                   .upper_arm = 0.31f,
+                   .forearm = 0.27f,
+                   .orientation = glm::angleAxis(glm::radians(90.0f), glm::vec3(1, 0, 0)),
+                   .units_per_metre = 100.0f,
                    .frame_seed = 11};
   const SyntheticRig a_pose = test::make_humanoid(test::unreal_names(), a_shape);
   for (int direction = 0; direction < 2; ++direction) {
@@ -167,7 +175,8 @@ TEST(Retarget, AcrossConventionsChainsAndIkFeet) {
       {one, RigShape{.thigh = 0.38f, .shin = 0.40f, .frame_seed = 2}},
       {five, RigShape{.arm_down_degrees = 30.0f, .frame_seed = 3}},
       {test::cmu_names(), RigShape{.units_per_metre = 39.37f, .frame_seed = 4}},
-      {test::quaternius_names(), RigShape{.thigh = 0.33f, .shin = 0.5f, .hip_width = 0.12f, .frame_seed = 5, .ik_feet = true}},
+      {test::quaternius_names(),
+       RigShape{.thigh = 0.33f, .shin = 0.5f, .hip_width = 0.12f, .frame_seed = 5, .ik_feet = true}},
   };
   for (size_t a = 0; a < rigs.size(); ++a) {
     for (size_t b = 0; b < rigs.size(); ++b) {
@@ -191,7 +200,8 @@ TEST(Retarget, RigOntoItselfIsTheSource) {
   for (const auto& [names, shape] : std::vector<std::pair<HumanoidNames, RigShape>>{
            {test::mixamo_names(), RigShape{.frame_seed = 9}},
            {test::quaternius_names(), RigShape{.units_per_metre = 100.0f, .frame_seed = 10, .ik_feet = true}},
-           {test::cmu_names(), RigShape{.orientation = glm::angleAxis(3.14159265f, glm::vec3(0, 1, 0)), .frame_seed = 12}}}) {
+           {test::cmu_names(),
+            RigShape{.orientation = glm::angleAxis(3.14159265f, glm::vec3(0, 1, 0)), .frame_seed = 12}}}) {
     SCOPED_TRACE(names.convention);
     const SyntheticRig rig = test::make_humanoid(names, shape);
     auto map = make_retarget_map(rig.rig("self"), rig.rig("self"));
@@ -258,7 +268,8 @@ void lunge(const SyntheticRig& rig, uint32_t frame, PoseSpan out) {
   swing.rotation = glm::normalize(swing.rotation * (glm::inverse(m) * lift * m));
   set_transform(out, static_cast<uint32_t>(right), swing);
   local_to_model(rig.parents, out, model);
-  const int up = rig.joint("mixamorig:LeftUpLeg"), knee = rig.joint("mixamorig:LeftLeg"), foot = rig.joint("mixamorig:LeftFoot");
+  const int up = rig.joint("mixamorig:LeftUpLeg"), knee = rig.joint("mixamorig:LeftLeg"),
+            foot = rig.joint("mixamorig:LeftFoot");
   TwoBoneIkInput ik;
   ik.start = model[static_cast<size_t>(up)];
   ik.mid = model[static_cast<size_t>(knee)];
@@ -278,7 +289,8 @@ TEST(Retarget, PlantedFeetStayPlanted) {
   HumanoidNames mixamo = test::mixamo_names();
   const SyntheticRig s = test::make_humanoid(mixamo, RigShape{.frame_seed = 21});
   const SyntheticRig t = test::make_humanoid(
-      test::quaternius_names(), RigShape{.thigh = 0.33f, .shin = 0.52f, .hip_width = 0.13f, .frame_seed = 22, .ik_feet = true});
+      test::quaternius_names(),
+      RigShape{.thigh = 0.33f, .shin = 0.52f, .hip_width = 0.13f, .frame_seed = 22, .ik_feet = true});
   auto built = make_retarget_map(s.rig("lunge"), t.rig("quaternius"));
   ASSERT_TRUE(built.ok()) << built.error().message;
   const RetargetMap& map = *built;
@@ -342,7 +354,8 @@ TEST(Retarget, FramesAllocateNothing) {
   auto map = make_retarget_map(s.rig("s"), t.rig("t"));
   ASSERT_TRUE(map.ok());
   RetargetScratch scratch = make_retarget_scratch(*map);
-  Pose in(static_cast<uint32_t>(s.names.size())), out(static_cast<uint32_t>(t.names.size())), base(static_cast<uint32_t>(t.names.size()));
+  Pose in(static_cast<uint32_t>(s.names.size())), out(static_cast<uint32_t>(t.names.size())),
+      base(static_cast<uint32_t>(t.names.size()));
   test::bind_pose(t, base);
   std::array<FootContact, 2> contacts{FootContact{1.0f, glm::vec3(0.01f, 0.0f, 0.0f), {}},
                                       FootContact{0.5f, glm::vec3(0.0f), glm::vec3(0.01f, 0.0f, 0.0f)}};

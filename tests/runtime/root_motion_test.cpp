@@ -32,7 +32,6 @@
 #include "test_files.h"
 #include "allocation_counter.h"
 
-
 namespace ossa {
 namespace {
 
@@ -72,9 +71,7 @@ void apply(Placement& p, const RootMotionDelta& d, int up) {
   p.yaw += d.yaw;
 }
 
-glm::dmat4 matrix(const Placement& p, int up) {
-  return trs(p.position, glm::angleAxis(p.yaw, axis(up)));
-}
+glm::dmat4 matrix(const Placement& p, int up) { return trs(p.position, glm::angleAxis(p.yaw, axis(up))); }
 
 // ---------------------------------------------------------------------------------------------
 // A synthetic root running round a circle.
@@ -82,12 +79,12 @@ glm::dmat4 matrix(const Placement& p, int up) {
 struct Circle {
   int up = 1;
   float rate = 30.0f;
-  uint32_t frames = 61;           // 2 s at 30 Hz
-  double turns = 1.5;             // heading change over the clip: 3 pi, so unwrapping matters
+  uint32_t frames = 61;  // 2 s at 30 Hz
+  double turns = 1.5;    // heading change over the clip: 3 pi, so unwrapping matters
   double radius = 2.0;
   glm::dvec3 start_offset{0.3, 0.0, -0.2};  // ground offset of the circle (up component ignored)
-  double roll = 0.05;             // roll amplitude: makes the swing twist-free only when 0
-  bool tilt = true;               // constant -90 degrees about the first ground axis
+  double roll = 0.05;                       // roll amplitude: makes the swing twist-free only when 0
+  bool tilt = true;                         // constant -90 degrees about the first ground axis
 
   double duration() const { return double(frames - 1) / rate; }
   double omega() const { return 2.0 * kPi * turns / duration(); }
@@ -98,7 +95,8 @@ struct Circle {
     glm::dvec3 off = start_offset;
     off[up] = 0.0;
     const double phi = omega() * t;
-    return off + radius * (std::sin(phi) * i + (std::cos(phi) - 1.0) * j) + (0.9 + 0.05 * std::sin(6.0 * kPi * t / duration())) * u;
+    return off + radius * (std::sin(phi) * i + (std::cos(phi) - 1.0) * j) +
+           (0.9 + 0.05 * std::sin(6.0 * kPi * t / duration())) * u;
   }
   glm::dquat rotation(double t) const {
     const glm::dvec3 i = axis(up + 1), j = axis(up + 2), u = axis(up);
@@ -406,7 +404,8 @@ TEST(RootMotionDelta, ReverseIsTheInverse) {
     Placement p;
     apply(p, forward, 1);
     apply(p, backward, 1);
-    EXPECT_LT(glm::length(p.position), 1e-4 * (1.0 + glm::length(glm::dvec3(forward.translation)))) << pr[0] << " -> " << pr[1];
+    EXPECT_LT(glm::length(p.position), 1e-4 * (1.0 + glm::length(glm::dvec3(forward.translation))))
+        << pr[0] << " -> " << pr[1];
     EXPECT_NEAR(p.yaw, 0.0, 1e-5);
     EXPECT_NEAR(forward.yaw, -backward.yaw, 1e-5);
     // Playing backwards over the same span by small steps gives the same inverse.
@@ -534,8 +533,8 @@ TEST(RootMotionCooked, PabWalkMovesForwardWithTheRootInPlace) {
   // One cycle moves the character forward, in the ground plane, without turning much.
   const RootMotionDelta cycle = root_motion_delta(clip, 0.0, duration);
   const double distance_m = glm::length(glm::dvec3(cycle.translation)) * metres;
-  std::printf("Pab walk: %.3f s cycle, root motion %.3f m (%.1f units) per cycle, yaw %.4f rad\n", duration,
-              distance_m, double(glm::length(cycle.translation)), double(cycle.yaw));
+  std::printf("Pab walk: %.3f s cycle, root motion %.3f m (%.1f units) per cycle, yaw %.4f rad\n", duration, distance_m,
+              double(glm::length(cycle.translation)), double(cycle.yaw));
   EXPECT_GT(distance_m, 0.5);
   EXPECT_GT(cycle.translation.z, 0.99f * glm::length(cycle.translation));  // Pab faces +z
   EXPECT_EQ(cycle.translation.y, 0.0f);

@@ -256,7 +256,8 @@ TEST(RuntimeView, ClipAndMaterialViewsReturnWhatWasWritten) {
     EXPECT_EQ(level.height, sizes[k][1]);
     ASSERT_EQ(level.bytes.size(), sizes[k][2]);
     EXPECT_EQ(level.bytes.data(), bc4.data().data() + offset);
-    EXPECT_TRUE(std::equal(level.bytes.begin(), level.bytes.end(), test::kBc4Chain.begin() + static_cast<ptrdiff_t>(offset)));
+    EXPECT_TRUE(
+        std::equal(level.bytes.begin(), level.bytes.end(), test::kBc4Chain.begin() + static_cast<ptrdiff_t>(offset)));
     offset += level.bytes.size();
   }
   EXPECT_TRUE(bc4.level(4).bytes.empty());  // past the chain
@@ -523,14 +524,14 @@ struct CountingAllocator {
     ++self->allocations;
     self->live_bytes += size;
     self->max_alignment = std::max(self->max_alignment, alignment);
-    return ::operator new(size, std::align_val_t{alignment});
+    return ::operator new (size, std::align_val_t{alignment});
   }
   static void deallocate(void* p, size_t size, size_t alignment, void* user) {
     auto* self = static_cast<CountingAllocator*>(user);
     ++self->frees;
     if (size > self->live_bytes) self->size_mismatch = true;
     self->live_bytes -= std::min(size, self->live_bytes);
-    ::operator delete(p, std::align_val_t{alignment});
+    ::operator delete (p, std::align_val_t{alignment});
   }
 };
 

@@ -59,7 +59,9 @@ std::array<double, 4> decoded_key(const ClipView& clip, const fb::AnimatedChanne
   return q;
 }
 
-uint32_t first_component(fb::Channel c) { return c == fb::Channel::Translation ? kTx : c == fb::Channel::Rotation ? kRx : kSx; }
+uint32_t first_component(fb::Channel c) {
+  return c == fb::Channel::Translation ? kTx : c == fb::Channel::Rotation ? kRx : kSx;
+}
 
 enum class RefRotation { Nlerp, Slerp };
 
@@ -132,7 +134,8 @@ double max_difference(ConstPoseSpan pose, const std::vector<RefJoint>& ref) {
 /// Bitwise equality of the joints' lanes of two poses.
 bool same_bits(ConstPoseSpan a, ConstPoseSpan b) {
   for (uint32_t c = 0; c < kPoseComponents; ++c)
-    if (std::memcmp(a[static_cast<PoseComponent>(c)], b[static_cast<PoseComponent>(c)], a.joint_count * sizeof(float)) != 0)
+    if (std::memcmp(a[static_cast<PoseComponent>(c)], b[static_cast<PoseComponent>(c)],
+                    a.joint_count * sizeof(float)) != 0)
       return false;
   return true;
 }
@@ -188,10 +191,10 @@ const Pab* pab() {
   return data.get();
 }
 
-#define REQUIRE_PAB()                                                             \
-  const Pab* p = pab();                                                           \
+#define REQUIRE_PAB()                                                            \
+  const Pab* p = pab();                                                          \
   ASSERT_NE(p, nullptr) << "tests/fixtures/Pab could not be opened (see above)"; \
-  const ClipView clip = p->walk.clip(0);                                          \
+  const ClipView clip = p->walk.clip(0);                                         \
   const SkeletonView skeleton = p->skeleton.skeleton()
 
 // ---- synthetic clips -----------------------------------------------------------------------
@@ -529,7 +532,8 @@ TEST(SamplePab, CacheIsInvisible) {
   const SampleOptions loop{};
   expect_cache_invisible(clip, skeleton, playback(clip, 1.0f, 400, true), loop, "forward 60 Hz");
   expect_cache_invisible(clip, skeleton, playback(clip, -1.0f, 400, true, 0.3f), loop, "reverse");
-  expect_cache_invisible(clip, skeleton, playback(clip, 0.37f, 400, false), SampleOptions{.loop = false}, "slow, clamped");
+  expect_cache_invisible(clip, skeleton, playback(clip, 0.37f, 400, false), SampleOptions{.loop = false},
+                         "slow, clamped");
   // Many updates between keys (a montage's held section): pass 1 skips every run until one's pair ends.
   expect_cache_invisible(clip, skeleton, playback(clip, 0.05f, 400, true, 0.4f), loop, "very slow");
   expect_cache_invisible(clip, skeleton, playback(clip, -0.05f, 400, true, 0.4f), loop, "very slow, reverse");

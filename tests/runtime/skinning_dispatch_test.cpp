@@ -54,8 +54,8 @@ TEST(SkinningDispatch, EveryAvailablePathMatchesPortable) {
 
   std::vector<glm::mat4> model(asset->skeleton().joint_count());
   for (size_t j = 0; j < model.size(); ++j)
-    model[j] = glm::rotate(glm::translate(glm::mat4(1.0f), glm::vec3(0.1f * float(j), 0.2f, -0.3f)), 0.3f * float(j + 1),
-                           glm::normalize(glm::vec3(1.0f, 2.0f, 0.5f)));
+    model[j] = glm::rotate(glm::translate(glm::mat4(1.0f), glm::vec3(0.1f * float(j), 0.2f, -0.3f)),
+                           0.3f * float(j + 1), glm::normalize(glm::vec3(1.0f, 2.0f, 0.5f)));
   std::vector<glm::mat4> palette(mesh.joints().size());
   skinning_matrices(mesh, model, palette);
 

@@ -61,9 +61,10 @@ SyntheticAsset load(const std::vector<uint8_t>& bytes) {
 /// in: octahedral xy of a direction perpendicular-ish to each normal, sign alternating.
 std::vector<uint8_t> with_tangents(ossa::test::SyntheticSpec spec) {
   ossa::test::SyntheticMesh& m = spec.meshes[0];
-  m.layout = {{VertexSemantic::Position, VertexFormat::Unorm16x4, 0}, {VertexSemantic::Normal, VertexFormat::Snorm16x2, 8},
-              {VertexSemantic::Tangent, VertexFormat::Snorm16x4, 12}, {VertexSemantic::TexCoord0, VertexFormat::Float16x2, 20},
-              {VertexSemantic::Joints, VertexFormat::Uint8x4, 24},    {VertexSemantic::Weights, VertexFormat::Unorm8x4, 28}};
+  m.layout = {
+      {VertexSemantic::Position, VertexFormat::Unorm16x4, 0}, {VertexSemantic::Normal, VertexFormat::Snorm16x2, 8},
+      {VertexSemantic::Tangent, VertexFormat::Snorm16x4, 12}, {VertexSemantic::TexCoord0, VertexFormat::Float16x2, 20},
+      {VertexSemantic::Joints, VertexFormat::Uint8x4, 24},    {VertexSemantic::Weights, VertexFormat::Unorm8x4, 28}};
   m.vertex_stride = 32;
   std::vector<uint8_t> bytes = ossa::test::make_valid_file(spec);
   const ossa::fb::File* file = ossa::fb::GetFile(bytes.data());
@@ -86,10 +87,14 @@ std::vector<std::pair<std::string, std::vector<uint8_t>>> synthetic_files() {
   using F = VertexFormat;
   std::vector<std::pair<std::string, std::vector<uint8_t>>> out;
   for (const auto& [name, spec] : ossa::test::valid_variants())
-    if (name == "default" || name == "float32-layout" || name == "static-mesh") out.emplace_back(name, ossa::test::make_valid_file(spec));
+    if (name == "default" || name == "float32-layout" || name == "static-mesh")
+      out.emplace_back(name, ossa::test::make_valid_file(spec));
   ossa::test::SyntheticSpec wide;
-  wide.meshes[0].layout = {{S::Position, F::Unorm16x4, 0}, {S::Normal, F::Snorm16x2, 8}, {S::TexCoord0, F::Float16x2, 12},
-                           {S::Joints, F::Uint16x4, 16},   {S::Weights, F::Unorm8x4, 24}};
+  wide.meshes[0].layout = {{S::Position, F::Unorm16x4, 0},
+                           {S::Normal, F::Snorm16x2, 8},
+                           {S::TexCoord0, F::Float16x2, 12},
+                           {S::Joints, F::Uint16x4, 16},
+                           {S::Weights, F::Unorm8x4, 24}};
   wide.meshes[0].vertex_stride = 28;
   out.emplace_back("quantized-wide-slots", ossa::test::make_valid_file(wide));
   out.emplace_back("tangents", with_tangents({}));
@@ -145,23 +150,32 @@ std::vector<std::pair<std::string, std::vector<uint8_t>>> synthetic_files() {
   // reads differently from the cooker's: 16-bit slots, weights apart from the slots, and the normal
   // apart from the position (each read on its own); plus the broken order with it.
   ossa::test::SyntheticSpec ordered_wide = ordered;
-  ordered_wide.meshes[0].layout = {{S::Position, F::Unorm16x4, 0}, {S::Normal, F::Snorm16x2, 8}, {S::TexCoord0, F::Float16x2, 12},
-                                   {S::Joints, F::Uint16x4, 16},   {S::Weights, F::Unorm8x4, 24}};
+  ordered_wide.meshes[0].layout = {{S::Position, F::Unorm16x4, 0},
+                                   {S::Normal, F::Snorm16x2, 8},
+                                   {S::TexCoord0, F::Float16x2, 12},
+                                   {S::Joints, F::Uint16x4, 16},
+                                   {S::Weights, F::Unorm8x4, 24}};
   ordered_wide.meshes[0].vertex_stride = 28;
   out.emplace_back("ordered-wide-slots", ossa::test::make_valid_file(ordered_wide));
   ossa::test::SyntheticSpec ordered_apart = ordered;
-  ordered_apart.meshes[0].layout = {{S::Position, F::Unorm16x4, 0}, {S::TexCoord0, F::Float16x2, 8}, {S::Joints, F::Uint8x4, 12},
-                                    {S::Normal, F::Snorm16x2, 16},  {S::Weights, F::Unorm8x4, 20}};
+  ordered_apart.meshes[0].layout = {{S::Position, F::Unorm16x4, 0},
+                                    {S::TexCoord0, F::Float16x2, 8},
+                                    {S::Joints, F::Uint8x4, 12},
+                                    {S::Normal, F::Snorm16x2, 16},
+                                    {S::Weights, F::Unorm8x4, 20}};
   out.emplace_back("ordered-attributes-apart", ossa::test::make_valid_file(ordered_apart));
   ossa::test::SyntheticSpec tight = ordered;  // 12 bytes from the position to the end: no 16-byte load
-  tight.meshes[0].layout = {{S::Joints, F::Uint8x4, 0}, {S::Weights, F::Unorm8x4, 4}, {S::Position, F::Unorm16x4, 8},
+  tight.meshes[0].layout = {{S::Joints, F::Uint8x4, 0},
+                            {S::Weights, F::Unorm8x4, 4},
+                            {S::Position, F::Unorm16x4, 8},
                             {S::Normal, F::Snorm16x2, 16}};
   tight.meshes[0].vertex_stride = 20;
   out.emplace_back("ordered-position-last", ossa::test::make_valid_file(tight));
   // Every vertex of one class but the last, which needs all four influences.
   ossa::test::SyntheticSpec last = ordered;
   std::vector<ossa::test::SyntheticVertex>& lv = last.meshes[0].vertices;
-  lv.erase(std::remove_if(lv.begin(), lv.end(), [](const auto& v) { return influence_class(v.weights) != 2; }), lv.end());
+  lv.erase(std::remove_if(lv.begin(), lv.end(), [](const auto& v) { return influence_class(v.weights) != 2; }),
+           lv.end());
   lv.back().weights = {10, 20, 30, 195};
   out.emplace_back("one-class-then-four", ossa::test::make_valid_file(last));
   return out;
@@ -241,15 +255,14 @@ TEST(Skinning, PaletteFoldsDequantization) {
   ASSERT_EQ(palette.size(), mesh.joints().size());
   const auto& o = *mesh.fb->position_offset();
   const auto& sc = *mesh.fb->position_scale();
-  const glm::dmat4 d = glm::scale(glm::translate(glm::dmat4(1.0), glm::dvec3(o.x(), o.y(), o.z())),
-                                  glm::dvec3(sc.x(), sc.y(), sc.z()));
+  const glm::dmat4 d =
+      glm::scale(glm::translate(glm::dmat4(1.0), glm::dvec3(o.x(), o.y(), o.z())), glm::dvec3(sc.x(), sc.y(), sc.z()));
   for (size_t slot = 0; slot < palette.size(); ++slot) {
     const glm::dmat4 expected = pose.model_d[mesh.joints()[slot]] * inverse_bind_d(mesh, slot) * d;
     for (int c = 0; c < 4; ++c)
       for (int r = 0; r < 4; ++r) EXPECT_NEAR(palette[slot][c][r], expected[c][r], 1e-5) << "slot " << slot;
   }
 }
-
 
 TEST(Skinning, PreparedPaletteOfAStaticMeshIsItsDequantization) {
   for (const auto& [name, spec] : ossa::test::valid_variants()) {
@@ -351,8 +364,9 @@ TEST(Skinning, DualQuaternionKeepsVolumeOnTwistedJoint) {
   SyntheticAsset s = load(ossa::test::make_valid_file(spec));
   ASSERT_NE(s.asset, nullptr);
   const ossa::MeshView mesh = s.asset->mesh(0);
-  const std::vector<glm::mat4> model = {
-      glm::mat4(1.0f), glm::translate(glm::mat4(1.0f), glm::vec3(1, 0, 0)) * glm::mat4_cast(glm::angleAxis(glm::radians(170.0f), glm::vec3(1, 0, 0)))};
+  const std::vector<glm::mat4> model = {glm::mat4(1.0f),
+                                        glm::translate(glm::mat4(1.0f), glm::vec3(1, 0, 0)) *
+                                            glm::mat4_cast(glm::angleAxis(glm::radians(170.0f), glm::vec3(1, 0, 0)))};
   const auto palette = palette_of(mesh, model);
   const Skinned lbs = skin(mesh, palette, ossa::SkinningMethod::Linear);
   const Skinned dqs = skin(mesh, palette, ossa::SkinningMethod::DualQuaternion);
@@ -383,9 +397,10 @@ TEST(Skinning, OnlyRequestedStreamsAreWritten) {
     const Skinned all = skin(mesh, palette, ossa::SkinningMethod::Linear);
     for (int mask = 1; mask < 8; ++mask) {
       std::vector<float> p(3 * n, NAN), nn(3 * n, NAN), t(4 * n, NAN);
-      ossa::skin_cpu(mesh, palette, ossa::SkinningMethod::Linear,
-                     {mask & 1 ? std::span<float>(p) : std::span<float>(), mask & 2 ? std::span<float>(nn) : std::span<float>(),
-                      mask & 4 ? std::span<float>(t) : std::span<float>()});
+      ossa::skin_cpu(
+          mesh, palette, ossa::SkinningMethod::Linear,
+          {mask & 1 ? std::span<float>(p) : std::span<float>(), mask & 2 ? std::span<float>(nn) : std::span<float>(),
+           mask & 4 ? std::span<float>(t) : std::span<float>()});
       for (size_t i = 0; i < 3 * n; ++i) {
         if (mask & 1) EXPECT_EQ(p[i], all.positions[i]) << isa_name(isa) << " mask " << mask;
         else EXPECT_TRUE(std::isnan(p[i]));
@@ -421,8 +436,9 @@ TEST(Skinning, RangeLoopsReadEveryWeightByteAsTheClassifiedLoopsDo) {
       if (v.weights[k - 1] == 0) v.weights[k - 1] = 1;  // class k: its last influence is used
       vs.push_back(v);
     }
-  std::stable_sort(vs.begin(), vs.end(),
-                   [](const auto& a, const auto& b) { return influence_class(a.weights) < influence_class(b.weights); });
+  std::stable_sort(vs.begin(), vs.end(), [](const auto& a, const auto& b) {
+    return influence_class(a.weights) < influence_class(b.weights);
+  });
   ossa::test::SyntheticSpec reversed = spec;
   std::reverse(reversed.meshes[0].vertices.begin(), reversed.meshes[0].vertices.end());
   // Tangents from each vertex's own position, so that both files give a vertex the same one.
@@ -434,7 +450,8 @@ TEST(Skinning, RangeLoopsReadEveryWeightByteAsTheClassifiedLoopsDo) {
     for (size_t i = 0; i < v.size(); ++i) {
       const glm::vec3 t = glm::normalize(glm::vec3(1.0f, v[i].position.x(), -0.2f));
       const ossa::Float2 e = ossa::octahedral_encode({t.x, t.y, t.z});
-      const int16_t q[4] = {ossa::float_to_snorm16(e.x), ossa::float_to_snorm16(e.y), int16_t(v[i].position.z() < 0 ? -32767 : 32767), 0};
+      const int16_t q[4] = {ossa::float_to_snorm16(e.x), ossa::float_to_snorm16(e.y),
+                            int16_t(v[i].position.z() < 0 ? -32767 : 32767), 0};
       std::memcpy(bytes.data() + at + i * 32 + 12, q, 8);
     }
     return bytes;
@@ -479,7 +496,8 @@ TEST(Skinning, EveryStreamSelectionGivesBitIdenticalResults) {
       IsaScope scope(isa);
       for (const bool unit : {true, false}) {
         const Skinned all = skin(mesh, palette, ossa::SkinningMethod::Linear, unit);
-        std::vector<float> p(3 * n, NAN), nn(3 * n, NAN), p_only(3 * n, NAN), n_only(3 * n, NAN), t(has_tangents ? 4 * n : 0, NAN);
+        std::vector<float> p(3 * n, NAN), nn(3 * n, NAN), p_only(3 * n, NAN), n_only(3 * n, NAN),
+            t(has_tangents ? 4 * n : 0, NAN);
         ossa::skin_cpu(mesh, palette, ossa::SkinningMethod::Linear, {p, nn, {}, unit});
         ossa::skin_cpu(mesh, palette, ossa::SkinningMethod::Linear, {p_only, {}, {}, unit});
         ossa::skin_cpu(mesh, palette, ossa::SkinningMethod::Linear, {{}, n_only, {}, unit});

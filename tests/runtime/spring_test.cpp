@@ -100,7 +100,8 @@ TEST(SpringChain, EnergyStaysBoundedOverALongRun) {
     float speed = 0.0f;
     for (size_t i = 0; i < rig.chain.current.size(); ++i)
       speed = std::max(speed, glm::length(rig.chain.current[i] - rig.chain.previous[i]) / s.step);
-    for (const glm::vec3& p : rig.chain.current) ASSERT_TRUE(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z));
+    for (const glm::vec3& p : rig.chain.current)
+      ASSERT_TRUE(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z));
     // Tails stay within the chain's reach of the base.
     EXPECT_LT(glm::length(rig.tip() - rig.joint(1)), 0.45f + 1e-4f);
     if (t > 5.0f && t < 10.0f) max_speed_early = std::max(max_speed_early, speed);

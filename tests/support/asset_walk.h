@@ -40,9 +40,7 @@ namespace ossa::test {
 class AssetWalker {
  public:
   explicit AssetWalker(const Asset& asset)
-      : asset_(asset),
-        begin_(reinterpret_cast<uintptr_t>(asset.bytes().data())),
-        end_(begin_ + asset.bytes().size()) {}
+      : asset_(asset), begin_(reinterpret_cast<uintptr_t>(asset.bytes().data())), end_(begin_ + asset.bytes().size()) {}
 
   /// The first broken promise, or "" when every check passed.
   std::string run() {
@@ -280,7 +278,8 @@ class AssetWalker {
       for (size_t i = 1; i < f.size(); ++i)
         if (f[i] <= f[i - 1]) return fail(kw, "key frames not strictly increasing");
       if (f.size() > 1 && f.back() != frame_count - 1) return fail(kw, "last key not at the last frame");
-      if (!std::isfinite(track.range_min()) || !std::isfinite(track.range_extent())) return fail(kw, "range not finite");
+      if (!std::isfinite(track.range_min()) || !std::isfinite(track.range_extent()))
+        return fail(kw, "range not finite");
     }
 
     size_t keys = constants.size();
@@ -288,7 +287,8 @@ class AssetWalker {
       const fb::ConstantChannel& ch = constants[k];
       if (static_cast<unsigned>(ch.channel()) > 2) return fail(where, "constant channel enum unknown");
       if (ch.joint() >= joints) return fail(where, "constant joint >= clip joint_count");
-      if (k > 0 && channel_key(ch.joint(), ch.channel()) <= channel_key(constants[k - 1].joint(), constants[k - 1].channel()))
+      if (k > 0 &&
+          channel_key(ch.joint(), ch.channel()) <= channel_key(constants[k - 1].joint(), constants[k - 1].channel()))
         return fail(where, "constants not sorted by (joint, channel) or repeated");
       if (!finite(fb::Vec3(ch.value().x(), ch.value().y(), ch.value().z())))
         return fail(where, "constant value not finite");
@@ -323,7 +323,8 @@ class AssetWalker {
         if (!(frames[i] > frames[i - 1])) return fail(at, "key frames not strictly increasing");
       const uint32_t b = ch.bits();
       if (!((b >= 1 && b <= 19) || b == 32)) return fail(at, "bits not in 1..19 or 32");
-      if (ch.channel() == fb::Channel::Rotation && ch.dropped() > 3) return fail(at, "rotation drops no component 0..3");
+      if (ch.channel() == fb::Channel::Rotation && ch.dropped() > 3)
+        return fail(at, "rotation drops no component 0..3");
       if (values.size() < 8) return fail(at, "key values shorter than their padding");
       const uint64_t end = ch.bit_offset() + 3ull * b * n;
       if (end > 8ull * (values.size() - 8)) return fail(at, "keys past key_values (before padding)");
@@ -463,7 +464,8 @@ class AssetWalker {
           const std::string lw = where + " texture level " + std::to_string(k);
           if (level.width != std::max(1u, view.width() >> k) || level.height != std::max(1u, view.height() >> k))
             fail(lw, "has the wrong size");
-          if (level.bytes.size() != texture_level_bytes(view.encoding(), level.width, level.height) || level.bytes.empty())
+          if (level.bytes.size() != texture_level_bytes(view.encoding(), level.width, level.height) ||
+              level.bytes.empty())
             fail(lw, "has the wrong byte count");
           if (level.bytes.data() != view.data().data() + next) fail(lw, "is not where the previous level ended");
           next += level.bytes.size();

@@ -13,8 +13,10 @@
 
 namespace ossa::test {
 
-inline const std::string kBlendShapeFbx = fbx_ascii_head(
-    "\t\tP: \"UnitScaleFactor\", \"double\", \"Number\", \"\",100\n\t\tP: \"TimeMode\", \"enum\", \"\", \"\",6\n") + R"(Objects:  {
+inline const std::string kBlendShapeFbx =
+    fbx_ascii_head(
+        "\t\tP: \"UnitScaleFactor\", \"double\", \"Number\", \"\",100\n\t\tP: \"TimeMode\", \"enum\", \"\", \"\",6\n") +
+    R"(Objects:  {
 	Geometry: 2000, "Geometry::face", "Mesh" {
 		Vertices: *12 {
 			a: 0,0,0,1,0,0,0,1,0,1,1,0

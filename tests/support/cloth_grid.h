@@ -84,8 +84,7 @@ inline GridCloth make_grid_cloth(uint32_t columns, uint32_t rows, float spacing,
   g.stretch = colour_cloth_edges(stretch, n);
   g.bend = colour_cloth_edges(bend, n);
   for (uint32_t r = 1; r < rows; ++r)
-    for (uint32_t c = 0; c < columns; ++c)
-      g.tethers.emplace_back(id(c, r), id(c, 0), spacing * static_cast<float>(r));
+    for (uint32_t c = 0; c < columns; ++c) g.tethers.emplace_back(id(c, r), id(c, 0), spacing * static_cast<float>(r));
   g.settings.gravity = glm::vec3(0.0f, -9.81f, 0.0f);
   g.settings.damping = 0.5f;
   g.settings.bend_compliance = 1e-3f;

@@ -22,7 +22,7 @@
 #include <ossa/loader/asset.h>
 
 /// In a test: `rig` is Pab's rig (a missing or unreadable fixture is a failure, named).
-#define NEED_RIG()                                            \
+#define NEED_RIG()                                           \
   const ::ossa::test::PabRig* rig = ::ossa::test::pab_rig(); \
   ASSERT_NE(rig, nullptr) << "tests/fixtures/Pab could not be read"
 

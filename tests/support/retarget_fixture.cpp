@@ -54,7 +54,8 @@ void name_fingers(HumanoidNames& n, const std::array<std::string, 5>& fingers, c
         for (const auto& [key, value] : {std::pair<std::string, std::string>{"{finger}", fingers[f]},
                                          {"{n}", std::to_string(static_cast<int>(k) + first)},
                                          {"{side}", sides[s]}}) {
-          for (size_t at = name.find(key); at != std::string::npos; at = name.find(key)) name.replace(at, key.size(), value);
+          for (size_t at = name.find(key); at != std::string::npos; at = name.find(key))
+            name.replace(at, key.size(), value);
         }
         n.fingers[s][f][k] = name;
       }
@@ -371,11 +372,14 @@ SyntheticRig make_humanoid(const HumanoidNames& n, const RigShape& shape) {
   const float a = glm::radians(shape.arm_down_degrees);
   for (int s = 0; s < 2; ++s) {
     const float x = s == 0 ? 1.0f : -1.0f;
-    const int hip_joint = add(n.hip_joint[static_cast<size_t>(s)], hips, {x * shape.hip_width * 0.5f, hips_y - 0.03f, 0.0f});
-    const int upper_leg = add(n.upper_leg[static_cast<size_t>(s)], hip_joint, {x * shape.hip_width, hips_y - 0.05f, 0.0f});
+    const int hip_joint =
+        add(n.hip_joint[static_cast<size_t>(s)], hips, {x * shape.hip_width * 0.5f, hips_y - 0.03f, 0.0f});
+    const int upper_leg =
+        add(n.upper_leg[static_cast<size_t>(s)], hip_joint, {x * shape.hip_width, hips_y - 0.05f, 0.0f});
     const int lower_leg =
         add(n.lower_leg[static_cast<size_t>(s)], upper_leg, {x * shape.hip_width, hips_y - 0.05f - shape.thigh, 0.01f});
-    const int foot = add(n.foot[static_cast<size_t>(s)], shape.ik_feet ? root : lower_leg, {x * shape.hip_width, 0.08f, 0.0f});
+    const int foot =
+        add(n.foot[static_cast<size_t>(s)], shape.ik_feet ? root : lower_leg, {x * shape.hip_width, 0.08f, 0.0f});
     add(n.toes[static_cast<size_t>(s)], foot, {x * shape.hip_width, 0.02f, 0.12f});
     const glm::vec3 d(x * std::cos(a), -std::sin(a), 0.0f);
     const int shoulder = add(n.shoulder[static_cast<size_t>(s)], chest, {x * 0.03f, hips_y + 0.45f, 0.0f});
@@ -385,7 +389,8 @@ SyntheticRig make_humanoid(const HumanoidNames& n, const RigShape& shape) {
     const glm::vec3 wrist = ua + d * (shape.upper_arm + shape.forearm);
     const int hand = add(n.hand[static_cast<size_t>(s)], lower_arm, wrist);
     for (size_t f = 0; f < 5; ++f) {
-      glm::vec3 p = wrist + d * (f == 0 ? 0.03f : 0.09f) + glm::vec3(0.0f, f == 0 ? -0.01f : 0.0f, 0.04f - 0.02f * static_cast<float>(f));
+      glm::vec3 p = wrist + d * (f == 0 ? 0.03f : 0.09f) +
+                    glm::vec3(0.0f, f == 0 ? -0.01f : 0.0f, 0.04f - 0.02f * static_cast<float>(f));
       int parent = hand;
       for (size_t k = 0; k < 3; ++k) {
         parent = add(n.fingers[static_cast<size_t>(s)][f][k], parent, p);
@@ -452,7 +457,8 @@ void synthetic_motion(const SyntheticRig& rig, uint32_t frame, float degrees, Po
   for (size_t j = 0; j < rig.bind.size(); ++j) {
     Transform x = rig.bind[j];
     const float fj = static_cast<float>(j);
-    const glm::vec3 axis = glm::normalize(glm::vec3(std::sin(fj * 1.3f), std::cos(fj * 0.7f), std::sin(fj * 2.1f) + 0.5f));
+    const glm::vec3 axis =
+        glm::normalize(glm::vec3(std::sin(fj * 1.3f), std::cos(fj * 0.7f), std::sin(fj * 2.1f) + 0.5f));
     const float angle = glm::radians(degrees) * std::sin(6.2831853f * (0.7f * t + 0.13f * fj));
     x.rotation = glm::normalize(x.rotation * glm::angleAxis(angle, axis));
     if (rig.parents[j] < 0) x.translation += glm::vec3(0.0f, 0.0f, 0.02f * t);  // travels

@@ -26,7 +26,7 @@ namespace ossa::test {
 struct HumanoidNames {
   std::string convention;
   std::string root, hips;
-  std::vector<std::string> spine;  // hips -> chest, at least one
+  std::vector<std::string> spine;           // hips -> chest, at least one
   std::string neck, neck2, head, head_end;  // neck2: a second neck joint (CMU's Neck1, Rigify's spine.005)
   // [side 0 left, 1 right]
   std::array<std::string, 2> shoulder, upper_arm, lower_arm, hand, upper_leg, lower_leg, foot, toes;
@@ -50,13 +50,13 @@ HumanoidNames biped_names();       // 3ds Max Biped: Bip01 Pelvis, Bip01 L Thigh
 HumanoidNames quaternius_names();  // Quaternius: Body, Hips (its lower spine), UpperArm.L, Palm.L, Foot.L (IK)
 
 struct RigShape {
-  float arm_down_degrees = 0.0f;   // 0: T-pose, 45: A-pose
+  float arm_down_degrees = 0.0f;  // 0: T-pose, 45: A-pose
   float thigh = 0.43f, shin = 0.42f, upper_arm = 0.28f, forearm = 0.26f;
   float hip_width = 0.09f, shoulder_width = 0.17f;
   glm::quat orientation{1.0f, 0.0f, 0.0f, 0.0f};  // canonical -> model (a Z-up rig, one facing -z)
-  float units_per_metre = 1.0f;    // 100 for a centimetre rig
-  uint32_t frame_seed = 0;         // 0: joint frames aligned with the model; else turned at random
-  bool ik_feet = false;            // feet hang from the root (Quaternius) instead of the shins
+  float units_per_metre = 1.0f;                   // 100 for a centimetre rig
+  uint32_t frame_seed = 0;                        // 0: joint frames aligned with the model; else turned at random
+  bool ik_feet = false;                           // feet hang from the root (Quaternius) instead of the shins
 };
 
 struct SyntheticRig {

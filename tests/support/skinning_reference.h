@@ -129,9 +129,9 @@ inline glm::dvec3 oct_decode_d(double x, double y) {
 inline double snorm_d(int16_t v) { return std::max(static_cast<double>(v) / 32767.0, -1.0); }
 
 struct RefVertex {
-  glm::dvec3 position;        // mesh space, de-quantized
+  glm::dvec3 position;  // mesh space, de-quantized
   glm::dvec3 normal{0.0};
-  glm::dvec4 tangent{0.0};    // xyz, sign
+  glm::dvec4 tangent{0.0};  // xyz, sign
   uint32_t slots[4] = {0, 0, 0, 0};
   double weights[4] = {1.0, 0.0, 0.0, 0.0};
 };
@@ -219,7 +219,8 @@ inline RefSkinned skin_reference(const ossa::MeshView& mesh, const std::vector<g
   const std::vector<RefVertex> verts = decode_reference(mesh);
   const bool skinned = mesh.attribute(VertexSemantic::Joints) != nullptr;
   std::vector<glm::dmat4> slot_matrix;
-  for (size_t s = 0; s < mesh.joints().size(); ++s) slot_matrix.push_back(model[mesh.joints()[s]] * inverse_bind_d(mesh, s));
+  for (size_t s = 0; s < mesh.joints().size(); ++s)
+    slot_matrix.push_back(model[mesh.joints()[s]] * inverse_bind_d(mesh, s));
   RefSkinned out;
   for (const RefVertex& r : verts) {
     glm::dmat4 m(skinned ? 0.0 : 1.0);
@@ -255,7 +256,7 @@ inline std::vector<glm::mat4> palette_of(const ossa::MeshView& mesh, const std::
 
 /// Skins every stream the mesh has. NaN-filled outputs, so an unwritten value cannot pass.
 inline Skinned skin(const ossa::MeshView& mesh, std::span<const glm::mat4> palette, ossa::SkinningMethod method,
-             bool renormalize = true) {
+                    bool renormalize = true) {
   const size_t n = mesh.vertex_count();
   Skinned s;
   s.positions.assign(3 * n, NAN);

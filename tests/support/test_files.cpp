@@ -46,12 +46,10 @@ namespace {
 
 // A 2x2 RGBA PNG (generated for these tests; CRCs and zlib stream are real).
 constexpr uint8_t kTinyPng[] = {
-    0x89, 0x50, 0x4e, 0x47, 0x0d, 0x0a, 0x1a, 0x0a, 0x00, 0x00, 0x00, 0x0d, 0x49, 0x48, 0x44, 0x52, 0x00,
-    0x00, 0x00, 0x02, 0x00, 0x00, 0x00, 0x02, 0x08, 0x06, 0x00, 0x00, 0x00, 0x72, 0xb6, 0x0d, 0x24, 0x00,
-    0x00, 0x00, 0x11, 0x49, 0x44, 0x41, 0x54, 0x78, 0xda, 0x63, 0x38, 0x51, 0x11, 0xf5, 0x1f, 0x84, 0x19,
-    0x60, 0x0c, 0x00, 0x5c, 0x88, 0x0a, 0x65, 0x38, 0xa8, 0x9b, 0x14, 0x00, 0x00, 0x00, 0x00, 0x49, 0x45,
-    0x4e, 0x44, 0xae, 0x42, 0x60, 0x82};
-
+    0x89, 0x50, 0x4e, 0x47, 0x0d, 0x0a, 0x1a, 0x0a, 0x00, 0x00, 0x00, 0x0d, 0x49, 0x48, 0x44, 0x52, 0x00, 0x00, 0x00,
+    0x02, 0x00, 0x00, 0x00, 0x02, 0x08, 0x06, 0x00, 0x00, 0x00, 0x72, 0xb6, 0x0d, 0x24, 0x00, 0x00, 0x00, 0x11, 0x49,
+    0x44, 0x41, 0x54, 0x78, 0xda, 0x63, 0x38, 0x51, 0x11, 0xf5, 0x1f, 0x84, 0x19, 0x60, 0x0c, 0x00, 0x5c, 0x88, 0x0a,
+    0x65, 0x38, 0xa8, 0x9b, 0x14, 0x00, 0x00, 0x00, 0x00, 0x49, 0x45, 0x4e, 0x44, 0xae, 0x42, 0x60, 0x82};
 
 fb::Mat4 to_fb(const glm::mat4& m) {
   float columns[16];
@@ -137,13 +135,12 @@ void encode_attribute(const fb::VertexAttribute& a, const SyntheticVertex& v, co
       if (f == F::Unorm8x4)
         for (int c = 0; c < 4; ++c) put(bytes, at + c, v.weights[c]);
       break;
-    default:
-      break;  // Tangent, Color0: left zero
+    default: break;  // Tangent, Color0: left zero
   }
 }
 
 flatbuffers::Offset<flatbuffers::Vector<uint8_t>> aligned_bytes(flatbuffers::FlatBufferBuilder& fbb,
-                                                                 const std::vector<uint8_t>& bytes) {
+                                                                const std::vector<uint8_t>& bytes) {
   fbb.ForceVectorAlignment(bytes.size(), 1, 16);
   return fbb.CreateVector(bytes);
 }
@@ -169,8 +166,8 @@ flatbuffers::Offset<fb::Mesh> write_mesh(flatbuffers::FlatBufferBuilder& fbb, co
   for (const fb::VertexAttribute& a : m.layout)
     quantized |= a.semantic() == fb::VertexSemantic::Position && a.format() == fb::VertexFormat::Unorm16x4;
   const fb::Vec3 offset = quantized ? lo : fb::Vec3(0, 0, 0);
-  const fb::Vec3 scale = quantized ? fb::Vec3(extent(lo.x(), hi.x()), extent(lo.y(), hi.y()), extent(lo.z(), hi.z()))
-                                   : fb::Vec3(1, 1, 1);
+  const fb::Vec3 scale =
+      quantized ? fb::Vec3(extent(lo.x(), hi.x()), extent(lo.y(), hi.y()), extent(lo.z(), hi.z())) : fb::Vec3(1, 1, 1);
 
   std::vector<uint8_t> vertices(m.vertices.size() * m.vertex_stride, 0);
   for (size_t i = 0; i < m.vertices.size(); ++i) {
@@ -187,7 +184,8 @@ flatbuffers::Offset<fb::Mesh> write_mesh(flatbuffers::FlatBufferBuilder& fbb, co
       const auto i16 = static_cast<uint16_t>(index);
       indices.insert(indices.end(), reinterpret_cast<const uint8_t*>(&i16), reinterpret_cast<const uint8_t*>(&i16) + 2);
     } else {
-      indices.insert(indices.end(), reinterpret_cast<const uint8_t*>(&index), reinterpret_cast<const uint8_t*>(&index) + 4);
+      indices.insert(indices.end(), reinterpret_cast<const uint8_t*>(&index),
+                     reinterpret_cast<const uint8_t*>(&index) + 4);
     }
   }
   indices.resize(indices.size() + m.index_padding_bytes, 0);
@@ -224,11 +222,11 @@ flatbuffers::Offset<fb::Mesh> write_mesh(flatbuffers::FlatBufferBuilder& fbb, co
     cloth = fb::CreateCloth(fbb, fbb.CreateVector(c->particle_vertices), fbb.CreateVector(c->inverse_masses),
                             max_distances, 0, fbb.CreateVector(c->vertices), fbb.CreateVector(c->vertex_particles), 0,
                             fbb.CreateVector(c->triangles), fbb.CreateVectorOfStructs(c->stretch), 0,
-                            fbb.CreateVectorOfStructs(c->tethers), fbb.CreateVectorOfStructs(c->colliders), 0.01f,
-                            0.0f, 1e-4f, 1.0f, c->damping, 0.5f, &gravity);
+                            fbb.CreateVectorOfStructs(c->tethers), fbb.CreateVectorOfStructs(c->colliders), 0.01f, 0.0f,
+                            1e-4f, 1.0f, c->damping, 0.5f, &gravity);
   }
-  return fb::CreateMesh(fbb, name, count, m.vertex_stride, layout, vertex_bytes, m.index_format, index_bytes,
-                        submeshes, &lo, &hi, &offset, &scale, joints, inverse_bind, target_vector, cloth);
+  return fb::CreateMesh(fbb, name, count, m.vertex_stride, layout, vertex_bytes, m.index_format, index_bytes, submeshes,
+                        &lo, &hi, &offset, &scale, joints, inverse_bind, target_vector, cloth);
 }
 
 flatbuffers::Offset<fb::Clip> write_clip(flatbuffers::FlatBufferBuilder& fbb, const SyntheticClip& c,
@@ -254,16 +252,13 @@ flatbuffers::Offset<fb::Clip> write_clip(flatbuffers::FlatBufferBuilder& fbb, co
     const auto bit_offset = static_cast<uint32_t>(writer.bit_size());
     for (const auto& v : a.values) {
       for (int i = 0; i < 3; ++i) {
-        if (a.bits == kRawFloatBits)
-          writer.write_float(v[i]);
-        else if (a.bits >= 1 && a.bits <= kMaxQuantBits)
-          writer.write(quantize(v[i], rmin[i], rext[i], a.bits), a.bits);
+        if (a.bits == kRawFloatBits) writer.write_float(v[i]);
+        else if (a.bits >= 1 && a.bits <= kMaxQuantBits) writer.write(quantize(v[i], rmin[i], rext[i], a.bits), a.bits);
       }
     }
     animated.emplace_back(a.joint, a.channel, a.bits, a.dropped.value_or(a.channel == fb::Channel::Rotation ? 3 : 0),
-                          a.first_key.value_or(first_key),
-                          a.key_count.value_or(static_cast<uint32_t>(a.frames.size())), a.bit_offset.value_or(bit_offset),
-                          range_min, range_extent);
+                          a.first_key.value_or(first_key), a.key_count.value_or(static_cast<uint32_t>(a.frames.size())),
+                          a.bit_offset.value_or(bit_offset), range_min, range_extent);
   }
   std::vector<uint8_t> key_values = writer.finish();
   key_values.resize(key_values.size() - kKeyValuePadding + c.key_value_padding, 0);
@@ -294,7 +289,8 @@ flatbuffers::Offset<fb::Clip> write_clip(flatbuffers::FlatBufferBuilder& fbb, co
     root_motion = fb::CreateRootMotion(fbb, translations, yaws, c.root_motion->up_axis);
   }
   std::vector<flatbuffers::Offset<fb::ClipEvent>> events;
-  for (const auto& [event_name, time] : c.events) events.push_back(fb::CreateClipEventDirect(fbb, event_name.c_str(), time));
+  for (const auto& [event_name, time] : c.events)
+    events.push_back(fb::CreateClipEventDirect(fbb, event_name.c_str(), time));
   const auto event_vector = events.empty() ? 0 : fbb.CreateVector(events);
   std::vector<flatbuffers::Offset<fb::MorphTrack>> tracks;
   for (const SyntheticMorphTrack& t : c.morph_weights)
@@ -316,14 +312,15 @@ flatbuffers::Offset<flatbuffers::Vector<flatbuffers::Offset<fb::Montage>>> write
       fb::CreateMontageTrack(fbb, fbb.CreateString(m.track_slot), fbb.CreateVectorOfStructs(segments))};
   std::vector<flatbuffers::Offset<fb::MontageSection>> sections;
   for (size_t k = 0; k < m.section_starts.size(); ++k)
-    sections.push_back(fb::CreateMontageSection(fbb, fbb.CreateString(k < m.section_names.size() ? m.section_names[k] : "s"),
-                                                m.section_starts[k], k < m.section_next.size() ? m.section_next[k] : -1));
+    sections.push_back(
+        fb::CreateMontageSection(fbb, fbb.CreateString(k < m.section_names.size() ? m.section_names[k] : "s"),
+                                 m.section_starts[k], k < m.section_next.size() ? m.section_next[k] : -1));
   std::vector<flatbuffers::Offset<fb::MontageNotify>> notifies = {
       fb::CreateMontageNotify(fbb, fbb.CreateString(m.notify), m.notify_time, m.notify_duration, m.notify_kind)};
-  std::vector<flatbuffers::Offset<fb::Montage>> montages = {fb::CreateMontage(
-      fbb, fbb.CreateString(m.name), fbb.CreateString(m.group), fbb.CreateVector(tracks), fbb.CreateVector(sections),
-      fbb.CreateVector(notifies), m.rate, m.blend_in, m.blend_in_curve, m.blend_out, m.blend_out_curve, m.trigger,
-      m.root_motion)};
+  std::vector<flatbuffers::Offset<fb::Montage>> montages = {
+      fb::CreateMontage(fbb, fbb.CreateString(m.name), fbb.CreateString(m.group), fbb.CreateVector(tracks),
+                        fbb.CreateVector(sections), fbb.CreateVector(notifies), m.rate, m.blend_in, m.blend_in_curve,
+                        m.blend_out, m.blend_out_curve, m.trigger, m.root_motion)};
   return fbb.CreateVector(montages);
 }
 
@@ -337,8 +334,8 @@ flatbuffers::Offset<fb::Graph> write_graph(flatbuffers::FlatBufferBuilder& fbb, 
   params.push_back(fb::CreateParameterDirect(fbb, "flag", PT::Bool));
   params.push_back(fb::CreateParameterDirect(fbb, "go", PT::Trigger));
   std::vector<flatbuffers::Offset<flatbuffers::String>> values = {fbb.CreateString("a"), fbb.CreateString("b")};
-  params.push_back(fb::CreateParameter(fbb, fbb.CreateString("mode"), PT::Enum, 0.0f, -3.4e38f, 3.4e38f,
-                                       fbb.CreateVector(values)));
+  params.push_back(
+      fb::CreateParameter(fbb, fbb.CreateString("mode"), PT::Enum, 0.0f, -3.4e38f, 3.4e38f, fbb.CreateVector(values)));
   params.push_back(fb::CreateParameterDirect(fbb, "count", PT::Int, 0.0f, 0.0f, 3.0f));
   const fb::Vec3 target_default(0.5f, 1.5f, 0.2f);
   params.push_back(fb::CreateParameter(fbb, fbb.CreateString("target"), PT::Vector, 0.0f, -3.4e38f, 3.4e38f, 0,
@@ -348,37 +345,42 @@ flatbuffers::Offset<fb::Graph> write_graph(flatbuffers::FlatBufferBuilder& fbb, 
   };
   std::vector<flatbuffers::Offset<fb::Node>> nodes;
   const uint16_t first_clip = retarget && retarget->clip_node_plays_it ? retarget->clip : 0;
-  nodes.push_back(node(fb::NodeData::ClipNode, fb::CreateClipNode(fbb, first_clip, 1.0f, 0).Union()));     // 0
-  nodes.push_back(node(fb::NodeData::ClipNode, fb::CreateClipNode(fbb, 0, -1.0f, -1, false).Union()));     // 1
-  nodes.push_back(node(fb::NodeData::BlendAlphaNode, fb::CreateBlendAlphaNode(fbb, 0, 1, 0).Union()));    // 2
+  nodes.push_back(node(fb::NodeData::ClipNode, fb::CreateClipNode(fbb, first_clip, 1.0f, 0).Union()));  // 0
+  nodes.push_back(node(fb::NodeData::ClipNode, fb::CreateClipNode(fbb, 0, -1.0f, -1, false).Union()));  // 1
+  nodes.push_back(node(fb::NodeData::BlendAlphaNode, fb::CreateBlendAlphaNode(fbb, 0, 1, 0).Union()));  // 2
   const std::vector<fb::BlendSample> samples = {{0, 0.0f, 0.0f}, {0, 2.0f, 0.0f}};
   nodes.push_back(node(fb::NodeData::BlendSpaceNode,
                        fb::CreateBlendSpaceNode(fbb, 0, -1, fbb.CreateVectorOfStructs(samples)).Union()));  // 3
   const std::vector<uint16_t> children = {2, 3};
-  nodes.push_back(node(fb::NodeData::SelectNode, fb::CreateSelectNode(fbb, 3, fbb.CreateVector(children), 0.2f).Union()));  // 4
-  nodes.push_back(node(fb::NodeData::ClipNode, fb::CreateClipNode(fbb, 0, 1.0f, -1, true, 0.5f).Union()));  // 5
-  nodes.push_back(node(fb::NodeData::AdditiveNode, fb::CreateAdditiveNode(fbb, 4, 5, 0.5f).Union()));      // 6
-  nodes.push_back(node(fb::NodeData::ClipNode, fb::CreateClipNode(fbb, 0).Union()));                       // 7
-  nodes.push_back(node(fb::NodeData::StateMachineNode, fb::CreateStateMachineNode(fbb, 0).Union()));       // 8
-  nodes.push_back(node(fb::NodeData::ClipNode, fb::CreateClipNode(fbb, 0).Union()));                       // 9
+  nodes.push_back(
+      node(fb::NodeData::SelectNode, fb::CreateSelectNode(fbb, 3, fbb.CreateVector(children), 0.2f).Union()));  // 4
+  nodes.push_back(node(fb::NodeData::ClipNode, fb::CreateClipNode(fbb, 0, 1.0f, -1, true, 0.5f).Union()));      // 5
+  nodes.push_back(node(fb::NodeData::AdditiveNode, fb::CreateAdditiveNode(fbb, 4, 5, 0.5f).Union()));           // 6
+  nodes.push_back(node(fb::NodeData::ClipNode, fb::CreateClipNode(fbb, 0).Union()));                            // 7
+  nodes.push_back(node(fb::NodeData::StateMachineNode, fb::CreateStateMachineNode(fbb, 0).Union()));            // 8
+  nodes.push_back(node(fb::NodeData::ClipNode, fb::CreateClipNode(fbb, 0).Union()));                            // 9
   const std::vector<fb::MaskEntry> mask = {{1, -1}};
   std::vector<flatbuffers::Offset<fb::Layer>> layers = {
       fb::CreateLayer(fbb, 9, fbb.CreateVectorOfStructs(mask), 1.0f, 1, 0.1f, true)};
-  nodes.push_back(node(fb::NodeData::LayeredBlendNode, fb::CreateLayeredBlendNode(fbb, 8, fbb.CreateVector(layers)).Union()));  // 10
+  nodes.push_back(node(fb::NodeData::LayeredBlendNode,
+                       fb::CreateLayeredBlendNode(fbb, 8, fbb.CreateVector(layers)).Union()));  // 10
   // Procedural nodes (format v6) over the chain 0 > 1 > 2, one of each kind.
   const fb::Vec3 pole(0.0f, 0.0f, 1.0f), axis(0.0f, 0.0f, 1.0f), up(0.0f, 1.0f, 0.0f), forward(0.0f, 0.0f, 1.0f);
-  nodes.push_back(node(fb::NodeData::TwoBoneIkNode,
-                       fb::CreateTwoBoneIkNode(fbb, 10, 0, 1, 2, 5, -1, &pole, &axis, 0.1f, 0.95f, 1.0f, 0).Union()));  // 11
+  nodes.push_back(
+      node(fb::NodeData::TwoBoneIkNode,
+           fb::CreateTwoBoneIkNode(fbb, 10, 0, 1, 2, 5, -1, &pole, &axis, 0.1f, 0.95f, 1.0f, 0).Union()));  // 11
   const std::vector<fb::AimJoint> aim = {{1, 0.5f, 1.0f}, {2, 1.0f, 3.2f}};
-  nodes.push_back(node(fb::NodeData::AimNode, fb::CreateAimNode(fbb, 11, fbb.CreateVectorOfStructs(aim), 5, &forward,
-                                                                 &up, &up, 1.0f, 1).Union()));  // 12
+  nodes.push_back(
+      node(fb::NodeData::AimNode,
+           fb::CreateAimNode(fbb, 11, fbb.CreateVectorOfStructs(aim), 5, &forward, &up, &up, 1.0f, 1).Union()));  // 12
   const auto leg = [&](bool lock) {
     return fb::CreateFootLeg(fbb, 0, 1, 2, lock ? -1 : 0, lock ? -1 : 5, lock ? 1 : -1,
                              fbb.CreateString(lock ? "plant" : ""), fbb.CreateString(lock ? "lift" : ""));
   };
   std::vector<flatbuffers::Offset<fb::FootLeg>> place_legs = {leg(false)}, lock_legs = {leg(true)};
-  nodes.push_back(node(fb::NodeData::FootPlacementNode,
-                       fb::CreateFootPlacementNode(fbb, 12, 0, fbb.CreateVector(place_legs), &up, 0.3f).Union()));  // 13
+  nodes.push_back(
+      node(fb::NodeData::FootPlacementNode,
+           fb::CreateFootPlacementNode(fbb, 12, 0, fbb.CreateVector(place_legs), &up, 0.3f).Union()));  // 13
   nodes.push_back(node(fb::NodeData::FootLockNode,
                        fb::CreateFootLockNode(fbb, 13, fbb.CreateVector(lock_legs), 0.2f, 0.1f).Union()));  // 14
   const std::vector<uint16_t> spring_joints = {1, 2};
@@ -386,14 +388,15 @@ flatbuffers::Offset<fb::Graph> write_graph(flatbuffers::FlatBufferBuilder& fbb, 
   std::vector<flatbuffers::Offset<fb::SpringChainSettings>> chains = {
       fb::CreateSpringChainSettings(fbb, fbb.CreateVector(spring_joints), 4.0f, 0.4f, &gravity, 0.05f, 0.5f)};
   const std::vector<fb::SpringColliderShape> colliders = {{0, {0.0f, 0.5f, 0.0f}, {0.0f, 1.0f, 0.0f}, 0.2f}};
-  nodes.push_back(node(fb::NodeData::SpringNode,
-                       fb::CreateSpringNode(fbb, 14, fbb.CreateVector(chains), fbb.CreateVectorOfStructs(colliders),
-                                            1.0f / 120.0f, 10.0f).Union()));  // 15
+  nodes.push_back(
+      node(fb::NodeData::SpringNode, fb::CreateSpringNode(fbb, 14, fbb.CreateVector(chains),
+                                                          fbb.CreateVectorOfStructs(colliders), 1.0f / 120.0f, 10.0f)
+                                         .Union()));  // 15
 
   using Op = fb::ConditionOp;
   const std::vector<fb::ConditionInstr> go = {{Op::Trigger, 2, 0.0f}};
   // (speed > 1 && !flag) || count == 2
-  const std::vector<fb::ConditionInstr> back = {{Op::Greater, 0, 1.0f}, {Op::Bool, 1, 0.0f}, {Op::Not, 0, 0.0f},
+  const std::vector<fb::ConditionInstr> back = {{Op::Greater, 0, 1.0f}, {Op::Bool, 1, 0.0f},  {Op::Not, 0, 0.0f},
                                                 {Op::And, 0, 0.0f},     {Op::Equal, 4, 2.0f}, {Op::Or, 0, 0.0f}};
   const std::vector<fb::ConditionInstr> flag = {{Op::Bool, 1, 0.0f}};
   std::vector<flatbuffers::Offset<fb::Transition>> transitions = {
@@ -410,7 +413,8 @@ flatbuffers::Offset<fb::Graph> write_graph(flatbuffers::FlatBufferBuilder& fbb, 
     const std::vector<fb::MaskEntry> slot_mask = {{montage->mask_joint, montage->mask_depth}};
     nodes.push_back(node(fb::NodeData::SlotNode,
                          fb::CreateSlotNode(fbb, 15, fbb.CreateString(montage->slot), fbb.CreateString(montage->group),
-                                            fbb.CreateVectorOfStructs(slot_mask), false, true).Union()));  // 16
+                                            fbb.CreateVectorOfStructs(slot_mask), false, true)
+                             .Union()));  // 16
     root = 16;
     montages_v = write_montages(fbb, *montage);
   }
@@ -421,14 +425,16 @@ flatbuffers::Offset<fb::Graph> write_graph(flatbuffers::FlatBufferBuilder& fbb, 
     const auto source_bones = fbb.CreateVector(r.source_bones);
     const auto target_bones = fbb.CreateVector(r.target_bones);
     const auto rest_v = fbb.CreateVectorOfStructs(rests);
-    nodes.push_back(node(fb::NodeData::RetargetNode,
-                         fb::CreateRetargetNode(fbb, r.clip, r.source_hash, r.source_joints, source_bones, target_bones,
-                                                r.rate, r.rate_parameter, true, r.start, true, r.source_rest,
-                                                r.target_rest, 0, rest_v).Union()));
+    nodes.push_back(
+        node(fb::NodeData::RetargetNode,
+             fb::CreateRetargetNode(fbb, r.clip, r.source_hash, r.source_joints, source_bones, target_bones, r.rate,
+                                    r.rate_parameter, true, r.start, true, r.source_rest, r.target_rest, 0, rest_v)
+                 .Union()));
     clips.push_back(fbb.CreateString("other_walk"));
   }
   return fb::CreateGraph(fbb, fbb.CreateString("g"), skeleton_hash, joint_count, fbb.CreateVector(params),
-                         fbb.CreateVector(clips), fbb.CreateVector(nodes), fbb.CreateVector(machines), root, montages_v);
+                         fbb.CreateVector(clips), fbb.CreateVector(nodes), fbb.CreateVector(machines), root,
+                         montages_v);
 }
 
 flatbuffers::Offset<fb::Material> write_material(flatbuffers::FlatBufferBuilder& fbb, const SyntheticMaterial& m) {
@@ -437,7 +443,8 @@ flatbuffers::Offset<fb::Material> write_material(flatbuffers::FlatBufferBuilder&
     const auto path = t.path.empty() ? 0 : fbb.CreateString(t.path);
     const auto mime = t.mime.empty() ? 0 : fbb.CreateString(t.mime);
     const auto data = t.data ? aligned_bytes(fbb, *t.data) : 0;
-    textures.push_back(fb::CreateTexture(fbb, t.role, path, mime, data, t.encoding, t.srgb, t.width, t.height, t.mip_count));
+    textures.push_back(
+        fb::CreateTexture(fbb, t.role, path, mime, data, t.encoding, t.srgb, t.width, t.height, t.mip_count));
   }
   const auto name = fbb.CreateString(m.name);
   const auto texture_vector = fbb.CreateVector(textures);
@@ -450,8 +457,11 @@ flatbuffers::Offset<fb::Material> write_material(flatbuffers::FlatBufferBuilder&
 std::vector<fb::VertexAttribute> SyntheticMesh::quantized_layout() {
   using S = fb::VertexSemantic;
   using F = fb::VertexFormat;
-  return {{S::Position, F::Unorm16x4, 0}, {S::Normal, F::Snorm16x2, 8}, {S::TexCoord0, F::Float16x2, 12},
-          {S::Joints, F::Uint8x4, 16},    {S::Weights, F::Unorm8x4, 20}};
+  return {{S::Position, F::Unorm16x4, 0},
+          {S::Normal, F::Snorm16x2, 8},
+          {S::TexCoord0, F::Float16x2, 12},
+          {S::Joints, F::Uint8x4, 16},
+          {S::Weights, F::Unorm8x4, 20}};
 }
 
 std::vector<SyntheticVertex> SyntheticMesh::default_vertices() {
@@ -491,7 +501,8 @@ std::vector<SyntheticAnimated> SyntheticClip::default_animated() {
   };
   return {channel(1, fb::Channel::Rotation, 16, {0, 15, 30}, {{0, 0, 0}, {0, 0.38268343f, 0}, {0, 0, 0}}),
           channel(3, fb::Channel::Translation, 12, {0, 30}, {{0.5f, 0.5f, 0}, {0.6f, 0.4f, 0}}),
-          channel(3, fb::Channel::Scale, 32, {0, 8, 23, 30}, {{1, 1, 1}, {1, 1, 1}, {1.2f, 1.2f, 1.2f}, {1.2f, 1.2f, 1.2f}})};
+          channel(3, fb::Channel::Scale, 32, {0, 8, 23, 30},
+                  {{1, 1, 1}, {1, 1, 1}, {1.2f, 1.2f, 1.2f}, {1.2f, 1.2f, 1.2f}})};
 }
 
 namespace {
@@ -499,7 +510,8 @@ namespace {
 std::vector<uint8_t> bc4_chain() {
   std::vector<uint8_t> out;
   for (uint8_t b = 0; b < 5; ++b) {
-    const uint8_t block[8] = {255, 0, static_cast<uint8_t>(0x49 * (b + 1)), 0x92, 0x24, 0x49, 0x92, static_cast<uint8_t>(b)};
+    const uint8_t block[8] = {
+        255, 0, static_cast<uint8_t>(0x49 * (b + 1)), 0x92, 0x24, 0x49, 0x92, static_cast<uint8_t>(b)};
     out.insert(out.end(), block, block + 8);
   }
   return out;
@@ -527,8 +539,11 @@ std::vector<std::pair<std::string, SyntheticSpec>> valid_variants() {
   out.emplace_back("uint32-indices", spec);
 
   spec = {};
-  spec.meshes[0].layout = {{S::Position, F::Float32x3, 0}, {S::Normal, F::Float32x3, 12}, {S::TexCoord0, F::Float32x2, 24},
-                           {S::Joints, F::Uint16x4, 32},   {S::Weights, F::Unorm8x4, 40}};
+  spec.meshes[0].layout = {{S::Position, F::Float32x3, 0},
+                           {S::Normal, F::Float32x3, 12},
+                           {S::TexCoord0, F::Float32x2, 24},
+                           {S::Joints, F::Uint16x4, 32},
+                           {S::Weights, F::Unorm8x4, 40}};
   spec.meshes[0].vertex_stride = 44;
   out.emplace_back("float32-layout", spec);
 
@@ -660,10 +675,10 @@ std::vector<uint8_t> make_valid_file(const SyntheticSpec& spec) {
   std::vector<flatbuffers::Offset<fb::Graph>> graphs;
   if (spec.graph && !spec.clips.empty())
     graphs.push_back(write_graph(fbb, spec.clips[0].name, hash, joint_count, spec.montage, spec.retarget));
-  const auto root = fb::CreateFileDirect(fbb, spec.version, spec.metres_per_unit, skeleton,
-                                         spec.meshes.empty() ? nullptr : &meshes, spec.clips.empty() ? nullptr : &clips,
-                                         spec.materials.empty() ? nullptr : &materials, provenance,
-                                         graphs.empty() ? nullptr : &graphs);
+  const auto root =
+      fb::CreateFileDirect(fbb, spec.version, spec.metres_per_unit, skeleton, spec.meshes.empty() ? nullptr : &meshes,
+                           spec.clips.empty() ? nullptr : &clips, spec.materials.empty() ? nullptr : &materials,
+                           provenance, graphs.empty() ? nullptr : &graphs);
   std::string identifier = spec.identifier;
   identifier.resize(4, ' ');
   fbb.Finish(root, identifier.c_str());
@@ -674,11 +689,11 @@ AlignedBytes::AlignedBytes(std::span<const uint8_t> bytes) : size_(bytes.size())
   // Aligned operator new with the exact size (not aligned_alloc, which rounds up and which MinGW
   // lacks), so AddressSanitizer reports a read one byte past the end instead of letting it land
   // in rounding slack.
-  data_ = static_cast<uint8_t*>(::operator new(bytes.empty() ? 1 : bytes.size(), std::align_val_t{16}));
+  data_ = static_cast<uint8_t*>(::operator new (bytes.empty() ? 1 : bytes.size(), std::align_val_t{16}));
   if (!bytes.empty()) std::memcpy(data_, bytes.data(), bytes.size());
 }
 
-AlignedBytes::~AlignedBytes() { ::operator delete(data_, std::align_val_t{16}); }
+AlignedBytes::~AlignedBytes() { ::operator delete (data_, std::align_val_t{16}); }
 
 // ---------------------------------------------------------------------------------------------
 

@@ -56,10 +56,10 @@ struct SyntheticVertex {
 /// A morph target as stored (ossa.fbs MorphTarget): listed vertices with int16 deltas times steps.
 struct SyntheticMorphTarget {
   std::string name = "smile";
-  std::vector<uint32_t> vertices = {4, 5};                   // the head row of the default grid
+  std::vector<uint32_t> vertices = {4, 5};  // the head row of the default grid
   std::vector<int16_t> position_deltas = {0, 1000, 0, 0, 2000, 0};
   fb::Vec3 position_step{0.0001f, 0.0001f, 0.0001f};
-  std::vector<int16_t> normal_deltas;                        // empty: none
+  std::vector<int16_t> normal_deltas;  // empty: none
   fb::Vec3 normal_step{0, 0, 0};
   float default_weight = 0.0f;
 };
@@ -129,19 +129,19 @@ struct SyntheticConstant {
 struct SyntheticAnimated {
   uint16_t joint = 0;
   fb::Channel channel = fb::Channel::Translation;
-  uint8_t bits = 16;                          // 1..19, or 32 (raw floats)
+  uint8_t bits = 16;  // 1..19, or 32 (raw floats)
   /// Rotations: the component not stored (0..3 = x, y, z, w). Default: 3 (w) for rotations, 0
   /// for other channels (which store 0).
   std::optional<uint8_t> dropped;
-  std::vector<uint16_t> frames;               // one per key
+  std::vector<uint16_t> frames;  // one per key
   /// One per key, as stored: rotations give the three components other than `dropped` (in x, y,
   /// z, w order) of the unit quaternion taken with its dropped component >= 0.
   std::vector<std::array<float, 3>> values;
-  std::optional<fb::Vec3> range_min;          // default: the values' minimum per component
-  std::optional<fb::Vec3> range_extent;       // default: max - min
-  std::optional<uint32_t> first_key;          // default: where its frames were appended
-  std::optional<uint32_t> key_count;          // default: frames.size()
-  std::optional<uint32_t> bit_offset;         // default: where its keys were packed
+  std::optional<fb::Vec3> range_min;     // default: the values' minimum per component
+  std::optional<fb::Vec3> range_extent;  // default: max - min
+  std::optional<uint32_t> first_key;     // default: where its frames were appended
+  std::optional<uint32_t> key_count;     // default: frames.size()
+  std::optional<uint32_t> bit_offset;    // default: where its keys were packed
 };
 
 struct SyntheticRootMotion {
@@ -186,8 +186,8 @@ struct SyntheticClip {
 
 struct SyntheticTexture {
   fb::TextureRole role = fb::TextureRole::Diffuse;
-  std::string path;                 // empty: field left out
-  std::string mime;                 // empty: field left out
+  std::string path;  // empty: field left out
+  std::string mime;  // empty: field left out
   std::optional<std::vector<uint8_t>> data;
   // A cooked mip chain (format v7; ossa/loader/texture.h): Source leaves the rest out.
   fb::TextureEncoding encoding = fb::TextureEncoding::Source;
@@ -206,8 +206,8 @@ struct SyntheticMaterial {
   fb::Vec3 specular{0.2f, 0.2f, 0.2f};
   float shininess = 16.0f;
   float opacity = 1.0f;
-  std::optional<fb::Vec3> emissive;      // format v11
-  std::optional<fb::PbrFactors> pbr;     // format v11
+  std::optional<fb::Vec3> emissive;   // format v11
+  std::optional<fb::PbrFactors> pbr;  // format v11
   /// An embedded 2x2 PNG (diffuse) and a normal map referenced by path.
   std::vector<SyntheticTexture> textures = default_textures();
 
@@ -245,7 +245,7 @@ struct SyntheticRetarget {
   float rate = 1.0f, start = 0.0f;
   int16_t rate_parameter = 0;  // "speed"
   uint8_t source_rest = 0, target_rest = 1;
-  uint16_t rest_joint = 2;     // one target rest rotation
+  uint16_t rest_joint = 2;  // one target rest rotation
   fb::Quat rest_rotation{0.0f, 0.0f, 0.0f, 1.0f};
   bool clip_node_plays_it = false;  // the graph's first clip node plays the retarget clip too
 };
@@ -278,7 +278,8 @@ std::vector<uint8_t> make_valid_file(const SyntheticSpec& spec = {});
 /// slots), static-mesh (no skeleton), clip-only, empty-channels (plus a clip without channels),
 /// single-frame (a 1-frame clip of constants), root-motion, low-bits (1- and 3-bit keys), drop-y
 /// (a rotation storing x, z, w in 19 bits), two-meshes, graph (an animation graph with a montage, and clip events),
-/// morph (a mesh with two morph targets and a clip driving them). For suites that must not over-fit the default, and for seeding fuzz corpora.
+/// morph (a mesh with two morph targets and a clip driving them). For suites that must not over-fit the default, and
+/// for seeding fuzz corpora.
 std::vector<std::pair<std::string, SyntheticSpec>> valid_variants();
 
 /// A 16-byte aligned copy of some bytes: what verify_buffer expects, and what a std::vector

@@ -71,7 +71,8 @@ TEST(DiffCli, IdenticalCooksAreTheSame) {
 TEST(DiffCli, ClipToleranceDifferenceIsMeasuredAndJudged) {
   const fs::path dir = ossa::test::make_temp_dir("diff-tol");
   const PabWalk rig = pab(dir);
-  const fs::path fine = rig.walk(dir, "fine", "--clip-tolerance 0.1"), coarse = rig.walk(dir, "coarse", "--clip-tolerance 0.5");
+  const fs::path fine = rig.walk(dir, "fine", "--clip-tolerance 0.1"),
+                 coarse = rig.walk(dir, "coarse", "--clip-tolerance 0.5");
   const std::string skel = "--skeleton " + q(rig.skeleton);
   int code = -1;
   const nlohmann::json j = diff_json(fine, coarse, skel, &code);
@@ -267,7 +268,8 @@ TEST(DiffCli, JsonOutputMatchesItsSchema) {
   const fs::path dir = ossa::test::make_temp_dir("diff-schema");
   const PabWalk rig = pab(dir);
   const fs::path fine = rig.walk(dir, "fine", ""), coarse = rig.walk(dir, "coarse", "--clip-tolerance 0.5");
-  const fs::path fox = cook(dir, "fox", asset("Fox/Fox.glb")), fox_float = cook(dir, "foxf", asset("Fox/Fox.glb"), "--float-vertices");
+  const fs::path fox = cook(dir, "fox", asset("Fox/Fox.glb")),
+                 fox_float = cook(dir, "foxf", asset("Fox/Fox.glb"), "--float-vertices");
   ossa::test::SyntheticSpec base, changed;
   base.graph = changed.graph = true;
   base.clips[0].events = {{"step", 0.5f}};
@@ -298,7 +300,8 @@ TEST(DiffCli, JsonOutputMatchesItsSchema) {
     EXPECT_EQ(j["differences"].empty(), c.expected == 0);
     docs += " " + q(dir / c.out);
   }
-  const std::string check = "/usr/bin/python3 " + q(ossa::test::source_dir() / "tests" / "support" / "json_schema_check.py") + " " +
+  const std::string check = "/usr/bin/python3 " +
+                            q(ossa::test::source_dir() / "tests" / "support" / "json_schema_check.py") + " " +
                             q(ossa::test::source_dir() / "docs" / "schemas" / "ossa-diff.schema.json");
   auto r = run_command(check + docs);
   EXPECT_EQ(r.exit_code, 0) << r.out << r.err;

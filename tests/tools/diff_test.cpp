@@ -20,8 +20,8 @@
 
 namespace {
 
-using ossa::diff::DiffReport;
 using ossa::diff::Difference;
+using ossa::diff::DiffReport;
 using ossa::test::SyntheticSpec;
 
 ossa::Asset open_spec(const SyntheticSpec& spec, const char* name) {
@@ -61,7 +61,8 @@ TEST(PoseError, RotationMovesTheProbePointsAndTheChildren) {
   ossa::Pose a(2), b(2);
   ossa::set_transform(a, 1, {glm::vec3(1, 0, 0), glm::quat(1, 0, 0, 0), glm::vec3(1)});
   ossa::set_transform(b, 1, {glm::vec3(1, 0, 0), glm::quat(1, 0, 0, 0), glm::vec3(1)});
-  ossa::set_transform(b, 0, {glm::vec3(0), glm::angleAxis(static_cast<float>(theta), glm::vec3(0, 0, 1)), glm::vec3(1)});
+  ossa::set_transform(b, 0,
+                      {glm::vec3(0), glm::angleAxis(static_cast<float>(theta), glm::vec3(0, 0, 1)), glm::vec3(1)});
   ossa::ModelAffine scratch[4];
   const ossa::PoseError e = ossa::pose_error(parents, a, b, p, scratch);
   EXPECT_EQ(e.joint, 1);
@@ -144,8 +145,11 @@ TEST(Diff, FloatAndQuantizedLayoutsCompareByPosition) {
   using S = ossa::fb::VertexSemantic;
   using F = ossa::fb::VertexFormat;
   SyntheticSpec floats;
-  floats.meshes[0].layout = {{S::Position, F::Float32x3, 0}, {S::Normal, F::Float32x3, 12}, {S::TexCoord0, F::Float32x2, 24},
-                             {S::Joints, F::Uint16x4, 32},   {S::Weights, F::Unorm8x4, 40}};
+  floats.meshes[0].layout = {{S::Position, F::Float32x3, 0},
+                             {S::Normal, F::Float32x3, 12},
+                             {S::TexCoord0, F::Float32x2, 24},
+                             {S::Joints, F::Uint16x4, 32},
+                             {S::Weights, F::Unorm8x4, 40}};
   floats.meshes[0].vertex_stride = 44;
   const DiffReport r = diff(SyntheticSpec{}, floats);
   ASSERT_EQ(r.meshes.items.size(), 1u);
@@ -250,7 +254,8 @@ TEST(Diff, EventsDurationAndRootMotionAreCompared) {
   b.clips[0].root_motion = ossa::test::SyntheticRootMotion{std::vector<ossa::fb::Vec3>(31, ossa::fb::Vec3(0, 0, 0)),
                                                            std::vector<float>(31, 0.0f), 1};
   const std::string lines = all_lines(diff(a, b));
-  EXPECT_NE(lines.find("clips 'walk': event: 'foot_right' at 0.75 s -> 'foot_right' at 0.8 s"), std::string::npos) << lines;
+  EXPECT_NE(lines.find("clips 'walk': event: 'foot_right' at 0.75 s -> 'foot_right' at 0.8 s"), std::string::npos)
+      << lines;
   EXPECT_NE(lines.find("clips 'walk': root motion: added"), std::string::npos) << lines;
 }
 

@@ -38,8 +38,8 @@ CommandResult tool(const char* name, const std::string& args) {
 
 /// json_schema_check.py SCHEMA DOCS...: 0 all valid, 1 some invalid, 2 unreadable.
 CommandResult check(const fs::path& schema_file, const std::vector<fs::path>& docs) {
-  std::string cmd = "/usr/bin/python3 " + q(ossa::test::source_dir() / "tests/support/json_schema_check.py") + " " +
-                    q(schema_file);
+  std::string cmd =
+      "/usr/bin/python3 " + q(ossa::test::source_dir() / "tests/support/json_schema_check.py") + " " + q(schema_file);
   for (const fs::path& d : docs) cmd += " " + q(d);
   return run_command(cmd);
 }
@@ -55,7 +55,8 @@ bool write_json(const fs::path& path, const json& doc) { return ossa::test::writ
 const json* find_record(const json& report, const std::string& input_suffix) {
   for (const json& r : report["records"]) {
     const std::string in = r["input"].get<std::string>();
-    if (in.size() >= input_suffix.size() && in.compare(in.size() - input_suffix.size(), input_suffix.size(), input_suffix) == 0)
+    if (in.size() >= input_suffix.size() &&
+        in.compare(in.size() - input_suffix.size(), input_suffix.size(), input_suffix) == 0)
       return &r;
   }
   return nullptr;
@@ -65,16 +66,16 @@ const json* find_record(const json& report, const std::string& input_suffix) {
 /// glTF with its buffer and every texture image (the shared AnimeBoy, when ../shared is there).
 TEST(CookReportSchema, SourceBytesCountEveryFileRead) {
   const fs::path dir = ossa::test::make_temp_dir("schema-report-bytes");
-  const CommandResult r = tool("ossa-cook", q(asset("Pab/walk.fbx")) + " -q -o " + q(dir / "out") + " --report " +
-                                                q(dir / "report.json"));
+  const CommandResult r =
+      tool("ossa-cook", q(asset("Pab/walk.fbx")) + " -q -o " + q(dir / "out") + " --report " + q(dir / "report.json"));
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const json report = read_json(dir / "report.json");
   ASSERT_EQ(report["records"].size(), 1u);
   EXPECT_EQ(report["records"][0]["source_bytes"].get<uint64_t>(),
             fs::file_size(asset("Pab/walk.fbx")) + fs::file_size(asset("Pab/walk.events.json")));
   // An up-to-date output's record counts the same files.
-  const CommandResult again = tool("ossa-cook", q(asset("Pab/walk.fbx")) + " -q -o " + q(dir / "out") +
-                                                    " --report " + q(dir / "again.json"));
+  const CommandResult again =
+      tool("ossa-cook", q(asset("Pab/walk.fbx")) + " -q -o " + q(dir / "out") + " --report " + q(dir / "again.json"));
   ASSERT_EQ(again.exit_code, 0) << again.err;
   const json second = read_json(dir / "again.json");
   EXPECT_EQ(second["records"][0]["up_to_date"], true);
@@ -87,8 +88,8 @@ TEST(CookReportSchema, SourceBytesCountEveryFileRead) {
     if (e.is_regular_file() && (e.path().extension() == ".gltf" || e.path().extension() == ".bin" ||
                                 e.path().extension() == ".png" || e.path().extension() == ".jpg"))
       everything += e.file_size();
-  const CommandResult g = tool("ossa-cook", q(boy / "scene.gltf") + " -q -o " + q(dir / "boy") + " --report " +
-                                                q(dir / "boy.json"));
+  const CommandResult g =
+      tool("ossa-cook", q(boy / "scene.gltf") + " -q -o " + q(dir / "boy") + " --report " + q(dir / "boy.json"));
   ASSERT_EQ(g.exit_code, 0) << g.err;
   const json boy_report = read_json(dir / "boy.json");
   const uint64_t counted = boy_report["records"][0]["source_bytes"].get<uint64_t>();
@@ -108,9 +109,9 @@ TEST(CookReportSchema, BatchWithFailuresIsValidAndFailedRecordsNameNoOutput) {
   ASSERT_TRUE(ossa::test::write_file(src / "bad.fbx", std::string_view("this is a text file, not an FBX\n")));
   fs::copy_file(asset("RiggedSimple/RiggedSimple.glb"), src / "rigged.glb");
   ASSERT_TRUE(ossa::test::write_file(src / "rigged.events.json", std::string_view("{ \"clips\": [ oops ] }\n")));
-  const CommandResult r = tool("ossa-cook", q(src / "bad.fbx") + " " + q(src / "missing.gltf") + " " +
-                                                q(src / "rigged.glb") + " " + q(asset("Fox/Fox.glb")) + " -q -j 2 -o " +
-                                                q(out) + " --report " + q(report_path));
+  const CommandResult r =
+      tool("ossa-cook", q(src / "bad.fbx") + " " + q(src / "missing.gltf") + " " + q(src / "rigged.glb") + " " +
+                            q(asset("Fox/Fox.glb")) + " -q -j 2 -o " + q(out) + " --report " + q(report_path));
   ASSERT_EQ(r.exit_code, 1) << r.err;
 
   const CommandResult v = check(schema("ossa-cook-report"), {report_path});
@@ -165,8 +166,8 @@ TEST(CookReportSchema, BatchWithFailuresIsValidAndFailedRecordsNameNoOutput) {
 
 TEST(CookReportSchema, GraphFileReportIsValid) {
   const fs::path dir = ossa::test::make_temp_dir("schema-report-graph");
-  const CommandResult r = tool("ossa-cook", q(asset("Pab/pab.graph.json")) + " -q -o " + q(dir / "out") +
-                                                " --report " + q(dir / "report.json"));
+  const CommandResult r = tool(
+      "ossa-cook", q(asset("Pab/pab.graph.json")) + " -q -o " + q(dir / "out") + " --report " + q(dir / "report.json"));
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const CommandResult v = check(schema("ossa-cook-report"), {dir / "report.json"});
   EXPECT_EQ(v.exit_code, 0) << v.out << v.err;
@@ -307,26 +308,27 @@ TEST(SchemasConstrain, MutatedReportsAreRejected) {
   const json report = read_json(dir / "report.json");
   ASSERT_EQ(report["records"][0]["status"], "failed");
   ASSERT_EQ(report["records"][1]["status"], "ok");
-  expect_rejected(schema("ossa-cook-report"), report,
-                  {
-                      {"an unknown top-level field", [](json& d) { d["colour"] = "blue"; }},
-                      {"an unknown record field", [](json& d) { d["records"][1]["speed"] = 1; }},
-                      {"an unknown clip field", [](json& d) { d["records"][1]["clip_compression"][0]["x"] = 1; }},
-                      {"a count as a string", [](json& d) { d["records"][1]["joints"] = "24"; }},
-                      {"a negative size", [](json& d) { d["records"][1]["source_bytes"] = -1; }},
-                      {"an error as a string", [](json& d) { d["records"][1]["clip_compression"][0]["max_error_mm"] = "0.1"; }},
-                      {"a failed record naming an output", [](json& d) { d["records"][0]["output"] = "out/bad.ossa"; }},
-                      {"a failed record with cooked bytes", [](json& d) { d["records"][0]["cooked_bytes"] = 10; }},
-                      {"a failed record without its error", [](json& d) { d["records"][0].erase("error"); }},
-                      {"an ok record without its output", [](json& d) { d["records"][1].erase("output"); }},
-                      {"an ok record without a count", [](json& d) { d["records"][1].erase("vertices"); }},
-                      {"an ok record with an error", [](json& d) { d["records"][1]["error"] = "?"; }},
-                      {"an unknown status", [](json& d) { d["records"][1]["status"] = "maybe"; }},
-                      {"another schema name", [](json& d) { d["schema"] = "ossa-inspect"; }},
-                      {"another schema version", [](json& d) { d["schema_version"] = 2; }},
-                      {"no schema version", [](json& d) { d.erase("schema_version"); }},
-                  },
-                  dir);
+  expect_rejected(
+      schema("ossa-cook-report"), report,
+      {
+          {"an unknown top-level field", [](json& d) { d["colour"] = "blue"; }},
+          {"an unknown record field", [](json& d) { d["records"][1]["speed"] = 1; }},
+          {"an unknown clip field", [](json& d) { d["records"][1]["clip_compression"][0]["x"] = 1; }},
+          {"a count as a string", [](json& d) { d["records"][1]["joints"] = "24"; }},
+          {"a negative size", [](json& d) { d["records"][1]["source_bytes"] = -1; }},
+          {"an error as a string", [](json& d) { d["records"][1]["clip_compression"][0]["max_error_mm"] = "0.1"; }},
+          {"a failed record naming an output", [](json& d) { d["records"][0]["output"] = "out/bad.ossa"; }},
+          {"a failed record with cooked bytes", [](json& d) { d["records"][0]["cooked_bytes"] = 10; }},
+          {"a failed record without its error", [](json& d) { d["records"][0].erase("error"); }},
+          {"an ok record without its output", [](json& d) { d["records"][1].erase("output"); }},
+          {"an ok record without a count", [](json& d) { d["records"][1].erase("vertices"); }},
+          {"an ok record with an error", [](json& d) { d["records"][1]["error"] = "?"; }},
+          {"an unknown status", [](json& d) { d["records"][1]["status"] = "maybe"; }},
+          {"another schema name", [](json& d) { d["schema"] = "ossa-inspect"; }},
+          {"another schema version", [](json& d) { d["schema_version"] = 2; }},
+          {"no schema version", [](json& d) { d.erase("schema_version"); }},
+      },
+      dir);
 }
 
 TEST(SchemasConstrain, MutatedInspectDocumentsAreRejected) {
@@ -335,21 +337,22 @@ TEST(SchemasConstrain, MutatedInspectDocumentsAreRejected) {
   const CommandResult r = tool("ossa-inspect", q(dir / "Fox.ossa") + " --json -v");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const json doc = json::parse(r.out);
-  expect_rejected(schema("ossa-inspect"), doc,
-                  {
-                      {"an unknown top-level field", [](json& d) { d["vertices"] = 1; }},
-                      {"an unknown joint field", [](json& d) { d["skeleton"]["joints"][0]["weight"] = 1.0; }},
-                      {"an unknown channel field", [](json& d) { d["clips"][0]["channels"][0]["x"] = 0; }},
-                      {"an unknown vertex format", [](json& d) { d["meshes"][0]["layout"][0]["format"] = "Float64x9"; }},
-                      {"an error as a string", [](json& d) { d["clips"][0]["compression"]["max_error_mm"] = "small"; }},
-                      {"a bounds vector of two", [](json& d) { d["meshes"][0]["bounds"]["min"].erase(2); }},
-                      {"a short hash", [](json& d) { d["content_hash"] = "abc"; }},
-                      {"no content hash", [](json& d) { d.erase("content_hash"); }},
-                      {"a negative count", [](json& d) { d["meshes"][0]["vertex_count"] = -3; }},
-                      {"bits out of range", [](json& d) { d["clips"][0]["channels"][0]["bits"] = 33; }},
-                      {"another schema version", [](json& d) { d["schema_version"] = 0; }},
-                  },
-                  dir);
+  expect_rejected(
+      schema("ossa-inspect"), doc,
+      {
+          {"an unknown top-level field", [](json& d) { d["vertices"] = 1; }},
+          {"an unknown joint field", [](json& d) { d["skeleton"]["joints"][0]["weight"] = 1.0; }},
+          {"an unknown channel field", [](json& d) { d["clips"][0]["channels"][0]["x"] = 0; }},
+          {"an unknown vertex format", [](json& d) { d["meshes"][0]["layout"][0]["format"] = "Float64x9"; }},
+          {"an error as a string", [](json& d) { d["clips"][0]["compression"]["max_error_mm"] = "small"; }},
+          {"a bounds vector of two", [](json& d) { d["meshes"][0]["bounds"]["min"].erase(2); }},
+          {"a short hash", [](json& d) { d["content_hash"] = "abc"; }},
+          {"no content hash", [](json& d) { d.erase("content_hash"); }},
+          {"a negative count", [](json& d) { d["meshes"][0]["vertex_count"] = -3; }},
+          {"bits out of range", [](json& d) { d["clips"][0]["channels"][0]["bits"] = 33; }},
+          {"another schema version", [](json& d) { d["schema_version"] = 0; }},
+      },
+      dir);
 }
 
 TEST(SchemasConstrain, EveryObjectIsClosedAndEveryPropertyDescribed) {

@@ -74,8 +74,10 @@ TEST(ToolsCli, UnknownOptionIsAUsageErrorWithTheClosestMatch) {
   for (const Case& c : cases) {
     const CommandResult r = run_tool(c.tool, c.args);
     EXPECT_EQ(r.exit_code, 2) << c.tool << " " << c.args << "\n" << r.err;
-    EXPECT_NE(r.err.find(std::string("unknown option ") + c.typo + ": did you mean " + c.guess + "?"), std::string::npos)
-        << c.tool << " " << c.args << "\n" << r.err;
+    EXPECT_NE(r.err.find(std::string("unknown option ") + c.typo + ": did you mean " + c.guess + "?"),
+              std::string::npos)
+        << c.tool << " " << c.args << "\n"
+        << r.err;
     EXPECT_NE(r.err.find(std::string("run '") + c.tool + " --help'"), std::string::npos) << r.err;
     EXPECT_TRUE(r.out.empty()) << r.out;
   }
@@ -177,10 +179,10 @@ TEST(ToolsCli, InspectQuietOnlyAnswersByStatusVerboseListsChannels) {
 /// alone for one.
 TEST(ToolsCli, InspectTakesSeveralFiles) {
   const fs::path dir = ossa::test::make_temp_dir("tools-inspect-many");
-  ASSERT_EQ(run_tool("ossa-cook", q(asset("Fox/Fox.glb")) + " " + q(asset("CesiumMan/CesiumMan.glb")) + " -q -o " +
-                                      q(dir))
-                .exit_code,
-            0);
+  ASSERT_EQ(
+      run_tool("ossa-cook", q(asset("Fox/Fox.glb")) + " " + q(asset("CesiumMan/CesiumMan.glb")) + " -q -o " + q(dir))
+          .exit_code,
+      0);
   ASSERT_TRUE(ossa::test::write_file(dir / "junk.ossa", std::string_view("junk junk junk junk")));
   const std::string fox = q(dir / "Fox.ossa"), cesium = q(dir / "CesiumMan.ossa");
 
@@ -232,8 +234,8 @@ TEST(CliHelper, ClosestName) {
 }
 
 TEST(CliHelper, VersionLineNamesTheTool) {
-  EXPECT_EQ(ossa::cli::version_line("ossa-diff"),
-            std::string("ossa-diff ") + ossa::kVersionString + " (format " + std::to_string(ossa::kFormatVersion) + ")");
+  EXPECT_EQ(ossa::cli::version_line("ossa-diff"), std::string("ossa-diff ") + ossa::kVersionString + " (format " +
+                                                      std::to_string(ossa::kFormatVersion) + ")");
 }
 
 // A 30,000-joint chain is within the format's joint limit: ossa-inspect prints it in bounded
@@ -284,8 +286,8 @@ TEST(ToolsCli, ExitStatusesAreTheDocumentedOnes) {
   };
   const Case cases[] = {
       {"ossa-cook", q(asset("RiggedSimple/RiggedSimple.glb")) + out, 0},
-      {"ossa-cook", q(dir / "no-such-source.fbx") + out, 1},  // a failed input, named
-      {"ossa-cook", q(dir / "empty") + out, 2},                // no source found
+      {"ossa-cook", q(dir / "no-such-source.fbx") + out, 1},                              // a failed input, named
+      {"ossa-cook", q(dir / "empty") + out, 2},                                           // no source found
       {"ossa-cook", q(asset("Pab/walk.fbx")) + " " + q(asset("Pab/walk.fbx")) + out, 2},  // outputs collide
       {"ossa-cook", q(asset("Pab/walk.fbx")) + " --skeleton " + q(dir / "no-rig.ossa") + out, 2},
       {"ossa-inspect", "-q " + skeleton, 0},

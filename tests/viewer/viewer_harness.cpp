@@ -67,7 +67,8 @@ void start_xvfb(XServer& x) {
   // Close the read end before the dup2: pipe() may have returned it as fd 3 itself.
   posix_spawn_file_actions_addclose(&actions, fds[0]);
   posix_spawn_file_actions_adddup2(&actions, fds[1], 3);
-  const char* argv[] = {"Xvfb", "-displayfd", "3", "-screen", "0", "1920x1200x24", "-nolisten", "tcp", "-noreset", nullptr};
+  const char* argv[] = {"Xvfb",         "-displayfd", "3",   "-screen",  "0",
+                        "1920x1200x24", "-nolisten",  "tcp", "-noreset", nullptr};
   const int rc = posix_spawnp(&x.pid, "Xvfb", &actions, nullptr, const_cast<char**>(argv), environ);
   posix_spawn_file_actions_destroy(&actions);
   close(fds[1]);
@@ -136,14 +137,17 @@ Image load_png(const std::filesystem::path& path) {
 double coverage(const Image& image) {
   if (image.empty()) return 0.0;
   const std::array<const uint8_t*, 4> corners = {image.at(0, 0), image.at(image.width - 1, 0),
-                                                 image.at(0, image.height - 1), image.at(image.width - 1, image.height - 1)};
+                                                 image.at(0, image.height - 1),
+                                                 image.at(image.width - 1, image.height - 1)};
   std::map<std::array<uint8_t, 3>, int> votes;
   for (const uint8_t* c : corners) ++votes[{c[0], c[1], c[2]}];
-  const auto background = std::max_element(votes.begin(), votes.end(), [](auto& a, auto& b) { return a.second < b.second; })->first;
+  const auto background =
+      std::max_element(votes.begin(), votes.end(), [](auto& a, auto& b) { return a.second < b.second; })->first;
   size_t covered = 0;
   for (size_t i = 0; i < image.rgb.size(); i += 3) {
     int d = 0;
-    for (int c = 0; c < 3; ++c) d = std::max(d, std::abs(int(image.rgb[i + c]) - int(background[static_cast<size_t>(c)])));
+    for (int c = 0; c < 3; ++c)
+      d = std::max(d, std::abs(int(image.rgb[i + c]) - int(background[static_cast<size_t>(c)])));
     covered += d > 6 ? 1 : 0;
   }
   return static_cast<double>(covered) / (static_cast<double>(image.rgb.size()) / 3.0);

@@ -47,9 +47,9 @@ Image load_png(const std::filesystem::path& path);
 double coverage(const Image& image);
 
 struct ImageDiff {
-  double mean_abs = 0.0;        // mean |a - b| over all channels, in 0..255 units
-  double differing = 0.0;       // fraction of pixels with any channel differing by > threshold
-  int max_channel = 0;          // largest channel difference
+  double mean_abs = 0.0;   // mean |a - b| over all channels, in 0..255 units
+  double differing = 0.0;  // fraction of pixels with any channel differing by > threshold
+  int max_channel = 0;     // largest channel difference
 };
 /// Pixel differences between two images of equal size (threshold in 0..255 units).
 ImageDiff compare(const Image& a, const Image& b, int threshold);

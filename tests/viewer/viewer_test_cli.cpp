@@ -84,14 +84,15 @@ TEST_F(Viewer, ClipOnlyFileAloneHasNoMesh) {
 TEST_F(Viewer, SkeletonOnlyFileIsShownAsBones) {
   const std::string bvh =
       "HIERARCHY\nROOT Hips\n{\n  OFFSET 0 0 0\n  CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation "
-      "Yrotation\n  JOINT Spine\n  {\n    OFFSET 0 0.5 0\n    CHANNELS 3 Zrotation Xrotation Yrotation\n    JOINT Head\n"
+      "Yrotation\n  JOINT Spine\n  {\n    OFFSET 0 0.5 0\n    CHANNELS 3 Zrotation Xrotation Yrotation\n    JOINT "
+      "Head\n"
       "    {\n      OFFSET 0 0.5 0\n      CHANNELS 3 Zrotation Xrotation Yrotation\n      End Site\n      {\n"
       "        OFFSET 0 0.2 0\n      }\n    }\n  }\n}\nMOTION\nFrames: 3\nFrame Time: 0.5\n"
       "0 1 0 0 0 0 0 0 0 0 0 0\n0 1 0 0 0 0 40 0 0 0 0 0\n0 1 0 0 0 0 80 0 0 0 0 0\n";
   ASSERT_TRUE(ossa::test::write_file(dir_ / "mocap.bvh", bvh));
-  const CommandResult cooked_bvh = ossa::test::run_command(quote((ossa::test::bin_dir() / "ossa-cook").string()) + " " +
-                                                           quote((dir_ / "mocap.bvh").string()) + " -o " +
-                                                           quote(dir_.string()) + " -q");
+  const CommandResult cooked_bvh =
+      ossa::test::run_command(quote((ossa::test::bin_dir() / "ossa-cook").string()) + " " +
+                              quote((dir_ / "mocap.bvh").string()) + " -o " + quote(dir_.string()) + " -q");
   ASSERT_EQ(cooked_bvh.exit_code, 0) << cooked_bvh.err;
   const std::string base = quote((dir_ / "mocap.ossa").string()) + " --size 192x192 --no-grid";
   const CommandResult start = run_viewer(base + " --time 0 --screenshot " + quote((dir_ / "bones0.png").string()));
@@ -106,16 +107,18 @@ TEST_F(Viewer, SkeletonOnlyFileIsShownAsBones) {
 // A model coloured only by its vertex colours (no texture, a grey default material) is drawn in
 // those colours: the left half of the quad red, the right half blue.
 TEST_F(Viewer, VertexColoursTintTheSurface) {
-  ASSERT_TRUE(ossa::test::write_file(dir_ / "painted.obj",
-                                     std::string("v -1 0 0 1 0 0\nv 0 0 0 1 0 0\nv 0 2 0 1 0 0\nv -1 2 0 1 0 0\n"
-                                                 "v 0 0 0 0 0 1\nv 1 0 0 0 0 1\nv 1 2 0 0 0 1\nv 0 2 0 0 0 1\n"
-                                                 "vn 0 0 1\nf 1//1 2//1 3//1\nf 1//1 3//1 4//1\nf 5//1 6//1 7//1\nf 5//1 7//1 8//1\n")));
-  const CommandResult cooked_obj = ossa::test::run_command(quote((ossa::test::bin_dir() / "ossa-cook").string()) + " " +
-                                                           quote((dir_ / "painted.obj").string()) + " -o " +
-                                                           quote(dir_.string()) + " -q");
+  ASSERT_TRUE(ossa::test::write_file(
+      dir_ / "painted.obj",
+      std::string("v -1 0 0 1 0 0\nv 0 0 0 1 0 0\nv 0 2 0 1 0 0\nv -1 2 0 1 0 0\n"
+                  "v 0 0 0 0 0 1\nv 1 0 0 0 0 1\nv 1 2 0 0 0 1\nv 0 2 0 0 0 1\n"
+                  "vn 0 0 1\nf 1//1 2//1 3//1\nf 1//1 3//1 4//1\nf 5//1 6//1 7//1\nf 5//1 7//1 8//1\n")));
+  const CommandResult cooked_obj =
+      ossa::test::run_command(quote((ossa::test::bin_dir() / "ossa-cook").string()) + " " +
+                              quote((dir_ / "painted.obj").string()) + " -o " + quote(dir_.string()) + " -q");
   ASSERT_EQ(cooked_obj.exit_code, 0) << cooked_obj.err;
-  const CommandResult r = run_viewer(quote((dir_ / "painted.ossa").string()) + " --size 128x128 --no-grid --yaw 0 --pitch 0 " +
-                                     "--screenshot " + quote((dir_ / "painted.png").string()));
+  const CommandResult r =
+      run_viewer(quote((dir_ / "painted.ossa").string()) + " --size 128x128 --no-grid --yaw 0 --pitch 0 " +
+                 "--screenshot " + quote((dir_ / "painted.png").string()));
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const Image img = load_png(dir_ / "painted.png");
   ASSERT_FALSE(img.empty());
@@ -128,15 +131,22 @@ TEST_F(Viewer, VertexColoursTintTheSurface) {
       const uint8_t* p = img.at(x, y);
       if (std::abs(p[0] - bg[0]) + std::abs(p[1] - bg[1]) + std::abs(p[2] - bg[2]) < 30) continue;
       const glm::dvec3 c(p[0], p[1], p[2]);
-      if (x < img.width / 3) { left += c; ++nl; }
-      if (x >= 2 * img.width / 3) { right += c; ++nr; }
+      if (x < img.width / 3) {
+        left += c;
+        ++nl;
+      }
+      if (x >= 2 * img.width / 3) {
+        right += c;
+        ++nr;
+      }
     }
   ASSERT_GT(nl, 20.0);
   ASSERT_GT(nr, 20.0);
   left /= nl;
   right /= nr;
   EXPECT_GT(left.r, 3.0 * std::max(left.g, left.b) + 10.0) << "red half: " << left.r << " " << left.g << " " << left.b;
-  EXPECT_GT(right.b, 3.0 * std::max(right.r, right.g) + 10.0) << "blue half: " << right.r << " " << right.g << " " << right.b;
+  EXPECT_GT(right.b, 3.0 * std::max(right.r, right.g) + 10.0)
+      << "blue half: " << right.r << " " << right.g << " " << right.b;
 }
 
 // A prop far larger than its rig (a 4 m plank held by a 0.2 m two-joint rig) is framed whole:
@@ -195,15 +205,16 @@ TEST_F(Viewer, APropLargerThanItsSkeletonIsFramedWhole) {
 </COLLADA>
 )";
   ASSERT_TRUE(ossa::test::write_file(dir_ / "plank.dae", dae));
-  const CommandResult cooked_dae = ossa::test::run_command(quote((ossa::test::bin_dir() / "ossa-cook").string()) + " " +
-                                                           quote((dir_ / "plank.dae").string()) + " -o " +
-                                                           quote(dir_.string()) + " -q");
+  const CommandResult cooked_dae =
+      ossa::test::run_command(quote((ossa::test::bin_dir() / "ossa-cook").string()) + " " +
+                              quote((dir_ / "plank.dae").string()) + " -o " + quote(dir_.string()) + " -q");
   ASSERT_EQ(cooked_dae.exit_code, 0) << cooked_dae.err;
   auto plank = ossa::Asset::open((dir_ / "plank.ossa").string());
   ASSERT_TRUE(plank.ok()) << plank.error().message;
   ASSERT_EQ(plank->skeleton().joint_count(), 2u) << "the plank is skinned to a rig, not baked";
-  const CommandResult r = run_viewer(quote((dir_ / "plank.ossa").string()) + " --size 160x120 --no-grid --yaw 0 --pitch 0 " +
-                                     "--screenshot " + quote((dir_ / "plank.png").string()));
+  const CommandResult r =
+      run_viewer(quote((dir_ / "plank.ossa").string()) + " --size 160x120 --no-grid --yaw 0 --pitch 0 " +
+                 "--screenshot " + quote((dir_ / "plank.png").string()));
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const Image img = load_png(dir_ / "plank.png");
   ASSERT_FALSE(img.empty());
@@ -226,8 +237,8 @@ TEST_F(Viewer, APropLargerThanItsSkeletonIsFramedWhole) {
 }
 
 TEST_F(Viewer, ClipOfAnotherSkeletonIsRefused) {
-  const CommandResult r = run_viewer(quote(cooked("Fox/Fox.ossa").string()) + " " + quote(cooked("Pab/walk.ossa").string()) +
-                                     " --frames 1");
+  const CommandResult r = run_viewer(quote(cooked("Fox/Fox.ossa").string()) + " " +
+                                     quote(cooked("Pab/walk.ossa").string()) + " --frames 1");
   EXPECT_NE(r.exit_code, 0);
   EXPECT_NE(r.err.find("walk.ossa"), std::string::npos) << r.err;
 }
@@ -241,7 +252,8 @@ TEST_F(Viewer, UnknownClipNameListsTheClips) {
 
 TEST_F(Viewer, UnwritableScreenshotIsNamed) {
   const fs::path out = dir_ / "missing-dir" / "out.png";
-  const CommandResult r = run_viewer(quote(cooked("Fox/Fox.ossa").string()) + " --size 64x64 --screenshot " + quote(out.string()));
+  const CommandResult r =
+      run_viewer(quote(cooked("Fox/Fox.ossa").string()) + " --size 64x64 --screenshot " + quote(out.string()));
   EXPECT_NE(r.exit_code, 0);
   EXPECT_NE(r.err.find(out.string()), std::string::npos) << r.err;
 }
@@ -287,16 +299,15 @@ TEST_F(Viewer, HostileTexturesAreLeftOutByName) {
   const auto png = tiny_png();
   std::vector<uint8_t> bomb(png.begin(), png.end());
   for (int k = 0; k < 2; ++k) {  // IHDR width and height -> 16384
-    bomb.at(16 + 4 * k) = 0;  // at(): GCC 12 -O3 warns of a write past an empty vector with []
+    bomb.at(16 + 4 * k) = 0;     // at(): GCC 12 -O3 warns of a write past an empty vector with []
     bomb.at(17 + 4 * k) = 0;
     bomb.at(18 + 4 * k) = 0x40;
     bomb.at(19 + 4 * k) = 0;
   }
   SyntheticSpec spec;
-  spec.materials[0].textures = {
-      {ossa::fb::TextureRole::Diffuse, "", "image/png", bomb},
-      {ossa::fb::TextureRole::Normal, "../../../../../../etc/passwd", "", std::nullopt},
-      {ossa::fb::TextureRole::Specular, "pipe.png", "", std::nullopt}};
+  spec.materials[0].textures = {{ossa::fb::TextureRole::Diffuse, "", "image/png", bomb},
+                                {ossa::fb::TextureRole::Normal, "../../../../../../etc/passwd", "", std::nullopt},
+                                {ossa::fb::TextureRole::Specular, "pipe.png", "", std::nullopt}};
   SyntheticMaterial second;
   second.textures = {{ossa::fb::TextureRole::Diffuse, "/dev/zero", "", std::nullopt},
                      {ossa::fb::TextureRole::Normal, "folder.png", "", std::nullopt}};

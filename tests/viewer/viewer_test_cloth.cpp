@@ -19,8 +19,8 @@ class ViewerCloth : public Viewer {
  protected:
   Image shot(const std::string& name, const std::string& args) {
     const fs::path png = dir_ / (name + ".png");
-    return screenshot(quote(cooked("CapedMan/CapedMan.ossa").string()) + " --size 256x256 --no-grid --yaw 150 " +
-                          args + " --screenshot " + quote(png.string()),
+    return screenshot(quote(cooked("CapedMan/CapedMan.ossa").string()) + " --size 256x256 --no-grid --yaw 150 " + args +
+                          " --screenshot " + quote(png.string()),
                       png);
   }
 };

@@ -31,9 +31,9 @@ namespace ossa::test {
 // uniform, so it cannot tell); a wrong palette moves whole limbs. A clip frame vs the bind pose differs on
 // 6.5 % (Pab walk) to 11 % of the pixels.
 constexpr int kPixelThreshold = 24;
-constexpr double kMaxDifferingSame = 0.002;   // GPU vs CPU, float vs quantized
+constexpr double kMaxDifferingSame = 0.002;  // GPU vs CPU, float vs quantized
 constexpr double kMaxMeanSame = 0.15;
-constexpr double kMinDifferingPosed = 0.01;   // a clip frame vs the bind pose
+constexpr double kMinDifferingPosed = 0.01;  // a clip frame vs the bind pose
 
 /// Runs ossa-view with `args` (which write a screenshot to `png`); fails the test on a non-zero
 /// exit or any GL error message, and returns the image.
@@ -46,7 +46,6 @@ inline Image screenshot(const std::string& args, const std::filesystem::path& pn
   return image;
 }
 
-
 /// Whether (x, y) differs from the top-left corner's colour by more than 6 in a channel.
 inline bool foreground(const Image& image, int x, int y) {
   const uint8_t *p = image.at(x, y), *bg = image.at(0, 0);
@@ -58,10 +57,12 @@ inline std::vector<uint8_t> solid_png(uint8_t r, uint8_t g, uint8_t b) {
   std::vector<uint8_t> texels;
   for (int i = 0; i < 64; ++i) texels.insert(texels.end(), {r, g, b});
   std::vector<uint8_t> out;
-  stbi_write_png_to_func([](void* ctx, void* data, int size) {
-    auto* o = static_cast<std::vector<uint8_t>*>(ctx);
-    o->insert(o->end(), static_cast<uint8_t*>(data), static_cast<uint8_t*>(data) + size);
-  }, &out, 8, 8, 3, texels.data(), 24);
+  stbi_write_png_to_func(
+      [](void* ctx, void* data, int size) {
+        auto* o = static_cast<std::vector<uint8_t>*>(ctx);
+        o->insert(o->end(), static_cast<uint8_t*>(data), static_cast<uint8_t*>(data) + size);
+      },
+      &out, 8, 8, 3, texels.data(), 24);
   return out;
 }
 
@@ -72,8 +73,10 @@ inline bool write_quad_bin(const std::filesystem::path& dir) {
                             0,  0,  1, 0, 0,  1, 0, 0, 1, 0,  0, 1,  // normals
                             0,  1,  1, 1, 1,  0, 0, 0};              // texture coordinates
   const uint16_t indices[] = {0, 1, 2, 0, 2, 3};
-  std::vector<uint8_t> bin(reinterpret_cast<const uint8_t*>(geometry), reinterpret_cast<const uint8_t*>(geometry) + sizeof geometry);
-  bin.insert(bin.end(), reinterpret_cast<const uint8_t*>(indices), reinterpret_cast<const uint8_t*>(indices) + sizeof indices);
+  std::vector<uint8_t> bin(reinterpret_cast<const uint8_t*>(geometry),
+                           reinterpret_cast<const uint8_t*>(geometry) + sizeof geometry);
+  bin.insert(bin.end(), reinterpret_cast<const uint8_t*>(indices),
+             reinterpret_cast<const uint8_t*>(indices) + sizeof indices);
   return bin.size() == 140 && write_file(dir / "quad.bin", bin);
 }
 
@@ -88,7 +91,8 @@ inline std::string quad_gltf(const std::string& tail) {
     "accessors": [{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [-1, -1, 0], "max": [1, 1, 0]},
                   {"bufferView": 1, "componentType": 5126, "count": 4, "type": "VEC3"},
                   {"bufferView": 2, "componentType": 5126, "count": 4, "type": "VEC2"},
-                  {"bufferView": 3, "componentType": 5123, "count": 6, "type": "SCALAR"}],)" + tail + "}";
+                  {"bufferView": 3, "componentType": 5123, "count": 6, "type": "SCALAR"}],)" +
+         tail + "}";
 }
 
 class Viewer : public ::testing::Test {
@@ -101,6 +105,5 @@ class Viewer : public ::testing::Test {
   std::filesystem::path cooked(const char* rel) const { return viewer_cooked_dir() / "quantized" / rel; }
   std::filesystem::path dir_;
 };
-
 
 }  // namespace ossa::test

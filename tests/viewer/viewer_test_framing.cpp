@@ -73,17 +73,17 @@ std::string figure(int turn) {
   for (const float x : {-0.15f, 0.05f}) {
     f.box({x, 0.0f, -0.05f}, {x + 0.1f, 0.08f, 0.2f}, grey, grey, grey);  // a foot
     for (int k = 0; k < 8; ++k)  // a leg, in segments: vertices all the way up, as a real mesh has
-      f.box({x, 0.08f + 0.1f * static_cast<float>(k), -0.05f}, {x + 0.1f, 0.18f + 0.1f * static_cast<float>(k), 0.05f}, grey,
-            grey, grey);
+      f.box({x, 0.08f + 0.1f * static_cast<float>(k), -0.05f}, {x + 0.1f, 0.18f + 0.1f * static_cast<float>(k), 0.05f},
+            grey, grey, grey);
   }
-  f.box({-0.2f, 0.9f, -0.1f}, {0.2f, 1.5f, 0.1f}, grey, grey, grey);       // the body
-  f.box({-0.12f, 1.52f, -0.12f}, {0.12f, 1.8f, 0.12f}, grey, red, blue);   // the head
+  f.box({-0.2f, 0.9f, -0.1f}, {0.2f, 1.5f, 0.1f}, grey, grey, grey);      // the body
+  f.box({-0.12f, 1.52f, -0.12f}, {0.12f, 1.8f, 0.12f}, grey, red, blue);  // the head
   return f.text();
 }
 
 CommandResult cook(const fs::path& source, const fs::path& out, const std::string& extra = "") {
-  return run_command(quote((bin_dir() / "ossa-cook").string()) + " " + quote(source.string()) + " -o " + quote(out.string()) +
-                     " -q " + extra);
+  return run_command(quote((bin_dir() / "ossa-cook").string()) + " " + quote(source.string()) + " -o " +
+                     quote(out.string()) + " -q " + extra);
 }
 
 /// The axis ossa-view -v says the character faces ("front: -z (...)").
@@ -121,7 +121,8 @@ TEST_F(Viewer, DefaultViewFacesTheCharactersFront) {
     ASSERT_TRUE(write_file(dir_ / (stem + ".obj"), figure(c.turn)));
     const CommandResult cooked = cook(dir_ / (stem + ".obj"), dir_);
     ASSERT_EQ(cooked.exit_code, 0) << cooked.err;
-    const std::string base = quote((dir_ / (stem + ".ossa")).string()) + " --size 160x240 --no-grid --yaw 0 --pitch 0 -v";
+    const std::string base =
+        quote((dir_ / (stem + ".ossa")).string()) + " --size 160x240 --no-grid --yaw 0 --pitch 0 -v";
     const fs::path png = dir_ / (stem + ".png");
     const CommandResult r = run_viewer(base + " --screenshot " + quote(png.string()));
     ASSERT_EQ(r.exit_code, 0) << r.err;
@@ -172,7 +173,8 @@ namespace {
 /// extent grows late.
 std::string late_reach_bvh() {
   std::string bvh =
-      "HIERARCHY\nROOT Hips\n{\n  OFFSET 0 0 0\n  CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation\n"
+      "HIERARCHY\nROOT Hips\n{\n  OFFSET 0 0 0\n  CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation "
+      "Yrotation\n"
       "  JOINT Spine\n  {\n    OFFSET 0 0.5 0\n    CHANNELS 3 Zrotation Xrotation Yrotation\n"
       "    JOINT Head\n    {\n      OFFSET 0 0.5 0\n      CHANNELS 3 Zrotation Xrotation Yrotation\n"
       "      End Site\n      {\n        OFFSET 0 0.2 0\n      }\n    }\n"
@@ -223,7 +225,8 @@ TEST_F(Viewer, FramingCoversTheWholeClip) {
   ASSERT_TRUE(write_file(dir_ / "reach.bvh", late_reach_bvh()));
   const CommandResult c = cook(dir_ / "reach.bvh", dir_);
   ASSERT_EQ(c.exit_code, 0) << c.err;
-  const std::string base = quote((dir_ / "reach.ossa").string()) + " --size 200x200 --no-grid --yaw 0 --pitch 0 --stats";
+  const std::string base =
+      quote((dir_ / "reach.ossa").string()) + " --size 200x200 --no-grid --yaw 0 --pitch 0 --stats";
   const CommandResult early = run_viewer(base + " --time 0 --screenshot " + quote((dir_ / "early.png").string()));
   const CommandResult late = run_viewer(base + " --time 0.95 --screenshot " + quote((dir_ / "late.png").string()));
   ASSERT_EQ(early.exit_code + late.exit_code, 0) << early.err << late.err;
@@ -250,8 +253,9 @@ TEST_F(Viewer, CapturedClipIsFramedOverItsWholeLength) {
   std::vector<Framed> framed;
   for (const char* t : {"0", "2", "5"}) {
     const fs::path png = dir_ / (std::string("cmu-") + t + ".png");
-    const CommandResult r = run_viewer(quote((dir_ / "CMU_BVH" / "01_03.ossa").string()) +
-                                       " --no-grid --size 320x180 --stats --time " + t + " --screenshot " + quote(png.string()));
+    const CommandResult r =
+        run_viewer(quote((dir_ / "CMU_BVH" / "01_03.ossa").string()) + " --no-grid --size 320x180 --stats --time " + t +
+                   " --screenshot " + quote(png.string()));
     ASSERT_EQ(r.exit_code, 0) << r.err;
     framed.push_back(parse_framed(r.out));
     ASSERT_TRUE(framed.back().found) << r.out;

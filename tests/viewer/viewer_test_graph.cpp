@@ -38,10 +38,10 @@ class ViewerGraph : public Viewer {
 };
 
 TEST_F(ViewerGraph, ParametersChangeThePose) {
-  const Image walk = render_graph("walk", "");  // speed's default, 1.07: the walk sample
-  const Image sprint = render_graph("sprint", "--set speed=6.5");  // past 5.5: the sprint state
+  const Image walk = render_graph("walk", "");                         // speed's default, 1.07: the walk sample
+  const Image sprint = render_graph("sprint", "--set speed=6.5");      // past 5.5: the sprint state
   const Image arms = render_graph("arms", "--set crossed_arms=true");  // the crossarms layer
-  const Image stop = render_graph("stop", "--set strike_pose");  // trigger: the pose state
+  const Image stop = render_graph("stop", "--set strike_pose");        // trigger: the pose state
   const Image bind = render_graph("bind", "--bind-pose");
   EXPECT_GT(coverage(walk), 0.02);
   EXPECT_GT(compare(walk, bind, kPixelThreshold).differing, kMinDifferingPosed) << "the graph does not move the mesh";
@@ -171,7 +171,8 @@ TEST_F(ViewerProcedural, LookTargetTurnsTheHeadOnly) {
 
 TEST_F(ViewerProcedural, MalformedVectorIsNamed) {
   for (const char* bad : {"1,2", "1,2,3,4", "1,x,3", "nan,1,1", "1;2;3", ""}) {
-    const CommandResult r = run_viewer(pab() + " --graph pab --param 'look_target=" + bad + "' --frames 1 --size 32x32");
+    const CommandResult r =
+        run_viewer(pab() + " --graph pab --param 'look_target=" + bad + "' --frames 1 --size 32x32");
     EXPECT_EQ(r.exit_code, 1) << bad << ": " << r.err;
     EXPECT_NE(r.err.find("look_target"), std::string::npos) << bad << ": " << r.err;
     EXPECT_NE(r.err.find("three finite numbers"), std::string::npos) << bad << ": " << r.err;

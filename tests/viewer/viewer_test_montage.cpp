@@ -20,8 +20,8 @@ class ViewerMontage : public Viewer {
   std::string files() const { return quote(cooked("Pab/pab.ossa").string()); }
   Image render(const std::string& tag, const std::string& extra) {
     const fs::path png = dir_ / (tag + ".png");
-    const CommandResult r = run_viewer(files() + " --graph pab --no-grid --size 192x192 --screenshot " +
-                                       quote(png.string()) + " " + extra);
+    const CommandResult r =
+        run_viewer(files() + " --graph pab --no-grid --size 192x192 --screenshot " + quote(png.string()) + " " + extra);
     EXPECT_EQ(r.exit_code, 0) << r.err;
     return load_png(png);
   }
@@ -45,8 +45,9 @@ TEST_F(ViewerMontage, UnknownMontageIsNamed) {
 
 TEST_F(ViewerMontage, WindowShowsTheMontagePanelAndTimeline) {
   const fs::path png = dir_ / "window.png";
-  const CommandResult r = run_viewer(files() + " --graph pab --montage cross_arms --size 640x400 --window-frames 3 -v --screenshot " +
-                                     quote(png.string()));
+  const CommandResult r =
+      run_viewer(files() + " --graph pab --montage cross_arms --size 640x400 --window-frames 3 -v --screenshot " +
+                 quote(png.string()));
   ASSERT_EQ(r.exit_code, 0) << r.err;
   // The strip under the scene is the montage timeline (a graph without montages has none).
   const size_t at = r.err.find("timeline ");

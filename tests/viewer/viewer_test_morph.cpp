@@ -31,7 +31,7 @@ namespace {
 
 SyntheticSpec morph_spec() {
   SyntheticSpec spec;
-  SyntheticMorphTarget smile;  // vertices {4, 5}
+  SyntheticMorphTarget smile;                        // vertices {4, 5}
   smile.position_deltas = {4000, 0, 0, 4000, 0, 0};  // x 0.0001 per step: +0.4
   smile.normal_deltas = {6000, 0, 0, 6000, 0, 0};
   smile.normal_step = {0.0001f, 0.0001f, 0.0001f};  // +0.6 in x: the normals tilt about 31 degrees
@@ -83,7 +83,8 @@ class ViewerMorph : public Viewer {
   }
   Image shot(const fs::path& file, const std::string& tag, const std::string& extra) {
     const fs::path png = dir_ / (tag + ".png");
-    const std::string args = quote(file.string()) + " -q --no-grid --size 256x256 --screenshot " + quote(png.string()) + " " + extra;
+    const std::string args =
+        quote(file.string()) + " -q --no-grid --size 256x256 --screenshot " + quote(png.string()) + " " + extra;
     return screenshot(args, png);
   }
 };
@@ -107,15 +108,16 @@ TEST_F(ViewerMorph, HeldWeightMovesTheHeadRowWhereItsDeltasSay) {
     bottom = y;
   }
   ASSERT_GT(bottom - top, 100) << "the grid fills most of the image height";
-  const int middle = (top + bottom) / 2;  // model y = 1: the camera looks level at the box centre
+  const int middle = (top + bottom) / 2;                       // model y = 1: the camera looks level at the box centre
   const RowSpan base = row_span(rest, (middle + bottom) / 2);  // the edges at the top and bottom slant
-  const double pixels_per_unit = base.right - base.left + 1;  // the grid is one unit wide
+  const double pixels_per_unit = base.right - base.left + 1;   // the grid is one unit wide
 
   // The lower half: not moved, not re-lit.
   int changed_below = 0;
   for (int y = middle + 3; y < rest.height; ++y)
     for (int x = 0; x < rest.width; ++x)
-      for (int c = 0; c < 3; ++c) changed_below += std::abs(rest.at(x, y)[c] - smile.at(x, y)[c]) > kPixelThreshold ? 1 : 0;
+      for (int c = 0; c < 3; ++c)
+        changed_below += std::abs(rest.at(x, y)[c] - smile.at(x, y)[c]) > kPixelThreshold ? 1 : 0;
   EXPECT_EQ(changed_below, 0) << "pixels below the middle row changed";
 
   // The upper half: each row shifted by 0.4 units times how far up the half it is.
@@ -142,8 +144,10 @@ TEST_F(ViewerMorph, HeldWeightMovesTheHeadRowWhereItsDeltasSay) {
 TEST_F(ViewerMorph, GpuMatchesCpuOnMorphingFrames) {
   // smile also moves the head row down and back here (y and z are the axes whose position_scale
   // is not 1: a delta not divided by it in the shader lands elsewhere).
-  std::vector<std::pair<std::string, SyntheticSpec>> specs = {{"quantized", morph_spec()}, {"float", morph_spec_float()}};
-  for (auto& [name, spec] : specs) spec.meshes[0].morph_targets[0].position_deltas = {4000, -3000, 1000, 4000, -3000, 1000};
+  std::vector<std::pair<std::string, SyntheticSpec>> specs = {{"quantized", morph_spec()},
+                                                              {"float", morph_spec_float()}};
+  for (auto& [name, spec] : specs)
+    spec.meshes[0].morph_targets[0].position_deltas = {4000, -3000, 1000, 4000, -3000, 1000};
   for (const auto& [name, spec] : valid_variants())
     if (name == "morph") specs.emplace_back("variant", spec);
   ASSERT_EQ(specs.size(), 3u);
@@ -210,7 +214,8 @@ TEST_F(ViewerMorph, RobotExpressiveSurprisedChangesTheFaceOnly) {
   for (int y = 0; y < neutral.height; ++y)
     for (int x = 0; x < neutral.width; ++x) {
       bool differs = false;
-      for (int c = 0; c < 3; ++c) differs = differs || std::abs(neutral.at(x, y)[c] - surprised.at(x, y)[c]) > kPixelThreshold;
+      for (int c = 0; c < 3; ++c)
+        differs = differs || std::abs(neutral.at(x, y)[c] - surprised.at(x, y)[c]) > kPixelThreshold;
       changed += differs ? 1 : 0;
       changed_below_head += differs && y > head_bottom ? 1 : 0;
     }
@@ -251,7 +256,8 @@ TEST_F(ViewerMorph, UnknownOrMalformedMorphIsAnError) {
   const fs::path file = write_spec("morph", morph_spec());
   const CommandResult unknown = run_viewer(quote(file.string()) + " -q --morph grin=1 --frames 1");
   EXPECT_EQ(unknown.exit_code, 1);
-  EXPECT_NE(unknown.err.find("morph.ossa: no morph target named 'grin' (morph targets: 'smile', 'frown')"), std::string::npos)
+  EXPECT_NE(unknown.err.find("morph.ossa: no morph target named 'grin' (morph targets: 'smile', 'frown')"),
+            std::string::npos)
       << unknown.err;
 
   const fs::path plain = dir_ / "plain.ossa";
@@ -270,8 +276,9 @@ TEST_F(ViewerMorph, UnknownOrMalformedMorphIsAnError) {
 TEST_F(ViewerMorph, WindowModeShowsTheMorphPanel) {
   const fs::path file = write_spec("morph", morph_spec());
   const fs::path png = dir_ / "window.png";
-  const CommandResult r = run_viewer(quote(file.string()) + " -q --morph frown=1 --size 480x320 --window-frames 3 --screenshot " +
-                                     quote(png.string()));
+  const CommandResult r =
+      run_viewer(quote(file.string()) + " -q --morph frown=1 --size 480x320 --window-frames 3 --screenshot " +
+                 quote(png.string()));
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(load_png(png).width, 480);
 }

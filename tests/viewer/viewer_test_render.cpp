@@ -60,7 +60,8 @@ std::string files_of(const Sample& s, const char* layout) {
 Image render(const Sample& sample, const fs::path& dir, const std::string& tag, const std::string& extra,
              const char* layout = "quantized") {
   const fs::path png = dir / (tag + ".png");
-  std::string args = files_of(sample, layout) + "--size 256x256 --no-grid --screenshot " + quote(png.string()) + " " + extra;
+  std::string args =
+      files_of(sample, layout) + "--size 256x256 --no-grid --screenshot " + quote(png.string()) + " " + extra;
   if (*sample.clip) args += std::string(" --clip ") + quote(sample.clip);
   return screenshot(args, png);
 }
@@ -178,7 +179,8 @@ TEST_F(Viewer, CrowdDrawsEveryInstanceOnBothSkinningPaths) {
 
 TEST_F(Viewer, ClipsFromSeparateFilesPlayOnTheCharacter) {
   const std::string files = quote(cooked("Pab/arnaud.ossa").string()) + " " + quote(cooked("Pab/walk.ossa").string()) +
-                            " " + quote(cooked("Pab/run.ossa").string()) + " " + quote(cooked("Pab/crossarms.ossa").string());
+                            " " + quote(cooked("Pab/run.ossa").string()) + " " +
+                            quote(cooked("Pab/crossarms.ossa").string());
   std::vector<Image> images;
   for (const char* clip : {"walk", "run", "crossarms"}) {
     const fs::path png = dir_ / (std::string(clip) + ".png");
@@ -187,18 +189,23 @@ TEST_F(Viewer, ClipsFromSeparateFilesPlayOnTheCharacter) {
     ASSERT_EQ(r.exit_code, 0) << r.err;
     images.push_back(load_png(png));
   }
-  EXPECT_GT(compare(images[0], images[1], kPixelThreshold).differing, kMinDifferingPosed) << "walk and run look the same";
-  EXPECT_GT(compare(images[0], images[2], kPixelThreshold).differing, kMinDifferingPosed) << "walk and crossarms look the same";
+  EXPECT_GT(compare(images[0], images[1], kPixelThreshold).differing, kMinDifferingPosed)
+      << "walk and run look the same";
+  EXPECT_GT(compare(images[0], images[2], kPixelThreshold).differing, kMinDifferingPosed)
+      << "walk and crossarms look the same";
 }
 
 TEST_F(Viewer, OverlaysChangeTheImage) {
   const std::string base = quote(cooked("CesiumMan/CesiumMan.ossa").string()) + " --size 192x192 --time 0.4 --no-grid";
   const CommandResult plain = run_viewer(base + " --screenshot " + quote((dir_ / "plain.png").string()));
-  const CommandResult skeleton = run_viewer(base + " --skeleton --screenshot " + quote((dir_ / "skeleton.png").string()));
+  const CommandResult skeleton =
+      run_viewer(base + " --skeleton --screenshot " + quote((dir_ / "skeleton.png").string()));
   const CommandResult wire = run_viewer(base + " --wireframe --screenshot " + quote((dir_ / "wire.png").string()));
-  const CommandResult grid = run_viewer(quote(cooked("CesiumMan/CesiumMan.ossa").string()) +
-                                        " --size 192x192 --time 0.4 --screenshot " + quote((dir_ / "grid.png").string()));
-  ASSERT_EQ(plain.exit_code + skeleton.exit_code + wire.exit_code + grid.exit_code, 0) << plain.err << skeleton.err << wire.err << grid.err;
+  const CommandResult grid =
+      run_viewer(quote(cooked("CesiumMan/CesiumMan.ossa").string()) + " --size 192x192 --time 0.4 --screenshot " +
+                 quote((dir_ / "grid.png").string()));
+  ASSERT_EQ(plain.exit_code + skeleton.exit_code + wire.exit_code + grid.exit_code, 0)
+      << plain.err << skeleton.err << wire.err << grid.err;
   const Image p = load_png(dir_ / "plain.png");
   EXPECT_GT(compare(p, load_png(dir_ / "skeleton.png"), kPixelThreshold).differing, 0.002);
   EXPECT_GT(compare(p, load_png(dir_ / "wire.png"), kPixelThreshold).differing, 0.01);
@@ -207,8 +214,8 @@ TEST_F(Viewer, OverlaysChangeTheImage) {
 
 TEST_F(Viewer, WindowModeWithPanelRunsAndCaptures) {
   const fs::path png = dir_ / "window.png";
-  const CommandResult r = run_viewer(quote(cooked("Fox/Fox.ossa").string()) + " --size 480x320 --window-frames 3 --screenshot " +
-                                     quote(png.string()));
+  const CommandResult r = run_viewer(quote(cooked("Fox/Fox.ossa").string()) +
+                                     " --size 480x320 --window-frames 3 --screenshot " + quote(png.string()));
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const Image image = load_png(png);
   ASSERT_EQ(image.width, 480);

@@ -56,7 +56,8 @@ struct Box {
 Box scene_foreground(const Image& img, const Layout& l) {
   Box b;
   const int x0 = static_cast<int>(l.x), y0 = static_cast<int>(l.y) + 48;
-  const int x1 = std::min(static_cast<int>(l.x + l.width), img.width), y1 = std::min(static_cast<int>(l.y + l.height), img.height);
+  const int x1 = std::min(static_cast<int>(l.x + l.width), img.width),
+            y1 = std::min(static_cast<int>(l.y + l.height), img.height);
   const uint8_t* bg = img.at(x1 - 2, y0 + 2);
   for (int y = y0; y < y1; ++y) {
     for (int x = x0; x < x1; ++x) {
@@ -90,8 +91,8 @@ class ViewerWindow : public Viewer {
     std::string why;
     const auto display = test_display(&why);
     if (!display) return {-1, "", "no display: " + why};
-    return run_command(env + " DISPLAY=" + quote(*display) + " " + quote((bin_dir() / "ossa-view").string()) + " " + args +
-                       " -v --window-frames 3 --screenshot " + quote(png.string()));
+    return run_command(env + " DISPLAY=" + quote(*display) + " " + quote((bin_dir() / "ossa-view").string()) + " " +
+                       args + " -v --window-frames 3 --screenshot " + quote(png.string()));
   }
   Image shot(const std::string& tag) { return load_png(dir_ / (tag + ".png")); }
   std::string fox() const { return quote(cooked("Fox/Fox.ossa").string()); }
@@ -179,10 +180,10 @@ class BackgroundViewer {
     std::string why;
     const auto display = test_display(&why);
     if (!display) return;
-    run_command("( " + env + " DISPLAY=" + quote(*display) + " " + quote((bin_dir() / "ossa-view").string()) + " " + args +
-                " -v >/dev/null 2>" + quote(err_path().string()) + " & echo $! > " + quote((dir_ / "pid").string()) +
-                "; wait $!; echo $? > " + quote((dir_ / "rc.tmp").string()) + "; mv " + quote((dir_ / "rc.tmp").string()) +
-                " " + quote((dir_ / "rc").string()) + " ) >/dev/null 2>&1 &");
+    run_command("( " + env + " DISPLAY=" + quote(*display) + " " + quote((bin_dir() / "ossa-view").string()) + " " +
+                args + " -v >/dev/null 2>" + quote(err_path().string()) + " & echo $! > " +
+                quote((dir_ / "pid").string()) + "; wait $!; echo $? > " + quote((dir_ / "rc.tmp").string()) + "; mv " +
+                quote((dir_ / "rc.tmp").string()) + " " + quote((dir_ / "rc").string()) + " ) >/dev/null 2>&1 &");
   }
   ~BackgroundViewer() { stop(); }
   std::string err() const { return read_text(err_path()).value_or(""); }
@@ -231,9 +232,10 @@ TEST_F(ViewerWindow, CookAndOpenShowsTheCookedCharacter) {
   ASSERT_TRUE(BackgroundViewer::wait_for([&] { return gate.started() || viewer.exited(); }, 120.0)) << viewer.err();
   ASSERT_FALSE(viewer.exited()) << "the viewer ended before its cook:\n" << viewer.err();
   // The cook is held at the gate: the window must go on drawing meanwhile.
-  ASSERT_TRUE(BackgroundViewer::wait_for([&] { return frames_reported_while_cooking(viewer.err()) >= 2 || viewer.exited(); },
-                                         120.0))
-      << "the window stopped drawing while the cooker ran:\n" << viewer.err();
+  ASSERT_TRUE(BackgroundViewer::wait_for(
+      [&] { return frames_reported_while_cooking(viewer.err()) >= 2 || viewer.exited(); }, 120.0))
+      << "the window stopped drawing while the cooker ran:\n"
+      << viewer.err();
   ASSERT_FALSE(viewer.exited()) << viewer.err();
   gate.open();
   ASSERT_TRUE(BackgroundViewer::wait_for([&] { return viewer.exited(); }, 600.0)) << viewer.err();
@@ -258,13 +260,14 @@ TEST_F(ViewerWindow, CookAndOpenShowsTheCookedCharacter) {
 TEST_F(ViewerWindow, CookAndOpenWithoutAFrameLimitKeepsTheWindow) {
   const fs::path source = source_dir() / "assets" / "Fox" / "Fox.glb";
   const GatedCook gate(dir_);
-  BackgroundViewer viewer(dir_, cache_env() + " " + gate.env(), "--cook-and-open " + quote(source.string()) + " --size 640x400");
+  BackgroundViewer viewer(dir_, cache_env() + " " + gate.env(),
+                          "--cook-and-open " + quote(source.string()) + " --size 640x400");
   ASSERT_TRUE(BackgroundViewer::wait_for([&] { return gate.started() || viewer.exited(); }, 120.0)) << viewer.err();
   ASSERT_FALSE(viewer.exited()) << "the window closed before its cook (exit " << viewer.exit_code() << "):\n"
                                 << viewer.err();
   gate.open();
-  ASSERT_TRUE(BackgroundViewer::wait_for([&] { return viewer.err().find("opened ") != std::string::npos || viewer.exited(); },
-                                         600.0))
+  ASSERT_TRUE(BackgroundViewer::wait_for(
+      [&] { return viewer.err().find("opened ") != std::string::npos || viewer.exited(); }, 600.0))
       << viewer.err();
   EXPECT_NE(viewer.err().find("cooked " + source.string()), std::string::npos) << viewer.err();
   // A window that closes by itself does so within a frame or two; a second is ample to see it.
@@ -383,8 +386,8 @@ TEST_F(ViewerWindow, PanelFitsTheWindowAt1280x720And1600x1000) {
       for (const std::string& line : c.region_lines) {
         float x, y, w, h, px, py, pw, ph;
         const size_t at = line.find(": ", line.find("panel region "));
-        const int got = std::sscanf(line.c_str() + at + 2, "%f %f %f %f in panel %f %f %f %f", &x, &y, &w, &h, &px, &py,
-                                    &pw, &ph);
+        const int got =
+            std::sscanf(line.c_str() + at + 2, "%f %f %f %f in panel %f %f %f %f", &x, &y, &w, &h, &px, &py, &pw, &ph);
         ASSERT_EQ(got, 8) << line;
         EXPECT_GE(x, px - 1.0f) << line;
         EXPECT_GE(y, py - 1.0f) << line;

@@ -26,8 +26,8 @@ namespace fs = std::filesystem;
 struct Textured {
   const char* name;
   const char* file;
-  uint64_t bc_bytes;      // the BC1 chain of its 1024 x 1024 texture
-  uint64_t rgba8_bytes;   // an RGBA8 chain of the same
+  uint64_t bc_bytes;     // the BC1 chain of its 1024 x 1024 texture
+  uint64_t rgba8_bytes;  // an RGBA8 chain of the same
 };
 const Textured kTextured[] = {{"CesiumMan", "CesiumMan/CesiumMan.ossa", 699064, 5592404},
                               {"Fox", "Fox/Fox.ossa", 699064, 5592404}};
@@ -102,7 +102,8 @@ TEST_P(ViewerTexture, GpuMemoryIsTheFilesChains) {
 /// The quad's document with a grey material and, when `normal_map` is given, that image as its
 /// normal texture.
 std::string quad_with_normal_map(const std::string& normal_map) {
-  if (normal_map.empty()) return quad_gltf(R"("materials": [{"pbrMetallicRoughness": {"baseColorFactor": [0.6, 0.6, 0.6, 1]}}])");
+  if (normal_map.empty())
+    return quad_gltf(R"("materials": [{"pbrMetallicRoughness": {"baseColorFactor": [0.6, 0.6, 0.6, 1]}}])");
   return quad_gltf(R"("images": [{"uri": ")" + normal_map + R"("}], "textures": [{"source": 0}],
     "materials": [{"pbrMetallicRoughness": {"baseColorFactor": [0.6, 0.6, 0.6, 1]}, "normalTexture": {"index": 0}}])");
 }
@@ -141,9 +142,11 @@ TEST_F(Viewer, Bc5NormalMapsRebuildZ) {
   const Image tilt_bc = shot("bc", "tilt");
   const ImageDiff tilted = compare(plain, tilt_bc, kPixelThreshold);
   const ImageDiff tilt_vs_source = compare(tilt_bc, shot("source", "tilt"), kPixelThreshold);
-  std::printf("flat BC5 vs no map: %.4f differ, mean %.3f; flat source: %.4f, %.3f; tilted vs no map: %.4f, %.3f; "
-              "tilted BC5 vs source: %.4f, %.3f\n", flat.differing, flat.mean_abs, flat_source.differing,
-              flat_source.mean_abs, tilted.differing, tilted.mean_abs, tilt_vs_source.differing, tilt_vs_source.mean_abs);
+  std::printf(
+      "flat BC5 vs no map: %.4f differ, mean %.3f; flat source: %.4f, %.3f; tilted vs no map: %.4f, %.3f; "
+      "tilted BC5 vs source: %.4f, %.3f\n",
+      flat.differing, flat.mean_abs, flat_source.differing, flat_source.mean_abs, tilted.differing, tilted.mean_abs,
+      tilt_vs_source.differing, tilt_vs_source.mean_abs);
   EXPECT_LT(flat.differing, 0.002);
   EXPECT_LT(flat.mean_abs, 0.5);
   EXPECT_LT(flat_source.mean_abs, 0.5);

@@ -66,7 +66,8 @@ TEST(ViewerOptions, ScreenshotMeansHeadlessOneFrame) {
 }
 
 TEST(ViewerOptions, GraphValuesTakeOneArgumentEach) {
-  const ParsedOptions p = parse({"--graph", "pab", "--set", "speed=3", "--set", "strike_pose", "pab.ossa", "walk.ossa"});
+  const ParsedOptions p =
+      parse({"--graph", "pab", "--set", "speed=3", "--set", "strike_pose", "pab.ossa", "walk.ossa"});
   ASSERT_TRUE(p.options);
   EXPECT_EQ(p.options->graph, "pab");
   EXPECT_EQ(p.options->set, (std::vector<std::string>{"speed=3", "strike_pose"}));
@@ -317,11 +318,11 @@ TEST(ViewerMorph, EntriesAreListedPerVertexInTargetOrder) {
   const auto near = [](const std::vector<float>& got, const std::vector<float>& want) {
     for (size_t k = 0; k < want.size(); ++k) EXPECT_NEAR(got[k], want[k], 1e-6f) << "component " << k;
   };
-  near(entry(0), {-0.05f, 0, 0, 1, 0, 0, 0.1f, 0});     // vertex 2: frown, its normal delta
-  near(entry(1), {0.05f, 0, 0, 1, 0, 0, -0.1f, 0});     // vertex 3: frown
-  near(entry(2), {0, 0.1f, 0, 0, 0, 0, 0, 0});          // vertex 4: smile first (no normal deltas)
-  near(entry(3), {0, -0.03f, 0, 1, 0, 0, 0, 0});        // vertex 4: then frown
-  near(entry(4), {0, 0.2f, 0, 0, 0, 0, 0, 0});          // vertex 5: smile
+  near(entry(0), {-0.05f, 0, 0, 1, 0, 0, 0.1f, 0});  // vertex 2: frown, its normal delta
+  near(entry(1), {0.05f, 0, 0, 1, 0, 0, -0.1f, 0});  // vertex 3: frown
+  near(entry(2), {0, 0.1f, 0, 0, 0, 0, 0, 0});       // vertex 4: smile first (no normal deltas)
+  near(entry(3), {0, -0.03f, 0, 1, 0, 0, 0, 0});     // vertex 4: then frown
+  near(entry(4), {0, 0.2f, 0, 0, 0, 0, 0, 0});       // vertex 5: smile
 
   const MorphEntries frown_only = build_morph_entries(mesh, std::vector<int32_t>{-1, 0});
   EXPECT_EQ(frown_only.entry_count, 3u) << "a target bound to no channel is left out";

@@ -27,10 +27,10 @@ using namespace ossa::view;
 namespace {
 
 struct DriveRun {
-  std::vector<glm::vec3> particles;  // the simulation's output, the character's own space
-  std::vector<glm::vec3> drawn_skin; // the cloth particles skinned with the drawn model matrices
+  std::vector<glm::vec3> particles;   // the simulation's output, the character's own space
+  std::vector<glm::vec3> drawn_skin;  // the cloth particles skinned with the drawn model matrices
   std::vector<float> inverse_masses;
-  glm::mat4 cloth_world{1.0f};       // the model-to-world transform the cloth last received
+  glm::mat4 cloth_world{1.0f};  // the model-to-world transform the cloth last received
   glm::mat4 drive_world{1.0f};
   float heading = 0.0f;
   float metres_per_unit = 1.0f;
@@ -93,7 +93,8 @@ TEST(ViewerDrive, ClothReceivesTheTurningWorldTransform) {
   EXPECT_NEAR(turning.heading, glm::half_pi<float>() * 2.0f, 1e-3f);
   // The cloth's last model-to-world transform is the drive's (no crowd offset here), a half turn.
   for (int c = 0; c < 4; ++c)
-    for (int r = 0; r < 4; ++r) EXPECT_NEAR(turning.cloth_world[c][r], turning.drive_world[c][r], 1e-4f) << c << "," << r;
+    for (int r = 0; r < 4; ++r)
+      EXPECT_NEAR(turning.cloth_world[c][r], turning.drive_world[c][r], 1e-4f) << c << "," << r;
   EXPECT_NEAR(turning.cloth_world[0][0], -1.0f, 1e-3f) << "x turned to -x: the cloth saw the turn";
   EXPECT_NEAR(still.cloth_world[0][0], 1.0f, 1e-6f);
   // Pinned particles, put where they are drawn, lie on the drawn (turned) body.

@@ -50,7 +50,8 @@ TEST(MontageHost, MistakesNameTheMontageOrSection) {
   ASSERT_TRUE(g) << g.error().message;
   Status s = add_montage_commands(*g, {"crossarms"}, {}, {});
   ASSERT_FALSE(s);
-  EXPECT_NE(s.message().find("no montage named 'crossarms' (montages: 'cross_arms')"), std::string::npos) << s.message();
+  EXPECT_NE(s.message().find("no montage named 'crossarms' (montages: 'cross_arms')"), std::string::npos)
+      << s.message();
   s = add_montage_commands(*g, {"cross_arms@soon"}, {}, {});
   ASSERT_FALSE(s);
   EXPECT_NE(s.message().find("NAME@SECONDS"), std::string::npos) << s.message();

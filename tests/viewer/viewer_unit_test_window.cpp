@@ -113,8 +113,8 @@ TEST(ViewerLayout, SceneTakesWhatThePanelAndTimelineLeave) {
 
 TEST(ViewerLayout, UiScaleIsContentScaleOverFramebufferRatio) {
   EXPECT_FLOAT_EQ(ui_scale_for(1.0f, 1.0f), 1.0f);
-  EXPECT_FLOAT_EQ(ui_scale_for(2.0f, 1.0f), 2.0f);   // X11 / Windows at 200 %
-  EXPECT_FLOAT_EQ(ui_scale_for(2.0f, 2.0f), 1.0f);   // Retina: window units are points already
+  EXPECT_FLOAT_EQ(ui_scale_for(2.0f, 1.0f), 2.0f);  // X11 / Windows at 200 %
+  EXPECT_FLOAT_EQ(ui_scale_for(2.0f, 2.0f), 1.0f);  // Retina: window units are points already
   EXPECT_FLOAT_EQ(ui_scale_for(1.5f, 1.0f), 1.5f);
   EXPECT_FLOAT_EQ(ui_scale_for(0.0f, 1.0f), 1.0f);
   EXPECT_FLOAT_EQ(ui_scale_for(std::numeric_limits<float>::quiet_NaN(), 1.0f), 1.0f);
@@ -123,11 +123,11 @@ TEST(ViewerLayout, UiScaleIsContentScaleOverFramebufferRatio) {
 
 TEST(ViewerTimeline, LoopTimeWrapsWithinTheRange) {
   EXPECT_FLOAT_EQ(loop_time(1.5f, 1.0f, 2.0f), 1.5f);
-  EXPECT_FLOAT_EQ(loop_time(2.0f, 1.0f, 2.0f), 2.0f);   // the end is inside
+  EXPECT_FLOAT_EQ(loop_time(2.0f, 1.0f, 2.0f), 2.0f);  // the end is inside
   EXPECT_FLOAT_EQ(loop_time(2.25f, 1.0f, 2.0f), 1.25f);
-  EXPECT_FLOAT_EQ(loop_time(0.75f, 1.0f, 2.0f), 1.75f); // backwards past the start
+  EXPECT_FLOAT_EQ(loop_time(0.75f, 1.0f, 2.0f), 1.75f);  // backwards past the start
   EXPECT_FLOAT_EQ(loop_time(5.5f, 1.0f, 2.0f), 1.5f);
-  EXPECT_FLOAT_EQ(loop_time(1.5f, 2.0f, 2.0f), 2.0f);   // an empty range: its start
+  EXPECT_FLOAT_EQ(loop_time(1.5f, 2.0f, 2.0f), 2.0f);  // an empty range: its start
 }
 
 TEST(ViewerTimeline, PlaybackLoopsWithinTheLoopRangeOnlyWithLoopOn) {
@@ -201,19 +201,22 @@ TEST(ViewerBrowser, ListsFoldersFirstThenUsableFilesIgnoringCase) {
   fs::create_directories(dir / "b");
   fs::create_directories(dir / "A");
   fs::create_directories(dir / ".git");
-  for (const char* f : {"z.ossa", "Fox.GLB", "notes.txt", ".hidden.ossa", "a.fbx", "walk.bvh", "scene.gltf", "x.dae", "m.obj"})
+  for (const char* f :
+       {"z.ossa", "Fox.GLB", "notes.txt", ".hidden.ossa", "a.fbx", "walk.bvh", "scene.gltf", "x.dae", "m.obj"})
     ASSERT_TRUE(test::write_file(dir / f, std::string("x")));
   std::string error;
   const std::vector<BrowserEntry> e = list_folder(dir, error);
   EXPECT_TRUE(error.empty()) << error;
   std::vector<std::string> names;
   for (const BrowserEntry& x : e) names.push_back(x.name);
-  EXPECT_EQ(names, (std::vector<std::string>{"A", "b", "a.fbx", "Fox.GLB", "m.obj", "scene.gltf", "walk.bvh", "x.dae", "z.ossa"}));
+  EXPECT_EQ(names, (std::vector<std::string>{"A", "b", "a.fbx", "Fox.GLB", "m.obj", "scene.gltf", "walk.bvh", "x.dae",
+                                             "z.ossa"}));
   EXPECT_EQ(e[0].kind, EntryKind::kFolder);
   EXPECT_EQ(e[2].kind, EntryKind::kSource);
   EXPECT_EQ(e.back().kind, EntryKind::kOssa);
 
-  std::vector<BrowserEntry> same_but_case = {{"b.ossa", EntryKind::kOssa}, {"B.ossa", EntryKind::kOssa}, {"c", EntryKind::kFolder}};
+  std::vector<BrowserEntry> same_but_case = {
+      {"b.ossa", EntryKind::kOssa}, {"B.ossa", EntryKind::kOssa}, {"c", EntryKind::kFolder}};
   sort_entries(same_but_case);
   EXPECT_EQ(same_but_case[0].name, "c");
   EXPECT_EQ(same_but_case[1].name, "B.ossa");  // ties by byte order
@@ -229,7 +232,8 @@ TEST(ViewerBrowser, ListsFoldersFirstThenUsableFilesIgnoringCase) {
 }
 
 TEST(ViewerCook, SourcesAreKnownByExtension) {
-  for (const char* s : {"a.fbx", "a.FBX", "b.gltf", "c.glb", "d.dae", "e.bvh", "f.obj"}) EXPECT_TRUE(is_cook_source(s)) << s;
+  for (const char* s : {"a.fbx", "a.FBX", "b.gltf", "c.glb", "d.dae", "e.bvh", "f.obj"})
+    EXPECT_TRUE(is_cook_source(s)) << s;
   for (const char* s : {"a.ossa", "a.txt", "fbx", "a.graph.json", "a.fbx.bak"}) EXPECT_FALSE(is_cook_source(s)) << s;
   EXPECT_EQ(file_kind("a.OSSA"), EntryKind::kOssa);
   EXPECT_FALSE(file_kind("a.png"));
@@ -257,7 +261,8 @@ TEST(ViewerCook, CookerIsFoundBesideTheViewerThenOnPath) {
 
 TEST(ViewerCook, CacheRootFollowsXdgThenHome) {
   EXPECT_EQ(cook_cache_root("/x/cache", "/home/u"), fs::path("/x/cache/ossa-view"));
-  EXPECT_EQ(cook_cache_root("relative", "/home/u"), fs::path("/home/u/.cache/ossa-view")) << "XDG paths must be absolute";
+  EXPECT_EQ(cook_cache_root("relative", "/home/u"), fs::path("/home/u/.cache/ossa-view"))
+      << "XDG paths must be absolute";
   EXPECT_EQ(cook_cache_root(nullptr, "/home/u"), fs::path("/home/u/.cache/ossa-view"));
   EXPECT_EQ(cook_cache_root(nullptr, nullptr).filename(), "ossa-view-cache");
   const fs::path a = cook_output_for("/c", "/assets/one/Fox.glb"), b = cook_output_for("/c", "/assets/two/Fox.glb");
@@ -334,8 +339,8 @@ ParsedOptions parse(std::vector<const char*> args) {
 }
 
 TEST(ViewerOptions, WindowOptionsAndStartingWithoutAFile) {
-  const ParsedOptions p = parse({"a.ossa", "--panel", "collapsed", "--ui-scale", "2", "--browse", "/d", "--cook-and-open",
-                                 "x.fbx", "--cook-and-open", "y.glb"});
+  const ParsedOptions p = parse({"a.ossa", "--panel", "collapsed", "--ui-scale", "2", "--browse", "/d",
+                                 "--cook-and-open", "x.fbx", "--cook-and-open", "y.glb"});
   ASSERT_TRUE(p.options);
   EXPECT_TRUE(p.options->panel_collapsed);
   EXPECT_FLOAT_EQ(p.options->ui_scale, 2.0f);

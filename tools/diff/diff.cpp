@@ -51,9 +51,9 @@ std::string item_label(const std::vector<std::string>& names, size_t index) {
   return repeats > 0 ? label + "#" + std::to_string(repeats) : label;
 }
 
-void report_added_removed(Context& c, const char* section, const NameMatch& m, const std::vector<std::string>& old_names,
-                          const std::vector<std::string>& new_names, std::vector<std::string>& added,
-                          std::vector<std::string>& removed) {
+void report_added_removed(Context& c, const char* section, const NameMatch& m,
+                          const std::vector<std::string>& old_names, const std::vector<std::string>& new_names,
+                          std::vector<std::string>& added, std::vector<std::string>& removed) {
   for (size_t i : m.only_old) {
     removed.push_back(item_label(old_names, i));
     c.add_text(section, removed.back(), "removed", "only in the old file");
@@ -134,8 +134,9 @@ Result<DiffReport> diff_assets(const Asset& old_asset, const Asset& new_asset, c
   report.tolerance_mm = options.tolerance_mm;
   internal::Context c{old_asset, new_asset, old_rig, new_rig, options.tolerance_mm, report};
   if (report.old_file.metres_per_unit != report.new_file.metres_per_unit)
-    report.notes.push_back(ossa::detail::format("units differ (%g m per unit -> %g m per unit); lengths are compared in mm",
-                                                report.old_file.metres_per_unit, report.new_file.metres_per_unit));
+    report.notes.push_back(
+        ossa::detail::format("units differ (%g m per unit -> %g m per unit); lengths are compared in mm",
+                             report.old_file.metres_per_unit, report.new_file.metres_per_unit));
   internal::compare_skeletons(c);
   internal::compare_meshes(c);
   if (Status s = internal::compare_clips(c); !s) return s.error();

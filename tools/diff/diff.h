@@ -39,9 +39,9 @@ struct Options {
 
 /// One failed comparison. `value` is a figure (in `unit`) or, for a changed name or count, text.
 struct Difference {
-  std::string section;  // "file", "skeleton", "meshes", "clips", "materials", "graphs"
-  std::string item;     // the joint, mesh, clip, material or graph; "" for the section as a whole
-  std::string what;     // what differs: "bind pose", "topology", "joint error", "removed", ...
+  std::string section;          // "file", "skeleton", "meshes", "clips", "materials", "graphs"
+  std::string item;             // the joint, mesh, clip, material or graph; "" for the section as a whole
+  std::string what;             // what differs: "bind pose", "topology", "joint error", "removed", ...
   std::optional<double> value;  // the figure, when there is one
   std::string text;             // the value as words when there is no figure ("'Hips' -> 'hips'")
   std::string unit;             // "mm", "deg", "s", "Hz", "count" or "" (no figure)
@@ -59,27 +59,27 @@ struct FileFacts {
 };
 
 struct JointBind {
-  std::string name;              // the old name (renamed joints: see SkeletonSection::renamed)
-  double translation_mm = 0.0;   // |local translation difference|
-  double rotation_deg = 0.0;     // angle of the local rotation difference
-  double scale_delta = 0.0;      // largest |local scale component difference| (unitless)
-  double probe_mm = 0.0;         // the probe measure on the local transforms: what is judged
+  std::string name;             // the old name (renamed joints: see SkeletonSection::renamed)
+  double translation_mm = 0.0;  // |local translation difference|
+  double rotation_deg = 0.0;    // angle of the local rotation difference
+  double scale_delta = 0.0;     // largest |local scale component difference| (unitless)
+  double probe_mm = 0.0;        // the probe measure on the local transforms: what is judged
 };
 
 struct SkeletonSection {
   bool old_present = false, new_present = false;
   size_t old_joints = 0, new_joints = 0;
   uint64_t old_hash = 0, new_hash = 0;
-  std::vector<std::string> added, removed;                       // by name
-  std::vector<std::pair<std::string, std::string>> renamed;      // (old, new), same index and parent
-  std::vector<std::string> reordered;                            // in both, at another index
+  std::vector<std::string> added, removed;                   // by name
+  std::vector<std::pair<std::string, std::string>> renamed;  // (old, new), same index and parent
+  std::vector<std::string> reordered;                        // in both, at another index
   struct ParentChange {
-    std::string joint, old_parent, new_parent;                   // "" for a root
+    std::string joint, old_parent, new_parent;  // "" for a root
   };
   std::vector<ParentChange> parent_changed;
-  std::vector<JointBind> bind;                                   // every joint in both (renames paired)
-  double max_bind_mm = 0.0;                                      // largest JointBind::probe_mm
-  std::string worst_joint;                                       // where it occurs ("" when none)
+  std::vector<JointBind> bind;  // every joint in both (renames paired)
+  double max_bind_mm = 0.0;     // largest JointBind::probe_mm
+  std::string worst_joint;      // where it occurs ("" when none)
 };
 
 struct MeshShape {
@@ -90,9 +90,9 @@ struct MeshShape {
 struct MeshItem {
   std::string name;
   MeshShape old_shape, new_shape;
-  bool topology_same = false;    // vertex, index and submesh counts, submesh ranges, index values
-  bool index_data_same = false;  // index values (whatever their width)
-  bool layout_same = false;      // stride and every attribute's semantic, format and offset
+  bool topology_same = false;                 // vertex, index and submesh counts, submesh ranges, index values
+  bool index_data_same = false;               // index values (whatever their width)
+  bool layout_same = false;                   // stride and every attribute's semantic, format and offset
   std::optional<double> max_displacement_mm;  // positions, vertex i to vertex i; none when skipped
   uint32_t worst_vertex = 0;
   std::string note;  // why displacement was skipped
@@ -121,17 +121,17 @@ struct ClipSide {
 struct ClipItem {
   std::string name;
   ClipSide old_side, new_side;
-  bool sampled = false;               // false: not comparable (see note)
-  size_t times = 0;                   // sample times compared
+  bool sampled = false;  // false: not comparable (see note)
+  size_t times = 0;      // sample times compared
   size_t joints_compared = 0, joints_skipped = 0;
-  double max_error_mm = 0.0;          // over every compared joint at every time
+  double max_error_mm = 0.0;            // over every compared joint at every time
   double max_error_at_frames_mm = 0.0;  // the same over the old clip's own frame times only
-  std::string worst_joint;            // where max_error_mm occurs ("" when nothing compared)
+  std::string worst_joint;              // where max_error_mm occurs ("" when nothing compared)
   double worst_time_s = 0.0;
   std::optional<double> root_motion_mm;   // largest root-motion translation difference (both have it)
   std::optional<double> root_motion_deg;  // largest root-motion yaw difference
   bool events_same = true;
-  size_t morph_tracks_compared = 0;   // weight tracks in both clips, paired by name
+  size_t morph_tracks_compared = 0;     // weight tracks in both clips, paired by name
   double max_morph_weight_error = 0.0;  // largest |old - new| weight over those tracks and the times
   std::string note;
 };

@@ -58,7 +58,8 @@ Status check_side(const Asset& file, const Asset* rig, const char* side) {
       return Error{file.name() + ": a clip-only file (no skeleton): pass --skeleton (or --" + side +
                    "-skeleton) with the cooked rig its clips were made for"};
     return Error{rig->name() + ": clip " + quote_name(clip.name()) + " of " + file.name() +
-                 " was not cooked for this skeleton (" + check_clip_binding(clip, rig->skeleton(), clip.name()).message() + ")"};
+                 " was not cooked for this skeleton (" +
+                 check_clip_binding(clip, rig->skeleton(), clip.name()).message() + ")"};
   }
   return {};
 }
@@ -70,7 +71,8 @@ ClipSide side_of(const ClipView& clip, double mm_per_unit) {
   s.frame_count = clip.frame_count();
   s.root_motion = has_root_motion(clip);
   if (const auto* events = clip.fb->events())
-    for (const fb::ClipEvent* e : *events) s.events.push_back({std::string(flatbuffers::GetStringView(e->name())), e->time()});
+    for (const fb::ClipEvent* e : *events)
+      s.events.push_back({std::string(flatbuffers::GetStringView(e->name())), e->time()});
   if (const fb::ClipCompression* c = clip.compression()) s.cooker_max_error_mm = c->max_error() * mm_per_unit;
   return s;
 }
@@ -204,13 +206,14 @@ void measure(Context& c, const std::string& label, ClipItem& item, Player& a, Pl
   item.root_motion_deg = rm_deg;
   if (rm_mm > c.tolerance_mm) c.add_figure(kSection, label, "root motion translation", rm_mm, "mm", c.tolerance_mm);
   // A yaw difference is judged by how far it moves a point at the probe distance.
-  const double limit_deg = 2.0 * std::asin(std::min(1.0, c.tolerance_mm / (2.0 * kProbeMetres * 1000.0))) * 180.0 / std::numbers::pi;
+  const double limit_deg =
+      2.0 * std::asin(std::min(1.0, c.tolerance_mm / (2.0 * kProbeMetres * 1000.0))) * 180.0 / std::numbers::pi;
   if (rm_deg > limit_deg) c.add_figure(kSection, label, "root motion yaw", rm_deg, "deg", limit_deg);
 }
 
 /// Weight tracks: added and removed ones named, the paired ones sampled at `times`.
-void compare_morph_weights(Context& c, const std::string& label, ClipItem& item, const ClipView& a,
-                           const ClipView& b, const std::vector<SampleTime>& times) {
+void compare_morph_weights(Context& c, const std::string& label, ClipItem& item, const ClipView& a, const ClipView& b,
+                           const std::vector<SampleTime>& times) {
   std::vector<std::string> old_names, new_names;
   for (size_t i = 0; i < a.morph_track_count(); ++i)
     old_names.emplace_back(flatbuffers::GetStringView(a.morph_track(i).name()));
@@ -251,8 +254,7 @@ ClipItem compare_clip(Context& c, const std::string& label, const ClipView& a, c
   if (std::fabs(x.rate_hz - y.rate_hz) > kRateEpsilon)
     c.add_figure(kSection, label, "frame rate", std::fabs(x.rate_hz - y.rate_hz), "Hz", kRateEpsilon,
                  num(x.rate_hz) + " Hz -> " + num(y.rate_hz) + " Hz");
-  if (x.root_motion != y.root_motion)
-    c.add_text(kSection, label, "root motion", x.root_motion ? "removed" : "added");
+  if (x.root_motion != y.root_motion) c.add_text(kSection, label, "root motion", x.root_motion ? "removed" : "added");
   compare_events(c, label, item);
   compare_morph_weights(c, label, item, a, b, sample_times(a, b));
   if (morph_only(a) && morph_only(b)) {

@@ -54,7 +54,8 @@ const fb::Vec3 kBlack(0.0f, 0.0f, 0.0f);  // an absent emissive colour
 
 double vec_delta(const fb::Vec3* a, const fb::Vec3* b) {
   if (!a || !b) return a == b ? 0.0 : INFINITY;
-  return std::max({std::fabs(double(a->x()) - b->x()), std::fabs(double(a->y()) - b->y()), std::fabs(double(a->z()) - b->z())});
+  return std::max(
+      {std::fabs(double(a->x()) - b->x()), std::fabs(double(a->y()) - b->y()), std::fabs(double(a->z()) - b->z())});
 }
 
 MaterialItem compare_material(Context& c, const std::string& label, const fb::Material& a, const fb::Material& b) {
@@ -69,11 +70,13 @@ MaterialItem compare_material(Context& c, const std::string& label, const fb::Ma
   const struct {
     const char* name;
     const fb::Vec3 *x, *y;
-  } colours[] = {{"ambient", a.ambient(), b.ambient()}, {"diffuse", a.diffuse(), b.diffuse()},
+  } colours[] = {{"ambient", a.ambient(), b.ambient()},
+                 {"diffuse", a.diffuse(), b.diffuse()},
                  {"specular", a.specular(), b.specular()},
                  {"emissive", a.emissive() ? a.emissive() : &kBlack, b.emissive() ? b.emissive() : &kBlack}};
   for (const auto& col : colours)
-    if (vec_delta(col.x, col.y) > kParameterEpsilon) changed(col.name, "largest component change " + num(vec_delta(col.x, col.y)));
+    if (vec_delta(col.x, col.y) > kParameterEpsilon)
+      changed(col.name, "largest component change " + num(vec_delta(col.x, col.y)));
   if (std::fabs(a.shininess() - b.shininess()) > kParameterEpsilon)
     changed("shininess", num(a.shininess()) + " -> " + num(b.shininess()));
   if (std::fabs(a.opacity() - b.opacity()) > kParameterEpsilon)
@@ -81,8 +84,9 @@ MaterialItem compare_material(Context& c, const std::string& label, const fb::Ma
   const auto pbr_text = [](const fb::PbrFactors* p) {
     return p ? "metallic " + num(p->metallic()) + ", roughness " + num(p->roughness()) : std::string("none (Phong)");
   };
-  if ((a.pbr() == nullptr) != (b.pbr() == nullptr) || (a.pbr() && (std::fabs(a.pbr()->metallic() - b.pbr()->metallic()) > kParameterEpsilon ||
-                                           std::fabs(a.pbr()->roughness() - b.pbr()->roughness()) > kParameterEpsilon)))
+  if ((a.pbr() == nullptr) != (b.pbr() == nullptr) ||
+      (a.pbr() && (std::fabs(a.pbr()->metallic() - b.pbr()->metallic()) > kParameterEpsilon ||
+                   std::fabs(a.pbr()->roughness() - b.pbr()->roughness()) > kParameterEpsilon)))
     changed("pbr", pbr_text(a.pbr()) + " -> " + pbr_text(b.pbr()));
   const auto &ta = item.old_textures, &tb = item.new_textures;
   if (ta.size() != tb.size())
@@ -93,15 +97,15 @@ MaterialItem compare_material(Context& c, const std::string& label, const fb::Ma
     if (ta[i].path != tb[i].path) changed(which + " path", quote_name(ta[i].path) + " -> " + quote_name(tb[i].path));
     if (ta[i].mime != tb[i].mime) changed(which + " mime", quote_name(ta[i].mime) + " -> " + quote_name(tb[i].mime));
     const auto shape = [](const TextureFact& t) {
-      return t.encoding + (t.srgb ? " sRGB " : " ") + std::to_string(t.width) + " x " + std::to_string(t.height) + ", " +
-             std::to_string(t.mips) + " mips";
+      return t.encoding + (t.srgb ? " sRGB " : " ") + std::to_string(t.width) + " x " + std::to_string(t.height) +
+             ", " + std::to_string(t.mips) + " mips";
     };
     if (shape(ta[i]) != shape(tb[i])) changed(which + " encoding", shape(ta[i]) + " -> " + shape(tb[i]));
     if (ta[i].bytes != tb[i].bytes || ta[i].hash != tb[i].hash)
-      changed(which + " data", std::to_string(ta[i].bytes) + " bytes -> " + std::to_string(tb[i].bytes) +
-                                   " bytes, " + detail::format("hash %016llx -> %016llx",
-                                                               static_cast<unsigned long long>(ta[i].hash),
-                                                               static_cast<unsigned long long>(tb[i].hash)));
+      changed(which + " data",
+              std::to_string(ta[i].bytes) + " bytes -> " + std::to_string(tb[i].bytes) + " bytes, " +
+                  detail::format("hash %016llx -> %016llx", static_cast<unsigned long long>(ta[i].hash),
+                                 static_cast<unsigned long long>(tb[i].hash)));
   }
   return item;
 }
@@ -169,7 +173,8 @@ void compare_materials(Context& c) {
   const NameMatch m = match_by_name(old_names, new_names);
   report_added_removed(c, "materials", m, old_names, new_names, out.added, out.removed);
   for (const auto& [i, k] : m.pairs)
-    out.items.push_back(compare_material(c, item_label(old_names, i), c.old_asset.material(i), c.new_asset.material(k)));
+    out.items.push_back(
+        compare_material(c, item_label(old_names, i), c.old_asset.material(i), c.new_asset.material(k)));
 }
 
 void compare_graphs(Context& c) {

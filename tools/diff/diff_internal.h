@@ -39,13 +39,12 @@ struct Context {
 
   void add(Difference d) { report.differences.push_back(std::move(d)); }
   /// A figure over its limit.
-  void add_figure(const char* section, std::string item, std::string what, double value, const char* unit,
-                  double limit, std::string detail = {}) {
+  void add_figure(const char* section, std::string item, std::string what, double value, const char* unit, double limit,
+                  std::string detail = {}) {
     add(Difference{section, std::move(item), std::move(what), value, {}, unit, limit, std::move(detail)});
   }
   /// A change without a figure (a name, a count, presence).
-  void add_text(const char* section, std::string item, std::string what, std::string text,
-                std::string detail = {}) {
+  void add_text(const char* section, std::string item, std::string what, std::string text, std::string detail = {}) {
     add(Difference{section, std::move(item), std::move(what), std::nullopt, std::move(text), "", std::nullopt,
                    std::move(detail)});
   }
@@ -64,15 +63,15 @@ NameMatch match_by_name(const std::vector<std::string>& old_names, const std::ve
 std::string item_label(const std::vector<std::string>& names, size_t index);
 
 /// Adds "added" / "removed" differences for unmatched items and fills the section's name lists.
-void report_added_removed(Context& c, const char* section, const NameMatch& m, const std::vector<std::string>& old_names,
-                          const std::vector<std::string>& new_names, std::vector<std::string>& added,
-                          std::vector<std::string>& removed);
+void report_added_removed(Context& c, const char* section, const NameMatch& m,
+                          const std::vector<std::string>& old_names, const std::vector<std::string>& new_names,
+                          std::vector<std::string>& added, std::vector<std::string>& removed);
 
 /// Joints of two rigs paired: by name first, then an unpaired joint at the same index as an
 /// unpaired joint of the other rig, under the same (paired) parent, counts as renamed.
 struct JointMapping {
-  std::vector<int> old_to_new;                  // -1: no counterpart
-  std::vector<std::pair<int, int>> renamed;     // (old, new)
+  std::vector<int> old_to_new;               // -1: no counterpart
+  std::vector<std::pair<int, int>> renamed;  // (old, new)
 };
 JointMapping map_joints(const SkeletonView& old_skeleton, const SkeletonView& new_skeleton);
 

@@ -129,20 +129,23 @@ MeshItem compare_mesh(Context& c, const std::string& label, const MeshView& a, c
   item.name = label;
   item.old_shape = shape_of(a);
   item.new_shape = shape_of(b);
-  item.layout_same = item.old_shape.layout == item.new_shape.layout && item.old_shape.vertex_stride == item.new_shape.vertex_stride;
+  item.layout_same =
+      item.old_shape.layout == item.new_shape.layout && item.old_shape.vertex_stride == item.new_shape.vertex_stride;
   item.index_data_same = decode_indices(a) == decode_indices(b);
   item.topology_same = a.vertex_count() == b.vertex_count() && item.index_data_same && same_submeshes(a, b);
   if (!item.layout_same)
     c.add_text(kSection, label, "layout",
-               "stride " + std::to_string(item.old_shape.vertex_stride) + " -> " + std::to_string(item.new_shape.vertex_stride),
+               "stride " + std::to_string(item.old_shape.vertex_stride) + " -> " +
+                   std::to_string(item.new_shape.vertex_stride),
                item.old_shape.layout + " -> " + item.new_shape.layout);
   if (!item.topology_same) {
     const bool counts_same = item.old_shape.vertex_count == item.new_shape.vertex_count &&
                              item.old_shape.index_count == item.new_shape.index_count &&
                              item.old_shape.submesh_count == item.new_shape.submesh_count;
     c.add_text(kSection, label, "topology",
-               counts_same ? std::string(item.index_data_same ? "submesh ranges or materials changed" : "index data changed")
-                           : counts_text(item.old_shape) + " -> " + counts_text(item.new_shape));
+               counts_same
+                   ? std::string(item.index_data_same ? "submesh ranges or materials changed" : "index data changed")
+                   : counts_text(item.old_shape) + " -> " + counts_text(item.new_shape));
     item.note = "topology changed: vertex displacement not measured";
     return item;
   }
@@ -180,7 +183,8 @@ void compare_meshes(Context& c) {
   report_added_removed(c, kSection, m, old_names, new_names, out.added, out.removed);
   for (const auto& [i, k] : m.pairs) {
     MeshItem item = compare_mesh(c, item_label(old_names, i), c.old_asset.mesh(i), c.new_asset.mesh(k));
-    if (item.max_displacement_mm) out.max_displacement_mm = std::max(out.max_displacement_mm, *item.max_displacement_mm);
+    if (item.max_displacement_mm)
+      out.max_displacement_mm = std::max(out.max_displacement_mm, *item.max_displacement_mm);
     if (!item.note.empty()) c.report.notes.push_back("mesh '" + item.name + "': " + item.note);
     out.items.push_back(std::move(item));
   }

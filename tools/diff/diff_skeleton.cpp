@@ -64,8 +64,8 @@ JointBind compare_bind(const Context& c, const SkeletonView& a, size_t i, const 
   jb.rotation_deg = rotation_angle_deg(x.r, y.r);
   const glm::dvec3 ds = glm::abs(glm::dvec3(x.s) - glm::dvec3(y.s));
   jb.scale_delta = std::max({ds.x, ds.y, ds.z});
-  jb.probe_mm = probe_error(affine_from_trs(x.t, x.r, x.s), affine_from_trs(y.t, y.r, y.s), c.probe_old_units()) *
-                c.old_mm();
+  jb.probe_mm =
+      probe_error(affine_from_trs(x.t, x.r, x.s), affine_from_trs(y.t, y.r, y.s), c.probe_old_units()) * c.old_mm();
   return jb;
 }
 
@@ -90,8 +90,9 @@ void compare_skeletons(Context& c) {
     return;
   }
   if (out.old_hash != out.new_hash)
-    c.add_text(kSection, "", "hash", detail::format("%016llx -> %016llx", static_cast<unsigned long long>(out.old_hash),
-                                                    static_cast<unsigned long long>(out.new_hash)),
+    c.add_text(kSection, "", "hash",
+               detail::format("%016llx -> %016llx", static_cast<unsigned long long>(out.old_hash),
+                              static_cast<unsigned long long>(out.new_hash)),
                "clips cooked for one rig do not bind to the other");
 
   const JointMapping m = map_joints(a, b);

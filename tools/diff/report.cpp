@@ -45,18 +45,28 @@ json skeleton_json(const SkeletonSection& s) {
                           {"rotation_deg", round6(j.rotation_deg)},
                           {"scale_delta", round6(j.scale_delta)},
                           {"probe_mm", round6(j.probe_mm)}});
-  return json{{"old_present", s.old_present}, {"new_present", s.new_present},
-              {"old_joints", s.old_joints},   {"new_joints", s.new_joints},
-              {"old_hash", hex16(s.old_hash)}, {"new_hash", hex16(s.new_hash)},
-              {"added", s.added},             {"removed", s.removed},
-              {"renamed", renamed},           {"reordered", s.reordered},
-              {"parent_changed", parents},    {"max_bind_mm", round6(s.max_bind_mm)},
-              {"worst_joint", s.worst_joint}, {"joints", joints}};
+  return json{{"old_present", s.old_present},
+              {"new_present", s.new_present},
+              {"old_joints", s.old_joints},
+              {"new_joints", s.new_joints},
+              {"old_hash", hex16(s.old_hash)},
+              {"new_hash", hex16(s.new_hash)},
+              {"added", s.added},
+              {"removed", s.removed},
+              {"renamed", renamed},
+              {"reordered", s.reordered},
+              {"parent_changed", parents},
+              {"max_bind_mm", round6(s.max_bind_mm)},
+              {"worst_joint", s.worst_joint},
+              {"joints", joints}};
 }
 
 json mesh_shape_json(const MeshShape& s) {
-  return json{{"vertex_count", s.vertex_count}, {"index_count", s.index_count}, {"submesh_count", s.submesh_count},
-              {"vertex_stride", s.vertex_stride}, {"layout", s.layout}};
+  return json{{"vertex_count", s.vertex_count},
+              {"index_count", s.index_count},
+              {"submesh_count", s.submesh_count},
+              {"vertex_stride", s.vertex_stride},
+              {"layout", s.layout}};
 }
 
 json meshes_json(const MeshSection& s) {
@@ -71,15 +81,22 @@ json meshes_json(const MeshSection& s) {
                          {"max_displacement_mm", optional_number(m.max_displacement_mm)},
                          {"worst_vertex", m.max_displacement_mm ? json(m.worst_vertex) : json(nullptr)},
                          {"note", m.note}});
-  return json{{"old_count", s.old_count}, {"new_count", s.new_count}, {"added", s.added}, {"removed", s.removed},
-              {"max_displacement_mm", round6(s.max_displacement_mm)}, {"items", items}};
+  return json{{"old_count", s.old_count},
+              {"new_count", s.new_count},
+              {"added", s.added},
+              {"removed", s.removed},
+              {"max_displacement_mm", round6(s.max_displacement_mm)},
+              {"items", items}};
 }
 
 json clip_side_json(const ClipSide& s) {
   json events = json::array();
   for (const ClipEventFact& e : s.events) events.push_back(json{{"name", e.name}, {"time_s", round6(e.time_s)}});
-  return json{{"duration_s", round6(s.duration_s)}, {"rate_hz", round6(s.rate_hz)},     {"frame_count", s.frame_count},
-              {"root_motion", s.root_motion},       {"events", events},
+  return json{{"duration_s", round6(s.duration_s)},
+              {"rate_hz", round6(s.rate_hz)},
+              {"frame_count", s.frame_count},
+              {"root_motion", s.root_motion},
+              {"events", events},
               {"cooker_max_error_mm", optional_number(s.cooker_max_error_mm)}};
 }
 
@@ -103,16 +120,27 @@ json clips_json(const ClipSection& s) {
                          {"morph_tracks_compared", c.morph_tracks_compared},
                          {"max_morph_weight_error", round6(c.max_morph_weight_error)},
                          {"note", c.note}});
-  return json{{"old_count", s.old_count}, {"new_count", s.new_count}, {"added", s.added}, {"removed", s.removed},
-              {"max_error_mm", round6(s.max_error_mm)}, {"items", items}};
+  return json{{"old_count", s.old_count},
+              {"new_count", s.new_count},
+              {"added", s.added},
+              {"removed", s.removed},
+              {"max_error_mm", round6(s.max_error_mm)},
+              {"items", items}};
 }
 
 json textures_json(const std::vector<TextureFact>& textures) {
   json out = json::array();
   for (const TextureFact& t : textures)
-    out.push_back(json{{"role", t.role},     {"path", t.path},     {"mime", t.mime},     {"bytes", t.bytes},
-                       {"hash", hex16(t.hash)}, {"encoding", t.encoding}, {"srgb", t.srgb}, {"width", t.width},
-                       {"height", t.height}, {"mips", t.mips}});
+    out.push_back(json{{"role", t.role},
+                       {"path", t.path},
+                       {"mime", t.mime},
+                       {"bytes", t.bytes},
+                       {"hash", hex16(t.hash)},
+                       {"encoding", t.encoding},
+                       {"srgb", t.srgb},
+                       {"width", t.width},
+                       {"height", t.height},
+                       {"mips", t.mips}});
   return out;
 }
 
@@ -123,7 +151,10 @@ json materials_json(const MaterialSection& s) {
                          {"changed", m.changed},
                          {"old_textures", textures_json(m.old_textures)},
                          {"new_textures", textures_json(m.new_textures)}});
-  return json{{"old_count", s.old_count}, {"new_count", s.new_count}, {"added", s.added}, {"removed", s.removed},
+  return json{{"old_count", s.old_count},
+              {"new_count", s.new_count},
+              {"added", s.added},
+              {"removed", s.removed},
               {"items", items}};
 }
 
@@ -140,11 +171,16 @@ json graphs_json(const GraphSection& s) {
                          {"new", graph_shape_json(g.new_shape)},
                          {"same", g.same},
                          {"changed", g.changed}});
-  return json{{"old_count", s.old_count}, {"new_count", s.new_count}, {"added", s.added}, {"removed", s.removed},
+  return json{{"old_count", s.old_count},
+              {"new_count", s.new_count},
+              {"added", s.added},
+              {"removed", s.removed},
               {"items", items}};
 }
 
-std::string figure(double value, const std::string& unit) { return format("%.4g", value) + (unit.empty() ? "" : " " + unit); }
+std::string figure(double value, const std::string& unit) {
+  return format("%.4g", value) + (unit.empty() ? "" : " " + unit);
+}
 
 }  // namespace
 
@@ -159,23 +195,24 @@ json to_json(const DiffReport& r) {
                                {"limit", optional_number(d.limit)},
                                {"detail", d.detail}});
   const auto change = static_cast<double>(r.new_file.bytes) - static_cast<double>(r.old_file.bytes);
-  return json{{"schema", "ossa-diff"},
-              {"schema_version", kJsonSchemaVersion},
-              {"old", file_json(r.old_file)},
-              {"new", file_json(r.new_file)},
-              {"tolerance_mm", round6(r.tolerance_mm)},
-              {"same", r.same()},
-              {"sections",
-               json{{"file",
-                     json{{"bytes_change", static_cast<int64_t>(change)},
-                          {"bytes_change_percent", r.old_file.bytes ? round6(100.0 * change / static_cast<double>(r.old_file.bytes)) : 0.0}}},
-                    {"skeleton", skeleton_json(r.skeleton)},
-                    {"meshes", meshes_json(r.meshes)},
-                    {"clips", clips_json(r.clips)},
-                    {"materials", materials_json(r.materials)},
-                    {"graphs", graphs_json(r.graphs)}}},
-              {"differences", differences},
-              {"notes", r.notes}};
+  return json{
+      {"schema", "ossa-diff"},
+      {"schema_version", kJsonSchemaVersion},
+      {"old", file_json(r.old_file)},
+      {"new", file_json(r.new_file)},
+      {"tolerance_mm", round6(r.tolerance_mm)},
+      {"same", r.same()},
+      {"sections",
+       json{{"file", json{{"bytes_change", static_cast<int64_t>(change)},
+                          {"bytes_change_percent",
+                           r.old_file.bytes ? round6(100.0 * change / static_cast<double>(r.old_file.bytes)) : 0.0}}},
+            {"skeleton", skeleton_json(r.skeleton)},
+            {"meshes", meshes_json(r.meshes)},
+            {"clips", clips_json(r.clips)},
+            {"materials", materials_json(r.materials)},
+            {"graphs", graphs_json(r.graphs)}}},
+      {"differences", differences},
+      {"notes", r.notes}};
 }
 
 std::string difference_line(const Difference& d) {
@@ -189,7 +226,9 @@ std::string difference_line(const Difference& d) {
 std::string to_text(const DiffReport& r, bool verbose) {
   std::string out;
   const auto line = [&](const std::string& s) { out += s + "\n"; };
-  const auto file = [](const FileFacts& f) { return ossa::detail::printable(f.path, 400) + " (" + std::to_string(f.bytes) + " bytes)"; };
+  const auto file = [](const FileFacts& f) {
+    return ossa::detail::printable(f.path, 400) + " (" + std::to_string(f.bytes) + " bytes)";
+  };
   line("old " + file(r.old_file));
   line("new " + file(r.new_file));
   for (const Difference& d : r.differences) line(difference_line(d));
@@ -202,31 +241,34 @@ std::string to_text(const DiffReport& r, bool verbose) {
     for (const MeshItem& m : r.meshes.items)
       line(format("  mesh '%s': %u -> %u vertices, topology %s, layout %s, ", m.name.c_str(), m.old_shape.vertex_count,
                   m.new_shape.vertex_count, m.topology_same ? "same" : "changed", m.layout_same ? "same" : "changed") +
-           (m.max_displacement_mm ? format("max displacement %.4g mm (vertex %u)", *m.max_displacement_mm, m.worst_vertex)
-                                  : std::string("displacement not measured")));
+           (m.max_displacement_mm
+                ? format("max displacement %.4g mm (vertex %u)", *m.max_displacement_mm, m.worst_vertex)
+                : std::string("displacement not measured")));
     for (const ClipItem& c : r.clips.items) {
-      std::string text = format("  clip '%s': %.4g s at %.4g Hz", c.name.c_str(), c.old_side.duration_s, c.old_side.rate_hz);
+      std::string text =
+          format("  clip '%s': %.4g s at %.4g Hz", c.name.c_str(), c.old_side.duration_s, c.old_side.rate_hz);
       if (c.sampled)
         text += format(", %zu times x %zu joints, max joint error %.4g mm (joint '%s' at %.4g s; at frames %.4g mm)",
                        c.times, c.joints_compared, c.max_error_mm, ossa::detail::printable(c.worst_joint).c_str(),
                        c.worst_time_s, c.max_error_at_frames_mm);
       if (c.morph_tracks_compared > 0)
-        text += format(", %zu morph tracks, max weight difference %.4g", c.morph_tracks_compared,
-                       c.max_morph_weight_error);
+        text +=
+            format(", %zu morph tracks, max weight difference %.4g", c.morph_tracks_compared, c.max_morph_weight_error);
       if (c.old_side.cooker_max_error_mm && c.new_side.cooker_max_error_mm)
-        text += format(", cooker's error %.4g -> %.4g mm", *c.old_side.cooker_max_error_mm, *c.new_side.cooker_max_error_mm);
+        text += format(", cooker's error %.4g -> %.4g mm", *c.old_side.cooker_max_error_mm,
+                       *c.new_side.cooker_max_error_mm);
       line(text);
     }
     for (const MaterialItem& m : r.materials.items)
-      line("  material '" + m.name + "': " + (m.changed.empty() ? "same" : std::to_string(m.changed.size()) + " changes"));
+      line("  material '" + m.name +
+           "': " + (m.changed.empty() ? "same" : std::to_string(m.changed.size()) + " changes"));
     for (const GraphItem& g : r.graphs.items) line("  graph '" + g.name + "': " + (g.same ? "same" : "changed"));
     for (const std::string& n : r.notes) line("  note: " + ossa::detail::printable(n, 400));
   }
-  if (r.same())
-    line(format("same within %g mm", r.tolerance_mm));
+  if (r.same()) line(format("same within %g mm", r.tolerance_mm));
   else
-    line(format("differs: %zu difference%s (tolerance %g mm)", r.differences.size(), r.differences.size() == 1 ? "" : "s",
-                r.tolerance_mm));
+    line(format("differs: %zu difference%s (tolerance %g mm)", r.differences.size(),
+                r.differences.size() == 1 ? "" : "s", r.tolerance_mm));
   return out;
 }
 

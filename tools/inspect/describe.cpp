@@ -53,10 +53,8 @@ json describe_skeleton(const SkeletonView& skeleton) {
   for (size_t i = 0; i < parents.size(); ++i) {
     // Validation proved parents[i] < i, so the parent's depth is already known.
     depth[i] = parents[i] < 0 ? 0 : depth[static_cast<size_t>(parents[i])] + 1;
-    joints.push_back(json{{"index", i},
-                          {"name", std::string(skeleton.joint_name(i))},
-                          {"parent", parents[i]},
-                          {"depth", depth[i]}});
+    joints.push_back(
+        json{{"index", i}, {"name", std::string(skeleton.joint_name(i))}, {"parent", parents[i]}, {"depth", depth[i]}});
   }
   return json{{"joint_count", skeleton.joint_count()}, {"hash", hex16(skeleton.hash())}, {"joints", std::move(joints)}};
 }
@@ -95,29 +93,33 @@ json describe_mesh(const MeshView& mesh, float metres_per_unit) {
         json{{"first_index", s.first_index()}, {"index_count", s.index_count()}, {"material", s.material()}});
   const fb::Mesh& m = *mesh.fb;
   json out{{"name", std::string(mesh.name())},
-              {"vertex_count", mesh.vertex_count()},
-              {"triangle_count", mesh.index_count() / 3},
-              {"vertex_stride", mesh.vertex_stride()},
-              {"vertex_bytes", mesh.vertex_bytes().size()},
-              {"index_format", fb::EnumNameIndexFormat(mesh.index_format())},
-              {"index_count", mesh.index_count()},
-              {"index_bytes", mesh.index_bytes().size()},
-              {"layout", std::move(layout)},
-              {"submeshes", std::move(submeshes)},
-              {"joint_slots", mesh.joints().size()},
-              {"bounds", json{{"min", vec3(m.bounds_min())}, {"max", vec3(m.bounds_max())}}},
-              {"position_offset", vec3(m.position_offset())},
-              {"position_scale", vec3(m.position_scale())}};
+           {"vertex_count", mesh.vertex_count()},
+           {"triangle_count", mesh.index_count() / 3},
+           {"vertex_stride", mesh.vertex_stride()},
+           {"vertex_bytes", mesh.vertex_bytes().size()},
+           {"index_format", fb::EnumNameIndexFormat(mesh.index_format())},
+           {"index_count", mesh.index_count()},
+           {"index_bytes", mesh.index_bytes().size()},
+           {"layout", std::move(layout)},
+           {"submeshes", std::move(submeshes)},
+           {"joint_slots", mesh.joints().size()},
+           {"bounds", json{{"min", vec3(m.bounds_min())}, {"max", vec3(m.bounds_max())}}},
+           {"position_offset", vec3(m.position_offset())},
+           {"position_scale", vec3(m.position_scale())}};
   // Only when present, so files without targets describe as they did before format v5.
   if (mesh.morph_target_count() > 0) out["morph_targets"] = describe_morph_targets(mesh, metres_per_unit);
   if (const fb::Cloth* c = m.cloth()) {  // format v10 (docs/CLOTH.md)
     size_t fixed = 0;
     for (const float w : *c->inverse_masses()) fixed += w == 0.0f ? 1 : 0;
     const auto size = [](const auto* v) { return v ? static_cast<size_t>(v->size()) : size_t{0}; };
-    out["cloth"] = json{{"particles", c->particle_vertices()->size()}, {"fixed", fixed},
-                        {"vertices", c->vertices()->size()}, {"stretch", size(c->stretch())},
-                        {"bend", size(c->bend())}, {"tethers", size(c->tethers())},
-                        {"colliders", size(c->colliders())}, {"thickness_m", c->thickness() * metres_per_unit}};
+    out["cloth"] = json{{"particles", c->particle_vertices()->size()},
+                        {"fixed", fixed},
+                        {"vertices", c->vertices()->size()},
+                        {"stretch", size(c->stretch())},
+                        {"bend", size(c->bend())},
+                        {"tethers", size(c->tethers())},
+                        {"colliders", size(c->colliders())},
+                        {"thickness_m", c->thickness() * metres_per_unit}};
   }
   return out;
 }
@@ -135,7 +137,8 @@ json describe_compression(const ClipView& clip, const SkeletonView& skeleton, fl
   const size_t bytes = clip_bytes(clip);
   // The worst joint is named only when this file's skeleton is the clip's rig; a clip-only file
   // knows just the index.
-  const bool named = !skeleton.empty() && skeleton.hash() == clip.skeleton_hash() && c->worst_joint() < skeleton.joint_count();
+  const bool named =
+      !skeleton.empty() && skeleton.hash() == clip.skeleton_hash() && c->worst_joint() < skeleton.joint_count();
   return json{{"tolerance", round6(c->tolerance())},
               {"tolerance_mm", round6(c->tolerance() * mm)},
               {"probe_distance", round6(c->probe_distance())},
@@ -165,24 +168,25 @@ json describe_channels(const ClipView& clip, const SkeletonView& skeleton) {
     rows.push_back({c.joint(), static_cast<size_t>(c.channel()), false, 1, 32});
   for (const fb::AnimatedChannel& a : clip.animated())
     rows.push_back({a.joint(), static_cast<size_t>(a.channel()), true, a.key_count(), a.bits()});
-  std::sort(rows.begin(), rows.end(), [](const Row& x, const Row& y) {
-    return x.joint != y.joint ? x.joint < y.joint : x.kind < y.kind;
-  });
+  std::sort(rows.begin(), rows.end(),
+            [](const Row& x, const Row& y) { return x.joint != y.joint ? x.joint < y.joint : x.kind < y.kind; });
   // Joint names only when this file's skeleton is the clip's rig (as for worst_joint_name).
   const bool named = !skeleton.empty() && skeleton.hash() == clip.skeleton_hash();
   json out = json::array();
   for (const Row& r : rows)
-    out.push_back(json{{"joint", r.joint},
-                       {"joint_name", named && r.joint < skeleton.joint_count() ? json(std::string(skeleton.joint_name(r.joint)))
-                                                                                : json(nullptr)},
-                       {"channel", kKinds[r.kind]},
-                       {"storage", r.animated ? "animated" : "constant"},
-                       {"key_count", r.keys},
-                       {"bits", r.bits}});
+    out.push_back(
+        json{{"joint", r.joint},
+             {"joint_name", named && r.joint < skeleton.joint_count() ? json(std::string(skeleton.joint_name(r.joint)))
+                                                                      : json(nullptr)},
+             {"channel", kKinds[r.kind]},
+             {"storage", r.animated ? "animated" : "constant"},
+             {"key_count", r.keys},
+             {"bits", r.bits}});
   return out;
 }
 
-json describe_clip(const ClipView& clip, const SkeletonView& skeleton, float metres_per_unit, const DescribeOptions& options) {
+json describe_clip(const ClipView& clip, const SkeletonView& skeleton, float metres_per_unit,
+                   const DescribeOptions& options) {
   size_t constants[3] = {0, 0, 0}, animated[3] = {0, 0, 0}, keys[3] = {0, 0, 0};
   // Validation proved every channel enum is 0..2.
   for (const fb::ConstantChannel& c : clip.constants()) ++constants[static_cast<size_t>(c.channel())];
@@ -199,19 +203,19 @@ json describe_clip(const ClipView& clip, const SkeletonView& skeleton, float met
     root_motion = json{{"up_axis", rm->up_axis() <= 2 ? kAxes[rm->up_axis()] : "?"}};
   }
   json out{{"name", std::string(clip.name())},
-              {"duration", round6(clip.duration())},
-              {"sample_rate", round6(clip.sample_rate())},
-              {"frame_count", clip.frame_count()},
-              {"skeleton_hash", hex16(clip.skeleton_hash())},
-              {"joint_count", clip.joint_count()},
-              {"binds_to_file_skeleton", !skeleton.empty() && skeleton.hash() == clip.skeleton_hash()},
-              {"constant_channels", by_kind(constants)},
-              {"animated_channels", by_kind(animated)},
-              {"key_count", clip.key_count()},
-              {"animated_keys", by_kind(keys)},
-              {"bytes", clip_bytes(clip)},
-              {"compression", describe_compression(clip, skeleton, metres_per_unit)},
-              {"root_motion", std::move(root_motion)}};
+           {"duration", round6(clip.duration())},
+           {"sample_rate", round6(clip.sample_rate())},
+           {"frame_count", clip.frame_count()},
+           {"skeleton_hash", hex16(clip.skeleton_hash())},
+           {"joint_count", clip.joint_count()},
+           {"binds_to_file_skeleton", !skeleton.empty() && skeleton.hash() == clip.skeleton_hash()},
+           {"constant_channels", by_kind(constants)},
+           {"animated_channels", by_kind(animated)},
+           {"key_count", clip.key_count()},
+           {"animated_keys", by_kind(keys)},
+           {"bytes", clip_bytes(clip)},
+           {"compression", describe_compression(clip, skeleton, metres_per_unit)},
+           {"root_motion", std::move(root_motion)}};
   // Only when present, so files without events describe as they did before format v3.
   if (const auto* events = clip.fb->events(); events && events->size() > 0) {
     json list = json::array();
@@ -268,7 +272,8 @@ std::string condition_text(const fb::Graph& g, const fb::Transition& t) {
 json describe_graph(const fb::Graph& g) {
   json params = json::array(), machines = json::array();
   for (const fb::Parameter* p : *g.parameters()) {
-    json item{{"name", str(p->name())}, {"type", fb::EnumNameParameterType(p->type())},
+    json item{{"name", str(p->name())},
+              {"type", fb::EnumNameParameterType(p->type())},
               {"default", round6(p->default_value())}};
     if (p->type() == fb::ParameterType::Vector) {
       const fb::Vec3* v = p->default_vector();
@@ -294,8 +299,11 @@ json describe_graph(const fb::Graph& g) {
       if (const auto* ts = m->transitions()) {
         for (const fb::Transition* t : *ts) {
           const auto state = [&](int i) { return i < 0 ? std::string("any") : str(m->states()->Get(i)->name()); };
-          json item{{"from", state(t->from())}, {"to", state(t->to())}, {"when", condition_text(g, *t)},
-                    {"duration", round6(t->duration())}, {"mode", fb::EnumNameTransitionMode(t->mode())}};
+          json item{{"from", state(t->from())},
+                    {"to", state(t->to())},
+                    {"when", condition_text(g, *t)},
+                    {"duration", round6(t->duration())},
+                    {"mode", fb::EnumNameTransitionMode(t->mode())}};
           if (t->exit_time() >= 0.0f) item["exit_time"] = round6(t->exit_time());
           transitions.push_back(std::move(item));
         }
@@ -308,7 +316,7 @@ json describe_graph(const fb::Graph& g) {
   }
   json clips = json::array();
   for (const flatbuffers::String* c : *g.clips()) clips.push_back(str(c));
-  json out{{"name", str(g.name())},        {"skeleton_hash", hex16(g.skeleton_hash())},
+  json out{{"name", str(g.name())},           {"skeleton_hash", hex16(g.skeleton_hash())},
            {"parameters", std::move(params)}, {"clips", std::move(clips)},
            {"node_count", g.nodes()->size()}, {"nodes", std::move(kinds)},
            {"machines", std::move(machines)}};
@@ -323,11 +331,12 @@ json describe_graph(const fb::Graph& g) {
       }
       for (const fb::MontageSection* sec : *m->sections()) {
         const int next = sec->next();
-        sections.push_back(json{{"name", str(sec->name())},
-                                {"start", round6(sec->start())},
-                                {"next", next >= 0 && next < static_cast<int>(m->sections()->size())
-                                             ? str(m->sections()->Get(static_cast<flatbuffers::uoffset_t>(next))->name())
-                                             : std::string()}});
+        sections.push_back(
+            json{{"name", str(sec->name())},
+                 {"start", round6(sec->start())},
+                 {"next", next >= 0 && next < static_cast<int>(m->sections()->size())
+                              ? str(m->sections()->Get(static_cast<flatbuffers::uoffset_t>(next))->name())
+                              : std::string()}});
       }
       const auto blend = [](float t, fb::MontageCurve c) {
         return format("%g s ", static_cast<double>(t)) + fb::EnumNameMontageCurve(c);
@@ -362,16 +371,17 @@ json describe_material(const fb::Material& m) {
                               {"height", t->height()},
                               {"mips", static_cast<unsigned>(t->mip_count())}});
   }
-  return json{{"name", str(m.name())},
-              {"ambient", vec3(m.ambient())},
-              {"diffuse", vec3(m.diffuse())},
-              {"specular", vec3(m.specular())},
-              {"shininess", round6(m.shininess())},
-              {"opacity", round6(m.opacity())},
-              {"emissive", m.emissive() ? vec3(m.emissive()) : json::array({0.0, 0.0, 0.0})},
-              {"pbr", m.pbr() ? json{{"metallic", round6(m.pbr()->metallic())}, {"roughness", round6(m.pbr()->roughness())}}
-                              : json(nullptr)},
-              {"textures", std::move(textures)}};
+  return json{
+      {"name", str(m.name())},
+      {"ambient", vec3(m.ambient())},
+      {"diffuse", vec3(m.diffuse())},
+      {"specular", vec3(m.specular())},
+      {"shininess", round6(m.shininess())},
+      {"opacity", round6(m.opacity())},
+      {"emissive", m.emissive() ? vec3(m.emissive()) : json::array({0.0, 0.0, 0.0})},
+      {"pbr", m.pbr() ? json{{"metallic", round6(m.pbr()->metallic())}, {"roughness", round6(m.pbr()->roughness())}}
+                      : json(nullptr)},
+      {"textures", std::move(textures)}};
 }
 
 // ---- text ----------------------------------------------------------------------------------
@@ -428,23 +438,25 @@ json describe(const Asset& asset, std::string_view file_name, const DescribeOpti
   }
   const SkeletonView skeleton = asset.skeleton();
   json meshes = json::array(), clips = json::array(), materials = json::array();
-  for (size_t i = 0; i < asset.mesh_count(); ++i) meshes.push_back(describe_mesh(asset.mesh(i), asset.file().metres_per_unit()));
-  for (size_t i = 0; i < asset.clip_count(); ++i) clips.push_back(describe_clip(asset.clip(i), skeleton, file.metres_per_unit(), options));
+  for (size_t i = 0; i < asset.mesh_count(); ++i)
+    meshes.push_back(describe_mesh(asset.mesh(i), asset.file().metres_per_unit()));
+  for (size_t i = 0; i < asset.clip_count(); ++i)
+    clips.push_back(describe_clip(asset.clip(i), skeleton, file.metres_per_unit(), options));
   for (size_t i = 0; i < asset.material_count(); ++i) materials.push_back(describe_material(asset.material(i)));
   json out{{"schema", kSchema},
-              {"schema_version", kSchemaVersion},
-              {"file", std::string(file_name)},
-              {"file_bytes", asset.bytes().size()},
-              // Hash of every byte: goldens and build caches see any change in cooked output, not
-              // only changes in the counts and sizes summarised below.
-              {"content_hash", hex16(hash_bytes(asset.bytes().data(), asset.bytes().size()))},
-              {"format_version", file.version()},
-              {"metres_per_unit", round6(file.metres_per_unit())},
-              {"provenance", std::move(provenance)},
-              {"skeleton", describe_skeleton(skeleton)},
-              {"meshes", std::move(meshes)},
-              {"clips", std::move(clips)},
-              {"materials", std::move(materials)}};
+           {"schema_version", kSchemaVersion},
+           {"file", std::string(file_name)},
+           {"file_bytes", asset.bytes().size()},
+           // Hash of every byte: goldens and build caches see any change in cooked output, not
+           // only changes in the counts and sizes summarised below.
+           {"content_hash", hex16(hash_bytes(asset.bytes().data(), asset.bytes().size()))},
+           {"format_version", file.version()},
+           {"metres_per_unit", round6(file.metres_per_unit())},
+           {"provenance", std::move(provenance)},
+           {"skeleton", describe_skeleton(skeleton)},
+           {"meshes", std::move(meshes)},
+           {"clips", std::move(clips)},
+           {"materials", std::move(materials)}};
   if (const auto* graphs = file.graphs(); graphs && graphs->size() > 0) {
     json list = json::array();
     for (const fb::Graph* g : *graphs) list.push_back(describe_graph(*g));
@@ -460,18 +472,16 @@ std::string describe_text(const json& d) {
        text(d["content_hash"]) + ")");
   line("format version   " + text(d["format_version"]));
   line("metres per unit  " + text(d["metres_per_unit"]));
-  if (const json& p = d["provenance"]; p.is_object())
-  {
+  if (const json& p = d["provenance"]; p.is_object()) {
     line("provenance       source '" + text(p["source_name"]) + "' (hash " + text(p["source_hash"]) + "), " +
          text(p["cooker_version"]) + ", options '" + text(p["options"]) + "'");
     if (p.contains("cook_key")) line("cook key         " + text(p["cook_key"]));
     if (p.contains("inputs"))
       for (const json& f : p["inputs"])
         line("  input          " + text(f["path"]) +
-             (f.contains("absent") ? std::string(" (absent)") : " (" + text(f["bytes"]) + " bytes, hash " + text(f["hash"]) + ")"));
-  }
-  else
-    line("provenance       -");
+             (f.contains("absent") ? std::string(" (absent)")
+                                   : " (" + text(f["bytes"]) + " bytes, hash " + text(f["hash"]) + ")"));
+  } else line("provenance       -");
 
   if (const json& s = d["skeleton"]; s.is_object()) {
     line("");
@@ -518,8 +528,8 @@ std::string describe_text(const json& d) {
       size_t t = 0;
       for (const json& mt : m["morph_targets"])
         line(format("  morph %-8zu ", t++) + "'" + text(mt["name"]) + "': " + text(mt["vertices"]) + " vertices" +
-             (mt["normals"].get<bool>() ? " + normals" : "") + (mt["tangents"].get<bool>() ? " + tangents" : "") + ", " +
-             text(mt["bytes"]) + " bytes, error " + text(mt["position_error_mm"]) + " mm / " +
+             (mt["normals"].get<bool>() ? " + normals" : "") + (mt["tangents"].get<bool>() ? " + tangents" : "") +
+             ", " + text(mt["bytes"]) + " bytes, error " + text(mt["position_error_mm"]) + " mm / " +
              text(mt["normal_error_deg"]) + " deg, default weight " + text(mt["default_weight"]));
     }
   }
@@ -549,7 +559,8 @@ std::string describe_text(const json& d) {
     } else {
       line("  compression    -");
     }
-    line("  root motion    " + (c["root_motion"].is_object() ? "yes, up axis " + text(c["root_motion"]["up_axis"]) : std::string("no")));
+    line("  root motion    " +
+         (c["root_motion"].is_object() ? "yes, up axis " + text(c["root_motion"]["up_axis"]) : std::string("no")));
     if (c.contains("morph_weights")) {
       std::string tracks;
       for (const json& t : c["morph_weights"])
@@ -559,14 +570,16 @@ std::string describe_text(const json& d) {
     }
     if (c.contains("events")) {
       std::string events;
-      for (const json& e : c["events"]) events += (events.empty() ? "" : ", ") + text(e["name"]) + " @" + text(e["time"]);
+      for (const json& e : c["events"])
+        events += (events.empty() ? "" : ", ") + text(e["name"]) + " @" + text(e["time"]);
       line("  events         " + events);
     }
     if (c.contains("channels")) {
       line("  channels       " + text(json(c["channels"].size())));
       for (const json& ch : c["channels"]) {
         const bool animated = ch["storage"] == "animated";
-        line("    joint " + text(ch["joint"]) + (ch["joint_name"].is_string() ? quoted_name(ch["joint_name"]) : "") + " " + text(ch["channel"]) + ": " +
+        line("    joint " + text(ch["joint"]) + (ch["joint_name"].is_string() ? quoted_name(ch["joint_name"]) : "") +
+             " " + text(ch["channel"]) + ": " +
              (animated ? text(ch["key_count"]) + " keys at " + text(ch["bits"]) + " bits" : std::string("constant")));
       }
     }
@@ -606,8 +619,8 @@ std::string describe_text(const json& d) {
   for (const json& m : d["materials"]) {
     line("");
     line(format("material %zu", index++) + quoted_name(m["name"]));
-    line("  colours        ambient " + vec_text(m["ambient"]) + ", diffuse " + vec_text(m["diffuse"]) +
-         ", specular " + vec_text(m["specular"]));
+    line("  colours        ambient " + vec_text(m["ambient"]) + ", diffuse " + vec_text(m["diffuse"]) + ", specular " +
+         vec_text(m["specular"]));
     line("  shininess      " + text(m["shininess"]) + ", opacity " + text(m["opacity"]));
     if (m["emissive"] != json::array({0.0, 0.0, 0.0})) line("  emissive       " + vec_text(m["emissive"]));
     if (!m["pbr"].is_null())
@@ -615,11 +628,13 @@ std::string describe_text(const json& d) {
     for (const json& t : m["textures"]) {
       std::string where;
       if (t["bytes"].get<size_t>() > 0 && t["encoding"].get<std::string>() != "Source")
-        where = text(t["encoding"]) + (t["srgb"].get<bool>() ? " sRGB " : " ") + text(t["width"]) + " x " + text(t["height"]) +
-                ", " + text(t["mips"]) + " mips, " + text(t["bytes"]) + " bytes embedded";
+        where = text(t["encoding"]) + (t["srgb"].get<bool>() ? " sRGB " : " ") + text(t["width"]) + " x " +
+                text(t["height"]) + ", " + text(t["mips"]) + " mips, " + text(t["bytes"]) + " bytes embedded";
       else if (t["bytes"].get<size_t>() > 0)
-        where = text(t["bytes"]) + " bytes embedded" + (t["mime"].get<std::string>().empty() ? "" : " (" + text(t["mime"]) + ")");
-      if (!t["path"].get<std::string>().empty()) where += (where.empty() ? "" : ", ") + ("path '" + text(t["path"]) + "'");
+        where = text(t["bytes"]) + " bytes embedded" +
+                (t["mime"].get<std::string>().empty() ? "" : " (" + text(t["mime"]) + ")");
+      if (!t["path"].get<std::string>().empty())
+        where += (where.empty() ? "" : ", ") + ("path '" + text(t["path"]) + "'");
       line(format("  texture %-6s %s", text(t["role"]).c_str(), where.c_str()));
     }
   }

@@ -11,7 +11,8 @@
 
 namespace ossa::inspect {
 
-Result<std::string> describe_humanoid(const Asset& asset, const tools::HumanoidMapFile* map, const std::string& map_name) {
+Result<std::string> describe_humanoid(const Asset& asset, const tools::HumanoidMapFile* map,
+                                      const std::string& map_name) {
   const SkeletonView sk = asset.skeleton();
   if (sk.empty()) return Error{asset.name() + ": holds no skeleton"};
   std::vector<std::string_view> names(sk.joint_count());
@@ -19,9 +20,9 @@ Result<std::string> describe_humanoid(const Asset& asset, const tools::HumanoidM
   const tools::RigMapSpec* spec = nullptr;
   if (map != nullptr) {
     spec = map->rig && tools::rig_map_fits(*map->rig, names) ? &*map->rig
-           : map->target                                      ? &*map->target
-           : map->source                                      ? &*map->source
-                                                              : nullptr;
+           : map->target                                     ? &*map->target
+           : map->source                                     ? &*map->source
+                                                             : nullptr;
   }
   auto applied = tools::apply_rig_map(spec, names, sk.parents(), map_name);
   if (!applied) return applied.error();
@@ -73,16 +74,18 @@ Result<std::string> describe_humanoid(const Asset& asset, const tools::HumanoidM
     return glm::degrees(std::asin(-d.y / glm::length(d)));
   };
   const glm::vec3 left = glm::inverse(pose->frame) * glm::vec3(1.0f, 0.0f, 0.0f);
-  std::snprintf(line, sizeof line,
-                "retargetable: up (%g, %g, %g), left (%g, %g, %g); arms %.1f / %.1f degrees below horizontal in the bind "
-                "pose (%s); retarget pose: %s; hips %g units over the ankles, ankles %g over the floor\n",
-                pose->up.x, pose->up.y, pose->up.z, left.x, left.y, left.z,
-                arm_below_horizontal(HumanoidBone::LeftUpperArm, HumanoidBone::LeftLowerArm),
-                arm_below_horizontal(HumanoidBone::RightUpperArm, HumanoidBone::RightLowerArm),
-                std::fabs(arm_below_horizontal(HumanoidBone::LeftUpperArm, HumanoidBone::LeftLowerArm)) < 15.0f ? "a T-pose"
-                                                                                                                 : "an A-pose or lower",
-                applied->rest == RestPose::Bind ? "the bind pose as it is" : "limbs straightened onto the body's axes",
-                static_cast<double>(pose->hips_height), static_cast<double>(pose->ankle_height));
+  std::snprintf(
+      line, sizeof line,
+      "retargetable: up (%g, %g, %g), left (%g, %g, %g); arms %.1f / %.1f degrees below horizontal in the bind "
+      "pose (%s); retarget pose: %s; hips %g units over the ankles, ankles %g over the floor\n",
+      pose->up.x, pose->up.y, pose->up.z, left.x, left.y, left.z,
+      arm_below_horizontal(HumanoidBone::LeftUpperArm, HumanoidBone::LeftLowerArm),
+      arm_below_horizontal(HumanoidBone::RightUpperArm, HumanoidBone::RightLowerArm),
+      std::fabs(arm_below_horizontal(HumanoidBone::LeftUpperArm, HumanoidBone::LeftLowerArm)) < 15.0f
+          ? "a T-pose"
+          : "an A-pose or lower",
+      applied->rest == RestPose::Bind ? "the bind pose as it is" : "limbs straightened onto the body's axes",
+      static_cast<double>(pose->hips_height), static_cast<double>(pose->ankle_height));
   out += line;
   return out;
 }

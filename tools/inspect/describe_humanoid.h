@@ -16,6 +16,7 @@ namespace ossa::inspect {
 /// The description; `map` (optional) is a parsed map file whose "rig" (or "target", else
 /// "source") section applies, `map_name` names it. Errors (a map naming joints the rig lacks) name
 /// the file. The rig must have a skeleton.
-Result<std::string> describe_humanoid(const Asset& asset, const tools::HumanoidMapFile* map, const std::string& map_name);
+Result<std::string> describe_humanoid(const Asset& asset, const tools::HumanoidMapFile* map,
+                                      const std::string& map_name);
 
 }  // namespace ossa::inspect

@@ -34,18 +34,20 @@
 #include <sstream>
 
 int main(int argc, char** argv) {
-  ossa::cli::Command command("ossa-inspect",
-                             "ossa-inspect: print what cooked .ossa files hold (skeleton, meshes, clips, materials, graphs)",
-                             "when the file is not a valid .ossa file");
+  ossa::cli::Command command(
+      "ossa-inspect", "ossa-inspect: print what cooked .ossa files hold (skeleton, meshes, clips, materials, graphs)",
+      "when the file is not a valid .ossa file");
   std::vector<std::string> paths;
   bool json = false;
   command.app().add_option("files", paths, "the .ossa files to inspect")->required();
-  command.app().add_flag("--json", json, "print JSON with a stable key order (docs/JSON.md; what the golden tests compare)");
+  command.app().add_flag("--json", json,
+                         "print JSON with a stable key order (docs/JSON.md; what the golden tests compare)");
   bool humanoid = false;
   std::string map_path;
-  command.app().add_flag("--humanoid", humanoid,
-                         "print the rig's humanoid mapping for retargeting (which joint plays which bone, what is missing, "
-                         "its retarget pose; docs/RETARGET.md) instead of the summary");
+  command.app().add_flag(
+      "--humanoid", humanoid,
+      "print the rig's humanoid mapping for retargeting (which joint plays which bone, what is missing, "
+      "its retarget pose; docs/RETARGET.md) instead of the summary");
   command.app().add_option("--map", map_path, "with --humanoid: a humanoid map file to apply (docs/RETARGET.md)");
   if (const auto exit_now = command.parse(argc, argv)) return *exit_now;
   if (humanoid && json) return command.usage_error("--humanoid prints text; it does not combine with --json");

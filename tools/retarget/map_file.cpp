@@ -36,8 +36,9 @@ Result<RigMapSpec> parse_section(const json& j, const std::string& where) {
         const HumanoidBone bone = find_humanoid_bone(bone_name);
         if (bone == HumanoidBone::Count) {
           const std::string guess = closest_bone(bone_name);
-          return Error{where + ".bones: '" + bone_name + "' is not a humanoid bone" +
-                       (guess.empty() ? std::string(" (docs/RETARGET.md lists them)") : " (did you mean '" + guess + "'?)")};
+          return Error{
+              where + ".bones: '" + bone_name + "' is not a humanoid bone" +
+              (guess.empty() ? std::string(" (docs/RETARGET.md lists them)") : " (did you mean '" + guess + "'?)")};
         }
         if (joint.is_null()) {
           spec.cleared.push_back(bone);
@@ -101,7 +102,10 @@ Result<HumanoidMapFile> parse_humanoid_map_file(std::string_view text, std::stri
   HumanoidMapFile out;
   for (const auto& [key, value] : doc.items()) {
     if (key == "ossa_humanoid_map") continue;
-    std::optional<RigMapSpec>* slot = key == "source" ? &out.source : key == "target" ? &out.target : key == "rig" ? &out.rig : nullptr;
+    std::optional<RigMapSpec>* slot = key == "source"   ? &out.source
+                                      : key == "target" ? &out.target
+                                      : key == "rig"    ? &out.rig
+                                                        : nullptr;
     if (slot == nullptr) return Error{name + ": unknown key '" + key + "' (source, target, rig)"};
     auto spec = parse_section(value, name + ": " + key);
     if (!spec) return spec.error();
@@ -119,7 +123,8 @@ bool rig_map_fits(const RigMapSpec& spec, std::span<const std::string_view> name
   return true;
 }
 
-const RigMapSpec* section_for(const HumanoidMapFile& file, std::string_view role, std::span<const std::string_view> names) {
+const RigMapSpec* section_for(const HumanoidMapFile& file, std::string_view role,
+                              std::span<const std::string_view> names) {
   const std::optional<RigMapSpec>& own = role == "source" ? file.source : file.target;
   if (own) return &*own;
   if (file.rig && rig_map_fits(*file.rig, names)) return &*file.rig;
@@ -139,7 +144,9 @@ Result<AppliedRigMap> apply_rig_map(const RigMapSpec* spec, std::span<const std:
   for (HumanoidBone b : spec->cleared) out.humanoid[b] = -1;
   for (const auto& [bone, joint] : spec->bones) {
     const int j = find(joint);
-    if (j < 0) return Error{where + ": bones." + std::string(humanoid_bone_name(bone)) + ": the rig has no joint '" + joint + "'"};
+    if (j < 0)
+      return Error{where + ": bones." + std::string(humanoid_bone_name(bone)) + ": the rig has no joint '" + joint +
+                   "'"};
     // A joint named for one bone leaves whatever bone the automatic mapping gave it.
     for (int16_t& other : out.humanoid.joints)
       if (other == j) other = -1;

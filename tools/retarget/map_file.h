@@ -39,7 +39,7 @@ namespace ossa::tools {
 /// One rig's section of a map file.
 struct RigMapSpec {
   std::vector<std::pair<HumanoidBone, std::string>> bones;  // bone -> joint name
-  std::vector<HumanoidBone> cleared;                         // bones set to null
+  std::vector<HumanoidBone> cleared;                        // bones set to null
   std::optional<RestPose> rest;
   std::vector<std::pair<std::string, glm::quat>> rest_rotations;
 };

@@ -12,8 +12,12 @@
 
 namespace ossa {
 
-struct Float2 { float x, y; };
-struct Float3 { float x, y, z; };
+struct Float2 {
+  float x, y;
+};
+struct Float3 {
+  float x, y, z;
+};
 
 /// Snorm16 as OpenGL normalizes it: max(v / 32767, -1).
 inline float snorm16_to_float(int16_t v) {

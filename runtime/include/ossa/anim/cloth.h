@@ -47,32 +47,31 @@
 
 namespace ossa {
 
-
 /// One character's cloth: the simulation state, made once; positions() / normals() are the output
 /// of the last update. Move-only in spirit (the vectors are its memory); reading any member is
 /// fine, writing anything but `settings` is the solver's business.
 struct ClothInstance {
   ClothSource source;
-  ClothSettings settings;              // starts as source.settings; change freely between updates
-  std::vector<glm::vec4> current;      // model space; w = inverse mass
-  std::vector<glm::vec4> previous;     // one substep ago, in the same frame as current
+  ClothSettings settings;           // starts as source.settings; change freely between updates
+  std::vector<glm::vec4> current;   // model space; w = inverse mass
+  std::vector<glm::vec4> previous;  // one substep ago, in the same frame as current
   std::vector<glm::vec3> skinned_before, skinned_normal_before;  // the last update's inputs
   std::vector<glm::vec3> skinned_older;                          // and the one's before it
   std::vector<glm::vec3> out_positions, out_normals;             // the last update's output
-  std::vector<glm::vec3> colliders_before;  // 2 per collider: model-space ends at the last update
+  std::vector<glm::vec3> colliders_before;                       // 2 per collider: model-space ends at the last update
   std::vector<glm::vec3> colliders_older, colliders_now;
-  std::vector<float> lambda;           // XPBD multipliers (stretch then bend) when iterations > 1
-  std::vector<uint16_t> facing;        // 3 per particle: a triangle it is a corner of (the wind's normal)
+  std::vector<float> lambda;     // XPBD multipliers (stretch then bend) when iterations > 1
+  std::vector<uint16_t> facing;  // 3 per particle: a triangle it is a corner of (the wind's normal)
   std::vector<uint32_t> stretch_runs, bend_runs, tether_runs;  // ends of runs that share no particle
   std::vector<glm::vec4> collider_step;  // 3 per collider, this substep's: ends (w: reach), bounding sphere
-  glm::mat4 world_before{1.0f};        // model_to_world at the last update
-  glm::mat4 world_state{1.0f};         // model_to_world at the last substep: current's frame
-  glm::mat4 world_older{1.0f};         // model_to_world at the update before the last
-  float dt_before = 0.0f;              // seconds between the older and the last update
-  uint32_t history = 0;                // updates with dt > 0 since the last restart, up to 2
-  float banked = 0.0f;                 // seconds not yet simulated (< substep)
-  bool started = false;                // false until the first update, and after reset_cloth
-  uint32_t restarts = 0;               // times the simulation restarted from the skinned pose
+  glm::mat4 world_before{1.0f};          // model_to_world at the last update
+  glm::mat4 world_state{1.0f};           // model_to_world at the last substep: current's frame
+  glm::mat4 world_older{1.0f};           // model_to_world at the update before the last
+  float dt_before = 0.0f;                // seconds between the older and the last update
+  uint32_t history = 0;                  // updates with dt > 0 since the last restart, up to 2
+  float banked = 0.0f;                   // seconds not yet simulated (< substep)
+  bool started = false;                  // false until the first update, and after reset_cloth
+  uint32_t restarts = 0;                 // times the simulation restarted from the skinned pose
 
   std::span<const glm::vec3> positions() const { return out_positions; }
   std::span<const glm::vec3> normals() const { return out_normals; }

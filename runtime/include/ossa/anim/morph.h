@@ -42,8 +42,7 @@ bool bind_morph_tracks(const ClipView& clip, std::span<const std::string_view> c
 
 /// weights[c] = the default weight of the first of the mesh's targets bound to channel c. Call it
 /// for each mesh, then let clips overwrite what they drive. O(targets).
-bool default_morph_weights(const MeshView& mesh, std::span<const int32_t> target_channel,
-                           std::span<float> weights);
+bool default_morph_weights(const MeshView& mesh, std::span<const int32_t> target_channel, std::span<float> weights);
 
 /// One weight track's value at `time` seconds (clamped to the clip), linear between keys. O(log keys).
 float sample_morph_track(const ClipView& clip, const fb::MorphTrack& track, float time);

@@ -32,13 +32,13 @@
 namespace ossa {
 
 struct SpringSettings {
-  float stiffness = 4.0f;        // pull towards the animated tail, per second (0: none)
-  float drag = 0.4f;             // velocity lost per step, in [0, 1]
+  float stiffness = 4.0f;                 // pull towards the animated tail, per second (0: none)
+  float drag = 0.4f;                      // velocity lost per step, in [0, 1]
   glm::vec3 gravity{0.0f, -9.81f, 0.0f};  // model-space acceleration, units / s^2
-  float radius = 0.0f;           // each tail's collision radius
-  float step = 1.0f / 120.0f;    // fixed internal step, seconds
-  float teleport_distance = 0.0f;  // > 0: a base moving further in one update resets the chain
-  float tail_length = 0.1f;      // the last joint's bone length (it has no child in the chain)
+  float radius = 0.0f;                    // each tail's collision radius
+  float step = 1.0f / 120.0f;             // fixed internal step, seconds
+  float teleport_distance = 0.0f;         // > 0: a base moving further in one update resets the chain
+  float tail_length = 0.1f;               // the last joint's bone length (it has no child in the chain)
 };
 
 /// A sphere (tail == offset) or capsule (offset .. tail) of `radius`, placed in `joint`'s local
@@ -53,13 +53,13 @@ struct SpringCollider {
 /// One chain's state: the tails' positions now and one step ago, the base's placement at the
 /// last update, and the time banked towards the next step. Opaque; made by make_spring_chain.
 struct SpringChain {
-  std::vector<uint16_t> joints;      // parents first, joints[i] the parent of joints[i + 1]
+  std::vector<uint16_t> joints;              // parents first, joints[i] the parent of joints[i + 1]
   std::vector<glm::vec3> current, previous;  // model-space tails, one per joint
   std::vector<glm::quat> scratch_rotation;   // per-joint working storage for update
   SpringSettings settings;
-  glm::mat4 base_before{1.0f};       // the base's model matrix at the end of the last update
-  float banked = 0.0f;               // seconds not yet simulated (< settings.step)
-  bool started = false;              // false until the first update (which resets)
+  glm::mat4 base_before{1.0f};  // the base's model matrix at the end of the last update
+  float banked = 0.0f;          // seconds not yet simulated (< settings.step)
+  bool started = false;         // false until the first update (which resets)
 };
 
 /// A chain over `joints` (each joint the parent of the next in `parents`; at least one). Errors

@@ -89,21 +89,21 @@ struct GraphEvent {
 
 /// What happened to a montage (GraphInstance::montage_events, MontageListener).
 enum class MontageEventType : uint8_t {
-  Started,      // play_montage
-  BlendingOut,  // its blend out began (interrupted: stopped or replaced before its end)
-  Ended,        // it has blended out and no longer plays (interrupted as for BlendingOut)
-  Notify,       // an instant notify was passed
-  NotifyBegin,  // playback entered a window notify
-  NotifyEnd,    // ... and left it (or the montage ended)
+  Started,         // play_montage
+  BlendingOut,     // its blend out began (interrupted: stopped or replaced before its end)
+  Ended,           // it has blended out and no longer plays (interrupted as for BlendingOut)
+  Notify,          // an instant notify was passed
+  NotifyBegin,     // playback entered a window notify
+  NotifyEnd,       // ... and left it (or the montage ended)
   BranchingPoint,  // a branching point was reached: the montage is exactly at its time
 };
 
 struct MontageEvent {
   MontageEventType type = MontageEventType::Started;
-  uint16_t montage = 0;     // index into the graph's montages
-  std::string_view name;    // the notify's (points into the file); empty for Started / BlendingOut / Ended
-  float position = 0.0f;    // the montage's timeline position when it happened, seconds
-  bool interrupted = false; // BlendingOut, Ended
+  uint16_t montage = 0;      // index into the graph's montages
+  std::string_view name;     // the notify's (points into the file); empty for Started / BlendingOut / Ended
+  float position = 0.0f;     // the montage's timeline position when it happened, seconds
+  bool interrupted = false;  // BlendingOut, Ended
 };
 
 /// Called as a montage event happens, during update() or the host call that caused it. At a
@@ -113,24 +113,24 @@ using MontageListener = void (*)(GraphInstance& instance, const MontageEvent& ev
 
 /// A montage's state, for the host and for tests.
 struct MontageStatus {
-  bool playing = false;        // it plays (blending in, at full weight or blending out)
+  bool playing = false;  // it plays (blending in, at full weight or blending out)
   bool blending_out = false;
-  float position = 0.0f;       // timeline seconds
-  int section = -1;            // the section playing
-  float weight = 0.0f;         // its blend weight, [0, 1]
-  float rate = 0.0f;           // host rate times the montage's rate
-  float slot_weight = 0.0f;    // the most weight a slot node showed it with in the last update (0: no
-                               // slot played it, e.g. every slot of its group lies in an inactive state)
+  float position = 0.0f;     // timeline seconds
+  int section = -1;          // the section playing
+  float weight = 0.0f;       // its blend weight, [0, 1]
+  float rate = 0.0f;         // host rate times the montage's rate
+  float slot_weight = 0.0f;  // the most weight a slot node showed it with in the last update (0: no
+                             // slot played it, e.g. every slot of its group lies in an inactive state)
 };
 
 /// Where a state machine is: for the host's UI and for tests.
 struct MachineStatus {
-  int current = -1;         // the state being entered (a transition's target while one runs)
-  int previous = -1;        // a running crossfade's source state, -1 when none
-  float weight = 1.0f;      // the current state's blend weight (1 when no crossfade runs)
-  float elapsed = 0.0f;     // seconds since the last transition started
-  float duration = 0.0f;    // that transition's duration (0 when none ever ran)
-  int transition = -1;      // index of the running transition, -1 when none
+  int current = -1;                 // the state being entered (a transition's target while one runs)
+  int previous = -1;                // a running crossfade's source state, -1 when none
+  float weight = 1.0f;              // the current state's blend weight (1 when no crossfade runs)
+  float elapsed = 0.0f;             // seconds since the last transition started
+  float duration = 0.0f;            // that transition's duration (0 when none ever ran)
+  int transition = -1;              // index of the running transition, -1 when none
   float inertial_remaining = 0.0f;  // seconds left on an inertialization offset (0: none)
 };
 

@@ -2,10 +2,10 @@
 //
 // Loading is the whole point of the format: Asset::open memory-maps the file read-only (files
 // up to 4 MiB are read into aligned memory instead: one read() is cheaper than mapping, faulting
-// in the pages verification touches and unmapping; OpenMode forces either), or Asset::borrow takes bytes the caller owns
-// (an engine's own file system or pack file), checks the identifier, runs flatbuffers::Verifier over every byte the reader could touch, checks the
-// format version, and then the semantic invariants FlatBuffers cannot see (validate.h). Only then
-// is an Asset handed out, so every view below can read without further checks. No per-vertex or
+// in the pages verification touches and unmapping; OpenMode forces either), or Asset::borrow takes bytes the caller
+// owns (an engine's own file system or pack file), checks the identifier, runs flatbuffers::Verifier over every byte
+// the reader could touch, checks the format version, and then the semantic invariants FlatBuffers cannot see
+// (validate.h). Only then is an Asset handed out, so every view below can read without further checks. No per-vertex or
 // per-key work happens here: views are spans straight into the file's bytes, ready for glBufferData.
 //
 // Assumes a little-endian host (as FlatBuffers' in-place struct access does).
@@ -51,10 +51,10 @@ struct MeshView {
   std::span<const uint8_t> vertex_bytes() const;  // 16-byte aligned, vertex_count * stride bytes
   fb::IndexFormat index_format() const;
   uint32_t index_count() const;
-  std::span<const uint8_t> index_bytes() const;   // 16-byte aligned
+  std::span<const uint8_t> index_bytes() const;  // 16-byte aligned
   std::span<const fb::Submesh> submeshes() const;
-  std::span<const uint16_t> joints() const;       // skeleton joint of each mesh-local slot
-  std::span<const fb::Mat4> inverse_bind() const; // one per slot
+  std::span<const uint16_t> joints() const;        // skeleton joint of each mesh-local slot
+  std::span<const fb::Mat4> inverse_bind() const;  // one per slot
   /// Morph targets (format v5; ossa/anim/morph.h applies them). Validated: listed vertices
   /// strictly increasing and < vertex_count(), three deltas per listed vertex, names unique.
   size_t morph_target_count() const;
@@ -112,10 +112,10 @@ enum class OpenMode : uint8_t {
 };
 
 /// A verified .ossa file. Owns its bytes: a read-only memory map or a 16-byte aligned heap copy
-/// (open, from_bytes), or borrows the caller's (borrow). Move-only; views stay valid while the Asset lives (a move does not move the
-/// bytes, so views taken before a move stay valid too). A moved-from Asset is empty: no skeleton,
-/// no meshes, clips or materials, and file() must not be called. mesh(i), clip(i) and material(i)
-/// need i < the matching count.
+/// (open, from_bytes), or borrows the caller's (borrow). Move-only; views stay valid while the Asset lives (a move does
+/// not move the bytes, so views taken before a move stay valid too). A moved-from Asset is empty: no skeleton, no
+/// meshes, clips or materials, and file() must not be called. mesh(i), clip(i) and material(i) need i < the matching
+/// count.
 class Asset {
  public:
   /// Read or map (OpenMode) + verify + validate. `path` is UTF-8 on every platform. Only regular
@@ -161,8 +161,8 @@ class Asset {
   std::string name_;
   const uint8_t* data_ = nullptr;
   size_t size_ = 0;
-  void* mapping_ = nullptr;   // mapping base when memory-mapped
-  void* heap_ = nullptr;      // aligned heap copy (installed Allocator) when read or copied
+  void* mapping_ = nullptr;  // mapping base when memory-mapped
+  void* heap_ = nullptr;     // aligned heap copy (installed Allocator) when read or copied
   const fb::File* file_ = nullptr;
 };
 

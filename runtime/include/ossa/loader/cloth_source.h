@@ -20,21 +20,21 @@ inline constexpr uint32_t kMaxClothParticles = 65535;
 /// What the solver does each substep; the defaults of a cooked cloth come from its file
 /// (cloth_source), and a host may change any of them between updates (ClothInstance::settings).
 struct ClothSettings {
-  float substep = 1.0f / 240.0f;     // seconds per internal step, in [1e-4, 0.05]
-  uint32_t iterations = 1;           // constraint passes per substep, 1..16 (small steps need one)
-  float thickness = 0.0f;            // particle collision radius, model units
-  float stretch_compliance = 0.0f;   // s^2 per unit mass (1 / stiffness): 0 inextensible
+  float substep = 1.0f / 240.0f;    // seconds per internal step, in [1e-4, 0.05]
+  uint32_t iterations = 1;          // constraint passes per substep, 1..16 (small steps need one)
+  float thickness = 0.0f;           // particle collision radius, model units
+  float stretch_compliance = 0.0f;  // s^2 per unit mass (1 / stiffness): 0 inextensible
   float bend_compliance = 0.0f;
-  float tether_scale = 1.0f;         // tether lengths times this, in [1, 2]
-  float damping = 0.0f;              // per second: velocity *= exp(-damping * t)
-  float drag = 0.0f;                 // per second: how fast the cloth takes the air's velocity along its normal
-  glm::vec3 gravity{0.0f};           // world space, world units / s^2 (identity transform: model units)
-  glm::vec3 wind{0.0f};              // the air's velocity, world space, world units / s
-  float linear_inertia = 1.0f;       // [0, 1]: share of the world's translation the cloth feels
-  float angular_inertia = 1.0f;      // [0, 1]: share of its rotation
-  float teleport_distance = 0.0f;    // world units; > 0: a jump further in one update restarts
-  float teleport_angle = 0.0f;       // radians; > 0: a turn further in one update restarts
-  float max_speed = 0.0f;            // model units / s; > 0: particle speeds are clamped to it
+  float tether_scale = 1.0f;       // tether lengths times this, in [1, 2]
+  float damping = 0.0f;            // per second: velocity *= exp(-damping * t)
+  float drag = 0.0f;               // per second: how fast the cloth takes the air's velocity along its normal
+  glm::vec3 gravity{0.0f};         // world space, world units / s^2 (identity transform: model units)
+  glm::vec3 wind{0.0f};            // the air's velocity, world space, world units / s
+  float linear_inertia = 1.0f;     // [0, 1]: share of the world's translation the cloth feels
+  float angular_inertia = 1.0f;    // [0, 1]: share of its rotation
+  float teleport_distance = 0.0f;  // world units; > 0: a jump further in one update restarts
+  float teleport_angle = 0.0f;     // radians; > 0: a turn further in one update restarts
+  float max_speed = 0.0f;          // model units / s; > 0: particle speeds are clamped to it
 };
 
 /// A cloth's cooked data as spans (into a loaded file, or the caller's arrays): see ossa.fbs
@@ -46,13 +46,13 @@ struct ClothSource {
   std::span<const float> backstops;      // empty: none
   std::span<const uint32_t> vertices;
   std::span<const uint16_t> vertex_particles;
-  std::span<const uint8_t> flipped;      // empty: none
+  std::span<const uint8_t> flipped;  // empty: none
   std::span<const uint16_t> triangles;
   std::span<const fb::ClothEdge> stretch;
   std::span<const fb::ClothEdge> bend;
   std::span<const fb::ClothTether> tethers;
   std::span<const fb::ClothCollider> colliders;
-  ClothSettings settings;                // the defaults
+  ClothSettings settings;  // the defaults
   size_t particle_count() const { return particle_vertices.size(); }
 };
 

@@ -16,18 +16,16 @@
 // per frame. Runs after verification; never reads out of bounds.
 //
 // Also checked, because a reader relies on them: pose values (bind translations and scales,
-// clip constants, ranges and raw keys) within 1e7 so pose arithmetic cannot overflow; metres_per_unit finite and > 0; joint names
-// non-empty; bind pose and inverse binds finite, rotations normalizable (also for keys); vertex
-// stride a multiple of 4 and attribute offsets aligned to their component size (so CPU decoding
-// reads aligned data); Joints uses an integer format and nothing else does; Position has >= 3
-// components and is present when there are vertices; Joints needs Weights, joint slots and every
-// slot < slot count (and Weights needs Joints); a mesh with joint slots needs a skeleton in the
-// same file; a clip bound (by hash) to the file's skeleton has its joint count; submesh index
-// counts are multiples of 3 and materials < max(1, material count); textures have a known role
-// and embedded data or a path; vertex, index and texture bytes are 16-byte aligned in memory; a
-// cooked texture has a known encoding, sides of 1..kMaxTextureSide, 1 to a full chain of mip
-// levels and exactly that chain's bytes (texture.h); a mesh's cloth (format v9) passes check_cloth
-// (ossa/anim/cloth.h) against the mesh's vertex count and the skeleton's joint count.
+// clip constants, ranges and raw keys) within 1e7 so pose arithmetic cannot overflow; metres_per_unit finite and > 0;
+// joint names non-empty; bind pose and inverse binds finite, rotations normalizable (also for keys); vertex stride a
+// multiple of 4 and attribute offsets aligned to their component size (so CPU decoding reads aligned data); Joints uses
+// an integer format and nothing else does; Position has >= 3 components and is present when there are vertices; Joints
+// needs Weights, joint slots and every slot < slot count (and Weights needs Joints); a mesh with joint slots needs a
+// skeleton in the same file; a clip bound (by hash) to the file's skeleton has its joint count; submesh index counts
+// are multiples of 3 and materials < max(1, material count); textures have a known role and embedded data or a path;
+// vertex, index and texture bytes are 16-byte aligned in memory; a cooked texture has a known encoding, sides
+// of 1..kMaxTextureSide, 1 to a full chain of mip levels and exactly that chain's bytes (texture.h); a mesh's cloth
+// (format v9) passes check_cloth (ossa/anim/cloth.h) against the mesh's vertex count and the skeleton's joint count.
 #pragma once
 #include <cstddef>
 #include <string_view>

@@ -57,7 +57,8 @@ float clip_floor(const RetargetMap& map, std::span<const ContactFrame> frames);
 
 /// Contacts over a clip, one ContactFrame per frame of its grid. Sorted by foot, then frame.
 std::vector<ContactSpan> find_foot_contacts(const RetargetMap& map, std::span<const ContactFrame> frames,
-                                            float sample_rate, float floor = 0.0f, const ContactSettings& settings = {});
+                                            float sample_rate, float floor = 0.0f,
+                                            const ContactSettings& settings = {});
 
 /// The contact input for the retarget job at a (fractional) frame (FootContact): inside a contact
 /// weight 1 and its offset; within blend_time before or after one, the eased weight and its entry

@@ -23,10 +23,10 @@
 // retargeted onto itself reproduce the source exactly.
 //
 // Feet: given contacts (find them over a clip with find_foot_contacts), each planted target ankle
-// is held where the scaled source holds its own, at the target's own stance (FootContact): the pelvis first moves by what the planted feet need (their mean, so
-// a single planted foot costs the legs nothing and the limbs keep the source's directions), then a
-// two-bone IK pass (ik.h) takes the rest (the two feet of a double support disagreeing), keeping
-// each foot's own orientation.
+// is held where the scaled source holds its own, at the target's own stance (FootContact): the pelvis first moves by
+// what the planted feet need (their mean, so a single planted foot costs the legs nothing and the limbs keep the
+// source's directions), then a two-bone IK pass (ik.h) takes the rest (the two feet of a double support disagreeing),
+// keeping each foot's own orientation.
 //
 // Shape: make_retarget_map (setup: allocates, validates, builds both retarget poses and every
 // per-joint decision into a plain struct) and retarget (per frame: spans in, pose out, no
@@ -62,11 +62,11 @@ struct RestRotation {
 
 /// One rig as a retarget sees it. Spans must stay valid during make_retarget_map only.
 struct RetargetRig {
-  std::string_view name;                      // for messages
-  std::span<const int16_t> parents;           // parents[i] < i, -1 for roots
-  std::span<const Transform> bind;            // local bind pose, one per joint
-  std::span<const std::string_view> names;    // joint names (extra joints are matched by name); may be empty
-  HumanoidMap humanoid;                       // map_humanoid(...) or a map file's
+  std::string_view name;                    // for messages
+  std::span<const int16_t> parents;         // parents[i] < i, -1 for roots
+  std::span<const Transform> bind;          // local bind pose, one per joint
+  std::span<const std::string_view> names;  // joint names (extra joints are matched by name); may be empty
+  HumanoidMap humanoid;                     // map_humanoid(...) or a map file's
   RestPose rest = RestPose::Straighten;
   std::span<const RestRotation> rest_rotations;
 };
@@ -74,14 +74,14 @@ struct RetargetRig {
 /// A rig's retarget pose and body frame, as make_retarget_map builds them (exposed for tools: the
 /// viewer draws it, ossa-inspect prints the frame).
 struct RetargetPose {
-  std::vector<Transform> local;        // the retarget (T-) pose, local, one per joint
-  std::vector<glm::mat4> model;        // its model matrices
+  std::vector<Transform> local;             // the retarget (T-) pose, local, one per joint
+  std::vector<glm::mat4> model;             // its model matrices
   glm::quat frame{1.0f, 0.0f, 0.0f, 0.0f};  // rig model space -> profile space (+x left, +y up, +z forward)
-  glm::vec3 up{0.0f, 1.0f, 0.0f};      // the rig's up, model space
-  glm::vec3 pelvis{0.0f};              // midway between the upper legs' joints (where the legs hang)
-  glm::vec3 origin{0.0f};              // the point under the pelvis at the height of the ankles
-  float hips_height = 0.0f;            // the pelvis above the ankles (the legs' reach), rig units
-  float ankle_height = 0.0f;           // the ankles (foot joints, mean of both) above the floor
+  glm::vec3 up{0.0f, 1.0f, 0.0f};           // the rig's up, model space
+  glm::vec3 pelvis{0.0f};                   // midway between the upper legs' joints (where the legs hang)
+  glm::vec3 origin{0.0f};                   // the point under the pelvis at the height of the ankles
+  float hips_height = 0.0f;                 // the pelvis above the ankles (the legs' reach), rig units
+  float ankle_height = 0.0f;                // the ankles (foot joints, mean of both) above the floor
 };
 
 /// Builds one rig's retarget pose (check_humanoid must pass first). Errors name the rig.
@@ -104,18 +104,19 @@ struct RetargetMap {
   struct Step {
     int16_t joint = -1;
     RetargetStep kind = RetargetStep::Keep;
-    int16_t source_a = -1, source_b = -1;    // Rotate/Blend/Hips/Anchored: source joints; Copy: source_a
-    float weight = 0.0f;                     // Blend: slerp(delta_a, delta_b, weight)
-    glm::quat rest{1.0f, 0.0f, 0.0f, 0.0f};  // inverse(R) * target retarget-pose model rotation; Copy: target rest local
+    int16_t source_a = -1, source_b = -1;  // Rotate/Blend/Hips/Anchored: source joints; Copy: source_a
+    float weight = 0.0f;                   // Blend: slerp(delta_a, delta_b, weight)
+    glm::quat rest{1.0f, 0.0f, 0.0f,
+                   0.0f};  // inverse(R) * target retarget-pose model rotation; Copy: target rest local
     glm::quat source_rest_local_inverse{1.0f, 0.0f, 0.0f, 0.0f};  // Copy
     /// Rotate/Hips/Anchored: the source joint has this joint's name under a parent of the same name
     /// (the same rig, or one of its family): its own translation and scale away from its bind
     /// ride along too, so a rig retargeted onto itself is reproduced exactly. Across rigs only
     /// rotations are carried (a clip's translation keys may disagree with its skin's bind).
     bool same_joint = false;
-    int16_t anchor = -1;                     // Anchored: the target joint it hangs from
-    glm::vec3 offset{0.0f};                  // Anchored: its position in the anchor's frame; Hips: its
-                                             // position from the pelvis, in its retarget-pose frame
+    int16_t anchor = -1;     // Anchored: the target joint it hangs from
+    glm::vec3 offset{0.0f};  // Anchored: its position in the anchor's frame; Hips: its
+                             // position from the pelvis, in its retarget-pose frame
   };
   struct Leg {
     int16_t upper = -1, lower = -1, foot = -1;  // target joints
@@ -135,7 +136,8 @@ struct RetargetMap {
   std::vector<Step> steps;                     // every target joint once, parents (and anchors) first
   std::array<Leg, 2> legs;                     // left, right
   glm::vec3 source_hips_offset{0.0f};          // source hips minus pelvis in its retarget pose
-  glm::quat target_hips_rest_inverse{1.0f, 0.0f, 0.0f, 0.0f};  // the target hips' retarget-pose model rotation, inverted
+  glm::quat target_hips_rest_inverse{1.0f, 0.0f, 0.0f,
+                                     0.0f};    // the target hips' retarget-pose model rotation, inverted
   glm::vec3 target_forward{0.0f, 0.0f, 1.0f};  // the target's forward, model space (a straight knee bends along it)
 
   /// A source model-space point carried to the target: origin_t + scale * R (p - origin_s), the
@@ -164,8 +166,12 @@ struct RetargetScratch {
   uint8_t adjusted = 0;
 };
 enum RetargetAdjusted : uint8_t {
-  kAdjustedLeftArm = 1, kAdjustedRightArm = 2, kAdjustedLeftLeg = 4, kAdjustedRightLeg = 8,  // mid-plane guard
-  kHeldLeftFoot = 16, kHeldRightFoot = 32,                                                    // contacts
+  kAdjustedLeftArm = 1,
+  kAdjustedRightArm = 2,
+  kAdjustedLeftLeg = 4,
+  kAdjustedRightLeg = 8,  // mid-plane guard
+  kHeldLeftFoot = 16,
+  kHeldRightFoot = 32,  // contacts
 };
 RetargetScratch make_retarget_scratch(const RetargetMap& map);
 
@@ -187,9 +193,9 @@ struct FootContact {
 };
 
 struct RetargetInput {
-  ConstPoseSpan source;                      // the source rig's local pose
-  ConstPoseSpan target_base;                 // optional: Keep joints' values (empty: the target's bind pose)
-  std::span<const FootContact> contacts;     // empty, or {left, right}
+  ConstPoseSpan source;                   // the source rig's local pose
+  ConstPoseSpan target_base;              // optional: Keep joints' values (empty: the target's bind pose)
+  std::span<const FootContact> contacts;  // empty, or {left, right}
   /// How high the source clip's floor stands above its rest pose's, source units (clip_floor):
   /// the clip's floor is put on the target's. 0 for a clip made on its rig's floor.
   float source_floor = 0.0f;
@@ -207,6 +213,5 @@ bool pose_source(const RetargetMap& map, ConstPoseSpan source, RetargetScratch& 
 /// posed the source: map_point(source ankle + contact.offset). Target model space.
 glm::vec3 held_ankle(const RetargetMap& map, const RetargetScratch& scratch, int foot, const FootContact& contact,
                      float source_floor = 0.0f);
-
 
 }  // namespace ossa

@@ -22,12 +22,26 @@
 namespace ossa {
 
 enum RetargetLimb : uint8_t {
-  kLeftUpperArm, kLeftLowerArm, kLeftUpperLeg, kLeftLowerLeg,
-  kRightUpperArm, kRightLowerArm, kRightUpperLeg, kRightLowerLeg, kRetargetLimbCount
+  kLeftUpperArm,
+  kLeftLowerArm,
+  kLeftUpperLeg,
+  kLeftLowerLeg,
+  kRightUpperArm,
+  kRightLowerArm,
+  kRightUpperLeg,
+  kRightLowerLeg,
+  kRetargetLimbCount
 };
 enum RetargetSidePoint : uint8_t {
-  kLeftHandPoint, kRightHandPoint, kLeftElbowPoint, kRightElbowPoint,
-  kLeftFootPoint, kRightFootPoint, kLeftKneePoint, kRightKneePoint, kRetargetSidePointCount
+  kLeftHandPoint,
+  kRightHandPoint,
+  kLeftElbowPoint,
+  kRightElbowPoint,
+  kLeftFootPoint,
+  kRightFootPoint,
+  kLeftKneePoint,
+  kRightKneePoint,
+  kRetargetSidePointCount
 };
 
 struct RetargetMeasure {

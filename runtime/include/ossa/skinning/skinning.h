@@ -56,8 +56,8 @@ struct SkinnedStreams {
 
 /// Skins every vertex of `mesh` with `palette` (from skinning_matrices), decoding the quantized
 /// or float layout. Normals and tangents are transformed by the blended matrix's linear part and
-/// renormalized (unless out.renormalize is false); since the palette holds D, directions are first divided by position_scale, so
-/// they see model * inverse_bind only (a GPU shader must do the same). Tangent w is the stored
+/// renormalized (unless out.renormalize is false); since the palette holds D, directions are first divided by
+/// position_scale, so they see model * inverse_bind only (a GPU shader must do the same). Tangent w is the stored
 /// bitangent sign (+-1). All-zero weights give zero outputs. Sizes are preconditions (asserted;
 /// a release build skips a stream that does not fit, or everything for a too-small palette).
 /// Allocation-free. O(vertices * influences).
