@@ -38,9 +38,11 @@ layout(location = 4) in vec4 a_weights;
 uniform samplerBuffer u_palette;
 uniform mat4 u_view_projection;
 out vec3 v_normal; out vec3 v_position; out vec2 v_uv;
-mat4 palette(uint s) { int t = 4 * int(s); return mat4(texelFetch(u_palette, t), texelFetch(u_palette, t + 1), texelFetch(u_palette, t + 2), texelFetch(u_palette, t + 3)); }
+mat4 palette(uint s) { int t = 4 * int(s); return mat4(texelFetch(u_palette, t), texelFetch(u_palette, t + 1),
+  texelFetch(u_palette, t + 2), texelFetch(u_palette, t + 3)); }
 void main() {
-  mat4 m = a_weights.x * palette(a_joints.x) + a_weights.y * palette(a_joints.y) + a_weights.z * palette(a_joints.z) + a_weights.w * palette(a_joints.w);
+  mat4 m = a_weights.x * palette(a_joints.x) + a_weights.y * palette(a_joints.y) + a_weights.z * palette(a_joints.z)
+      + a_weights.w * palette(a_joints.w);
   vec4 p = m * vec4(a_position, 1.0);
   v_position = p.xyz; v_normal = mat3(m) * a_normal; v_uv = a_uv;
   gl_Position = u_view_projection * p;

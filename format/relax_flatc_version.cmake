@@ -8,12 +8,14 @@
 # upgrade cannot silently change what is installed.
 cmake_minimum_required(VERSION 3.25)
 file(READ "${INPUT}" text)
-set(pattern "static_assert\\(FLATBUFFERS_VERSION_MAJOR == [0-9]+ &&[ \t\r\n]+FLATBUFFERS_VERSION_MINOR == [0-9]+ &&[ \t\r\n]+FLATBUFFERS_VERSION_REVISION == [0-9]+,[ \t\r\n]+\"Non-compatible flatbuffers version included\"\\);")
+string(CONCAT pattern "static_assert\\(FLATBUFFERS_VERSION_MAJOR == [0-9]+ &&[ \t\r\n]+"
+       "FLATBUFFERS_VERSION_MINOR == [0-9]+ &&[ \t\r\n]+FLATBUFFERS_VERSION_REVISION == [0-9]+,[ \t\r\n]+"
+       "\"Non-compatible flatbuffers version included\"\\);")
 string(REGEX MATCH "${pattern}" found "${text}")
 if(found)
-  string(REGEX REPLACE "${pattern}"
-         "static_assert(FLATBUFFERS_VERSION_MAJOR >= 2,\n              \"ossa's schema needs FlatBuffers 2.0 or newer\");"
-         text "${text}")
+  string(CONCAT relaxed "static_assert(FLATBUFFERS_VERSION_MAJOR >= 2,\n"
+         "              \"ossa's schema needs FlatBuffers 2.0 or newer\");")
+  string(REGEX REPLACE "${pattern}" "${relaxed}" text "${text}")
 elseif(NOT text MATCHES "FLATBUFFERS_VERSION_MAJOR >= 2")
   string(FIND "${text}" "FLATBUFFERS_VERSION_REVISION" pinned)
   if(NOT pinned EQUAL -1)

@@ -10,16 +10,22 @@ but itself and format/, and nothing includes the cooker but the cooker, its comm
 and benches. docs/ARCHITECTURE.md explains the table; change both together.
 
 File lengths: files over --max-lines (650) in those folders are listed. They fail the check only
-with --enforce-lines (which CTest passes); lines over 120 columns are
-counted the same way and fail only with --enforce-columns.
+with --enforce-lines; lines over 120 columns (in those folders and in every C++, GLSL and schema
+file of tests/, bench/, examples/ and shaders/) fail only with --enforce-columns. CTest passes both.
+
+Formatting: with --clang-format PROGRAM every C++ file in those folders is checked against
+.clang-format (CTest's format_check passes Debian 12's clang-format 14, the version the tree is
+formatted with; another version may wrap differently, so the test is added only for 14).
 
 Usage: scripts/check-layout.py [--root DIR] [--enforce-lines] [--enforce-columns] [--graph]
+                               [--clang-format PROGRAM]
   --graph prints every arrow between parts (with how many includes make it) and exits 0.
 Exit status: 0 clean, 1 a forbidden arrow (or an enforced length), 2 usage error.
 """
 import argparse
 import os
 import re
+import subprocess
 import sys
 from collections import defaultdict
 
@@ -78,7 +84,11 @@ PUBLIC_ONLY = {"runtime/internal"}
 
 CHECKED_TOPS = ("format", "common", "runtime", "cooker", "viewer", "tools")
 LENGTH_TOPS = ("format", "common", "runtime", "cooker", "viewer", "tools")
+# Line width (120 columns, what .clang-format holds) is checked in every C++, GLSL and schema file,
+# tests, benches and examples included, and in the parts' CMake files.
+WIDTH_TOPS = LENGTH_TOPS + ("tests", "bench", "examples", "shaders")
 SOURCE_EXT = (".h", ".hpp", ".cpp", ".cc", ".inl")
+CODE_EXT = SOURCE_EXT + (".glsl", ".vert", ".frag", ".fbs")
 INCLUDE_RE = re.compile(r'^\s*#\s*include\s*([<"])([^">]+)[">]')
 
 
@@ -139,6 +149,8 @@ def main():
     ap.add_argument("--enforce-lines", action="store_true")
     ap.add_argument("--enforce-columns", action="store_true")
     ap.add_argument("--graph", action="store_true")
+    ap.add_argument("--clang-format", metavar="PROGRAM",
+                    help="also run PROGRAM --dry-run --Werror over every C++ file (format_check)")
     args = ap.parse_args()
     root = os.path.abspath(args.root)
     allowed, runtime_all = allowed_table()
@@ -190,24 +202,39 @@ def main():
     print(f"include graph: {len(arrows)} arrows between parts, {bad} forbidden, {len(unresolved)} unresolved")
 
     long_files, wide = [], defaultdict(int)
-    for rel in walk(root, LENGTH_TOPS):
-        if not rel.endswith(SOURCE_EXT + (".txt", ".glsl", ".fbs", ".cmake")):
+    for rel in walk(root, WIDTH_TOPS):
+        in_part = rel.split("/")[0] in LENGTH_TOPS
+        if not (rel.endswith(CODE_EXT) or (in_part and rel.endswith((".txt", ".cmake")))):
             continue
         with open(os.path.join(root, rel), encoding="utf-8", errors="replace") as fh:
             lines = fh.read().split("\n")
         count = len(lines) - (1 if lines and lines[-1] == "" else 0)
-        if count > args.max_lines:
+        if in_part and count > args.max_lines:
             long_files.append((count, rel))
-        for line in lines:
+        for n, line in enumerate(lines, 1):
             if len(line) > 120:
                 wide[rel] += 1
+                if args.enforce_columns:
+                    print(f"over 120 columns: {rel}:{n} ({len(line)})")
     for count, rel in sorted(long_files, reverse=True):
         print(f"{'over' if args.enforce_lines else 'note: over'} {args.max_lines} lines: {rel} ({count})")
     print(f"file length: {len(long_files)} file(s) over {args.max_lines} lines"
           f"{'' if args.enforce_lines else ' (reported; --enforce-lines fails on them)'}")
     print(f"line length: {sum(wide.values())} line(s) over 120 columns in {len(wide)} file(s)"
           f"{'' if args.enforce_columns else ' (reported; --enforce-columns fails on them)'}")
-    failed = bad or unresolved or (args.enforce_lines and long_files) or (args.enforce_columns and wide)
+    unformatted = 0
+    if args.clang_format:
+        cxx = [os.path.join(root, r) for r in walk(root, WIDTH_TOPS) if r.endswith(SOURCE_EXT)]
+        for i in range(0, len(cxx), 64):
+            run = subprocess.run([args.clang_format, "--dry-run", "--Werror", "--style=file"] + cxx[i:i + 64],
+                                 capture_output=True, text=True)
+            if run.returncode != 0:
+                unformatted += 1
+                print(run.stderr[:4000], end="")
+        print(f"clang-format: {len(cxx)} file(s), {'all formatted' if not unformatted else 'some NOT formatted'}"
+              f" ({args.clang_format} -i FILE formats one)")
+    failed = (bad or unresolved or (args.enforce_lines and long_files) or (args.enforce_columns and wide)
+              or unformatted)
     return 1 if failed else 0
 
 

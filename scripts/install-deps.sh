@@ -9,13 +9,14 @@ PACKAGES=(
   libopenmesh-dev libmeshoptimizer-dev libcli11-dev nlohmann-json3-dev libxxhash-dev
   libgtest-dev libgmock-dev libbenchmark-dev libimgui-dev libepoxy-dev
   xvfb xauth libgl1-mesa-dri libglx-mesa0 mesa-utils
-  clang libclang-rt-14-dev
+  clang libclang-rt-14-dev clang-format
   python3 python3-jsonschema
   libcurl4-openssl-dev nginx-light
   g++-mingw-w64-x86-64-posix wine64
 )
 # libcurl4-openssl-dev: ossa-cook --cache over HTTP (optional: without it only folders); nginx-light:
 # its tests serve a cache over WebDAV on loopback (they skip, saying so, without nginx).
+# clang-format (14 on Debian 12): CTest's format_check holds every C++ file to .clang-format.
 # ccache: scripts/test.sh compiles its five builds through it, so they share what they compile alike.
 # g++-mingw-w64-x86-64-posix + wine64: the Windows stage of scripts/test.sh cross-builds the runtime
 # and its suites with MinGW-w64 (cmake/toolchains/mingw-w64-x86_64.cmake) and runs them under Wine;

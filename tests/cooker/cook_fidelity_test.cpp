@@ -390,9 +390,11 @@ const char* kBentArmDae = R"(<?xml version="1.0" encoding="utf-8"?>
     <geometry id="arm-mesh" name="arm">
       <mesh>
         <source id="arm-pos">
-          <float_array id="arm-pos-array" count="18">-0.1 0 0  0.1 0 0  0.1 1 0  -0.1 1 0  0.1 2 0  -0.1 2 0</float_array>
+          <float_array id="arm-pos-array" count="18">-0.1 0 0  0.1 0 0  0.1 1 0  -0.1 1 0  0.1 2 0  -0.1 2
+            0</float_array>
           <technique_common><accessor source="#arm-pos-array" count="6" stride="3">
-            <param name="X" type="float"/><param name="Y" type="float"/><param name="Z" type="float"/></accessor></technique_common>
+            <param name="X" type="float"/><param name="Y" type="float"/><param name="Z" type="float"/></accessor>
+              </technique_common>
         </source>
         <vertices id="arm-verts"><input semantic="POSITION" source="#arm-pos"/></vertices>
         <triangles count="4">
@@ -407,14 +409,21 @@ const char* kBentArmDae = R"(<?xml version="1.0" encoding="utf-8"?>
       <skin source="#arm-mesh">
         <bind_shape_matrix>1 0 0 0 0 1 0 0 0 0 1 0 0 0 0 1</bind_shape_matrix>
         <source id="arm-joints"><Name_array id="arm-joints-array" count="2">Upper Lower</Name_array>
-          <technique_common><accessor source="#arm-joints-array" count="2" stride="1"><param name="JOINT" type="name"/></accessor></technique_common></source>
-        <source id="arm-ibm"><float_array id="arm-ibm-array" count="32">1 0 0 0 0 1 0 0 0 0 1 0 0 0 0 1  1 0 0 0 0 1 0 -1 0 0 1 0 0 0 0 1</float_array>
-          <technique_common><accessor source="#arm-ibm-array" count="2" stride="16"><param name="TRANSFORM" type="float4x4"/></accessor></technique_common></source>
+          <technique_common><accessor source="#arm-joints-array" count="2" stride="1">
+            <param name="JOINT" type="name"/></accessor></technique_common></source>
+        <source id="arm-ibm">
+          <float_array id="arm-ibm-array" count="32">1 0 0 0 0 1 0 0 0 0 1 0 0 0 0 1  1 0 0 0 0 1 0 -1 0 0 1 0 0 0 0
+            1</float_array>
+          <technique_common><accessor source="#arm-ibm-array" count="2" stride="16">
+            <param name="TRANSFORM" type="float4x4"/></accessor></technique_common></source>
         <source id="arm-weights"><float_array id="arm-weights-array" count="2">1 1</float_array>
-          <technique_common><accessor source="#arm-weights-array" count="2" stride="1"><param name="WEIGHT" type="float"/></accessor></technique_common></source>
-        <joints><input semantic="JOINT" source="#arm-joints"/><input semantic="INV_BIND_MATRIX" source="#arm-ibm"/></joints>
+          <technique_common><accessor source="#arm-weights-array" count="2" stride="1">
+            <param name="WEIGHT" type="float"/></accessor></technique_common></source>
+        <joints><input semantic="JOINT" source="#arm-joints"/><input semantic="INV_BIND_MATRIX" source="#arm-ibm"/>
+          </joints>
         <vertex_weights count="6">
-          <input semantic="JOINT" source="#arm-joints" offset="0"/><input semantic="WEIGHT" source="#arm-weights" offset="1"/>
+          <input semantic="JOINT" source="#arm-joints" offset="0"/>
+            <input semantic="WEIGHT" source="#arm-weights" offset="1"/>
           <vcount>1 1 1 1 1 1</vcount>
           <v>0 0 0 0 1 1 1 1 1 1 1 1</v>
         </vertex_weights>

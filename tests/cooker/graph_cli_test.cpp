@@ -297,7 +297,8 @@ TEST(GraphCli, WhatTheLoaderWouldRefuseIsRefusedWithAPosition) {
            root + "\n}\n";
   };
   const auto machine = [](const std::string& transition) {
-    return R"({"state_machine": {"name": "m", "entry": "a", "states": {"a": {"node": {"clip": "walk"}}, "b": {"node": {"clip": "run"}}},
+    return R"({"state_machine": {"name": "m", "entry": "a", "states": {"a": {"node": {"clip": "walk"}},
+      "b": {"node": {"clip": "run"}}},
       "transitions": [{"from": "a", "to": "b"}, )" +
            transition + "]}}";
   };

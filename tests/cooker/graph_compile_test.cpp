@@ -137,12 +137,14 @@ TEST_F(GraphCompile, FullGraphIsPostOrderWithResolvedIndices) {
     "layered": {"state_machine": {"name": "loco", "entry": "move",
       "states": {
         "move": {"node": {"blend_space": "speed", "samples": [{"clip": "run", "x": 4}, {"clip": "walk", "x": 1}]}},
-        "turn": {"node": {"select": "gait", "children": {"idle": {"clip": "wave"}, "walk": {"clip": "walk"}, "run": {"use": "fast"}},
+        "turn": {"node": {"select": "gait", "children": {"idle": {"clip": "wave"}, "walk": {"clip": "walk"},
+          "run": {"use": "fast"}},
                           "blend_time": 0.2},
                  "restart": false}
       },
       "transitions": [
-        {"from": "move", "to": "turn", "when": "speed > 4 && !crossed", "priority": 2, "duration": 0.3, "mode": "sync_crossfade"},
+        {"from": "move", "to": "turn", "when": "speed > 4 && !crossed", "priority": 2, "duration": 0.3,
+          "mode": "sync_crossfade"},
         {"from": "any", "to": "move", "when": "stop", "mode": "inertialize", "duration": 0.2},
         {"from": "turn", "to": "move", "exit_time": 0.8, "priority": 2}
       ]}},
@@ -283,7 +285,8 @@ TEST_F(GraphCompile, MachinesAreNumberedInTheOrderMet) {
 TEST_F(GraphCompile, SelectFormsAdditiveAnd2DBlendSpace) {
   const std::string root = R"({"additive": {"select": "crossed", "children": [{"clip": "walk"}, {"clip": "run"}]},
     "add": {"select": "stance", "children": [{"clip": "wave"}, {"blend_space": "speed", "y": "lean", "samples": [
-      {"clip": "walk", "x": 0, "y": 0}, {"clip": "run", "x": 1, "y": 0}, {"clip": "wave", "x": 0, "y": 1}], "rate": 2, "loop": false}]},
+      {"clip": "walk", "x": 0, "y": 0}, {"clip": "run", "x": 1, "y": 0}, {"clip": "wave", "x": 0, "y": 1}], "rate": 2,
+        "loop": false}]},
     "weight": 0.75, "weight_parameter": "crossed"})";
   const GraphDef g = ok(graph(root)).graph;
   ASSERT_EQ(g.nodes.size(), 7u);
@@ -563,7 +566,8 @@ TEST_F(GraphCompile, DuplicateNamesAreRefused) {
       graph(R"({"clip": "walk"})", "{}", R"({"speed": {"type": "float"}, "speed": {"type": "bool"}})");
   EXPECT_HAS(errors(a), at(a, "\"speed\"", 1) + "duplicate key \"speed\"");
   const std::string b = graph(
-      R"({"state_machine": {"name": "m", "entry": "a", "states": {"a": {"node": {"clip": "walk"}}, "a": {"node": {"clip": "run"}}}}})");
+      R"({"state_machine": {"name": "m", "entry": "a", "states": {"a": {"node": {"clip": "walk"}},
+        "a": {"node": {"clip": "run"}}}}})");
   EXPECT_HAS(errors(b), at(b, "\"a\": {\"node\"", 1) + "duplicate key \"a\"");
   const std::string c = graph(R"({"use": "x"})", R"({"x": {"clip": "walk"}, "x": {"clip": "run"}})");
   EXPECT_HAS(errors(c), at(c, "\"x\": {\"clip\": \"run\"") + "duplicate key \"x\"");
@@ -617,7 +621,8 @@ TEST_F(GraphCompile, StateMachineStructure) {
   EXPECT_HAS(dm, at(d, "\"runing\"") + "\"to\" 'runing' is not a state of state machine 'm'; states: 'a'");
   EXPECT_HAS(dm, at(d, "\"z\"") + "\"from\" 'z' is not a state of state machine 'm'");
   const std::string e = graph(
-      R"({"state_machine": {"name": "m", "entry": "a", "states": {"a": {"node": {"clip": "walk"}}, "any": {"node": {"clip": "run"}}}}})");
+      R"({"state_machine": {"name": "m", "entry": "a", "states": {"a": {"node": {"clip": "walk"}},
+        "any": {"node": {"clip": "run"}}}}})");
   EXPECT_HAS(errors(e), at(e, "\"any\"") + "'any' is reserved");
   const std::string f = graph(R"({"state_machine": {"name": "m", "entry": "a", "states": {"a": {"clip": "walk"}}}})");
   EXPECT_HAS(errors(f),
@@ -630,7 +635,8 @@ TEST_F(GraphCompile, StateMachineStructure) {
 
 TEST_F(GraphCompile, TimesAndDurationsMustNotBeNegative) {
   const std::string sm =
-      R"({"state_machine": {"name": "m", "entry": "a", "states": {"a": {"node": {"clip": "walk"}}, "b": {"node": {"clip": "run"}}},
+      R"({"state_machine": {"name": "m", "entry": "a", "states": {"a": {"node": {"clip": "walk"}},
+        "b": {"node": {"clip": "run"}}},
     "transitions": [{"from": "a", "to": "b", "duration": -0.5, "exit_time": -1, "mode": "blend"}]}})";
   const std::string a = graph(sm);
   const std::string am = errors(a);
@@ -760,7 +766,8 @@ TEST_F(GraphCompile, BlendSpaceSamples) {
       {"clip": "run", "x": 1, "y": 1}, {"clip": "wave", "x": 0, "y": 0}]})");
   EXPECT_HAS(errors(c), at(c, "{\"clip\": \"wave\"") + "samples 'walk' and 'wave' are at the same point (0, 0)");
   const std::string d = graph(
-      R"({"blend_space": "speed", "y": "lean", "samples": [{"clip": "walk", "x": 0, "y": 0}, {"clip": "run", "x": 1}]})");
+      R"({"blend_space": "speed", "y": "lean", "samples": [{"clip": "walk", "x": 0, "y": 0}, {"clip": "run",
+        "x": 1}]})");
   const std::string dm = errors(d);
   EXPECT_HAS(dm, at(d, "{\"clip\": \"run\"") + "a sample of a 2D blend space needs \"y\"");
   const std::string e =
@@ -772,12 +779,14 @@ TEST_F(GraphCompile, BlendSpaceSamples) {
 
 TEST_F(GraphCompile, ConditionErrorsPointInsideTheString) {
   const std::string text = graph(
-      R"({"state_machine": {"name": "m", "entry": "a", "states": {"a": {"node": {"clip": "walk"}}, "b": {"node": {"clip": "run"}}},
+      R"({"state_machine": {"name": "m", "entry": "a", "states": {"a": {"node": {"clip": "walk"}},
+        "b": {"node": {"clip": "run"}}},
     "transitions": [{"from": "a", "to": "b", "when": "speed > 4 && !crosed"}]}})");
   // The column of 'c' of "crosed" inside the string.
   EXPECT_HAS(errors(text), at(text, "crosed") + "unknown parameter 'crosed'");
   const std::string t2 = graph(
-      R"({"state_machine": {"name": "m", "entry": "a", "states": {"a": {"node": {"clip": "walk"}}, "b": {"node": {"clip": "run"}}},
+      R"({"state_machine": {"name": "m", "entry": "a", "states": {"a": {"node": {"clip": "walk"}},
+        "b": {"node": {"clip": "run"}}},
     "transitions": [{"from": "a", "to": "b", "when": "stop == true"}]}})");
   EXPECT_HAS(errors(t2), at(t2, "stop == true") + "'stop' is a trigger: it cannot be compared");
 }
@@ -822,10 +831,12 @@ TEST_F(GraphCompile, UnusedNamedNodesAreStillChecked) {
 TEST_F(GraphCompile, MutatedGraphsFailCleanly) {
   const std::string base = graph(R"G({"layered": {"state_machine": {"name": "m", "entry": "a", "states": {
       "a": {"node": {"blend_space": "speed", "samples": [{"clip": "walk", "x": 1}, {"clip": "run", "x": 4}]}},
-      "b": {"node": {"select": "gait", "children": {"walk": {"use": "w"}, "run": {"clip": "run"}, "idle": {"clip": "wave"}}}}},
+      "b": {"node": {"select": "gait", "children": {"walk": {"use": "w"}, "run": {"clip": "run"},
+        "idle": {"clip": "wave"}}}}},
     "transitions": [{"from": "a", "to": "b", "when": "speed > 4 && !(crossed || stop)", "exit_time": 0.5},
                     {"from": "any", "to": "a", "when": "gait == walk", "mode": "inertialize", "priority": -1}]}},
-    "layers": [{"node": {"additive": {"use": "w"}, "add": {"clip": "wave"}}, "mask": [{"joint": "Spine", "depth": 1}]}]})G",
+    "layers": [{"node": {"additive": {"use": "w"}, "add": {"clip": "wave"}}, "mask": [{"joint": "Spine",
+      "depth": 1}]}]})G",
                                  R"({"w": {"blend": [{"clip": "walk"}, {"clip": "run"}], "alpha": "lean"}})");
   ok(base);
   const auto all_lines_positioned = [](const std::string& message) {

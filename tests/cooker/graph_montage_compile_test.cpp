@@ -169,15 +169,18 @@ TEST_F(MontageCompile, TrackMistakesPointAtTheTrack) {
             kSlot);
   EXPECT_HAS(errors(t), at(t, "\"wav\"") + "unknown clip 'wav' (did you mean 'wave'?)");
   t = graph(
-      R"({"m": {"group": "gestures", "tracks": {"arms": [{"clip": "wave", "end": 2.5}]}, "sections": {"all": {"time": 0}}}})",
+      R"({"m": {"group": "gestures", "tracks": {"arms": [{"clip": "wave", "end": 2.5}]},
+        "sections": {"all": {"time": 0}}}})",
       kSlot);
   EXPECT_HAS(errors(t), at(t, "2.5") + "a segment's \"end\" (clip seconds) must be within [0, 2], not 2.5");
   t = graph(
-      R"({"m": {"group": "gestures", "tracks": {"arms": [{"clip": "wave", "start": 1, "end": 1}]}, "sections": {"all": {"time": 0}}}})",
+      R"({"m": {"group": "gestures", "tracks": {"arms": [{"clip": "wave", "start": 1, "end": 1}]},
+        "sections": {"all": {"time": 0}}}})",
       kSlot);
   EXPECT_HAS(errors(t), at(t, "1}]") + "a segment's \"end\" (1 s) must be after its \"start\" (1 s)");
   t = graph(
-      R"({"m": {"group": "gestures", "tracks": {"arms": [{"clip": "wave", "rate": 0}]}, "sections": {"all": {"time": 0}}}})",
+      R"({"m": {"group": "gestures", "tracks": {"arms": [{"clip": "wave", "rate": 0}]},
+        "sections": {"all": {"time": 0}}}})",
       kSlot);
   EXPECT_HAS(errors(t), at(t, "0}]") + "a segment's \"rate\" must be within [0.001, 1000], not 0");
   t = graph(R"({"m": {"group": "gestures", "tracks": {"arms": []}, "sections": {"all": {"time": 0}}}})", kSlot);

@@ -156,7 +156,8 @@ const char* kSample = R"({
   "ossa_graph": 1,
   "name": "pab \u00e9\n é",
   "clips": {"walk": "walk.fbx", "run": {"source": "run.fbx", "events": [{"name": "foot", "time": 0.25}]}},
-  "parameters": {"speed": {"type": "float", "default": -1.5e-1, "min": 0, "max": 6}, "b": {"type": "bool", "default": true}},
+  "parameters": {"speed": {"type": "float", "default": -1.5e-1, "min": 0, "max": 6}, "b": {"type": "bool",
+    "default": true}},
   "root": {"blend": [{"clip": "walk"}, {"clip": "run"}], "alpha": "speed", "x": [null, [], {}, 0.5e2]}
 })";
 

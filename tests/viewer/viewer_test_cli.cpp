@@ -162,7 +162,8 @@ TEST_F(Viewer, APropLargerThanItsSkeletonIsFramedWhole) {
         <source id="plank-pos">
           <float_array id="plank-pos-array" count="12">-2 0.95 0  2 0.95 0  2 1.45 0  -2 1.45 0</float_array>
           <technique_common><accessor source="#plank-pos-array" count="4" stride="3">
-            <param name="X" type="float"/><param name="Y" type="float"/><param name="Z" type="float"/></accessor></technique_common>
+            <param name="X" type="float"/><param name="Y" type="float"/><param name="Z" type="float"/></accessor>
+              </technique_common>
         </source>
         <vertices id="plank-verts"><input semantic="POSITION" source="#plank-pos"/></vertices>
         <triangles count="2"><input semantic="VERTEX" source="#plank-verts" offset="0"/><p>0 1 2 0 2 3</p></triangles>
@@ -174,14 +175,21 @@ TEST_F(Viewer, APropLargerThanItsSkeletonIsFramedWhole) {
       <skin source="#plank-mesh">
         <bind_shape_matrix>1 0 0 0 0 1 0 0 0 0 1 0 0 0 0 1</bind_shape_matrix>
         <source id="plank-joints"><Name_array id="plank-joints-array" count="2">Hips Hand</Name_array>
-          <technique_common><accessor source="#plank-joints-array" count="2" stride="1"><param name="JOINT" type="name"/></accessor></technique_common></source>
-        <source id="plank-ibm"><float_array id="plank-ibm-array" count="32">1 0 0 0 0 1 0 -1 0 0 1 0 0 0 0 1  1 0 0 0 0 1 0 -1.2 0 0 1 0 0 0 0 1</float_array>
-          <technique_common><accessor source="#plank-ibm-array" count="2" stride="16"><param name="TRANSFORM" type="float4x4"/></accessor></technique_common></source>
+          <technique_common><accessor source="#plank-joints-array" count="2" stride="1">
+            <param name="JOINT" type="name"/></accessor></technique_common></source>
+        <source id="plank-ibm">
+          <float_array id="plank-ibm-array" count="32">1 0 0 0 0 1 0 -1 0 0 1 0 0 0 0 1  1 0 0 0 0 1 0 -1.2 0 0 1 0 0
+            0 0 1</float_array>
+          <technique_common><accessor source="#plank-ibm-array" count="2" stride="16">
+            <param name="TRANSFORM" type="float4x4"/></accessor></technique_common></source>
         <source id="plank-weights"><float_array id="plank-weights-array" count="1">1</float_array>
-          <technique_common><accessor source="#plank-weights-array" count="1" stride="1"><param name="WEIGHT" type="float"/></accessor></technique_common></source>
-        <joints><input semantic="JOINT" source="#plank-joints"/><input semantic="INV_BIND_MATRIX" source="#plank-ibm"/></joints>
+          <technique_common><accessor source="#plank-weights-array" count="1" stride="1">
+            <param name="WEIGHT" type="float"/></accessor></technique_common></source>
+        <joints><input semantic="JOINT" source="#plank-joints"/>
+          <input semantic="INV_BIND_MATRIX" source="#plank-ibm"/></joints>
         <vertex_weights count="4">
-          <input semantic="JOINT" source="#plank-joints" offset="0"/><input semantic="WEIGHT" source="#plank-weights" offset="1"/>
+          <input semantic="JOINT" source="#plank-joints" offset="0"/>
+            <input semantic="WEIGHT" source="#plank-weights" offset="1"/>
           <vcount>1 1 1 1</vcount>
           <v>1 0 1 0 1 0 1 0</v>
         </vertex_weights>
