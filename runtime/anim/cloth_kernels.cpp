@@ -2,14 +2,17 @@
 // colliders eight at a time, in AVX2 intrinsics (x86-64 ELF builds with GCC or Clang, as the
 // per-joint loops' AVX2 copy).
 //
-// Eight particles are eight vec4 rows (xyz, inverse mass); they are loaded as 16-byte rows and
-// transposed in registers into x, y, z and w vectors (two rows per 256-bit register, then the
-// 4 x 4 transpose in each 128-bit half) rather than gathered (gathers are slow on Zen). An edge or
-// tether is 8 bytes, so eight of them are two 256-bit loads and one shuffle lines their lengths
-// up; the lanes then run in that shuffle's order (kLane). The arithmetic repeats cloth_solve.cpp's
-// scalar expressions operation for operation (no FMA, the same association), and lanes the scalar
-// loop would skip keep their old values through blends, so the results are the scalar loop's bits.
+// The particles are planes (ClothParticles: x[], y[], z[], w[]), so eight consecutive particles
+// are one plain load per coordinate. A constraint group's ends are read by its kind (WideKind:
+// two blocks of consecutive particles, or sixteen consecutive ones in pairs, one in-lane shuffle
+// per coordinate and end; the general kind gathers and stores lane by lane), and its rest lengths
+// and inverse masses are per lane, in the lanes' order, in the wide list. The arithmetic repeats
+// cloth_solve.cpp's scalar expressions operation for operation (no FMA, the same association),
+// and lanes the scalar loop would skip keep their old values through blends, so the results are
+// the scalar loop's bits.
 #include "anim/cloth_kernels.h"
+
+#include <cmath>
 
 #include "internal/cpu.h"
 #include "internal/vector_clones.h"
@@ -34,81 +37,20 @@ struct Rows8 {
   __m256 x, y, z, w;
 };
 
-OSSA_CLOTH_TARGET OSSA_CLOTH_INLINE Rows8 transpose_in(__m128 r0, __m128 r1, __m128 r2, __m128 r3, __m128 r4, __m128 r5,
-                                                       __m128 r6, __m128 r7) {
-  const __m256 t0 = _mm256_insertf128_ps(_mm256_castps128_ps256(r0), r4, 1);
-  const __m256 t1 = _mm256_insertf128_ps(_mm256_castps128_ps256(r1), r5, 1);
-  const __m256 t2 = _mm256_insertf128_ps(_mm256_castps128_ps256(r2), r6, 1);
-  const __m256 t3 = _mm256_insertf128_ps(_mm256_castps128_ps256(r3), r7, 1);
-  const __m256 u0 = _mm256_unpacklo_ps(t0, t1), u1 = _mm256_unpackhi_ps(t0, t1);
-  const __m256 u2 = _mm256_unpacklo_ps(t2, t3), u3 = _mm256_unpackhi_ps(t2, t3);
-  return {_mm256_shuffle_ps(u0, u2, _MM_SHUFFLE(1, 0, 1, 0)), _mm256_shuffle_ps(u0, u2, _MM_SHUFFLE(3, 2, 3, 2)),
-          _mm256_shuffle_ps(u1, u3, _MM_SHUFFLE(1, 0, 1, 0)), _mm256_shuffle_ps(u1, u3, _MM_SHUFFLE(3, 2, 3, 2))};
+/// Eight particles' planes from `first`: the current position and inverse mass, or (`before`)
+/// the previous position (w unused).
+OSSA_CLOTH_TARGET OSSA_CLOTH_INLINE Rows8 load8(const ClothParticles& p, size_t first, bool before = false) {
+  if (before)
+    return {_mm256_loadu_ps(p.px.data() + first), _mm256_loadu_ps(p.py.data() + first),
+            _mm256_loadu_ps(p.pz.data() + first), _mm256_setzero_ps()};
+  return {_mm256_loadu_ps(p.x.data() + first), _mm256_loadu_ps(p.y.data() + first), _mm256_loadu_ps(p.z.data() + first),
+          _mm256_loadu_ps(p.w.data() + first)};
 }
 
-OSSA_CLOTH_TARGET OSSA_CLOTH_INLINE float* row(glm::vec4* x, uint32_t i) { return &x[i].x; }
-
-/// The eight edges' lanes run in the order 0, 1, 4, 5, 2, 3, 6, 7: the order in which one shuffle
-/// of two 256-bit loads of the edges (8 bytes each: a, b, rest) lines their rest lengths up.
-constexpr int kLane[8] = {0, 1, 4, 5, 2, 3, 6, 7};
-
-/// Eight floats in edge order into kLane order, and back.
-OSSA_CLOTH_TARGET OSSA_CLOTH_INLINE __m256 lane_order(__m256 v) {
-  return _mm256_castpd_ps(_mm256_permute4x64_pd(_mm256_castps_pd(v), _MM_SHUFFLE(3, 1, 2, 0)));
-}
-
-template <bool kB>
-OSSA_CLOTH_TARGET OSSA_CLOTH_INLINE uint32_t end_of(const fb::ClothEdge* e, int lane) {
-  return kB ? e[kLane[lane]].b() : e[kLane[lane]].a();
-}
-template <bool kB>
-OSSA_CLOTH_TARGET OSSA_CLOTH_INLINE uint32_t end_of(const fb::ClothTether* t, int lane) {
-  return kB ? t[kLane[lane]].anchor() : t[kLane[lane]].particle();
-}
-
-template <bool kB, typename Pair>
-OSSA_CLOTH_TARGET OSSA_CLOTH_INLINE Rows8 load_ends(glm::vec4* x, const Pair* e) {
-  return transpose_in(_mm_loadu_ps(row(x, end_of<kB>(e, 0))), _mm_loadu_ps(row(x, end_of<kB>(e, 1))),
-                      _mm_loadu_ps(row(x, end_of<kB>(e, 2))), _mm_loadu_ps(row(x, end_of<kB>(e, 3))),
-                      _mm_loadu_ps(row(x, end_of<kB>(e, 4))), _mm_loadu_ps(row(x, end_of<kB>(e, 5))),
-                      _mm_loadu_ps(row(x, end_of<kB>(e, 6))), _mm_loadu_ps(row(x, end_of<kB>(e, 7))));
-}
-
-/// Eight rows back where they came from; the pairs of a run share no particle, so no store overlaps.
-OSSA_CLOTH_TARGET OSSA_CLOTH_INLINE void transpose_out(const Rows8& r, __m128* rows) {
-  const __m256 u0 = _mm256_unpacklo_ps(r.x, r.y), u1 = _mm256_unpackhi_ps(r.x, r.y);
-  const __m256 u2 = _mm256_unpacklo_ps(r.z, r.w), u3 = _mm256_unpackhi_ps(r.z, r.w);
-  const __m256 t0 = _mm256_shuffle_ps(u0, u2, _MM_SHUFFLE(1, 0, 1, 0));  // rows 0 | 4
-  const __m256 t1 = _mm256_shuffle_ps(u0, u2, _MM_SHUFFLE(3, 2, 3, 2));  // rows 1 | 5
-  const __m256 t2 = _mm256_shuffle_ps(u1, u3, _MM_SHUFFLE(1, 0, 1, 0));  // rows 2 | 6
-  const __m256 t3 = _mm256_shuffle_ps(u1, u3, _MM_SHUFFLE(3, 2, 3, 2));  // rows 3 | 7
-  rows[0] = _mm256_castps256_ps128(t0);
-  rows[1] = _mm256_castps256_ps128(t1);
-  rows[2] = _mm256_castps256_ps128(t2);
-  rows[3] = _mm256_castps256_ps128(t3);
-  rows[4] = _mm256_extractf128_ps(t0, 1);
-  rows[5] = _mm256_extractf128_ps(t1, 1);
-  rows[6] = _mm256_extractf128_ps(t2, 1);
-  rows[7] = _mm256_extractf128_ps(t3, 1);
-}
-
-OSSA_CLOTH_TARGET OSSA_CLOTH_INLINE Rows8 load_block(const glm::vec4* x) {
-  const float* p = &x->x;
-  return transpose_in(_mm_loadu_ps(p), _mm_loadu_ps(p + 4), _mm_loadu_ps(p + 8), _mm_loadu_ps(p + 12),
-                      _mm_loadu_ps(p + 16), _mm_loadu_ps(p + 20), _mm_loadu_ps(p + 24), _mm_loadu_ps(p + 28));
-}
-
-OSSA_CLOTH_TARGET OSSA_CLOTH_INLINE void store_block(glm::vec4* x, const Rows8& r) {
-  __m128 rows[8];
-  transpose_out(r, rows);
-  for (size_t l = 0; l < 8; ++l) _mm_storeu_ps(&x[l].x, rows[l]);
-}
-
-template <bool kB, typename Pair>
-OSSA_CLOTH_TARGET OSSA_CLOTH_INLINE void store_ends(glm::vec4* x, const Pair* e, const Rows8& r) {
-  __m128 rows[8];
-  transpose_out(r, rows);
-  for (int l = 0; l < 8; ++l) _mm_storeu_ps(row(x, end_of<kB>(e, l)), rows[l]);
+OSSA_CLOTH_TARGET OSSA_CLOTH_INLINE void store8(ClothParticles& p, size_t first, const Rows8& r, bool before = false) {
+  _mm256_storeu_ps((before ? p.px : p.x).data() + first, r.x);
+  _mm256_storeu_ps((before ? p.py : p.y).data() + first, r.y);
+  _mm256_storeu_ps((before ? p.pz : p.z).data() + first, r.z);
 }
 
 OSSA_CLOTH_TARGET OSSA_CLOTH_INLINE __m256 splat(float v) { return _mm256_set1_ps(v); }
@@ -117,65 +59,181 @@ OSSA_CLOTH_TARGET OSSA_CLOTH_INLINE __m256 dot3(__m256 x0, __m256 y0, __m256 z0,
   return _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(x0, x1), _mm256_mul_ps(y0, y1)), _mm256_mul_ps(z0, z1));
 }
 
-template <bool kLambda>
-OSSA_CLOTH_TARGET void edges8(glm::vec4* x, const fb::ClothEdge* e, size_t count, float alpha, float* lambda) {
-  const __m256 va = _mm256_set1_ps(alpha), zero = _mm256_setzero_ps(), tiny = _mm256_set1_ps(1e-24f),
-               sign = _mm256_set1_ps(-0.0f);
-  static_assert(sizeof(fb::ClothEdge) == 8, "an edge is a, b (16 bits each) and rest (32 bits)");
-  for (size_t k = 0; k < count; k += 8) {
-    const fb::ClothEdge* eight = e + k;
-    const __m256 lo = _mm256_loadu_ps(reinterpret_cast<const float*>(eight));
-    const __m256 hi = _mm256_loadu_ps(reinterpret_cast<const float*>(eight + 4));
-    const __m256 rest = _mm256_shuffle_ps(lo, hi, _MM_SHUFFLE(3, 1, 3, 1));  // lanes in kLane order
-    Rows8 a = load_ends<false>(x, eight), b = load_ends<true>(x, eight);
-    const __m256 wsum = _mm256_add_ps(a.w, b.w);
-    const __m256 dx = _mm256_sub_ps(b.x, a.x), dy = _mm256_sub_ps(b.y, a.y), dz = _mm256_sub_ps(b.z, a.z);
-    const __m256 len2 = dot3(dx, dy, dz, dx, dy, dz);
-    const __m256 ok = _mm256_and_ps(_mm256_cmp_ps(len2, tiny, _CMP_GT_OQ), _mm256_cmp_ps(wsum, zero, _CMP_NEQ_UQ));
-    if (_mm256_testz_ps(ok, ok)) continue;
-    const __m256 len = _mm256_sqrt_ps(len2);
-    const __m256 neg_violation = _mm256_xor_ps(_mm256_sub_ps(len, rest), sign);
-    __m256 s;
-    if constexpr (kLambda) {
-      // Pairs of multipliers into kLane order and back (the swap of the middle pairs undoes itself).
-      const __m256 lam = lane_order(_mm256_loadu_ps(lambda + k));
-      const __m256 dl = _mm256_div_ps(_mm256_sub_ps(neg_violation, _mm256_mul_ps(va, lam)), _mm256_add_ps(wsum, va));
-      _mm256_storeu_ps(lambda + k, lane_order(_mm256_blendv_ps(lam, _mm256_add_ps(lam, dl), ok)));
-      s = _mm256_div_ps(dl, len);
-    } else {
-      s = _mm256_div_ps(neg_violation, _mm256_mul_ps(_mm256_add_ps(wsum, va), len));
-    }
-    const __m256 cx = _mm256_mul_ps(dx, s), cy = _mm256_mul_ps(dy, s), cz = _mm256_mul_ps(dz, s);
-    a.x = _mm256_blendv_ps(a.x, _mm256_sub_ps(a.x, _mm256_mul_ps(a.w, cx)), ok);
-    a.y = _mm256_blendv_ps(a.y, _mm256_sub_ps(a.y, _mm256_mul_ps(a.w, cy)), ok);
-    a.z = _mm256_blendv_ps(a.z, _mm256_sub_ps(a.z, _mm256_mul_ps(a.w, cz)), ok);
-    b.x = _mm256_blendv_ps(b.x, _mm256_add_ps(b.x, _mm256_mul_ps(b.w, cx)), ok);
-    b.y = _mm256_blendv_ps(b.y, _mm256_add_ps(b.y, _mm256_mul_ps(b.w, cy)), ok);
-    b.z = _mm256_blendv_ps(b.z, _mm256_add_ps(b.z, _mm256_mul_ps(b.w, cz)), ok);
-    store_ends<false>(x, eight, a);
-    store_ends<true>(x, eight, b);
+/// One end's coordinate for a group's eight lanes from its plane p (kind: WideKind), and back.
+template <int kKind>
+OSSA_CLOTH_TARGET OSSA_CLOTH_INLINE void load_plane(const float* p, const uint32_t* ia, const uint32_t* ib, __m256& a,
+                                                    __m256& b) {
+  if constexpr (kKind == kBlocks) {
+    a = _mm256_loadu_ps(p + ia[0]);
+    b = _mm256_loadu_ps(p + ib[0]);
+  } else if constexpr (kKind == kGather) {
+    a = _mm256_i32gather_ps(p, _mm256_loadu_si256(reinterpret_cast<const __m256i*>(ia)), 4);
+    b = _mm256_i32gather_ps(p, _mm256_loadu_si256(reinterpret_cast<const __m256i*>(ib)), 4);
+  } else {
+    // Sixteen particles: a's lanes 0, 2, 8, 10, 4, 6, 12, 14 and b = a + 1 (kPairs1), or a's
+    // 0, 1, 8, 9, 4, 5, 12, 13 and b = a + 2 (kPairs2): one in-lane shuffle of the two halves each.
+    const __m256 lo = _mm256_loadu_ps(p + ia[0]), hi = _mm256_loadu_ps(p + ia[0] + 8);
+    a = kKind == kPairs1 ? _mm256_shuffle_ps(lo, hi, _MM_SHUFFLE(2, 0, 2, 0))
+                         : _mm256_shuffle_ps(lo, hi, _MM_SHUFFLE(1, 0, 1, 0));
+    b = kKind == kPairs1 ? _mm256_shuffle_ps(lo, hi, _MM_SHUFFLE(3, 1, 3, 1))
+                         : _mm256_shuffle_ps(lo, hi, _MM_SHUFFLE(3, 2, 3, 2));
   }
 }
 
-OSSA_CLOTH_TARGET void tethers8(glm::vec4* x, const fb::ClothTether* t, size_t count, float scale) {
-  static_assert(sizeof(fb::ClothTether) == 8, "a tether is particle, anchor (16 bits each) and length (32 bits)");
-  for (size_t k = 0; k < count; k += 8) {
-    const fb::ClothTether* eight = t + k;
-    const __m256 lo = _mm256_loadu_ps(reinterpret_cast<const float*>(eight));
-    const __m256 hi = _mm256_loadu_ps(reinterpret_cast<const float*>(eight + 4));
-    const __m256 limit = _mm256_mul_ps(_mm256_shuffle_ps(lo, hi, _MM_SHUFFLE(3, 1, 3, 1)), _mm256_set1_ps(scale));
-    Rows8 p = load_ends<false>(x, eight);
-    const Rows8 a = load_ends<true>(x, eight);
-    const __m256 dx = _mm256_sub_ps(p.x, a.x), dy = _mm256_sub_ps(p.y, a.y), dz = _mm256_sub_ps(p.z, a.z);
-    const __m256 len2 = dot3(dx, dy, dz, dx, dy, dz);
-    const __m256 over = _mm256_and_ps(_mm256_cmp_ps(p.w, _mm256_setzero_ps(), _CMP_NEQ_UQ),
-                                      _mm256_cmp_ps(len2, _mm256_mul_ps(limit, limit), _CMP_NLE_UQ));
-    if (_mm256_testz_ps(over, over)) continue;
-    const __m256 s = _mm256_div_ps(limit, _mm256_sqrt_ps(len2));
-    p.x = _mm256_blendv_ps(p.x, _mm256_add_ps(a.x, _mm256_mul_ps(dx, s)), over);
-    p.y = _mm256_blendv_ps(p.y, _mm256_add_ps(a.y, _mm256_mul_ps(dy, s)), over);
-    p.z = _mm256_blendv_ps(p.z, _mm256_add_ps(a.z, _mm256_mul_ps(dz, s)), over);
-    store_ends<false>(x, eight, p);
+/// Stores a's lanes (and b's, with kB) back into the plane.
+template <int kKind, bool kB>
+OSSA_CLOTH_TARGET OSSA_CLOTH_INLINE void store_plane(float* p, const uint32_t* ia, const uint32_t* ib, __m256 a,
+                                                     __m256 b) {
+  if constexpr (kKind == kBlocks) {
+    _mm256_storeu_ps(p + ia[0], a);
+    if (kB) _mm256_storeu_ps(p + ib[0], b);
+  } else if constexpr (kKind == kGather) {
+    alignas(32) float out[2][8];
+    _mm256_store_ps(out[0], a);
+    _mm256_store_ps(out[1], b);
+    for (size_t l = 0; l < 8; ++l) {
+      p[ia[l]] = out[0][l];
+      if (kB) p[ib[l]] = out[1][l];
+    }
+  } else {
+    static_assert(kB, "the pair kinds are edges'");
+    _mm256_storeu_ps(p + ia[0], kKind == kPairs1 ? _mm256_unpacklo_ps(a, b) : _mm256_shuffle_ps(a, b, 0x44));
+    _mm256_storeu_ps(p + ia[0] + 8, kKind == kPairs1 ? _mm256_unpackhi_ps(a, b) : _mm256_shuffle_ps(a, b, 0xEE));
+  }
+}
+
+/// The current positions' planes.
+struct Planes {
+  float *x, *y, *z;
+};
+
+template <int kKind, bool kLambda>
+OSSA_CLOTH_TARGET OSSA_CLOTH_INLINE void edge_group(const Planes& p, const ClothWideList& l, size_t k, __m256 va,
+                                                    float* lambda) {
+  const __m256 zero = _mm256_setzero_ps(), tiny = _mm256_set1_ps(1e-24f), sign = _mm256_set1_ps(-0.0f);
+  const uint32_t *ia = l.a.data() + k, *ib = l.b.data() + k;
+  __m256 ax, ay, az, bx, by, bz;
+  load_plane<kKind>(p.x, ia, ib, ax, bx);
+  load_plane<kKind>(p.y, ia, ib, ay, by);
+  load_plane<kKind>(p.z, ia, ib, az, bz);
+  const __m256 wa = _mm256_loadu_ps(l.wa.data() + k), wb = _mm256_loadu_ps(l.wb.data() + k);
+  const __m256 wsum = _mm256_add_ps(wa, wb);
+  const __m256 dx = _mm256_sub_ps(bx, ax), dy = _mm256_sub_ps(by, ay), dz = _mm256_sub_ps(bz, az);
+  const __m256 len2 = dot3(dx, dy, dz, dx, dy, dz);
+  const __m256 ok = _mm256_and_ps(_mm256_cmp_ps(len2, tiny, _CMP_GT_OQ), _mm256_cmp_ps(wsum, zero, _CMP_NEQ_UQ));
+  if (_mm256_testz_ps(ok, ok)) return;
+  const __m256 len = _mm256_sqrt_ps(len2);
+  const __m256 neg_violation = _mm256_xor_ps(_mm256_sub_ps(len, _mm256_loadu_ps(l.rest.data() + k)), sign);
+  __m256 s;
+  if constexpr (kLambda) {
+    const __m256 lam = _mm256_loadu_ps(lambda + k);
+    const __m256 dl = _mm256_div_ps(_mm256_sub_ps(neg_violation, _mm256_mul_ps(va, lam)), _mm256_add_ps(wsum, va));
+    _mm256_storeu_ps(lambda + k, _mm256_blendv_ps(lam, _mm256_add_ps(lam, dl), ok));
+    s = _mm256_div_ps(dl, len);
+  } else {
+    s = _mm256_div_ps(neg_violation, _mm256_mul_ps(_mm256_add_ps(wsum, va), len));
+  }
+  const __m256 cx = _mm256_mul_ps(dx, s), cy = _mm256_mul_ps(dy, s), cz = _mm256_mul_ps(dz, s);
+  ax = _mm256_blendv_ps(ax, _mm256_sub_ps(ax, _mm256_mul_ps(wa, cx)), ok);
+  ay = _mm256_blendv_ps(ay, _mm256_sub_ps(ay, _mm256_mul_ps(wa, cy)), ok);
+  az = _mm256_blendv_ps(az, _mm256_sub_ps(az, _mm256_mul_ps(wa, cz)), ok);
+  bx = _mm256_blendv_ps(bx, _mm256_add_ps(bx, _mm256_mul_ps(wb, cx)), ok);
+  by = _mm256_blendv_ps(by, _mm256_add_ps(by, _mm256_mul_ps(wb, cy)), ok);
+  bz = _mm256_blendv_ps(bz, _mm256_add_ps(bz, _mm256_mul_ps(wb, cz)), ok);
+  store_plane<kKind, true>(p.x, ia, ib, ax, bx);
+  store_plane<kKind, true>(p.y, ia, ib, ay, by);
+  store_plane<kKind, true>(p.z, ia, ib, az, bz);
+}
+
+/// Lane k alone: cloth_solve.cpp's project_edge operation for operation.
+template <bool kLambda>
+OSSA_CLOTH_TARGET OSSA_CLOTH_INLINE void edge_one(const Planes& p, const ClothWideList& l, size_t k, float alpha,
+                                                  float* lambda) {
+  const uint32_t a = l.a[k], b = l.b[k];
+  const float wa = l.wa[k], wb = l.wb[k], wsum = wa + wb;
+  const float dx = p.x[b] - p.x[a], dy = p.y[b] - p.y[a], dz = p.z[b] - p.z[a];
+  const float len2 = dx * dx + dy * dy + dz * dz;
+  if (!(len2 > 1e-24f) || wsum == 0.0f) return;
+  const float len = std::sqrt(len2);
+  const float violation = len - l.rest[k];
+  float s;
+  if constexpr (kLambda) {
+    const float dl = (-violation - alpha * lambda[k]) / (wsum + alpha);
+    lambda[k] += dl;
+    s = dl / len;
+  } else {
+    s = -violation / ((wsum + alpha) * len);
+  }
+  const float cx = dx * s, cy = dy * s, cz = dz * s;
+  p.x[a] -= wa * cx;
+  p.y[a] -= wa * cy;
+  p.z[a] -= wa * cz;
+  p.x[b] += wb * cx;
+  p.y[b] += wb * cy;
+  p.z[b] += wb * cz;
+}
+
+template <int kKind>
+OSSA_CLOTH_TARGET OSSA_CLOTH_INLINE void tether_group(const Planes& p, const ClothWideList& l, size_t k, float scale) {
+  const uint32_t *ia = l.a.data() + k, *ib = l.b.data() + k;
+  __m256 px, py, pz, qx, qy, qz;
+  load_plane<kKind>(p.x, ia, ib, px, qx);
+  load_plane<kKind>(p.y, ia, ib, py, qy);
+  load_plane<kKind>(p.z, ia, ib, pz, qz);
+  const __m256 limit = _mm256_mul_ps(_mm256_loadu_ps(l.rest.data() + k), _mm256_set1_ps(scale));
+  const __m256 dx = _mm256_sub_ps(px, qx), dy = _mm256_sub_ps(py, qy), dz = _mm256_sub_ps(pz, qz);
+  const __m256 len2 = dot3(dx, dy, dz, dx, dy, dz);
+  const __m256 over = _mm256_and_ps(_mm256_cmp_ps(_mm256_loadu_ps(l.wa.data() + k), _mm256_setzero_ps(), _CMP_NEQ_UQ),
+                                    _mm256_cmp_ps(len2, _mm256_mul_ps(limit, limit), _CMP_NLE_UQ));
+  if (_mm256_testz_ps(over, over)) return;
+  const __m256 s = _mm256_div_ps(limit, _mm256_sqrt_ps(len2));
+  px = _mm256_blendv_ps(px, _mm256_add_ps(qx, _mm256_mul_ps(dx, s)), over);
+  py = _mm256_blendv_ps(py, _mm256_add_ps(qy, _mm256_mul_ps(dy, s)), over);
+  pz = _mm256_blendv_ps(pz, _mm256_add_ps(qz, _mm256_mul_ps(dz, s)), over);
+  store_plane<kKind, false>(p.x, ia, ib, px, qx);
+  store_plane<kKind, false>(p.y, ia, ib, py, qy);
+  store_plane<kKind, false>(p.z, ia, ib, pz, qz);
+}
+
+/// Lane k alone: cloth_solve.cpp's project_tether (hold_within) operation for operation.
+OSSA_CLOTH_TARGET OSSA_CLOTH_INLINE void tether_one(const Planes& p, const ClothWideList& l, size_t k, float scale) {
+  if (l.wa[k] == 0.0f) return;
+  const uint32_t a = l.a[k], b = l.b[k];
+  const float limit = l.rest[k] * scale;
+  const float dx = p.x[a] - p.x[b], dy = p.y[a] - p.y[b], dz = p.z[a] - p.z[b];
+  const float len2 = dx * dx + dy * dy + dz * dz;
+  if (len2 <= limit * limit) return;
+  const float s = limit / std::sqrt(len2);
+  p.x[a] = p.x[b] + dx * s;
+  p.y[a] = p.y[b] + dy * s;
+  p.z[a] = p.z[b] + dz * s;
+}
+
+template <bool kLambda>
+OSSA_CLOTH_TARGET void wide_edges(const Planes& p, const ClothWideList& l, float alpha, float* lambda) {
+  const __m256 va = _mm256_set1_ps(alpha);
+  size_t k = 0, group = 0;
+  for (size_t r = 0; r + 1 < l.runs.size(); r += 2) {
+    for (; k < l.runs[r]; k += 8, ++group) {
+      switch (l.kinds[group]) {
+        case kBlocks: edge_group<kBlocks, kLambda>(p, l, k, va, lambda); break;
+        case kPairs1: edge_group<kPairs1, kLambda>(p, l, k, va, lambda); break;
+        case kPairs2: edge_group<kPairs2, kLambda>(p, l, k, va, lambda); break;
+        default: edge_group<kGather, kLambda>(p, l, k, va, lambda); break;
+      }
+    }
+    for (; k < l.runs[r + 1]; ++k) edge_one<kLambda>(p, l, k, alpha, lambda);
+  }
+}
+
+OSSA_CLOTH_TARGET void wide_tethers(const Planes& p, const ClothWideList& l, float scale) {
+  size_t k = 0, group = 0;
+  for (size_t r = 0; r + 1 < l.runs.size(); r += 2) {
+    for (; k < l.runs[r]; k += 8, ++group) {
+      if (l.kinds[group] == kBlocks) tether_group<kBlocks>(p, l, k, scale);
+      else tether_group<kGather>(p, l, k, scale);
+    }
+    for (; k < l.runs[r + 1]; ++k) tether_one(p, l, k, scale);
   }
 }
 
@@ -196,19 +254,18 @@ OSSA_CLOTH_TARGET OSSA_CLOTH_INLINE void transform(Rows8& p, const glm::mat3& r,
   p.z = z;
 }
 
-OSSA_CLOTH_TARGET void carry8(glm::vec4* x, glm::vec4* previous, size_t count, const glm::mat3& r, const glm::vec3& t) {
-  for (size_t i = 0; i < count; i += 8) {
-    Rows8 a = load_block(x + i), b = load_block(previous + i);
-    transform(a, r, t);
-    transform(b, r, t);
-    store_block(x + i, a);
-    store_block(previous + i, b);
-  }
+OSSA_CLOTH_TARGET void carry8(ClothParticles& p, size_t count, const glm::mat3& r, const glm::vec3& t) {
+  for (size_t i = 0; i < count; i += 8)
+    for (const bool before : {false, true}) {
+      Rows8 a = load8(p, i, before);
+      transform(a, r, t);
+      store8(p, i, a, before);
+    }
 }
 
-OSSA_CLOTH_TARGET uint32_t predict8(glm::vec4* x, glm::vec4* previous, size_t first, float keep,
-                                    const glm::vec3& gravity, float max_step) {
-  Rows8 at = load_block(x + first), p = load_block(previous + first);
+OSSA_CLOTH_TARGET uint32_t predict8(ClothParticles& c, size_t first, float keep, const glm::vec3& gravity,
+                                    float max_step) {
+  const Rows8 at = load8(c, first), p = load8(c, first, true);
   const __m256 fixed = _mm256_cmp_ps(at.w, _mm256_setzero_ps(), _CMP_EQ_OQ);
   const __m256 k = _mm256_set1_ps(keep);
   __m256 vx = _mm256_add_ps(_mm256_mul_ps(_mm256_sub_ps(at.x, p.x), k), _mm256_set1_ps(gravity.x));
@@ -226,13 +283,14 @@ OSSA_CLOTH_TARGET uint32_t predict8(glm::vec4* x, glm::vec4* previous, size_t fi
     }
   }
   // Free lanes: previous = at, current = at + v; fixed lanes are left to the caller.
-  const Rows8 moved{_mm256_blendv_ps(_mm256_add_ps(at.x, vx), at.x, fixed),
-                    _mm256_blendv_ps(_mm256_add_ps(at.y, vy), at.y, fixed),
-                    _mm256_blendv_ps(_mm256_add_ps(at.z, vz), at.z, fixed), at.w};
-  const Rows8 was{_mm256_blendv_ps(at.x, p.x, fixed), _mm256_blendv_ps(at.y, p.y, fixed),
-                  _mm256_blendv_ps(at.z, p.z, fixed), p.w};
-  store_block(x + first, moved);
-  store_block(previous + first, was);
+  store8(
+      c, first,
+      {_mm256_blendv_ps(_mm256_add_ps(at.x, vx), at.x, fixed), _mm256_blendv_ps(_mm256_add_ps(at.y, vy), at.y, fixed),
+       _mm256_blendv_ps(_mm256_add_ps(at.z, vz), at.z, fixed), at.w});
+  store8(
+      c, first,
+      {_mm256_blendv_ps(at.x, p.x, fixed), _mm256_blendv_ps(at.y, p.y, fixed), _mm256_blendv_ps(at.z, p.z, fixed), p.w},
+      true);
   return static_cast<uint32_t>(_mm256_movemask_ps(fixed));
 }
 
@@ -290,37 +348,26 @@ OSSA_CLOTH_TARGET OSSA_CLOTH_INLINE __m256 push_out8(__m256& px, __m256& py, __m
   return moved;
 }
 
-OSSA_CLOTH_TARGET void push4(glm::vec4* x, const glm::vec4* previous, size_t first, const glm::vec4* step,
-                             size_t count) {
-  Rows8 r = load_block(x + first);
-  const Rows8 side = load_block(previous + first);
+OSSA_CLOTH_TARGET void push4(ClothParticles& c, size_t first, const glm::vec4* step, size_t count) {
+  Rows8 r = load8(c, first);
+  const Rows8 side = load8(c, first, true);
   const __m256 free = _mm256_cmp_ps(r.w, _mm256_setzero_ps(), _CMP_NEQ_UQ);
   const __m256 moved = push_out8(r.x, r.y, r.z, side.x, side.y, side.z, free, step, count);
-  if (_mm256_testz_ps(moved, moved)) return;
-  alignas(32) float out[3][8];
-  _mm256_store_ps(out[0], r.x);
-  _mm256_store_ps(out[1], r.y);
-  _mm256_store_ps(out[2], r.z);
-  const int mask = _mm256_movemask_ps(moved);
-  for (size_t l = 0; l < 8; ++l)
-    if (mask & (1 << l)) x[first + l] = glm::vec4(out[0][l], out[1][l], out[2][l], x[first + l].w);
+  if (!_mm256_testz_ps(moved, moved)) store8(c, first, r);  // lanes not moved keep their bits
 }
 
-OSSA_CLOTH_TARGET void push3(glm::vec3* p, const glm::vec4* state, size_t first, const glm::vec4* step, size_t count) {
-  alignas(32) float in[7][8];
+OSSA_CLOTH_TARGET void push3(glm::vec3* p, const ClothParticles& state, size_t first, const glm::vec4* step,
+                             size_t count) {
+  alignas(32) float in[3][8];
   for (size_t l = 0; l < 8; ++l) {
     in[0][l] = p[first + l].x;
     in[1][l] = p[first + l].y;
     in[2][l] = p[first + l].z;
-    in[3][l] = state[first + l].x;
-    in[4][l] = state[first + l].y;
-    in[5][l] = state[first + l].z;
-    in[6][l] = state[first + l].w;
   }
   __m256 px = _mm256_load_ps(in[0]), py = _mm256_load_ps(in[1]), pz = _mm256_load_ps(in[2]);
-  const __m256 free = _mm256_cmp_ps(_mm256_load_ps(in[6]), _mm256_setzero_ps(), _CMP_NEQ_UQ);
-  const __m256 moved =
-      push_out8(px, py, pz, _mm256_load_ps(in[3]), _mm256_load_ps(in[4]), _mm256_load_ps(in[5]), free, step, count);
+  const Rows8 side = load8(state, first);
+  const __m256 free = _mm256_cmp_ps(side.w, _mm256_setzero_ps(), _CMP_NEQ_UQ);
+  const __m256 moved = push_out8(px, py, pz, side.x, side.y, side.z, free, step, count);
   if (_mm256_testz_ps(moved, moved)) return;
   _mm256_store_ps(in[0], px);
   _mm256_store_ps(in[1], py);
@@ -332,30 +379,29 @@ OSSA_CLOTH_TARGET void push3(glm::vec3* p, const glm::vec4* state, size_t first,
 
 }  // namespace
 
-void project_edges8(glm::vec4* x, const fb::ClothEdge* edges, size_t count, float alpha, float* lambda) {
-  if (lambda) edges8<true>(x, edges, count, alpha, lambda);
-  else edges8<false>(x, edges, count, alpha, nullptr);
+void project_wide(ClothParticles& p, const ClothWideList& list, bool tethers, float alpha, float tether_scale,
+                  float* lambda) {
+  const Planes planes{p.x.data(), p.y.data(), p.z.data()};
+  if (tethers) wide_tethers(planes, list, tether_scale);
+  else if (lambda) wide_edges<true>(planes, list, alpha, lambda);
+  else wide_edges<false>(planes, list, alpha, nullptr);
 }
 
-void project_tethers8(glm::vec4* x, const fb::ClothTether* tethers, size_t count, float scale) {
-  tethers8(x, tethers, count, scale);
+void carry_particles8(ClothParticles& p, size_t count, const glm::mat3& r, const glm::vec3& t) {
+  carry8(p, count, r, t);
 }
 
-void carry_particles8(glm::vec4* x, glm::vec4* previous, size_t count, const glm::mat3& r, const glm::vec3& t) {
-  carry8(x, previous, count, r, t);
+uint32_t predict_particles8(ClothParticles& p, size_t first, float keep, const glm::vec3& gravity, float max_step) {
+  return predict8(p, first, keep, gravity, max_step);
 }
 
-uint32_t predict_particles8(glm::vec4* x, glm::vec4* previous, size_t first, float keep, const glm::vec3& gravity,
-                            float max_step) {
-  return predict8(x, previous, first, keep, gravity, max_step);
+void push_out_colliders8(ClothParticles& p, size_t first, const glm::vec4* step, size_t count) {
+  push4(p, first, step, count);
 }
 
-void push_out_colliders8(glm::vec4* x, const glm::vec4* previous, size_t first, const glm::vec4* step, size_t count) {
-  push4(x, previous, first, step, count);
-}
-
-void push_out_colliders8(glm::vec3* p, const glm::vec4* state, size_t first, const glm::vec4* step, size_t count) {
-  push3(p, state, first, step, count);
+void push_out_colliders8(glm::vec3* out, const ClothParticles& state, size_t first, const glm::vec4* step,
+                         size_t count) {
+  push3(out, state, first, step, count);
 }
 
 #else

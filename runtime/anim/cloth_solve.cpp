@@ -10,10 +10,13 @@
 // to their skinned position and never moved by a constraint, since every correction is weighted by
 // inverse mass.
 //
-// Layout: a particle is one vec4 (xyz, inverse mass in w), so a constraint loads two vec4s; the
-// cooker stores edges greedily coloured, so neighbouring constraints touch different particles and
-// the CPU overlaps them. With one iteration (the default: small steps) the XPBD multiplier starts
-// at zero every substep and is never read back, so that loop keeps no multipliers at all.
+// Layout: the particles are planes (ClothParticles: x[], y[], z[], inverse mass[]), and the
+// constraints run in the order of their wide lists (ClothWideList: the cooker's colours, each
+// regrouped by make_cloth_instance so that eight consecutive constraints touch different, mostly
+// consecutive, particles), which lets the AVX2 kernels take eight with plain loads and the CPU
+// overlap them on either path, with the stored order's bits.
+// With one iteration (the default: small steps) the XPBD multiplier starts at zero every substep
+// and is never read back, so that loop keeps no multipliers at all.
 #include <ossa/anim/cloth.h>
 
 #include <algorithm>
@@ -136,40 +139,37 @@ struct Step {
 void apply_carry(ClothInstance& c, const Carry& k) {
   if (k.identity) return;
   const glm::mat3 r = glm::mat3_cast(k.rotation);
-  const size_t n = c.current.size();
+  ClothParticles& p = c.particles;
+  const size_t n = p.size();
   size_t i = 0;
 #if OSSA_HAVE_VECTOR_CLONES
   if (detail::cloth_kernels_selected()) {
     i = n & ~size_t{7};
-    detail::carry_particles8(c.current.data(), c.previous.data(), i, r, k.translation);
+    detail::carry_particles8(p, i, r, k.translation);
   }
 #endif
   for (; i < n; ++i) {
-    glm::vec4& x = c.current[i];
-    glm::vec4& p = c.previous[i];
-    const glm::vec3 xn = r * xyz(x) + k.translation, pn = r * xyz(p) + k.translation;
-    x = glm::vec4(xn, x.w);
-    p = glm::vec4(pn, p.w);
+    p.set(i, r * p.at(i) + k.translation);
+    p.set_before(i, r * p.before(i) + k.translation);
   }
 }
 
 /// Particle i's prediction (see predict).
 OSSA_INLINE void predict_one(ClothInstance& c, size_t i, std::span<const glm::vec3> skinned, const Step& st) {
-  glm::vec4& x = c.current[i];
-  glm::vec4& p = c.previous[i];
-  if (x.w == 0.0f) {
-    p = x;
-    x = glm::vec4(st.w.of(c.skinned_older[i], c.skinned_before[i], skinned[i]), 0.0f);
+  ClothParticles& p = c.particles;
+  const glm::vec3 at = p.at(i);
+  if (p.w[i] == 0.0f) {
+    p.set_before(i, at);
+    p.set(i, st.w.of(c.skinned_older[i], c.skinned_before[i], skinned[i]));
     return;
   }
-  const glm::vec3 at = xyz(x);
-  glm::vec3 v = (at - xyz(p)) * st.keep;
+  glm::vec3 v = (at - p.before(i)) * st.keep;
   if (st.drag > 0.0f) {
     // The wind's drag along the normal of a triangle the particle is a corner of, from the
     // current positions (the particles before i already predicted, as the loop goes).
     const uint16_t* f = &c.facing[3 * i];
-    const glm::vec3 a = xyz(c.current[f[0]]);
-    glm::vec3 nrm = glm::cross(xyz(c.current[f[1]]) - a, xyz(c.current[f[2]]) - a);
+    const glm::vec3 a = p.at(f[0]);
+    glm::vec3 nrm = glm::cross(p.at(f[1]) - a, p.at(f[2]) - a);
     const float len2 = glm::dot(nrm, nrm);
     nrm = len2 > 1e-30f ? nrm * (1.0f / std::sqrt(len2)) : glm::vec3(0.0f);
     v += nrm * (glm::dot(nrm, st.wind_h - v) * st.drag);
@@ -180,90 +180,58 @@ OSSA_INLINE void predict_one(ClothInstance& c, size_t i, std::span<const glm::ve
     const float l2 = glm::dot(v, v);
     if (l2 > max2) v *= st.max_step / std::sqrt(l2);
   }
-  p = glm::vec4(at, p.w);
-  x = glm::vec4(at + v, x.w);
+  p.set_before(i, at);
+  p.set(i, at + v);
 }
 
 /// Damped velocity, the wind's drag, gravity and the speed limit for free particles; fixed ones
 /// step to their skinned position. Without drag the particles do not read each other, and the
 /// kernel takes eight at a time.
 void predict(ClothInstance& c, std::span<const glm::vec3> skinned, const Step& st) {
-  const size_t n = c.current.size();
+  const size_t n = c.particles.size();
   size_t i = 0;
 #if OSSA_HAVE_VECTOR_CLONES
   if (detail::cloth_kernels_selected() && !(st.drag > 0.0f)) {
     for (; i + 8 <= n; i += 8)
-      for (uint32_t fixed =
-               detail::predict_particles8(c.current.data(), c.previous.data(), i, st.keep, st.gravity_h2, st.max_step);
-           fixed != 0; fixed &= fixed - 1)
+      for (uint32_t fixed = detail::predict_particles8(c.particles, i, st.keep, st.gravity_h2, st.max_step); fixed != 0;
+           fixed &= fixed - 1)
         predict_one(c, i + static_cast<size_t>(__builtin_ctz(fixed)), skinned, st);
   }
 #endif
   for (; i < n; ++i) predict_one(c, i, skinned, st);
 }
 
-/// One XPBD distance constraint. kLambda: keep its multiplier across iterations (iterations > 1).
+/// Lane k of a wide list as one XPBD distance constraint (the kernels' edge_one; an idle lane
+/// has no inverse mass and changes nothing). kLambda: keep its multiplier across iterations.
 template <bool kLambda>
-OSSA_INLINE void project_edge(glm::vec4* x, const fb::ClothEdge& e, float alpha, float* lambda) {
-  glm::vec4& a = x[e.a()];
-  glm::vec4& b = x[e.b()];
-  const float wsum = a.w + b.w;
-  const glm::vec3 d(b.x - a.x, b.y - a.y, b.z - a.z);
+OSSA_INLINE void project_edge(ClothParticles& p, const ClothWideList& l, size_t k, float alpha, float* lambda) {
+  const uint32_t a = l.a[k], b = l.b[k];
+  const float wa = l.wa[k], wb = l.wb[k], wsum = wa + wb;
+  const glm::vec3 d(p.x[b] - p.x[a], p.y[b] - p.y[a], p.z[b] - p.z[a]);
   const float len2 = glm::dot(d, d);
   if (!(len2 > 1e-24f) || wsum == 0.0f) return;
   const float len = std::sqrt(len2);
-  const float violation = len - e.rest();
+  const float violation = len - l.rest[k];
   float s;  // the correction per unit of d: dl / len, in one division where no multiplier is kept
   if constexpr (kLambda) {
-    const float dl = (-violation - alpha * *lambda) / (wsum + alpha);
-    *lambda += dl;
+    const float dl = (-violation - alpha * lambda[k]) / (wsum + alpha);
+    lambda[k] += dl;
     s = dl / len;
   } else {
     s = -violation / ((wsum + alpha) * len);
   }
   const glm::vec3 corr = d * s;
-  a.x -= a.w * corr.x;
-  a.y -= a.w * corr.y;
-  a.z -= a.w * corr.z;
-  b.x += b.w * corr.x;
-  b.y += b.w * corr.y;
-  b.z += b.w * corr.z;
-}
-
-/// Visits [0, count) in order: `one(k)` for a single constraint; with the eight-wide kernels,
-/// `eight(k, n)` for the first multiple of 8 of each run of constraints that share no particle
-/// (`runs`: where each ends) and `one` for the run's last few, which gives the same bits as the
-/// stored order (no constraint of a run reads what another writes).
-template <typename Eight, typename One>
-OSSA_INLINE void by_runs(size_t count, std::span<const uint32_t> runs, bool wide, Eight eight, One one) {
-  size_t k = 0;
-#if OSSA_HAVE_VECTOR_CLONES
-  if (wide) {
-    for (const uint32_t end : runs) {
-      const size_t n = (end - k) & ~size_t{7};
-      if (n > 0) eight(k, n);
-      for (k += n; k < end; ++k) one(k);
-    }
-  }
-#else
-  (void)runs;
-  (void)wide;
-  (void)eight;
-#endif
-  for (; k < count; ++k) one(k);
+  p.x[a] -= wa * corr.x;
+  p.y[a] -= wa * corr.y;
+  p.z[a] -= wa * corr.z;
+  p.x[b] += wb * corr.x;
+  p.y[b] += wb * corr.y;
+  p.z[b] += wb * corr.z;
 }
 
 template <bool kLambda>
-void project_edges(glm::vec4* x, std::span<const fb::ClothEdge> edges, std::span<const uint32_t> runs, float alpha,
-                   float* lambda, bool wide) {
-  by_runs(
-      edges.size(), runs, wide,
-      [&]([[maybe_unused]] size_t k, [[maybe_unused]] size_t n) {
-#if OSSA_HAVE_VECTOR_CLONES
-        detail::project_edges8(x, edges.data() + k, n, alpha, kLambda ? lambda + k : nullptr);
-#endif
-      },
-      [&](size_t k) { project_edge<kLambda>(x, edges[k], alpha, kLambda ? lambda + k : nullptr); });
+void project_edges(ClothParticles& p, const ClothWideList& l, float alpha, float* lambda) {
+  for (size_t k = 0; k < l.a.size(); ++k) project_edge<kLambda>(p, l, k, alpha, lambda);
 }
 
 /// Moves `p` onto the sphere of radius `limit` around `anchor` when it is outside it (a tether).
@@ -275,23 +243,38 @@ OSSA_INLINE bool hold_within(glm::vec3& p, const glm::vec3& anchor, float limit)
   return true;
 }
 
-OSSA_INLINE void project_tether(glm::vec4* x, const fb::ClothTether& t, float scale) {
-  glm::vec4& p = x[t.particle()];
-  if (p.w == 0.0f) return;
-  glm::vec3 at = xyz(p);
-  if (hold_within(at, xyz(x[t.anchor()]), t.length() * scale)) p = glm::vec4(at, p.w);
+/// Lane k of a wide list as a tether (the particle a held within the length of the anchor b).
+OSSA_INLINE void project_tether(ClothParticles& p, const ClothWideList& l, size_t k, float scale) {
+  if (l.wa[k] == 0.0f) return;
+  glm::vec3 at = p.at(l.a[k]);
+  if (hold_within(at, p.at(l.b[k]), l.rest[k] * scale)) p.set(l.a[k], at);
 }
 
-void project_tethers(glm::vec4* x, std::span<const fb::ClothTether> tethers, std::span<const uint32_t> runs,
-                     float scale, bool wide) {
-  by_runs(
-      tethers.size(), runs, wide,
-      [&]([[maybe_unused]] size_t k, [[maybe_unused]] size_t n) {
+/// Stretch, bend and tethers, one pass, in the wide lists' order (the stored runs in turn: see
+/// ClothWideList): one lane at a time, or with the kernels, with the same bits.
+void project_distances(ClothInstance& c, float stretch_alpha, float bend_alpha, bool wide) {
+  ClothParticles& p = c.particles;
+  const ClothSettings& s = c.settings;
+  float* lambda = s.iterations > 1 ? c.lambda.data() : nullptr;
+  float* bend_lambda = lambda ? lambda + c.wide_stretch.a.size() : nullptr;
 #if OSSA_HAVE_VECTOR_CLONES
-        detail::project_tethers8(x, tethers.data() + k, n, scale);
+  if (wide) {
+    detail::project_wide(p, c.wide_stretch, false, stretch_alpha, 0.0f, lambda);
+    detail::project_wide(p, c.wide_bend, false, bend_alpha, 0.0f, bend_lambda);
+    detail::project_wide(p, c.wide_tethers, true, 0.0f, s.tether_scale, nullptr);
+    return;
+  }
+#else
+  (void)wide;
 #endif
-      },
-      [&](size_t k) { project_tether(x, tethers[k], scale); });
+  if (lambda) {
+    project_edges<true>(p, c.wide_stretch, stretch_alpha, lambda);
+    project_edges<true>(p, c.wide_bend, bend_alpha, bend_lambda);
+  } else {
+    project_edges<false>(p, c.wide_stretch, stretch_alpha, nullptr);
+    project_edges<false>(p, c.wide_bend, bend_alpha, nullptr);
+  }
+  for (size_t k = 0; k < c.wide_tethers.a.size(); ++k) project_tether(p, c.wide_tethers, k, s.tether_scale);
 }
 
 /// Max distance and backstop against the skinned pose `f` of the way through this update.
@@ -300,12 +283,11 @@ void project_limits(ClothInstance& c, std::span<const glm::vec3> skinned, std::s
   const float f = st.f;
   const ClothSource& s = c.source;
   if (s.max_distances.empty() && s.backstops.empty()) return;
-  const size_t n = c.current.size();
-  for (size_t i = 0; i < n; ++i) {
-    glm::vec4& x = c.current[i];
-    if (x.w == 0.0f) continue;
+  ClothParticles& p = c.particles;
+  for (size_t i = 0; i < p.size(); ++i) {
+    if (p.w[i] == 0.0f) continue;
     const glm::vec3 anchor = st.w.of(c.skinned_older[i], c.skinned_before[i], skinned[i]);
-    glm::vec3 at = xyz(x);
+    glm::vec3 at = p.at(i);
     if (!s.max_distances.empty()) {
       const float limit = s.max_distances[i];
       const glm::vec3 d = at - anchor;
@@ -317,7 +299,7 @@ void project_limits(ClothInstance& c, std::span<const glm::vec3> skinned, std::s
       const float depth = glm::dot(at - anchor, nrm);
       if (depth < -s.backstops[i]) at -= nrm * (depth + s.backstops[i]);
     }
-    x = glm::vec4(at, x.w);
+    p.set(i, at);
   }
 }
 
@@ -365,19 +347,18 @@ OSSA_INLINE void push_out(const ClothInstance& c, glm::vec3& at, const glm::vec3
 void project_colliders(ClothInstance& c, bool wide) {
   const size_t count = c.source.colliders.size();
   if (count == 0) return;
-  const size_t n = c.current.size();
+  ClothParticles& p = c.particles;
+  const size_t n = p.size();
   const auto push = [&](size_t i) {
-    glm::vec4& x = c.current[i];
-    if (x.w == 0.0f) return;
-    glm::vec3 at = xyz(x);
-    push_out(c, at, xyz(c.previous[i]));
-    x = glm::vec4(at, x.w);
+    if (p.w[i] == 0.0f) return;
+    glm::vec3 at = p.at(i);
+    push_out(c, at, p.before(i));
+    p.set(i, at);
   };
   size_t next = 0;
 #if OSSA_HAVE_VECTOR_CLONES
   if (wide) {
-    for (; next + 8 <= n; next += 8)
-      detail::push_out_colliders8(c.current.data(), c.previous.data(), next, c.collider_step.data(), count);
+    for (; next + 8 <= n; next += 8) detail::push_out_colliders8(p, next, c.collider_step.data(), count);
   }
 #else
   (void)wide;
@@ -390,20 +371,11 @@ void substep(ClothInstance& c, const ClothInput& in, const Step& st) {
   const ClothSettings& s = c.settings;
   const float h2 = st.h * st.h;
   const float stretch_alpha = s.stretch_compliance / h2, bend_alpha = s.bend_compliance / h2;
-  glm::vec4* x = c.current.data();
-  const ClothSource& src = c.source;
   if (s.iterations > 1) std::fill(c.lambda.begin(), c.lambda.end(), 0.0f);
   const bool wide = detail::cloth_kernels_selected();
   set_collider_step(c, st.w);
   for (uint32_t it = 0; it < s.iterations; ++it) {
-    if (s.iterations > 1) {
-      project_edges<true>(x, src.stretch, c.stretch_runs, stretch_alpha, c.lambda.data(), wide);
-      project_edges<true>(x, src.bend, c.bend_runs, bend_alpha, c.lambda.data() + src.stretch.size(), wide);
-    } else {
-      project_edges<false>(x, src.stretch, c.stretch_runs, stretch_alpha, nullptr, wide);
-      project_edges<false>(x, src.bend, c.bend_runs, bend_alpha, nullptr, wide);
-    }
-    project_tethers(x, src.tethers, c.tether_runs, s.tether_scale, wide);
+    project_distances(c, stretch_alpha, bend_alpha, wide);
     project_limits(c, in.skinned_positions, in.skinned_normals, st);
     project_colliders(c, wide);
   }
@@ -423,10 +395,10 @@ void place_colliders(ClothInstance& c, std::span<const glm::mat4> model) {
 }
 
 void restart(ClothInstance& c, const ClothInput& in) {
-  const size_t n = c.current.size();
+  const size_t n = c.particles.size();
   for (size_t i = 0; i < n; ++i) {
-    c.current[i] = glm::vec4(in.skinned_positions[i], c.current[i].w);
-    c.previous[i] = c.current[i];
+    c.particles.set(i, in.skinned_positions[i]);
+    c.particles.set_before(i, in.skinned_positions[i]);
     c.skinned_before[i] = c.skinned_older[i] = in.skinned_positions[i];
     c.skinned_normal_before[i] = in.skinned_normals.empty() ? glm::vec3(0.0f) : in.skinned_normals[i];
   }
@@ -454,17 +426,18 @@ Frame frame_at(const Frame& older, const Frame& before, const Frame& now, const 
 
 /// The output: free particles carried `ahead` substeps further along their velocity and by the
 /// world's motion since the last substep, then held to this update's limits and colliders; fixed
-/// particles at their skinned positions; normals from the triangles.
+/// particles at their skinned positions; normals: area-weighted sums over the triangles, unit length.
 void write_output(ClothInstance& c, const ClothInput& in, float ahead, const Carry& rest_of_frame) {
-  const size_t n = c.current.size();
+  const ClothParticles& p = c.particles;
+  const size_t n = p.size();
   const glm::mat3 r = glm::mat3_cast(rest_of_frame.rotation);
   for (size_t i = 0; i < n; ++i) {
-    const glm::vec4& x = c.current[i];
-    if (x.w == 0.0f) {
+    if (p.w[i] == 0.0f) {
       c.out_positions[i] = in.skinned_positions[i];
       continue;
     }
-    glm::vec3 o = xyz(x) + (xyz(x) - xyz(c.previous[i])) * ahead;
+    const glm::vec3 x = p.at(i);
+    glm::vec3 o = x + (x - p.before(i)) * ahead;
     if (!rest_of_frame.identity) o = r * o + rest_of_frame.translation;
     c.out_positions[i] = o;
   }
@@ -476,11 +449,11 @@ void write_output(ClothInstance& c, const ClothInput& in, float ahead, const Car
   const ClothSource& s = c.source;
   const float scale = c.settings.tether_scale * 1.01f;
   for (const fb::ClothTether& t : s.tethers) {
-    if (c.current[t.particle()].w == 0.0f) continue;
+    if (p.w[t.particle()] == 0.0f) continue;
     hold_within(c.out_positions[t.particle()], c.out_positions[t.anchor()], t.length() * scale);
   }
-  for (size_t i = 0; i < n; ++i) {
-    if (c.current[i].w == 0.0f) continue;
+  for (size_t i = 0; i < n && !(s.max_distances.empty() && s.backstops.empty()); ++i) {
+    if (p.w[i] == 0.0f) continue;
     glm::vec3& at = c.out_positions[i];
     const glm::vec3& anchor = in.skinned_positions[i];
     if (!s.max_distances.empty()) {
@@ -497,33 +470,32 @@ void write_output(ClothInstance& c, const ClothInput& in, float ahead, const Car
   }
   set_collider_step(c, Weights{}, true);
   const auto push = [&](size_t i) {
-    if (c.current[i].w != 0.0f) push_out(c, c.out_positions[i], xyz(c.current[i]));
+    if (p.w[i] != 0.0f) push_out(c, c.out_positions[i], p.at(i));
   };
   size_t next = 0;
 #if OSSA_HAVE_VECTOR_CLONES
   if (detail::cloth_kernels_selected() && !s.colliders.empty()) {
     for (; next + 8 <= n; next += 8)
-      detail::push_out_colliders8(c.out_positions.data(), c.current.data(), next, c.collider_step.data(),
-                                  s.colliders.size());
+      detail::push_out_colliders8(c.out_positions.data(), p, next, c.collider_step.data(), s.colliders.size());
   }
 #endif
   if (!s.colliders.empty())
     for (; next < n; ++next) push(next);
   // Normals: area-weighted sums over the triangles, then unit length.
-  std::fill(c.out_normals.begin(), c.out_normals.end(), glm::vec3(0.0f));
+  // Each particle sums its triangles' normals in the triangles' order (from its corner list),
+  // rather than each triangle adding to its corners: those adds would wait on each other's stores.
   const auto& tri = s.triangles;
-  for (size_t t = 0; t + 2 < tri.size(); t += 3) {
-    const glm::vec3& pa = c.out_positions[tri[t]];
-    const glm::vec3 nrm = glm::cross(c.out_positions[tri[t + 1]] - pa, c.out_positions[tri[t + 2]] - pa);
-    c.out_normals[tri[t]] += nrm;
-    c.out_normals[tri[t + 1]] += nrm;
-    c.out_normals[tri[t + 2]] += nrm;
+  for (size_t t = 0; 3 * t + 2 < tri.size(); ++t) {
+    const glm::vec3& pa = c.out_positions[tri[3 * t]];
+    c.triangle_normals[t] = glm::cross(c.out_positions[tri[3 * t + 1]] - pa, c.out_positions[tri[3 * t + 2]] - pa);
   }
   for (size_t i = 0; i < n; ++i) {
-    glm::vec3& nrm = c.out_normals[i];
+    glm::vec3 nrm(0.0f);
+    for (uint32_t k = c.corner_start[i]; k < c.corner_start[i + 1]; ++k) nrm += c.triangle_normals[c.corners[k]];
+    c.out_normals[i] = nrm;
     const float len2 = glm::dot(nrm, nrm);
-    if (len2 > 1e-30f) nrm *= 1.0f / std::sqrt(len2);
-    else nrm = in.skinned_normals.empty() ? glm::vec3(0.0f, 1.0f, 0.0f) : in.skinned_normals[i];
+    if (len2 > 1e-30f) c.out_normals[i] *= 1.0f / std::sqrt(len2);
+    else c.out_normals[i] = in.skinned_normals.empty() ? glm::vec3(0.0f, 1.0f, 0.0f) : in.skinned_normals[i];
   }
 }
 
@@ -535,7 +507,7 @@ float rotation_angle(const glm::quat& a, const glm::quat& b) {
 }  // namespace
 
 Status update_cloth(ClothInstance& c, const ClothInput& in) {
-  const size_t n = c.current.size();
+  const size_t n = c.particles.size();
   if (in.skinned_positions.size() < n)
     return Error{detail::format("cloth: %zu skinned positions for %zu particles", in.skinned_positions.size(), n)};
   const bool needs_normals = !c.source.backstops.empty() || c.settings.drag > 0.0f;

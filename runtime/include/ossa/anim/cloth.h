@@ -47,25 +47,60 @@
 
 namespace ossa {
 
+/// A constraint list (stretch, bend or tethers) laid out for the solver's eight-wide kernels
+/// (runtime/anim/cloth_kernels.h), made by make_cloth_instance: each run of the stored order whose
+/// constraints share no particle is regrouped (any order within a run gives the same bits) into
+/// groups of eight lanes whose ends lie in few contiguous particles, then the run's last few lanes.
+struct ClothWideList {
+  std::vector<uint32_t> a, b;       // per lane: the ends (an edge may be turned round: same bits)
+  std::vector<float> rest, wa, wb;  // per lane: rest length (a tether's length), inverse masses of a and b;
+                                    // all 0 in an idle lane (a group's pattern with no constraint there)
+  std::vector<uint8_t> kinds;       // per group: how its ends lie (cloth_kernels.h's WideKind)
+  std::vector<uint32_t> runs;       // per run, two lane counts: where its groups end, where it ends
+};
+
+/// The particles as planes (a structure of arrays, so that the solver's kernels load eight of a
+/// coordinate at once): current and previous positions in model space, and inverse masses.
+struct ClothParticles {
+  std::vector<float> x, y, z;     // now
+  std::vector<float> px, py, pz;  // one substep ago, in the same frame
+  std::vector<float> w;           // inverse mass (0: the particle is its skinned position)
+
+  size_t size() const { return x.size(); }
+  glm::vec3 at(size_t i) const { return {x[i], y[i], z[i]}; }
+  glm::vec3 before(size_t i) const { return {px[i], py[i], pz[i]}; }
+  void set(size_t i, const glm::vec3& v) {
+    x[i] = v.x;
+    y[i] = v.y;
+    z[i] = v.z;
+  }
+  void set_before(size_t i, const glm::vec3& v) {
+    px[i] = v.x;
+    py[i] = v.y;
+    pz[i] = v.z;
+  }
+};
+
 /// One character's cloth: the simulation state, made once; positions() / normals() are the output
 /// of the last update. Move-only in spirit (the vectors are its memory); reading any member is
 /// fine, writing anything but `settings` is the solver's business.
 struct ClothInstance {
   ClothSource source;
-  ClothSettings settings;           // starts as source.settings; change freely between updates
-  std::vector<glm::vec4> current;   // model space; w = inverse mass
-  std::vector<glm::vec4> previous;  // one substep ago, in the same frame as current
+  ClothSettings settings;    // starts as source.settings; change freely between updates
+  ClothParticles particles;  // the simulation's state
   std::vector<glm::vec3> skinned_before, skinned_normal_before;  // the last update's inputs
   std::vector<glm::vec3> skinned_older;                          // and the one's before it
   std::vector<glm::vec3> out_positions, out_normals;             // the last update's output
   std::vector<glm::vec3> colliders_before;                       // 2 per collider: model-space ends at the last update
   std::vector<glm::vec3> colliders_older, colliders_now;
-  std::vector<float> lambda;     // XPBD multipliers (stretch then bend) when iterations > 1
-  std::vector<uint16_t> facing;  // 3 per particle: a triangle it is a corner of (the wind's normal)
-  std::vector<uint32_t> stretch_runs, bend_runs, tether_runs;  // ends of runs that share no particle
+  std::vector<float> lambda;                    // XPBD multipliers (per wide lane, stretch then bend) if iterations > 1
+  std::vector<uint16_t> facing;                 // 3 per particle: a triangle it is a corner of (the wind's normal)
+  std::vector<uint32_t> corner_start, corners;  // from corner_start[i]: the triangles particle i is a corner of
+  std::vector<glm::vec3> triangle_normals;      // the output's, per triangle (area-weighted)
+  ClothWideList wide_stretch, wide_bend, wide_tethers;  // the constraints for the eight-wide kernels
   std::vector<glm::vec4> collider_step;  // 3 per collider, this substep's: ends (w: reach), bounding sphere
   glm::mat4 world_before{1.0f};          // model_to_world at the last update
-  glm::mat4 world_state{1.0f};           // model_to_world at the last substep: current's frame
+  glm::mat4 world_state{1.0f};           // model_to_world at the last substep: the particles' frame
   glm::mat4 world_older{1.0f};           // model_to_world at the update before the last
   float dt_before = 0.0f;                // seconds between the older and the last update
   uint32_t history = 0;                  // updates with dt > 0 since the last restart, up to 2
@@ -75,7 +110,7 @@ struct ClothInstance {
 
   std::span<const glm::vec3> positions() const { return out_positions; }
   std::span<const glm::vec3> normals() const { return out_normals; }
-  size_t particle_count() const { return current.size(); }
+  size_t particle_count() const { return particles.size(); }
 };
 
 /// Checks `source` (check_cloth) and allocates all the state an update uses. O(particles +
