@@ -355,6 +355,11 @@ TEST(Cloth, VectorAndScalarPathsAgreeBitForBit) {
     cases.push_back({"3 iterations, speed limit, thickness", g});
   }
   {
+    GridCloth g = make_grid_cloth(40, 10, 0.03f);  // rows of 40: the bench's groups, idle lanes
+    g.settings.iterations = 2;
+    cases.push_back({"40 wide, 2 iterations", g});
+  }
+  {
     GridCloth g = scrambled(make_grid_cloth(20, 24, 0.04f), 11);
     std::mt19937 rng(7);
     std::shuffle(g.stretch.begin(), g.stretch.end(), rng);
