@@ -264,8 +264,12 @@ OSSA_CLOTH_TARGET void carry8(ClothParticles& p, size_t count, const glm::mat3& 
 }
 
 OSSA_CLOTH_TARGET uint32_t predict8(ClothParticles& c, size_t first, float keep, const glm::vec3& gravity,
-                                    float max_step) {
-  const Rows8 at = load8(c, first), p = load8(c, first, true);
+                                    float max_step, const glm::mat3* r, const glm::vec3& t) {
+  Rows8 at = load8(c, first), p = load8(c, first, true);
+  if (r) {  // carry8's operations
+    transform(at, *r, t);
+    transform(p, *r, t);
+  }
   const __m256 fixed = _mm256_cmp_ps(at.w, _mm256_setzero_ps(), _CMP_EQ_OQ);
   const __m256 k = _mm256_set1_ps(keep);
   __m256 vx = _mm256_add_ps(_mm256_mul_ps(_mm256_sub_ps(at.x, p.x), k), _mm256_set1_ps(gravity.x));
@@ -391,8 +395,9 @@ void carry_particles8(ClothParticles& p, size_t count, const glm::mat3& r, const
   carry8(p, count, r, t);
 }
 
-uint32_t predict_particles8(ClothParticles& p, size_t first, float keep, const glm::vec3& gravity, float max_step) {
-  return predict8(p, first, keep, gravity, max_step);
+uint32_t predict_particles8(ClothParticles& p, size_t first, float keep, const glm::vec3& gravity, float max_step,
+                            const glm::mat3* r, const glm::vec3& t) {
+  return predict8(p, first, keep, gravity, max_step, r, t);
 }
 
 void push_out_colliders8(ClothParticles& p, size_t first, const glm::vec4* step, size_t count) {

@@ -52,8 +52,10 @@ void carry_particles8(ClothParticles& p, size_t count, const glm::mat3& r, const
 
 /// The prediction of particles first .. first + 7 without drag (cloth_solve.cpp's predict):
 /// free ones get previous = x, x += (x - previous) * keep + gravity (the step clamped to max_step
-/// when it is > 0). Returns the fixed lanes (w == 0), left for the caller. O(1).
-uint32_t predict_particles8(ClothParticles& p, size_t first, float keep, const glm::vec3& gravity, float max_step);
+/// when it is > 0); with r, all are first carried as carry_particles8 carries them. Returns the
+/// fixed lanes (w == 0), left for the caller. O(1).
+uint32_t predict_particles8(ClothParticles& p, size_t first, float keep, const glm::vec3& gravity, float max_step,
+                            const glm::mat3* r, const glm::vec3& t);
 
 /// Pushes particles first .. first + 7 (first + 8 <= particle count; free ones, w != 0) out of
 /// each collider in turn, as cloth_solve.cpp's push_out does, the previous position giving the
