@@ -322,6 +322,14 @@ void evaluate_layered(State& s, const NodeInfo& info, const Advance& advance, fl
     const std::vector<float>& morph_mask = s.def->layer_morphs[info.aux + k];
     for (size_t c = 0; c < ow.size(); ++c) ow[c] += (tw[c] - ow[c]) * (current * morph_mask[c]);
     const std::vector<float>& mask = s.def->masks[info.aux + k];
+    if (s.hidden >= 0 && s.def->layer_covered[info.aux + k][static_cast<size_t>(s.hidden)]) {
+      // Under a slot that covers every joint this layer weighs: only the slot's shown lanes are
+      // seen, and there the blend leaves the base (its weight is 0) but for its renormalization,
+      // which is kept bit for bit. A mesh-space blend turns only mask roots: all covered.
+      for (const auto& [first, last] : s.def->slot_shown_lanes[static_cast<size_t>(s.hidden)])
+        blend_layered_lanes(out, tmp, mask, current, out, first, last);
+      continue;
+    }
     if (layer.mesh_space_rotation()) blend_mesh_space(s, s.def->layer_joints[info.aux + k], mask, current, tmp, out);
     else blend_layered(out, tmp, mask, current, out);
   }
@@ -373,12 +381,36 @@ void evaluate_morph(State& s, const NodeInfo& info, const Advance& advance, floa
   }
 }
 
+/// Whether a node keeps poses for later or reads joints in model space (see evaluate).
+bool needs_whole_poses(Kind kind) {
+  switch (kind) {
+    case Kind::Clip:
+    case Kind::BlendAlpha:
+    case Kind::Select:
+    case Kind::Layered:
+    case Kind::BlendSpace:
+    case Kind::Additive:
+    case Kind::Morph: return false;
+    default: return true;
+  }
+}
+
 }  // namespace
 
 void evaluate(State& s, uint16_t n, const Advance& advance, float weight, bool dominant, PoseSpan out,
               std::span<float> ow, uint32_t depth) {
   const NodeInfo& info = s.def->nodes[n];
   s.node_weights[n] = weight;
+  if (s.hidden >= 0 && needs_whole_poses(info.kind)) {
+    // Nodes that keep poses for later (a machine's history, a slot's, spring and foot lock state)
+    // or read joints in model space (the procedural nodes, retargeting) see whole poses: their
+    // subtree evaluates every joint, as without a slot above.
+    const int32_t hidden = s.hidden;
+    s.hidden = -1;
+    evaluate(s, n, advance, weight, dominant, out, ow, depth);
+    s.hidden = hidden;
+    return;
+  }
   switch (info.kind) {
     case Kind::Clip: return evaluate_clip(s, n, info, advance, dominant, out, ow);
     case Kind::Retarget: return evaluate_retarget(s, n, advance, out, ow);
