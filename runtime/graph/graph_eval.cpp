@@ -381,36 +381,12 @@ void evaluate_morph(State& s, const NodeInfo& info, const Advance& advance, floa
   }
 }
 
-/// Whether a node keeps poses for later or reads joints in model space (see evaluate).
-bool needs_whole_poses(Kind kind) {
-  switch (kind) {
-    case Kind::Clip:
-    case Kind::BlendAlpha:
-    case Kind::Select:
-    case Kind::Layered:
-    case Kind::BlendSpace:
-    case Kind::Additive:
-    case Kind::Morph: return false;
-    default: return true;
-  }
-}
-
 }  // namespace
 
 void evaluate(State& s, uint16_t n, const Advance& advance, float weight, bool dominant, PoseSpan out,
               std::span<float> ow, uint32_t depth) {
   const NodeInfo& info = s.def->nodes[n];
   s.node_weights[n] = weight;
-  if (s.hidden >= 0 && needs_whole_poses(info.kind)) {
-    // Nodes that keep poses for later (a machine's history, a slot's, spring and foot lock state)
-    // or read joints in model space (the procedural nodes, retargeting) see whole poses: their
-    // subtree evaluates every joint, as without a slot above.
-    const int32_t hidden = s.hidden;
-    s.hidden = -1;
-    evaluate(s, n, advance, weight, dominant, out, ow, depth);
-    s.hidden = hidden;
-    return;
-  }
   switch (info.kind) {
     case Kind::Clip: return evaluate_clip(s, n, info, advance, dominant, out, ow);
     case Kind::Retarget: return evaluate_retarget(s, n, advance, out, ow);

@@ -191,7 +191,8 @@ struct GraphDefinition::Impl {
   /// the mask leaves out: what a slot showing a montage at full weight shows of its input.
   std::vector<std::vector<std::pair<uint32_t, uint32_t>>> slot_shown_lanes;
   /// Per layer (parallel to masks), per slot mask: 1 when the slot mask covers every joint the
-  /// layer weighs (the layer's blend is then seen only on the slot's shown lanes).
+  /// layer weighs and the layer lies under that slot with no node keeping poses or reading model
+  /// space on any way there (its blend is then seen only on the slot's shown lanes).
   std::vector<std::vector<uint8_t>> layer_covered;
   std::vector<graph_detail::MontageInfo> montages;
   std::vector<graph_detail::TrackInfo> tracks;
@@ -320,8 +321,8 @@ struct GraphInstance::State {
   GraphInstance* self = nullptr;  // handed to the listener
   RootMotionDelta root_motion;    // the last update's, from root-motion montages
   // While a masked override slot that shows its montages at full weight evaluates its input: its
-  // mask (Impl::slot_masks), whose joints nothing will see of that input; -1 otherwise. Nodes
-  // without pose memory may leave those joints unblended (graph_slot.cpp says which do).
+  // mask (Impl::slot_masks), whose joints nothing will see of that input; -1 otherwise. Layers
+  // marked in Impl::layer_covered for it leave those joints unblended (graph_slot.cpp).
   int32_t hidden = -1;
   glm::vec3 root_motion_up{0.0f, 1.0f, 0.0f};
 };

@@ -19,7 +19,8 @@
 // montages' clips for the joints it shows only (a filtered sampling cache, slot_shown_joints), and
 // while a masked override at full weight evaluates its input, State::hidden names its mask, so a
 // layer of that input whose mask the slot covers blends only the lanes the slot shows (graph_eval.cpp).
-// Nodes with pose memory or model-space reads evaluate their subtrees whole (evaluate() clears it).
+// Only layers reached with no node that keeps poses (a machine's history, a slot's, spring and foot
+// lock state) or reads model space (procedural nodes) on the way are marked (mark_reach).
 // bind_slots decodes the slot nodes for the definition.
 #include <algorithm>
 #include <cmath>
@@ -221,6 +222,58 @@ void evaluate_slot(State& s, uint16_t n, const Advance& advance, float weight, b
   inertia->last_dt = advance.dt;
 }
 
+namespace {
+
+/// Marks what node `n` reaches, itself included: in `open` what it reaches with no node that keeps
+/// poses or reads model space on the way (a layer there may leave a covering slot's joints
+/// unblended), in `closed` what it reaches through one (it may not: that node needs whole poses).
+void mark_reach(const GraphDefinition::Impl& d, uint16_t n, bool through, std::vector<uint8_t>& open,
+                std::vector<uint8_t>& closed) {
+  std::vector<uint8_t>& seen = through ? closed : open;
+  if (seen[n]) return;
+  seen[n] = 1;
+  const NodeInfo& info = d.nodes[n];
+  const auto go = [&](uint16_t child, bool memory) { mark_reach(d, child, through || memory, open, closed); };
+  switch (info.kind) {
+    case Kind::Clip:
+    case Kind::Retarget:
+    case Kind::BlendSpace: return;
+    case Kind::BlendAlpha: {
+      const auto* t = static_cast<const fb::BlendAlphaNode*>(info.table);
+      go(t->a(), false);
+      go(t->b(), false);
+      return;
+    }
+    case Kind::Select:
+      for (uint16_t c : *static_cast<const fb::SelectNode*>(info.table)->children()) go(c, false);
+      return;
+    case Kind::Layered: {
+      const auto* t = static_cast<const fb::LayeredBlendNode*>(info.table);
+      go(t->base(), false);
+      for (const fb::Layer* layer : *t->layers()) go(layer->node(), false);
+      return;
+    }
+    case Kind::Additive: {
+      const auto* t = static_cast<const fb::AdditiveNode*>(info.table);
+      go(t->base(), false);
+      go(t->additive(), false);
+      return;
+    }
+    case Kind::Morph: return go(static_cast<const fb::MorphWeightsNode*>(info.table)->input(), false);
+    case Kind::Machine:
+      for (const fb::State* st : *d.machines[info.machine].fb->states()) go(st->node(), true);
+      return;
+    case Kind::Slot: return go(static_cast<const fb::SlotNode*>(info.table)->input(), true);
+    case Kind::TwoBoneIk:
+    case Kind::Aim:
+    case Kind::FootPlacement:
+    case Kind::FootLock:
+    case Kind::Spring: return go(procedural_input(info), true);
+  }
+}
+
+}  // namespace
+
 void bind_slots(GraphDefinition::Impl& d) {
   const auto parents = d.skeleton.parents();
   for (NodeInfo& info : d.nodes) {
@@ -263,12 +316,6 @@ void bind_slots(GraphDefinition::Impl& d) {
         if (!shown.empty() && shown.back().second == j) shown.back().second = j + kPoseLanes;
         else shown.emplace_back(j, j + kPoseLanes);
       }
-      for (size_t l = 0; l < d.masks.size(); ++l) {
-        bool covered = true;
-        for (uint32_t j = 0; j < d.joints && covered; ++j) covered = !(d.masks[l][j] > 0.0f) || mask[j] > 0.0f;
-        d.layer_covered.resize(d.masks.size());
-        d.layer_covered[l].push_back(covered ? 1 : 0);
-      }
       slot.mask = static_cast<int32_t>(d.slot_masks.size());
       slot.mesh_space = t->mesh_space_rotation() && !slot.additive;
       d.slot_shown_lanes.push_back(std::move(shown));
@@ -278,6 +325,24 @@ void bind_slots(GraphDefinition::Impl& d) {
     }
     info.aux = static_cast<uint32_t>(d.slots.size());
     d.slots.push_back(slot);
+  }
+  d.layer_covered.assign(d.masks.size(), std::vector<uint8_t>(d.slot_masks.size(), 0));
+  for (const SlotInfo& slot : d.slots) {
+    if (slot.mask < 0) continue;
+    std::vector<uint8_t> open(d.nodes.size(), 0), closed(d.nodes.size(), 0);
+    mark_reach(d, slot.input, false, open, closed);
+    const std::vector<float>& mask = d.slot_masks[static_cast<size_t>(slot.mask)];
+    for (size_t n = 0; n < d.nodes.size(); ++n) {
+      const NodeInfo& info = d.nodes[n];
+      if (info.kind != Kind::Layered || !open[n] || closed[n]) continue;
+      const auto* t = static_cast<const fb::LayeredBlendNode*>(info.table);
+      for (uint32_t k = 0; k < t->layers()->size(); ++k) {
+        const std::vector<float>& layer = d.masks[info.aux + k];
+        bool covered = true;
+        for (uint32_t j = 0; j < d.joints && covered; ++j) covered = !(layer[j] > 0.0f) || mask[j] > 0.0f;
+        d.layer_covered[info.aux + k][static_cast<size_t>(slot.mask)] = covered ? 1 : 0;
+      }
+    }
   }
 }
 
