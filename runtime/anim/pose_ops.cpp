@@ -313,15 +313,19 @@ OSSA_INLINE static void blend_n_body(std::span<const ConstPoseSpan> poses, std::
 OSSA_VECTOR_DISPATCH(blend_n, (std::span<const ConstPoseSpan> poses, std::span<const float> weights, PoseSpan out),
                      (poses, weights, out))
 
-OSSA_INLINE static void blend_layered_body(ConstPoseSpan base, ConstPoseSpan layer,
-                                           std::span<const float> joint_weights, float weight, PoseSpan out) {
+OSSA_INLINE static void blend_layered_range_body(ConstPoseSpan base, ConstPoseSpan layer,
+                                                 std::span<const float> joint_weights, float weight, PoseSpan out,
+                                                 size_t lo, size_t hi) {
   const detail::FlushDenormals flush;  // internal/float_env.h
   const size_t stride = common_stride(base, layer, out);
+  hi = std::min(hi, stride);
   // Joints past joint_weights (and padding lanes) get weight 0: they keep the base pose.
   const size_t weighted = std::min<size_t>(joint_weights.size(), out.joint_count);
   float ts[kChunk];
-  for (size_t first = 0; first < stride; first += kChunk) {
-    const size_t count = std::min<size_t>(kChunk, stride - first);
+  // Every lane's result depends on that lane alone, so a range of whole blocks gives its lanes
+  // the bits a whole-pose call gives them.
+  for (size_t first = lo; first < hi; first += kChunk) {
+    const size_t count = std::min<size_t>(kChunk, hi - first);
     const size_t known = weighted > first ? std::min(weighted - first, count) : 0;
     const float* jw = joint_weights.data() + first;
     size_t l = 0;
@@ -339,10 +343,23 @@ OSSA_INLINE static void blend_layered_body(ConstPoseSpan base, ConstPoseSpan lay
   }
 }
 
-OSSA_VECTOR_DISPATCH(blend_layered,
+namespace {
+OSSA_VECTOR_DISPATCH(blend_layered_range,
                      (ConstPoseSpan base, ConstPoseSpan layer, std::span<const float> joint_weights, float weight,
-                      PoseSpan out),
-                     (base, layer, joint_weights, weight, out))
+                      PoseSpan out, size_t lo, size_t hi),
+                     (base, layer, joint_weights, weight, out, lo, hi))
+}  // namespace
+
+void blend_layered(ConstPoseSpan base, ConstPoseSpan layer, std::span<const float> joint_weights, float weight,
+                   PoseSpan out) {
+  blend_layered_range(base, layer, joint_weights, weight, out, 0, out.stride);
+}
+
+void blend_layered_lanes(ConstPoseSpan base, ConstPoseSpan layer, std::span<const float> joint_weights, float weight,
+                         PoseSpan out, uint32_t first, uint32_t last) {
+  assert(first % kPoseLanes == 0 && last % kPoseLanes == 0);
+  blend_layered_range(base, layer, joint_weights, weight, out, first, last);
+}
 
 void build_joint_mask(std::span<const int16_t> parents, int joint, int depth, std::span<float> out) {
   const size_t n = std::min(parents.size(), out.size());

@@ -33,7 +33,7 @@
 // (check_clip_binding), so no check is repeated per sample.
 //
 // Cost: make_sampling_cache O(joints + animated channels), a few allocations; sample O(joints +
-// runs) + O(keys passed), no allocation; reset O(runs); advance_time O(1).
+// runs) + O(keys passed), no allocation; reset O(runs). advance_time is advance_time.cpp.
 #include <ossa/anim/sample.h>
 
 #include <algorithm>
@@ -44,6 +44,7 @@
 #include <map>
 #include <new>
 #include <span>
+#include <string>
 #include <type_traits>
 #include <utility>
 #include <vector>
@@ -141,8 +142,10 @@ struct SamplingCache::State {
   // run, so pass 1 is one compare (a slow clip, updates faster than keys). Empty when forgotten.
   float all_enter = kInf, all_leave = -kInf;
   std::vector<Track> tracks;  // grouped by run
-  // What move_run reads: tracks, or a prototype's (identical: they depend on the clip and rig only).
+  // What move_run reads: tracks, or a prototype's (identical: they depend on the clip, rig and filter only).
   const Track* track_data = nullptr;
+  // The joint filter the cache was made with (empty: every joint), compared with a prototype's.
+  std::span<const uint8_t> filter;
 };
 
 SamplingCache::SamplingCache() = default;
@@ -476,9 +479,13 @@ void interpolate_slerp(const Lanes& l, float frame) {
 // ---- public API --------------------------------------------------------------------------------
 
 Result<SamplingCache> make_sampling_cache(const ClipView& clip, const SkeletonView& skeleton,
-                                          const SamplingCache* prototype) {
+                                          const SamplingCache* prototype, std::span<const uint8_t> joints) {
   if (Status st = check_clip_binding(clip, skeleton, "make_sampling_cache"); !st) return st.error();
+  if (!joints.empty() && joints.size() != skeleton.joint_count())
+    return Error{"make_sampling_cache: a joint filter of " + std::to_string(joints.size()) + " entries for " +
+                 std::to_string(skeleton.joint_count()) + " joints"};
   auto s = std::make_unique<State>();
+  s->filter = joints;
   s->clip = clip.fb;
   s->stream = clip.key_values().data();
   s->joint_count = static_cast<uint32_t>(skeleton.joint_count());
@@ -486,14 +493,20 @@ Result<SamplingCache> make_sampling_cache(const ClipView& clip, const SkeletonVi
   s->last_frame = static_cast<float>(clip.frame_count() - 1);
   const size_t stride = s->stride;
   // Runs: channels that address the same key-frame range share one, in order of first use;
-  // tracks are grouped by run.
+  // tracks are grouped by run. A filter drops the channels of the joints it leaves out (and runs
+  // left without a channel), but not their blocks' kinds: pass 2 then treats every lane as the
+  // unfiltered cache does, which keeps the kept joints' bits.
   s->block_kinds.assign(s->stride / kPoseLanes, 0);
   std::vector<Run> runs;
-  const auto animated = clip.animated();
+  std::vector<const fb::AnimatedChannel*> animated;
+  for (const fb::AnimatedChannel& a : clip.animated()) {
+    s->block_kinds[a.joint() / kPoseLanes] |= static_cast<uint8_t>(1u << static_cast<uint32_t>(a.channel()));
+    if (joints.empty() || joints[a.joint()] != 0) animated.push_back(&a);
+  }
   std::map<std::pair<uint32_t, uint32_t>, uint32_t> run_of;  // (first_key, key_count) -> run
   std::vector<uint32_t> run_index(animated.size());
   for (size_t i = 0; i < animated.size(); ++i) {
-    const fb::AnimatedChannel& a = animated[i];
+    const fb::AnimatedChannel& a = *animated[i];
     const auto [it, added] =
         run_of.emplace(std::make_pair(a.first_key(), a.key_count()), static_cast<uint32_t>(runs.size()));
     if (added) {
@@ -504,7 +517,6 @@ Result<SamplingCache> make_sampling_cache(const ClipView& clip, const SkeletonVi
     }
     run_index[i] = it->second;
     ++runs[it->second].track_count;
-    s->block_kinds[a.joint() / kPoseLanes] |= static_cast<uint8_t>(1u << static_cast<uint32_t>(a.channel()));
   }
   // Floats first (a multiple of 8 floats: the runs start 32-byte aligned), then the runs.
   const size_t floats = (2 * kPoseComponents + 6) * stride;
@@ -551,16 +563,17 @@ Result<SamplingCache> make_sampling_cache(const ClipView& clip, const SkeletonVi
   std::vector<uint32_t> filled(runs.size(), 0);
   for (size_t i = 0; i < animated.size(); ++i) {
     const Run& r = runs[run_index[i]];
-    s->tracks[r.first_track + filled[run_index[i]]++] = make_track(animated[i], s->stride);
+    s->tracks[r.first_track + filled[run_index[i]]++] = make_track(*animated[i], s->stride);
   }
   forget_cursors(*s);
   s->fixed = s->k0;
   s->track_data = s->tracks.data();
   s->kinds = s->block_kinds.data();
   if (prototype && prototype->state() && prototype->state()->clip == s->clip &&
-      prototype->state()->joint_count == s->joint_count) {
-    // Same clip, same rig: identical fixed blocks and decode records. Only the cursors and the
-    // decoded key pairs stay per instance.
+      prototype->state()->joint_count == s->joint_count && prototype->state()->filter.data() == joints.data() &&
+      prototype->state()->filter.size() == joints.size()) {
+    // Same clip, rig and filter: identical fixed blocks and decode records. Only the cursors and
+    // the decoded key pairs stay per instance.
     s->fixed = prototype->state()->fixed;
     s->track_data = prototype->state()->track_data;
     s->kinds = prototype->state()->kinds;
@@ -623,26 +636,6 @@ void sample(const ClipView& clip, float time, const SampleOptions& options, Samp
   const Lanes lanes{s.k0, s.fixed, s.k1, s.start, s.inv_length, s.kinds, out.base, s.stride};
   if (options.rotation == RotationInterpolation::Slerp) interpolate_slerp(lanes, frame);
   else interpolate_nlerp(lanes, frame);
-}
-
-float advance_time(float time, float dt, float rate, float duration, bool loop, int* loops) {
-  if (loops) *loops = 0;
-  double t = static_cast<double>(time) + static_cast<double>(dt) * static_cast<double>(rate);
-  if (!std::isfinite(t)) t = 0.0;
-  if (!(duration > 0.0f) || !std::isfinite(duration)) return 0.0f;
-  const double d = duration;
-  if (!loop) return static_cast<float>(t < 0.0 ? 0.0 : (t > d ? d : t));
-  const double wraps = std::floor(t / d);
-  double r = t - wraps * d;
-  if (r < 0.0) r = 0.0;
-  auto result = static_cast<float>(r);
-  int n = wraps > 1e9 ? 1000000000 : (wraps < -1e9 ? -1000000000 : static_cast<int>(wraps));
-  if (result >= duration) {  // r just below d rounds to d in float: that is the next cycle's start
-    result = 0.0f;
-    ++n;
-  }
-  if (loops) *loops = n;
-  return result;
 }
 
 }  // namespace ossa

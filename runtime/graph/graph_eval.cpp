@@ -322,6 +322,14 @@ void evaluate_layered(State& s, const NodeInfo& info, const Advance& advance, fl
     const std::vector<float>& morph_mask = s.def->layer_morphs[info.aux + k];
     for (size_t c = 0; c < ow.size(); ++c) ow[c] += (tw[c] - ow[c]) * (current * morph_mask[c]);
     const std::vector<float>& mask = s.def->masks[info.aux + k];
+    if (s.hidden >= 0 && s.def->layer_covered[info.aux + k][static_cast<size_t>(s.hidden)]) {
+      // Under a slot that covers every joint this layer weighs: only the slot's shown lanes are
+      // seen, and there the blend leaves the base (its weight is 0) but for its renormalization,
+      // which is kept bit for bit. A mesh-space blend turns only mask roots: all covered.
+      for (const auto& [first, last] : s.def->slot_shown_lanes[static_cast<size_t>(s.hidden)])
+        blend_layered_lanes(out, tmp, mask, current, out, first, last);
+      continue;
+    }
     if (layer.mesh_space_rotation()) blend_mesh_space(s, s.def->layer_joints[info.aux + k], mask, current, tmp, out);
     else blend_layered(out, tmp, mask, current, out);
   }

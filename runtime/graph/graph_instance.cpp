@@ -127,12 +127,13 @@ Result<GraphInstance> GraphInstance::create(const GraphDefinition& definition, s
   s->springs = d.springs;  // each instance its own chain state, copied from the checked prototypes
   s->event_capacity = event_capacity;
   s->events.reserve(event_capacity);
-  if (!d.montages.empty()) {  // montages: fixed plays, their section links, a cache per montage clip
+  if (!d.montages.empty()) {  // montages: fixed plays, their section links, a cache per track clip
     s->plays.resize(kMaxMontagePlays);
     s->montage_links.assign(size_t{kMaxMontagePlays} * d.max_sections, -1);
     for (size_t k = 0; k < s->plays.size(); ++k) s->plays[k].next = s->montage_links.data() + k * d.max_sections;
-    for (uint16_t clip : d.montage_cache_clips) {
-      auto cache = make_sampling_cache(d.clips[clip], d.skeleton, &d.prototypes[clip]);
+    for (size_t k = 0; k < d.montage_cache_clips.size(); ++k) {
+      auto cache = make_sampling_cache(d.clips[d.montage_cache_clips[k]], d.skeleton, &d.montage_prototypes[k],
+                                       d.montage_cache_joints[k]);
       if (!cache) return cache.error();
       s->montage_caches.push_back(std::move(*cache));
     }

@@ -187,15 +187,26 @@ struct GraphDefinition::Impl {
   /// depth-first order), so a slot writes exactly those and leaves every other joint's bits alone.
   std::vector<std::vector<std::pair<uint32_t, uint32_t>>> slot_ranges;
   std::vector<std::string_view> slot_names, groups;  // distinct names
+  /// Parallel to slot_masks: the lanes [first, last), whole blocks of kPoseLanes, that hold a joint
+  /// the mask leaves out: what a slot showing a montage at full weight shows of its input.
+  std::vector<std::vector<std::pair<uint32_t, uint32_t>>> slot_shown_lanes;
+  /// Per layer (parallel to masks), per slot mask: 1 when the slot mask covers every joint the
+  /// layer weighs and the layer lies under that slot with no node keeping poses or reading model
+  /// space on any way there (its blend is then seen only on the slot's shown lanes).
+  std::vector<std::vector<uint8_t>> layer_covered;
   std::vector<graph_detail::MontageInfo> montages;
   std::vector<graph_detail::TrackInfo> tracks;
   std::vector<graph_detail::SegmentInfo> segments;
   std::vector<graph_detail::Marker> markers;
   std::vector<uint16_t> montage_cache_clips;  // per montage sampling cache: its clip
-  std::vector<Pose> track_reference;          // per track: its first frame (additive slots)
-  Pose identity;                              // every joint at identity (masked additives)
-  uint32_t max_sections = 0;                  // sections of the largest montage
-  uint32_t inertial_slots = 0;                // slots with an inertialization state
+  // Parallel to montage_cache_clips: the joints its track's slots show (empty: all; ossa/anim/sample.h's
+  // joint filter), and the prototype of that clip and filter the instances' caches share.
+  std::vector<std::vector<uint8_t>> montage_cache_joints;
+  std::vector<SamplingCache> montage_prototypes;
+  std::vector<Pose> track_reference;  // per track: its first frame (additive slots)
+  Pose identity;                      // every joint at identity (masked additives)
+  uint32_t max_sections = 0;          // sections of the largest montage
+  uint32_t inertial_slots = 0;        // slots with an inertialization state
 };
 
 namespace graph_detail {
@@ -309,6 +320,10 @@ struct GraphInstance::State {
   void* listener_user = nullptr;
   GraphInstance* self = nullptr;  // handed to the listener
   RootMotionDelta root_motion;    // the last update's, from root-motion montages
+  // While a masked override slot that shows its montages at full weight evaluates its input: its
+  // mask (Impl::slot_masks), whose joints nothing will see of that input; -1 otherwise. Layers
+  // marked in Impl::layer_covered for it leave those joints unblended (graph_slot.cpp).
+  int32_t hidden = -1;
   glm::vec3 root_motion_up{0.0f, 1.0f, 0.0f};
 };
 
@@ -368,6 +383,13 @@ void evaluate_slot(GraphInstance::State& s, uint16_t n, const Advance& advance, 
 /// Decodes the slot nodes and montages of a definition (tracks, segments, markers, masks, reference
 /// poses); errors name the montage (a segment past its clip's end, a clip bound to no sampler).
 Status bind_montages(GraphDefinition::Impl& d, const std::string& where);
+/// Decodes the slot nodes (graph_slot.cpp): their names, groups, masks, mask ranges and chains.
+void bind_slots(GraphDefinition::Impl& d);
+/// The joints the slot nodes named `slot` read from a montage's pose (ossa/anim/sample.h's joint
+/// filter): their masks and mesh-space chains; empty (every joint) when one of them has no mask.
+std::vector<uint8_t> slot_shown_joints(const GraphDefinition::Impl& d, uint16_t slot);
+/// `name`'s index in `names`, appended when absent.
+uint16_t intern_name(std::vector<std::string_view>& names, std::string_view name);
 /// Advances every playing montage by dt: blend weights, positions, sections, notifies, root motion.
 void advance_montages(GraphInstance::State& s, float dt);
 /// After the graph is evaluated: montages blended out are ended and their plays freed.

@@ -32,13 +32,6 @@ constexpr uint32_t kMaxSectionSteps = 1024;  // section ends followed in one upd
                                              // under a huge dt plays at most this many passes)
 constexpr double kNever = std::numeric_limits<double>::infinity();
 
-uint16_t intern(std::vector<std::string_view>& names, std::string_view name) {
-  const auto it = std::find(names.begin(), names.end(), name);
-  if (it != names.end()) return static_cast<uint16_t>(it - names.begin());
-  names.push_back(name);
-  return static_cast<uint16_t>(names.size() - 1);
-}
-
 std::string_view sv(const flatbuffers::String* s) { return flatbuffers::GetStringView(s); }
 
 double section_end(const MontageInfo& mi, int k) {
@@ -264,6 +257,13 @@ MontagePlay* find_play(State& s, int montage, bool prefer_active) {
 
 }  // namespace
 
+uint16_t intern_name(std::vector<std::string_view>& names, std::string_view name) {
+  const auto it = std::find(names.begin(), names.end(), name);
+  if (it != names.end()) return static_cast<uint16_t>(it - names.begin());
+  names.push_back(name);
+  return static_cast<uint16_t>(names.size() - 1);
+}
+
 const TrackInfo* track_for(const GraphDefinition::Impl& d, const MontageInfo& m, uint16_t slot) {
   for (uint32_t t = 0; t < m.track_count; ++t)
     if (d.tracks[m.first_track + t].slot == slot) return &d.tracks[m.first_track + t];
@@ -283,62 +283,21 @@ void sample_track(State& s, const TrackInfo& track, double position, PoseSpan ou
 }
 
 Status bind_montages(GraphDefinition::Impl& d, const std::string& where) {
-  const auto parents = d.skeleton.parents();
-  for (NodeInfo& info : d.nodes) {
-    if (info.kind != Kind::Slot) continue;
-    const auto* t = static_cast<const fb::SlotNode*>(info.table);
-    SlotInfo slot;
-    slot.input = t->input();
-    slot.slot = intern(d.slot_names, sv(t->slot()));
-    slot.group = intern(d.groups, sv(t->group()));
-    slot.additive = t->additive();
-    if (t->mask() && t->mask()->size() > 0) {
-      std::vector<float> mask(d.joints, 0.0f);
-      for (const fb::MaskEntry* e : *t->mask()) build_joint_mask(parents, e->joint(), e->depth(), mask);
-      LayerJoints lj;  // mask roots and their ancestors, as a layer's (graph_definition.cpp)
-      std::vector<uint8_t> on_chain(d.joints, 0), is_root(d.joints, 0);
-      for (uint32_t j = 0; j < d.joints; ++j) {
-        const int p = parents[j];
-        if (!(mask[j] > 0.0f) || (p >= 0 && mask[static_cast<size_t>(p)] > 0.0f)) continue;
-        is_root[j] = 1;
-        for (int a = static_cast<int>(j); a >= 0 && !on_chain[static_cast<size_t>(a)];
-             a = parents[static_cast<size_t>(a)])
-          on_chain[static_cast<size_t>(a)] = 1;
-      }
-      for (uint32_t j = 0; j < d.joints; ++j) {
-        if (!on_chain[j]) continue;
-        lj.chain.push_back(static_cast<uint16_t>(j));
-        lj.root.push_back(is_root[j]);
-      }
-      std::vector<std::pair<uint32_t, uint32_t>> ranges;
-      for (uint32_t j = 0; j < d.joints; ++j) {
-        if (!(mask[j] > 0.0f)) continue;
-        if (!ranges.empty() && ranges.back().second == j) ranges.back().second = j + 1;
-        else ranges.emplace_back(j, j + 1);
-      }
-      slot.mask = static_cast<int32_t>(d.slot_masks.size());
-      slot.mesh_space = t->mesh_space_rotation() && !slot.additive;
-      d.slot_ranges.push_back(std::move(ranges));
-      d.slot_masks.push_back(std::move(mask));
-      d.slot_joints.push_back(std::move(lj));
-    }
-    info.aux = static_cast<uint32_t>(d.slots.size());
-    d.slots.push_back(slot);
-  }
-
+  bind_slots(d);
   if (const auto* montages = d.graph->montages()) {
     for (flatbuffers::uoffset_t i = 0; i < montages->size(); ++i) {
       const fb::Montage& m = *montages->Get(i);
       const std::string at = where + ": montage '" + std::string(sv(m.name())) + "'";
       MontageInfo mi;
       mi.fb = &m;
-      mi.group = intern(d.groups, sv(m.group()));
+      mi.group = intern_name(d.groups, sv(m.group()));
       mi.first_track = static_cast<uint32_t>(d.tracks.size());
       mi.track_count = m.tracks()->size();
-      const size_t first_cache = d.montage_cache_clips.size();
       for (const fb::MontageTrack* track : *m.tracks()) {
         TrackInfo ti;
-        ti.slot = intern(d.slot_names, sv(track->slot()));
+        ti.slot = intern_name(d.slot_names, sv(track->slot()));
+        const size_t first_cache = d.montage_cache_clips.size();
+        std::vector<uint8_t> shown = slot_shown_joints(d, ti.slot);
         ti.first_segment = static_cast<uint32_t>(d.segments.size());
         ti.segment_count = track->segments()->size();
         for (const fb::MontageSegment* seg : *track->segments()) {
@@ -355,7 +314,10 @@ Status bind_montages(GraphDefinition::Impl& d, const std::string& where) {
           const auto cached = std::find(d.montage_cache_clips.begin() + static_cast<std::ptrdiff_t>(first_cache),
                                         d.montage_cache_clips.end(), seg->clip());
           si.cache = static_cast<uint32_t>(cached - d.montage_cache_clips.begin());
-          if (cached == d.montage_cache_clips.end()) d.montage_cache_clips.push_back(seg->clip());
+          if (cached == d.montage_cache_clips.end()) {
+            d.montage_cache_clips.push_back(seg->clip());
+            d.montage_cache_joints.push_back(shown);
+          }
           si.begin = ti.length;
           ti.length +=
               (static_cast<double>(seg->end()) - static_cast<double>(seg->start())) / static_cast<double>(seg->rate());
@@ -404,6 +366,13 @@ Status bind_montages(GraphDefinition::Impl& d, const std::string& where) {
           m.blend_in_curve() == fb::MontageCurve::Inertialize || m.blend_out_curve() == fb::MontageCurve::Inertialize;
       d.montages.push_back(std::move(mi));
     }
+  }
+  // The filtered prototypes, once every filter has its final address.
+  for (size_t k = 0; k < d.montage_cache_clips.size(); ++k) {
+    const uint16_t clip = d.montage_cache_clips[k];
+    auto prototype = make_sampling_cache(d.clips[clip], d.skeleton, nullptr, d.montage_cache_joints[k]);
+    if (!prototype) return Error{where + ": " + prototype.error().message};
+    d.montage_prototypes.push_back(std::move(*prototype));
   }
   for (SlotInfo& slot : d.slots)
     for (const MontageInfo& mi : d.montages)

@@ -14,6 +14,14 @@
 // the quintic the state machines use (graph_machine.cpp), starting with the velocity of the slot's
 // own last outputs: no pop, no lag. Only slots of a group with an inertializing montage keep that
 // history.
+//
+// What nobody will see is not computed, where that keeps every seen bit: a masked slot samples its
+// montages' clips for the joints it shows only (a filtered sampling cache, slot_shown_joints), and
+// while a masked override at full weight evaluates its input, State::hidden names its mask, so a
+// layer of that input whose mask the slot covers blends only the lanes the slot shows (graph_eval.cpp).
+// Only layers reached with no node that keeps poses (a machine's history, a slot's, spring and foot
+// lock state) or reads model space (procedural nodes) on the way are marked (mark_reach).
+// bind_slots decodes the slot nodes for the definition.
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -175,7 +183,15 @@ void evaluate_slot(State& s, uint16_t n, const Advance& advance, float weight, b
   const auto input_seen = [&](float t) { return !replaces_all || t < 1.0f; };
   if (input_seen(total) || (switched && input_seen(total_before))) {
     const float shown = replaces_all ? 1.0f - std::min(total, 1.0f) : 1.0f;
+    // A masked override at full weight (and no switch, whose pose from before needs the input's
+    // masked joints) shows only the input's unmasked joints: the input may skip blending the rest.
+    float full = 0.0f;  // the weights summed as combine() sums them
+    for (uint32_t k = 0; k < count; ++k)
+      if (entries[k].play->weight > 0.0f) full += entries[k].play->weight;
+    const int32_t hidden = s.hidden;
+    if (!slot.additive && slot.mask >= 0 && full >= 1.0f && !switched) s.hidden = slot.mask;
     evaluate(s, slot.input, advance, weight * shown, dominant && shown >= 0.5f, out, ow, depth);
+    s.hidden = hidden;
   } else {
     std::copy(d.default_weights.begin(), d.default_weights.end(), ow.begin());
   }
@@ -204,6 +220,144 @@ void evaluate_slot(State& s, uint16_t n, const Advance& advance, float weight, b
   stream_pose(out, inertia->last);
   inertia->last_update = s.update_counter;
   inertia->last_dt = advance.dt;
+}
+
+namespace {
+
+/// Marks what node `n` reaches, itself included: in `open` what it reaches with no node that keeps
+/// poses or reads model space on the way (a layer there may leave a covering slot's joints
+/// unblended), in `closed` what it reaches through one (it may not: that node needs whole poses).
+void mark_reach(const GraphDefinition::Impl& d, uint16_t n, bool through, std::vector<uint8_t>& open,
+                std::vector<uint8_t>& closed) {
+  std::vector<uint8_t>& seen = through ? closed : open;
+  if (seen[n]) return;
+  seen[n] = 1;
+  const NodeInfo& info = d.nodes[n];
+  const auto go = [&](uint16_t child, bool memory) { mark_reach(d, child, through || memory, open, closed); };
+  switch (info.kind) {
+    case Kind::Clip:
+    case Kind::Retarget:
+    case Kind::BlendSpace: return;
+    case Kind::BlendAlpha: {
+      const auto* t = static_cast<const fb::BlendAlphaNode*>(info.table);
+      go(t->a(), false);
+      go(t->b(), false);
+      return;
+    }
+    case Kind::Select:
+      for (uint16_t c : *static_cast<const fb::SelectNode*>(info.table)->children()) go(c, false);
+      return;
+    case Kind::Layered: {
+      const auto* t = static_cast<const fb::LayeredBlendNode*>(info.table);
+      go(t->base(), false);
+      for (const fb::Layer* layer : *t->layers()) go(layer->node(), false);
+      return;
+    }
+    case Kind::Additive: {
+      const auto* t = static_cast<const fb::AdditiveNode*>(info.table);
+      go(t->base(), false);
+      go(t->additive(), false);
+      return;
+    }
+    case Kind::Morph: return go(static_cast<const fb::MorphWeightsNode*>(info.table)->input(), false);
+    case Kind::Machine:
+      for (const fb::State* st : *d.machines[info.machine].fb->states()) go(st->node(), true);
+      return;
+    case Kind::Slot: return go(static_cast<const fb::SlotNode*>(info.table)->input(), true);
+    case Kind::TwoBoneIk:
+    case Kind::Aim:
+    case Kind::FootPlacement:
+    case Kind::FootLock:
+    case Kind::Spring: return go(procedural_input(info), true);
+  }
+}
+
+}  // namespace
+
+void bind_slots(GraphDefinition::Impl& d) {
+  const auto parents = d.skeleton.parents();
+  for (NodeInfo& info : d.nodes) {
+    if (info.kind != Kind::Slot) continue;
+    const auto* t = static_cast<const fb::SlotNode*>(info.table);
+    SlotInfo slot;
+    slot.input = t->input();
+    slot.slot = intern_name(d.slot_names, flatbuffers::GetStringView(t->slot()));
+    slot.group = intern_name(d.groups, flatbuffers::GetStringView(t->group()));
+    slot.additive = t->additive();
+    if (t->mask() && t->mask()->size() > 0) {
+      std::vector<float> mask(d.joints, 0.0f);
+      for (const fb::MaskEntry* e : *t->mask()) build_joint_mask(parents, e->joint(), e->depth(), mask);
+      LayerJoints lj;  // mask roots and their ancestors, as a layer's (graph_definition.cpp)
+      std::vector<uint8_t> on_chain(d.joints, 0), is_root(d.joints, 0);
+      for (uint32_t j = 0; j < d.joints; ++j) {
+        const int p = parents[j];
+        if (!(mask[j] > 0.0f) || (p >= 0 && mask[static_cast<size_t>(p)] > 0.0f)) continue;
+        is_root[j] = 1;
+        for (int a = static_cast<int>(j); a >= 0 && !on_chain[static_cast<size_t>(a)];
+             a = parents[static_cast<size_t>(a)])
+          on_chain[static_cast<size_t>(a)] = 1;
+      }
+      for (uint32_t j = 0; j < d.joints; ++j) {
+        if (!on_chain[j]) continue;
+        lj.chain.push_back(static_cast<uint16_t>(j));
+        lj.root.push_back(is_root[j]);
+      }
+      std::vector<std::pair<uint32_t, uint32_t>> ranges;
+      for (uint32_t j = 0; j < d.joints; ++j) {
+        if (!(mask[j] > 0.0f)) continue;
+        if (!ranges.empty() && ranges.back().second == j) ranges.back().second = j + 1;
+        else ranges.emplace_back(j, j + 1);
+      }
+      std::vector<std::pair<uint32_t, uint32_t>> shown;  // blocks with an unmasked joint
+      for (uint32_t j = 0; j < d.joints; j += kPoseLanes) {
+        bool any = false;
+        for (uint32_t k = j; k < std::min(j + kPoseLanes, d.joints); ++k) any |= !(mask[k] > 0.0f);
+        if (!any) continue;
+        if (!shown.empty() && shown.back().second == j) shown.back().second = j + kPoseLanes;
+        else shown.emplace_back(j, j + kPoseLanes);
+      }
+      slot.mask = static_cast<int32_t>(d.slot_masks.size());
+      slot.mesh_space = t->mesh_space_rotation() && !slot.additive;
+      d.slot_shown_lanes.push_back(std::move(shown));
+      d.slot_ranges.push_back(std::move(ranges));
+      d.slot_masks.push_back(std::move(mask));
+      d.slot_joints.push_back(std::move(lj));
+    }
+    info.aux = static_cast<uint32_t>(d.slots.size());
+    d.slots.push_back(slot);
+  }
+  d.layer_covered.assign(d.masks.size(), std::vector<uint8_t>(d.slot_masks.size(), 0));
+  for (const SlotInfo& slot : d.slots) {
+    if (slot.mask < 0) continue;
+    std::vector<uint8_t> open(d.nodes.size(), 0), closed(d.nodes.size(), 0);
+    mark_reach(d, slot.input, false, open, closed);
+    const std::vector<float>& mask = d.slot_masks[static_cast<size_t>(slot.mask)];
+    for (size_t n = 0; n < d.nodes.size(); ++n) {
+      const NodeInfo& info = d.nodes[n];
+      if (info.kind != Kind::Layered || !open[n] || closed[n]) continue;
+      const auto* t = static_cast<const fb::LayeredBlendNode*>(info.table);
+      for (uint32_t k = 0; k < t->layers()->size(); ++k) {
+        const std::vector<float>& layer = d.masks[info.aux + k];
+        bool covered = true;
+        for (uint32_t j = 0; j < d.joints && covered; ++j) covered = !(layer[j] > 0.0f) || mask[j] > 0.0f;
+        d.layer_covered[info.aux + k][static_cast<size_t>(slot.mask)] = covered ? 1 : 0;
+      }
+    }
+  }
+}
+
+/// The joints the slot nodes named `slot` read from a montage's pose: their masks and the chains a
+/// mesh-space rotation walks (1 each); empty (every joint) when one of them has no mask.
+std::vector<uint8_t> slot_shown_joints(const GraphDefinition::Impl& d, uint16_t slot) {
+  std::vector<uint8_t> shown(d.joints, 0);
+  for (const SlotInfo& info : d.slots) {
+    if (info.slot != slot) continue;
+    if (info.mask < 0) return {};
+    const auto mask = static_cast<size_t>(info.mask);
+    for (const auto& [first, last] : d.slot_ranges[mask]) std::fill(shown.begin() + first, shown.begin() + last, 1);
+    for (const uint16_t j : d.slot_joints[mask].chain) shown[j] = 1;
+  }
+  return shown;
 }
 
 }  // namespace ossa::graph_detail

@@ -145,6 +145,60 @@ TEST(Slot, MaskedSlotChangesOnlyTheMaskedJoints) {
   }
 }
 
+TEST(Slot, LayersUnderAMachineStayWholeForItsHistory) {
+  // Under a slot covering Spine1's subtree at full weight, a machine's states layer crossarms on that
+  // subtree. The machine keeps its last outputs for an inertialization, so those layers must blend
+  // every joint: the montage is stopped and the machine inertializes in the same update, and once the
+  // montage has ended the pose is bit for bit the one of a character that never played it.
+  NEED_RIG();
+  const int spine1 = rig->joint("Spine1");
+  ASSERT_GE(spine1, 0);
+  GraphDef g = test::pab_graph(*rig);
+  const uint16_t go = test::add_param(g, "go", ParamType::Trigger);
+  uint16_t states[2];
+  for (int k = 0; k < 2; ++k) {
+    LayeredDef layered;
+    layered.base = test::clip_node(g, k == 0 ? test::kWalk : test::kJog);
+    LayerDef layer;
+    layer.node = test::clip_node(g, test::kCrossarms, k == 0 ? 1.0f : 0.5f);
+    layer.mask.push_back({static_cast<uint16_t>(spine1), -1});
+    layer.mesh_space_rotation = k == 1;
+    layered.layers.push_back(layer);
+    states[k] = test::add_node(g, layered);
+  }
+  StateMachineDef sm;
+  sm.name = "m";
+  sm.states = {{"a", states[0], true}, {"b", states[1], true}};
+  sm.transitions.push_back({0, 1, {{CondOp::Trigger, go, 0.0f}}, -1.0f, 1.0f, TransitionModeDef::Inertialize});
+  g.machines.push_back(sm);
+  GraphDef with_slot = slot_graph(*rig, spine1, false, true);  // its slot and montage, over the machine
+  SlotDef slot = std::get<SlotDef>(with_slot.nodes.back().kind);
+  slot.input = test::add_node(g, StateMachineRefDef{0}, "m");
+  test::add_node(g, slot, "slot");
+  g.montages = with_slot.montages;
+  Played p = play(*rig, g), ref = play(*rig, g);
+  ASSERT_TRUE(p.inst && ref.inst);
+  ASSERT_TRUE(p.inst->play_montage("arms"));
+  for (int f = 0; f < 60; ++f) {
+    p.inst->update(1.0f / 60.0f);
+    ref.inst->update(1.0f / 60.0f);
+  }
+  ASSERT_GE(p.inst->montage_status(0).weight, 1.0f);
+  ASSERT_TRUE(p.inst->stop_montage("arms"));
+  p.inst->set_trigger(go);
+  ref.inst->set_trigger(go);
+  int compared = 0;
+  for (int f = 0; f < 40; ++f) {
+    p.inst->update(1.0f / 60.0f);
+    ref.inst->update(1.0f / 60.0f);
+    if (p.inst->montage_playing(0)) continue;
+    ASSERT_GT(p.inst->machine_status(0).inertial_remaining, 0.0f);
+    ASSERT_TRUE(same_bits(p.inst->pose(), ref.inst->pose())) << "update " << f << " after the stop";
+    ++compared;
+  }
+  EXPECT_GT(compared, 10);
+}
+
 /// Pab's walk with its root motion taken out (as `ossa-cook --root-motion` does), and as authored.
 struct RootMotionClips {
   PabRig rig;  // the fixture's, with "walk_rm" added as clip 4
@@ -304,42 +358,49 @@ TEST(Slot, PabSamplePlaysItsUpperBodyMontageOverLocomotion) {
   if (!sample) GTEST_SKIP() << "assets/Pab/pab.graph.json not found or did not cook";
   auto def = GraphDefinition::create(*sample, "pab");
   ASSERT_TRUE(def.ok()) << def.error().message;
-  auto with = GraphInstance::create(*def), without = GraphInstance::create(*def);
-  ASSERT_TRUE(with.ok() && without.ok());
   const int montage = def->find_montage("cross_arms");
   ASSERT_GE(montage, 0);
   EXPECT_EQ(def->section_count(static_cast<size_t>(montage)), 3u);
-  for (GraphInstance* inst : {&*with, &*without}) {
-    for (const char* off : {"foot_lock", "feet_on_ground"}) inst->set_float(def->find_parameter(off), 0.0f);
-    inst->set_float(def->find_parameter("speed"), 1.07f);
-  }
   std::vector<float> mask(def->joint_count(), 0.0f);
   build_joint_mask(def->skeleton().parents(), def->skeleton().find_joint("Spine1"), -1, mask);
-  ASSERT_TRUE(with->play_montage("cross_arms"));
-  int changed = 0;
-  for (int f = 0; f < 60 * 6; ++f) {
-    with->update(1.0f / 60.0f);
-    without->update(1.0f / 60.0f);
-    for (uint32_t j = 0; j < def->joint_count(); ++j) {
-      if (mask[j] == 0.0f) ASSERT_TRUE(same_joint(with->pose(), without->pose(), j)) << "the legs walk on, joint " << j;
-      else changed += !same_joint(with->pose(), without->pose(), j);
+  // With the crossed_arms layer on too: its mask is the slot's, so under the montage at full weight
+  // only its blend's renormalization of the legs is seen, and that must stay bit for bit.
+  for (const bool crossed : {false, true}) {
+    auto with = GraphInstance::create(*def), without = GraphInstance::create(*def);
+    ASSERT_TRUE(with.ok() && without.ok());
+    for (GraphInstance* inst : {&*with, &*without}) {
+      for (const char* off : {"foot_lock", "feet_on_ground"}) inst->set_float(def->find_parameter(off), 0.0f);
+      inst->set_float(def->find_parameter("speed"), 1.07f);
+      inst->set_bool(def->find_parameter("crossed_arms"), crossed);
     }
-    const MontageStatus st = with->montage_status(montage);
-    ASSERT_TRUE(st.playing && !st.blending_out) << "the loop holds until told, frame " << f;
-    if (f > 120) {
-      EXPECT_EQ(st.section, def->find_section(static_cast<size_t>(montage), "loop"));
+    ASSERT_TRUE(with->play_montage("cross_arms"));
+    int changed = 0;
+    for (int f = 0; f < 60 * 6; ++f) {
+      with->update(1.0f / 60.0f);
+      without->update(1.0f / 60.0f);
+      for (uint32_t j = 0; j < def->joint_count(); ++j) {
+        if (mask[j] == 0.0f)
+          ASSERT_TRUE(same_joint(with->pose(), without->pose(), j))
+              << "the legs walk on, joint " << j << " " << crossed;
+        else changed += !same_joint(with->pose(), without->pose(), j);
+      }
+      const MontageStatus st = with->montage_status(montage);
+      ASSERT_TRUE(st.playing && !st.blending_out) << "the loop holds until told, frame " << f;
+      if (f > 120) {
+        EXPECT_EQ(st.section, def->find_section(static_cast<size_t>(montage), "loop"));
+      }
     }
+    EXPECT_GT(changed, 1000);
+    ASSERT_TRUE(with->set_next_section("cross_arms", "loop", "end"));
+    bool ended = false;
+    for (int f = 0; f < 60 * 5 && !ended; ++f) {
+      with->update(1.0f / 60.0f);
+      without->update(1.0f / 60.0f);
+      for (const MontageEvent& e : with->montage_events()) ended |= e.type == MontageEventType::Ended && !e.interrupted;
+    }
+    EXPECT_TRUE(ended);
+    EXPECT_TRUE(same_bits(with->pose(), without->pose())) << "after the montage the graph's own pose is back";
   }
-  EXPECT_GT(changed, 1000);
-  ASSERT_TRUE(with->set_next_section("cross_arms", "loop", "end"));
-  bool ended = false;
-  for (int f = 0; f < 60 * 5 && !ended; ++f) {
-    with->update(1.0f / 60.0f);
-    without->update(1.0f / 60.0f);
-    for (const MontageEvent& e : with->montage_events()) ended |= e.type == MontageEventType::Ended && !e.interrupted;
-  }
-  EXPECT_TRUE(ended);
-  EXPECT_TRUE(same_bits(with->pose(), without->pose())) << "after the montage the graph's own pose is back";
 }
 
 }  // namespace

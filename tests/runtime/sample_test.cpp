@@ -559,6 +559,59 @@ TEST(SamplePab, CacheIsInvisibleOnEveryClipAtEveryRate) {
   }
 }
 
+TEST(SamplePab, JointFilterKeepsTheKeptJointsBitsAndDecodesNothingElse) {
+  // A filtered cache (a masked slot's: Spine1's subtree, then the rest) samples every kept joint
+  // bit for bit as the full cache does, at every rate; the joints it drops hold their bind pose,
+  // so it decoded none of their keys.
+  REQUIRE_PAB();
+  (void)clip;
+  auto a = Asset::open((test::fixtures_dir() / "Pab" / "crossarms.ossa").string());
+  ASSERT_TRUE(a.ok()) << a.error().message;
+  const ClipView arms = a->clip(0);
+  const auto joints = static_cast<uint32_t>(skeleton.joint_count());
+  const int spine1 = skeleton.find_joint("Spine1");
+  ASSERT_GE(spine1, 0);
+  std::vector<uint8_t> upper(joints, 0), rest(joints, 0), none(joints, 0);
+  for (uint32_t j = 0; j < joints; ++j) {
+    for (int k = static_cast<int>(j); k >= 0; k = skeleton.parents()[static_cast<size_t>(k)])
+      if (k == spine1) upper[j] = 1;
+    rest[j] = upper[j] == 0;
+  }
+  auto bind_cache = make_sampling_cache(arms, skeleton, nullptr, none);
+  ASSERT_TRUE(bind_cache.ok());
+  Pose bind_pose(joints);
+  sample(arms, 1.0f, SampleOptions{}, *bind_cache, bind_pose);
+  const ConstPoseSpan bind = bind_pose.span();
+  int dropped_animated = 0;
+  for (const std::vector<uint8_t>* filter : {&upper, &rest}) {
+    auto prototype = make_sampling_cache(arms, skeleton, nullptr, *filter);
+    ASSERT_TRUE(prototype.ok()) << prototype.error().message;
+    for (float rate : {0.05f, 1.0f, -2.5f}) {
+      auto filtered = make_sampling_cache(arms, skeleton, &*prototype, *filter);
+      SamplingCache full = cache_for(arms, skeleton);
+      ASSERT_TRUE(filtered.ok()) << filtered.error().message;
+      Pose got_pose(joints), want_pose(joints);
+      const ConstPoseSpan got = got_pose.span(), want = want_pose.span();
+      for (const float t : playback(arms, rate, 300, true, 0.2f)) {
+        sample(arms, t, SampleOptions{}, *filtered, got_pose);
+        sample(arms, t, SampleOptions{}, full, want_pose);
+        for (uint32_t j = 0; j < joints; ++j) {
+          const ConstPoseSpan expected = (*filter)[j] ? want : bind;
+          for (uint32_t k = 0; k < kPoseComponents; ++k) {
+            const auto c = PoseComponent(k);
+            ASSERT_EQ(std::memcmp(&got[c][j], &expected[c][j], sizeof(float)), 0)
+                << "joint " << j << " component " << k << " at t=" << t << " rate " << rate;
+            dropped_animated += !(*filter)[j] && std::memcmp(&got[c][j], &want[c][j], sizeof(float)) != 0;
+          }
+        }
+      }
+    }
+  }
+  EXPECT_GT(dropped_animated, 0) << "crossarms animates joints on both sides of the filter";
+  const std::vector<uint8_t> wrong(joints + 1, 1);
+  EXPECT_FALSE(make_sampling_cache(arms, skeleton, nullptr, wrong).ok());
+}
+
 TEST(SamplePab, RefusedByAnotherRig) {
   REQUIRE_PAB();
   const Loaded other = load({});

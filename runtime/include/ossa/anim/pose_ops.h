@@ -28,6 +28,12 @@ void blend_n(std::span<const ConstPoseSpan> poses, std::span<const float> weight
 void blend_layered(ConstPoseSpan base, ConstPoseSpan layer, std::span<const float> joint_weights, float weight,
                    PoseSpan out);
 
+/// blend_layered on the lanes [first, last) only (multiples of kPoseLanes, last <= the stride):
+/// those lanes get exactly the bits blend_layered gives them, the others are not touched (a layer
+/// under a slot that covers the rest of the pose blends only what the slot shows).
+void blend_layered_lanes(ConstPoseSpan base, ConstPoseSpan layer, std::span<const float> joint_weights, float weight,
+                         PoseSpan out, uint32_t first, uint32_t last);
+
 /// A joint + depth mask: weight 1 on `joint` and its descendants up to `depth` levels below it
 /// (depth < 0: all), 0 elsewhere; entries are max-combined into `out` so several calls build one
 /// mask. Start from a zeroed span (entries must be >= 0). O(joints).

@@ -14,6 +14,7 @@
 #pragma once
 #include <cstdint>
 #include <memory>
+#include <span>
 
 #include <ossa/format/result.h>
 #include <ossa/loader/asset.h>
@@ -52,8 +53,13 @@ class SamplingCache {
 /// outlive this one; what never changes (constant and bind channels, and each animated channel's
 /// decode record) is then read from it, so many characters playing one clip share it in cache and
 /// each cache keeps only its cursors and decoded key pairs. O(joints + animated channels).
+/// `joints` (optional, one entry per joint): decode only the animated channels of the joints with
+/// a non-zero entry (a masked slot, which shows some joints of a clip, pays for their keys only).
+/// Every kept joint samples bit for bit as without the filter; a dropped joint's animated channels
+/// hold their bind values. It must outlive the cache, and a prototype must have the very same span.
 Result<SamplingCache> make_sampling_cache(const ClipView& clip, const SkeletonView& skeleton,
-                                          const SamplingCache* prototype = nullptr);
+                                          const SamplingCache* prototype = nullptr,
+                                          std::span<const uint8_t> joints = {});
 
 /// Forgets the cursors (the next sample searches from scratch). O(animated channels).
 void reset(SamplingCache& cache);
