@@ -27,10 +27,15 @@
 // A class-ordered mesh skinned for normals without tangents takes soa_kernel.h instead of steps
 // 2-4: eight vertices at a time, structure-of-arrays after the blend (see "meshes ordered by
 // influence class" below).
-// The per-vertex loops use 256-bit registers on both paths: on Zen 4, which executes a 512-bit
-// operation as two 256-bit halves, a 16-wide per-vertex kernel measured ~25% slower (more
-// cross-lane shuffles for the same arithmetic). The classification is where AVX-512 pays.
-// Scalar word loads rather than gathers in steps 1 and 2: measured faster on Zen 4.
+// The per-vertex transforms use 256-bit registers on both paths: on Zen 4, which executes a
+// 512-bit operation as two 256-bit halves, a 16-wide per-vertex kernel measured ~25% slower (more
+// cross-lane shuffles for the same arithmetic). The range loops' AVX-512 copy blends a vertex's
+// matrix in one 512-bit register (one FMA per influence instead of two): positions alone ~8%
+// faster on Zen 5, whose 512-bit units are full width. The classification is where AVX-512 pays
+// most. Scalar word loads rather than gathers in steps 1 and 2: measured faster on Zen 4.
+// Palette matrices are 64 bytes read as 32- or 64-byte loads; skin_quantized copies a palette
+// that is not 64-byte aligned (a std::vector<glm::mat4> is aligned to 16) to one that is, since a
+// load across two cache lines costs two (~7-10% of a call on arnaud, Zen 5, for a 3.4 KB copy).
 
 #include <algorithm>
 #include <cstdint>
@@ -47,56 +52,77 @@
 namespace ossa::skin_detail {
 namespace {
 
-template <Slots kSlots>
-inline uint32_t slot_of(uint64_t slot_bits, int k) {
-  return kSlots == Slots::Wide ? static_cast<uint32_t>(slot_bits >> (16 * k)) & 0xffffu
-                               : static_cast<uint32_t>(slot_bits >> (8 * k)) & 0xffu;
-}
-
 // ---- the per-class loops ----
 
 /// Blended matrix of the first K influences (K = 0: the first slot's matrix as it is), as
 /// columns 0-1 and 2-3. `wb` receives the vertex's four weight bytes (loaded for K = 0 only when
-/// kNeedWeights).
+/// kNeedWeights). Slots and weights are read byte by byte (16-bit slots word by word): a load
+/// each, where taking a 64-bit word apart costs two or three shifts and masks per influence.
 template <int K, Slots kSlots, bool kNeedWeights>
 OSSA_TARGET_AVX2 inline void blend_matrix(const float* palette, const uint8_t* vx, uint32_t off_joints,
                                           uint32_t off_weights, __m256& a01, __m256& a23, uint32_t& wb) {
-  uint64_t sb;
+  const uint8_t* const j = vx + off_joints;
+  const uint8_t* const w = kSlots == Slots::Packed ? j + 4 : vx + off_weights;
+  const auto matrix = [&](int k) {
+    uint32_t s;
+    if constexpr (kSlots == Slots::Wide) {
+      uint16_t q;
+      std::memcpy(&q, j + 2 * k, 2);
+      s = q;
+    } else {
+      s = j[k];
+    }
+    return palette + 16 * static_cast<size_t>(s);
+  };
   wb = 0;
-  if constexpr (kSlots == Slots::Packed) {
-    const uint64_t both = load_u64(vx + off_joints);
-    sb = both & 0xffffffffu;
-    wb = static_cast<uint32_t>(both >> 32);
-  } else {
-    sb = kSlots == Slots::Wide ? load_u64(vx + off_joints) : load_u32(vx + off_joints);
-    if constexpr (K > 0 || kNeedWeights) wb = load_u32(vx + off_weights);
-  }
-  const float* p0 = palette + 16 * slot_of<kSlots>(sb, 0);
+  if constexpr (K > 0 || kNeedWeights) wb = load_u32(w);
+  const float* p = matrix(0);
   if constexpr (K == 0) {
-    a01 = _mm256_loadu_ps(p0);
-    a23 = _mm256_loadu_ps(p0 + 8);
+    a01 = _mm256_loadu_ps(p);
+    a23 = _mm256_loadu_ps(p + 8);
   } else {
-    __m256 w = _mm256_broadcast_ss(&kWeight[wb & 0xffu]);
-    a01 = _mm256_mul_ps(w, _mm256_loadu_ps(p0));
-    a23 = _mm256_mul_ps(w, _mm256_loadu_ps(p0 + 8));
-    if constexpr (K > 1) {
-      const float* p = palette + 16 * slot_of<kSlots>(sb, 1);
-      w = _mm256_broadcast_ss(&kWeight[(wb >> 8) & 0xffu]);
-      a01 = _mm256_fmadd_ps(w, _mm256_loadu_ps(p), a01);
-      a23 = _mm256_fmadd_ps(w, _mm256_loadu_ps(p + 8), a23);
+    __m256 wk = _mm256_broadcast_ss(&kWeight[w[0]]);
+    a01 = _mm256_mul_ps(wk, _mm256_loadu_ps(p));
+    a23 = _mm256_mul_ps(wk, _mm256_loadu_ps(p + 8));
+#pragma GCC unroll 4
+    for (int k = 1; k < K; ++k) {
+      p = matrix(k);
+      wk = _mm256_broadcast_ss(&kWeight[w[k]]);
+      a01 = _mm256_fmadd_ps(wk, _mm256_loadu_ps(p), a01);
+      a23 = _mm256_fmadd_ps(wk, _mm256_loadu_ps(p + 8), a23);
     }
-    if constexpr (K > 2) {
-      const float* p = palette + 16 * slot_of<kSlots>(sb, 2);
-      w = _mm256_broadcast_ss(&kWeight[(wb >> 16) & 0xffu]);
-      a01 = _mm256_fmadd_ps(w, _mm256_loadu_ps(p), a01);
-      a23 = _mm256_fmadd_ps(w, _mm256_loadu_ps(p + 8), a23);
-    }
-    if constexpr (K > 3) {
-      const float* p = palette + 16 * slot_of<kSlots>(sb, 3);
-      w = _mm256_broadcast_ss(&kWeight[wb >> 24]);
-      a01 = _mm256_fmadd_ps(w, _mm256_loadu_ps(p), a01);
-      a23 = _mm256_fmadd_ps(w, _mm256_loadu_ps(p + 8), a23);
-    }
+  }
+}
+
+/// blend_matrix for the AVX-512 copy of the range loops: the blend in one 512-bit register (one
+/// FMA per influence where the 256-bit form needs two), split into the same columns. Rounds as
+/// blend_matrix does (the same products and sums per element). Not always_inline (an AVX2
+/// function may not inline it): skin_range_avx512 flattens its calls.
+template <int K, Slots kSlots, bool kNeedWeights>
+OSSA_TARGET_AVX512 inline void blend_matrix512(const float* palette, const uint8_t* vx, uint32_t off_joints,
+                                               uint32_t off_weights, __m256& a01, __m256& a23, uint32_t& wb) {
+  if constexpr (K == 0) {
+    blend_matrix<K, kSlots, kNeedWeights>(palette, vx, off_joints, off_weights, a01, a23, wb);
+  } else {
+    const uint8_t* const j = vx + off_joints;
+    const uint8_t* const w = kSlots == Slots::Packed ? j + 4 : vx + off_weights;
+    const auto matrix = [&](int k) {
+      uint32_t s;
+      if constexpr (kSlots == Slots::Wide) {
+        uint16_t q;
+        std::memcpy(&q, j + 2 * k, 2);
+        s = q;
+      } else {
+        s = j[k];
+      }
+      return palette + 16 * static_cast<size_t>(s);
+    };
+    wb = load_u32(w);
+    __m512 m = _mm512_mul_ps(_mm512_set1_ps(kWeight[w[0]]), _mm512_loadu_ps(matrix(0)));
+#pragma GCC unroll 4
+    for (int k = 1; k < K; ++k) m = _mm512_fmadd_ps(_mm512_set1_ps(kWeight[w[k]]), _mm512_loadu_ps(matrix(k)), m);
+    a01 = _mm512_castps512_ps256(m);
+    a23 = _mm512_extractf32x8_ps(m, 1);
   }
 }
 
@@ -149,13 +175,15 @@ struct VertexPointers {
 /// Skins one vertex of class K. kWide: the xyz outputs may be stored as 16 bytes (another vertex
 /// follows in memory order and is written later). Returns outside_class<K> of its weights (only
 /// computed when kCheck).
-template <int K, bool kCheck, bool kWide, Slots kSlots, bool kPositions, bool kNormals, bool kTangents>
+template <int K, bool kCheck, bool kWide, Slots kSlots, bool kPositions, bool kNormals, bool kTangents,
+          bool kAvx512 = false>
 [[gnu::always_inline]] OSSA_TARGET_AVX2 inline uint32_t skin_vertex(const float* palette, const VertexPointers& at,
                                                                     uint32_t off_position, uint32_t off_joints,
                                                                     uint32_t off_weights) {
   __m256 a01, a23;
   uint32_t wb;
-  blend_matrix<K, kSlots, kCheck>(palette, at.vx, off_joints, off_weights, a01, a23, wb);
+  if constexpr (kAvx512) blend_matrix512<K, kSlots, kCheck>(palette, at.vx, off_joints, off_weights, a01, a23, wb);
+  else blend_matrix<K, kSlots, kCheck>(palette, at.vx, off_joints, off_weights, a01, a23, wb);
   if constexpr (kPositions) {
     // The four unorm16 words twice (one duplicating load), widened: (x, y, z, 1) in both lanes.
     const __m256 scale = _mm256_setr_ps(1.0f / 65535.0f, 1.0f / 65535.0f, 1.0f / 65535.0f, 0.0f, 1.0f / 65535.0f,
@@ -203,8 +231,9 @@ OSSA_TARGET_AVX2 void skin_class(const uint32_t* list, uint32_t n, const float* 
 /// walking every pointer forward (no index arithmetic per vertex). Returns the OR of
 /// outside_class<K> over them: non-zero means some vertex did not belong to the range (and its
 /// outputs are wrong).
-template <int K, Slots kSlots, bool kPositions, bool kNormals, bool kTangents>
-OSSA_TARGET_AVX2 uint32_t skin_range(const float* palette, const FastMesh& mesh, const Batch& b, Outputs out) {
+template <int K, Slots kSlots, bool kPositions, bool kNormals, bool kTangents, bool kAvx512>
+[[gnu::always_inline]] OSSA_TARGET_AVX2 inline uint32_t range_loop(const float* palette, const FastMesh& mesh,
+                                                                   const Batch& b, Outputs out) {
   const size_t stride = mesh.stride;
   const uint32_t off_position = mesh.off_position, off_joints = mesh.off_joints, off_weights = mesh.off_weights;
   const size_t first = b.first;
@@ -219,8 +248,8 @@ OSSA_TARGET_AVX2 uint32_t skin_range(const float* palette, const FastMesh& mesh,
   uint32_t outside = 0;
 #pragma GCC unroll 2
   for (uint32_t i = 0; i < wide; ++i) {
-    outside |= skin_vertex<K, true, true, kSlots, kPositions, kNormals, kTangents>(palette, at, off_position,
-                                                                                   off_joints, off_weights);
+    outside |= skin_vertex<K, true, true, kSlots, kPositions, kNormals, kTangents, kAvx512>(palette, at, off_position,
+                                                                                            off_joints, off_weights);
     at.vx += stride;
     at.normal += 4;
     at.tangent += 4;
@@ -229,9 +258,20 @@ OSSA_TARGET_AVX2 uint32_t skin_range(const float* palette, const FastMesh& mesh,
     if constexpr (kTangents) at.tangent_out += 4;
   }
   if (wide < b.n)
-    outside |= skin_vertex<K, true, false, kSlots, kPositions, kNormals, kTangents>(palette, at, off_position,
-                                                                                    off_joints, off_weights);
+    outside |= skin_vertex<K, true, false, kSlots, kPositions, kNormals, kTangents, kAvx512>(palette, at, off_position,
+                                                                                             off_joints, off_weights);
   return outside;
+}
+
+/// range_loop compiled for AVX2 + FMA, and for AVX-512 (the 512-bit blend, flattened into it).
+template <int K, Slots kSlots, bool kPositions, bool kNormals, bool kTangents>
+OSSA_TARGET_AVX2 uint32_t skin_range(const float* palette, const FastMesh& mesh, const Batch& b, Outputs out) {
+  return range_loop<K, kSlots, kPositions, kNormals, kTangents, false>(palette, mesh, b, out);
+}
+template <int K, Slots kSlots, bool kPositions, bool kNormals, bool kTangents>
+OSSA_TARGET_AVX512 OSSA_SOA_FLATTEN uint32_t skin_range_avx512(const float* palette, const FastMesh& mesh,
+                                                               const Batch& b, Outputs out) {
+  return range_loop<K, kSlots, kPositions, kNormals, kTangents, true>(palette, mesh, b, out);
 }
 
 /// Class K's loop over the contiguous vertices [first, first + n) of a class-ordered mesh, eight at
@@ -355,7 +395,10 @@ OSSA_TARGET_AVX2 void skin_fast(const float* palette, const FastMesh& m, Outputs
     for (b.first = begin; b.first < end; b.first += kBatch) {
       b.n = std::min(kBatch, end - b.first);
       if constexpr (kNormals || kTangents) decode_directions<kTangents>(m, b);
-      if (skin_range<K, kSlots, kPositions, kNormals, kTangents>(palette, m, b, out) != 0) {
+      const uint32_t outside = avx512
+                                   ? skin_range_avx512<K, kSlots, kPositions, kNormals, kTangents>(palette, m, b, out)
+                                   : skin_range<K, kSlots, kPositions, kNormals, kTangents>(palette, m, b, out);
+      if (outside != 0) {
         skin_classified<kSlots, kPositions, kNormals, kTangents>(palette, m, out, avx512, b.first);
         return false;
       }
@@ -387,6 +430,8 @@ void skin_fast_streams(const float* palette, const FastMesh& m, Outputs out, boo
   else skin_fast_directions<kSlots, false>(palette, m, out, avx512);
 }
 
+constexpr size_t kAlignedSlots = 256;  // 16 KB of stack
+
 /// The fast paths read the cooker's quantized layout (8- or 16-bit slots), nothing else.
 bool fast_layout(const MeshFacts& m, Outputs out, FastMesh* f) {
   if (m.joints == nullptr || m.position == nullptr || m.position->format() != VertexFormat::Unorm16x4) return false;
@@ -415,6 +460,15 @@ bool fast_layout(const MeshFacts& m, Outputs out, FastMesh* f) {
 bool skin_quantized(const MeshFacts& m, const float* palette, Outputs out, bool avx512) {
   FastMesh f;
   if (!fast_layout(m, out, &f)) return false;
+  // The kernels load palette matrices as 32- and 64-byte words, and a load that straddles two
+  // cache lines costs two: a palette not 64-byte aligned (a std::vector<glm::mat4> is 16-byte
+  // aligned) is copied to one that is, when it has at most kAlignedSlots slots (on Pab's arnaud,
+  // Zen 5: ~7% faster with normals, ~10% positions alone, for a 3.4 KB copy).
+  alignas(64) float aligned[16 * kAlignedSlots];
+  if (reinterpret_cast<uintptr_t>(palette) % 64 != 0 && m.slot_count <= kAlignedSlots) {
+    std::memcpy(aligned, palette, 64 * m.slot_count);
+    palette = aligned;
+  }
   switch (f.slots) {
     case Slots::Narrow: skin_fast_streams<Slots::Narrow>(palette, f, out, avx512); break;
     case Slots::Wide: skin_fast_streams<Slots::Wide>(palette, f, out, avx512); break;

@@ -31,11 +31,12 @@
 // part and a stretch, and blends the rigid parts as dual quaternions.
 //
 // Costs: skinning_matrices O(slots). skin_cpu O(vertices * influences), allocation-free (stack
-// buffers: ~18 KB on the fast path, ~22 KB for dual quaternions), no virtual calls, no
-// per-vertex branches on the fast path. Measured on Pab's arnaud (3748 vertices, ossa-bench-anim,
-// Zen 5 VM at ~3.2 GHz, medians of 5): ~1.6 ns per vertex for positions, ~2.9 ns with normals
-// (~2.5 without renormalizing: soa_kernel.h), as cooked (class-ordered); ~2.8 / ~4.9 ns
-// classified per batch; portable ~19 / ~32 ns; dual quaternions ~69 ns.
+// buffers: ~35 KB on the fast path, 16 KB of it the 64-byte aligned palette copy; ~22 KB for dual
+// quaternions), no virtual calls, no per-vertex branches on the fast path. Measured on Pab's
+// arnaud (3836 vertices, a loop over skin_cpu, Zen 5 VM at ~3.1 GHz, AVX-512 copies, best of
+// 1000): ~1.35 ns per vertex for positions, ~1.95 ns with normals (~0.1 less without
+// renormalizing: soa_kernel.h), as cooked (class-ordered). An earlier measurement of the other
+// paths: ~2.8 / ~4.9 ns classified per batch; portable ~19 / ~32 ns; dual quaternions ~69 ns.
 //
 // Files: this one resolves a mesh's facts, keeps the ISA switch and dispatches skin_cpu;
 // skin_palette.cpp builds palettes; skin_portable.cpp, skin_dual_quaternion.cpp and skin_x86.cpp
