@@ -63,17 +63,7 @@ OSSA_TARGET_AVX2 inline void blend_matrix(const float* palette, const uint8_t* v
                                           uint32_t off_weights, __m256& a01, __m256& a23, uint32_t& wb) {
   const uint8_t* const j = vx + off_joints;
   const uint8_t* const w = kSlots == Slots::Packed ? j + 4 : vx + off_weights;
-  const auto matrix = [&](int k) {
-    uint32_t s;
-    if constexpr (kSlots == Slots::Wide) {
-      uint16_t q;
-      std::memcpy(&q, j + 2 * k, 2);
-      s = q;
-    } else {
-      s = j[k];
-    }
-    return palette + 16 * static_cast<size_t>(s);
-  };
+  const auto matrix = [&](int k) { return soa::slot_matrix<kSlots == Slots::Wide>(palette, j, k); };
   wb = 0;
   if constexpr (K > 0 || kNeedWeights) wb = load_u32(w);
   const float* p = matrix(0);
@@ -106,17 +96,7 @@ OSSA_TARGET_AVX512 inline void blend_matrix512(const float* palette, const uint8
   } else {
     const uint8_t* const j = vx + off_joints;
     const uint8_t* const w = kSlots == Slots::Packed ? j + 4 : vx + off_weights;
-    const auto matrix = [&](int k) {
-      uint32_t s;
-      if constexpr (kSlots == Slots::Wide) {
-        uint16_t q;
-        std::memcpy(&q, j + 2 * k, 2);
-        s = q;
-      } else {
-        s = j[k];
-      }
-      return palette + 16 * static_cast<size_t>(s);
-    };
+    const auto matrix = [&](int k) { return soa::slot_matrix<kSlots == Slots::Wide>(palette, j, k); };
     wb = load_u32(w);
     __m512 m = _mm512_mul_ps(_mm512_set1_ps(kWeight[w[0]]), _mm512_loadu_ps(matrix(0)));
 #pragma GCC unroll 4

@@ -58,6 +58,22 @@ namespace ossa::soa {
 #define OSSA_SOA_FLATTEN
 #endif
 
+/// The palette matrix (16 floats) of influence k of a vertex whose slots start at j: 8-bit slots
+/// read as bytes, 16-bit slots (kWideSlots) as unaligned words. Every blend kernel reads its
+/// matrices through this one function.
+template <bool kWideSlots>
+OSSA_SOA_INLINE const float* slot_matrix(const float* palette, const uint8_t* j, int k) {
+  uint32_t s;
+  if constexpr (kWideSlots) {
+    uint16_t q;
+    std::memcpy(&q, j + 2 * k, 2);
+    s = q;
+  } else {
+    s = j[k];
+  }
+  return palette + 16 * static_cast<size_t>(s);
+}
+
 /// 1 / sqrt(len2) to float precision (rsqrt's 12 bits + one Newton step), 0 for len2 = 0.
 OSSA_SOA_TARGET OSSA_SOA_INLINE __m256 inverse_length(__m256 len2) {
   len2 = _mm256_max_ps(len2, _mm256_set1_ps(1e-30f));
@@ -210,17 +226,7 @@ OSSA_SOA_TARGET OSSA_SOA_INLINE __m128i words_of(const uint8_t* position, const 
 template <int K, bool kWideSlots>
 OSSA_SOA_TARGET OSSA_SOA_INLINE void blend(const uint8_t* j, const uint8_t* w, const Layout& l, __m256& a01,
                                            __m256& a23) {
-  const auto matrix = [&](int k) {
-    uint32_t s;
-    if constexpr (kWideSlots) {
-      uint16_t q;
-      std::memcpy(&q, j + 2 * k, 2);
-      s = q;
-    } else {
-      s = j[k];
-    }
-    return l.palette + 16 * static_cast<size_t>(s);
-  };
+  const auto matrix = [&](int k) { return slot_matrix<kWideSlots>(l.palette, j, k); };
   const float* p = matrix(0);
   if constexpr (K == 0) {
     a01 = _mm256_loadu_ps(p);
@@ -400,17 +406,7 @@ OSSA_SOA_TARGET OSSA_SOA_INLINE uint32_t block(Cursor<kPacked> at, uint32_t last
 
 template <int K, bool kWideSlots>
 OSSA_SOA_TARGET512 inline void blend512(const uint8_t* j, const uint8_t* w, const Layout& l, __m512& m) {
-  const auto matrix = [&](int k) {
-    uint32_t s;
-    if constexpr (kWideSlots) {
-      uint16_t q;
-      std::memcpy(&q, j + 2 * k, 2);
-      s = q;
-    } else {
-      s = j[k];
-    }
-    return l.palette + 16 * static_cast<size_t>(s);
-  };
+  const auto matrix = [&](int k) { return slot_matrix<kWideSlots>(l.palette, j, k); };
   if constexpr (K == 0) {
     m = _mm512_loadu_ps(matrix(0));
   } else {
