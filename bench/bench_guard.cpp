@@ -33,7 +33,9 @@
 // (blend3: 0.04 on a Zen 5 EPYC, 0.16-0.21 on a Xeon family 6 model 207). Each row states the
 // ratios measured on both and sets each vendor's limit at about 2-3x its own, so only a large
 // regression fails — a lost fast path, an accidental O(n^2), a verify pass run twice — never a
-// noisy neighbour; another vendor gets the larger of the two. Exit status: 0 all within limits, 1 otherwise;
+// noisy neighbour; another vendor gets the larger of the two. The Intel figures are from a Xeon
+// family 6 model 207 (a GPU machine's host, two of its CPUs by taskset, sessions of 2026-11-27);
+// "within the limit" where that run's table was not kept. Exit status: 0 all within limits, 1 otherwise;
 // a build without NDEBUG (debug, sanitizers) prints the table and skips (77), since its ratios
 // mean nothing. Output: one tab-separated row per check, after the machine line.
 #include <fcntl.h>
@@ -183,7 +185,7 @@ bool plain_rows(int trials, const ossa::bench::BenchData& data, std::vector<Row>
     rows.push_back({name, ossa_s * 1e9, plain_s * 1e9, limit});
   };
   // AMD Zen 5: 0.40-0.41 measured, 0.55 once in a CI run beside four other builds, 0.71-0.72 with
-  // the denormal regression put back; the limit sits between the last two. Intel: not yet measured.
+  // the denormal regression put back; the limit sits between the last two. Intel Xeon 6/207: 0.402.
   sample_row("sample.plain", *caches[0], limit_for(0.63, 1.1));
   sample_row("sample.noisy", *caches[3],
              limit_for(0.63, 1.1));  // the same; a runtime without FTZ/DAZ alone fails this row
@@ -214,7 +216,7 @@ bool plain_rows(int trials, const ossa::bench::BenchData& data, std::vector<Row>
           g_sink = g_sink + static_cast<uint32_t>(plain_palette[0][3][0]);
         });
     rows.push_back({"frame.plain", ossa_s * 1e9, plain_s * 1e9,
-                    limit_for(0.32, 0.7)});  // Zen 5: 0.256-0.263, 0.349-0.352 regressed; Intel: not yet measured
+                    limit_for(0.32, 0.7)});  // Zen 5: 0.256-0.263, 0.349-0.352 regressed; Intel Xeon 6/207: 0.259
   }
   {
     // Skinning with the frame's last palette.
@@ -235,7 +237,7 @@ bool plain_rows(int trials, const ossa::bench::BenchData& data, std::vector<Row>
           g_sink = g_sink + static_cast<uint32_t>(plain_positions[0]);
         });
     rows.push_back({"skin.plain", ossa_s * 1e9, plain_s * 1e9,
-                    limit_for(0.35, 0.7)});  // Zen 5: 0.20-0.23; Intel: not yet measured
+                    limit_for(0.35, 0.7)});  // Zen 5: 0.14-0.23; Intel Xeon 6/207: 0.216
   }
   return true;
 }
@@ -375,7 +377,8 @@ int main(int argc, char** argv) {
           }
           g_sink = g_sink + static_cast<uint32_t>(slow.span().base[0]);
         });
-    // Measured: AMD EPYC Zen 5 0.043-0.052; Intel Xeon 6/207 0.157-0.209 (five runs, issue 25).
+    // Measured: AMD EPYC Zen 5 0.043-0.052; Intel Xeon 6/207 0.157-0.209 (five runs, issue 25), 0.105-0.109
+    // on the later builds.
     rows.push_back({"blend3", ossa_s * 1e9, glm_s * 1e9, limit_for(0.15, 0.45)});
   }
 
@@ -398,7 +401,7 @@ int main(int argc, char** argv) {
       }
     }
     ossa::set_vector_isa(ossa::VectorIsa::Avx2);
-    // Measured: AMD EPYC Zen 5 0.68-0.74; Intel Xeon 6/207 up to 0.938, where AVX2 gains little
+    // Measured: AMD EPYC Zen 5 0.68-0.74; Intel Xeon 6/207 0.884, up to 0.938 once, where AVX2 gains little
     // on these loops: there the row only catches an AVX2 copy slower than the baseline one.
     rows.push_back({"clone.avx2", avx2 * 1e9, baseline * 1e9, limit_for(0.9, 1.15)});
   }
@@ -425,7 +428,7 @@ int main(int argc, char** argv) {
           ossa::sample(clips[0], times[k++ & 255], {}, *cold, poses[1]);
           g_sink = g_sink + static_cast<uint32_t>(poses[1].span().base[0]);
         });
-    // Measured: AMD EPYC Zen 5 0.54-0.60; Intel Xeon 6/207: within the limit.
+    // Measured: AMD EPYC Zen 5 0.54-0.60; Intel Xeon 6/207 0.49-0.50.
     rows.push_back({"sample", forward * 1e9, reset * 1e9, limit_for(1.1, 1.1)});
   }
 
@@ -476,8 +479,9 @@ int main(int argc, char** argv) {
         });
     std::error_code ec;
     fs::remove_all(dir, ec);
-    // Measured: AMD EPYC Zen 5 0.86-1.10 (load average 20, or stress-ng on both cores). The same
-    // system calls on both sides: about 1 wherever it runs; a second read of the file gives ~1.7.
+    // Measured: AMD EPYC Zen 5 0.86-1.10 (load average 20, or stress-ng on both cores); Intel Xeon
+    // 6/207 1.00-1.11. The same system calls on both sides: about 1 wherever it runs; a second read
+    // of the file gives ~1.7.
     rows.push_back({"load", open_s * 1e9, plain_s * 1e9, limit_for(1.45, 1.45)});
   }
 
