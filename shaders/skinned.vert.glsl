@@ -31,6 +31,14 @@
 // position_scale) to be added to a_position. Direction deltas are added to the decoded direction
 // before the prescale, exactly as the CPU reference (apply_morphs, then skinning) does. A mesh
 // without targets sets u_morph_channels = 0 and skips all of it.
+//
+// Simulated cloth (viewer/cloth_view.h): a mesh with cloth is skinned here like any other, and
+// each of its cloth vertices then takes its particle's output instead. u_cloth_slots[gl_VertexID]
+// is -1 for a skinned vertex, else particle * 2 + 1 where its normal is flipped (gpu_mesh.h);
+// u_cloth_vertices holds two texels per particle and instance, from u_cloth_first and
+// u_cloth_texels apart: the position and the normal where they are drawn, computed on the CPU
+// exactly as the CPU-skinning path writes them, so both paths draw the same cloth. A mesh without
+// live cloth sets u_cloth_texels = 0.
 #version 330 core
 
 layout(location = 0) in vec4 a_position;
@@ -53,6 +61,11 @@ uniform samplerBuffer u_morph_entries;  // RGBA32F, u_morph_texels per entry
 uniform samplerBuffer u_morph_weights;  // R32F, per instance and channel
 uniform int u_morph_channels;           // channels per instance; 0: no morphs for this mesh
 uniform int u_morph_texels;             // 1: positions, 2: + normals, 3: + tangents
+uniform isamplerBuffer u_cloth_slots;   // R32I, per vertex: -1, or particle * 2 + (normal flipped)
+uniform samplerBuffer u_cloth_vertices; // RGBA32F, per instance and particle: position, normal
+uniform int u_cloth_first;              // first texel of this mesh's cloth for instance 0
+uniform int u_cloth_texels;             // texels from one instance's cloth to the next; 0: no cloth
+uniform int u_cloth_normals;            // 1: the cloth's normals replace the skinned ones
 
 out vec3 v_position;
 out vec3 v_normal;
@@ -104,6 +117,16 @@ void main() {
 
   v_normal = linear * (n * u_direction_prescale);
   v_tangent = u_tangent_encoding == 0 ? vec4(0.0) : vec4(linear * (t * u_direction_prescale), t_sign);
+
+  if (u_cloth_texels > 0) {
+    int slot = texelFetch(u_cloth_slots, gl_VertexID).r;
+    if (slot >= 0) {
+      int texel = u_cloth_first + gl_InstanceID * u_cloth_texels + 2 * (slot >> 1);
+      world = vec4(texelFetch(u_cloth_vertices, texel).xyz, 1.0);
+      vec3 cloth_normal = texelFetch(u_cloth_vertices, texel + 1).xyz;
+      if (u_cloth_normals != 0) v_normal = (slot & 1) != 0 ? -cloth_normal : cloth_normal;
+    }
+  }
 
   v_position = world.xyz;
   v_uv = a_uv;

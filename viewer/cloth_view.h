@@ -6,10 +6,10 @@
 // skin_cloth_particles with the instance's palette in model space (no crowd offset), and
 // update_cloth advances them with the joints' model matrices (colliders) and the crowd placement,
 // after the character's own motion through the world (--move / --turn, animation.h Drive), as the
-// model-to-world transform. The renderer then draws a cloth mesh from CPU-skinned streams with
-// the particles written over them (write_cloth_vertices, then `world` and the crowd placement
-// applied), on both skinning paths: the GPU path
-// skins every other mesh in its vertex shader. A root that jumps further than the cloth's teleport
+// model-to-world transform. The renderer then draws the particles where they are, `world` and the
+// crowd placement applied: on the GPU path its vertex shader reads them for the cloth vertices of
+// a mesh it skins (renderer.h), on the CPU path they are written over skin_cpu's streams
+// (write_cloth_vertices). A root that jumps further than the cloth's teleport
 // distance in one frame (a looping clip with root motion) restarts that cloth from the skinned pose,
 // as ClothInstance does for a jump of the world transform.
 #pragma once

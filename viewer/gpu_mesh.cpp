@@ -3,8 +3,10 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include <ossa/format/vertex_format.h>
+#include <ossa/loader/cloth_source.h>
 #include "viewer/morphs.h"
 
 namespace ossa::view {
@@ -94,6 +96,28 @@ Status upload_morphs(GpuMesh& g, const MeshView& mesh, std::string_view asset_na
   return {};
 }
 
+/// The cloth's vertex -> particle map as a texture buffer (gpu_mesh.h). O(vertices).
+Status upload_cloth_slots(GpuMesh& g, const MeshView& mesh, std::string_view asset_name) {
+  if (!mesh.fb->cloth()) return {};
+  const ClothSource source = cloth_source(mesh);
+  GLint max_texels = 0;
+  glGetIntegerv(GL_MAX_TEXTURE_BUFFER_SIZE, &max_texels);
+  if (mesh.vertex_count() > static_cast<size_t>(max_texels))
+    return Error{where(mesh, asset_name) + ": " + std::to_string(mesh.vertex_count()) +
+                 " cloth vertices exceed this GL's texture buffer (" + std::to_string(max_texels) + " texels)"};
+  std::vector<int32_t> slots(mesh.vertex_count(), -1);
+  for (size_t k = 0; k < source.vertices.size() && k < source.vertex_particles.size(); ++k) {
+    const uint32_t v = source.vertices[k], p = source.vertex_particles[k];
+    if (v >= slots.size() || p >= source.particle_count())
+      return Error{where(mesh, asset_name) + ": cloth vertex " + std::to_string(k) + " is past the mesh"};
+    const bool flipped = k < source.flipped.size() && source.flipped[k] != 0;
+    slots[v] = static_cast<int32_t>(2 * p + (flipped ? 1u : 0u));
+  }
+  make_texture_buffer(GL_R32I, slots.data(), slots.size() * sizeof(int32_t), g.cloth_slot_buffer, g.cloth_slot_texture);
+  g.cloth_particles = static_cast<uint32_t>(source.particle_count());
+  return {};
+}
+
 }  // namespace
 
 Result<GpuMesh> create_gpu_mesh(const MeshView& mesh, std::string_view asset_name,
@@ -156,16 +180,20 @@ Result<GpuMesh> create_gpu_mesh(const MeshView& mesh, std::string_view asset_nam
     destroy_gpu_mesh(g);
     return s.error();
   }
+  if (Status s = upload_cloth_slots(g, mesh, asset_name); !s) {
+    destroy_gpu_mesh(g);
+    return s.error();
+  }
   return g;
 }
 
 void destroy_gpu_mesh(GpuMesh& g) {
-  const GLuint buffers[] = {g.vertex_buffer, g.index_buffer,       g.cpu_positions,     g.cpu_normals,
-                            g.cpu_tangents,  g.morph_range_buffer, g.morph_entry_buffer};
+  const GLuint buffers[] = {g.vertex_buffer, g.index_buffer,       g.cpu_positions,      g.cpu_normals,
+                            g.cpu_tangents,  g.morph_range_buffer, g.morph_entry_buffer, g.cloth_slot_buffer};
   for (GLuint b : buffers) {
     if (b != 0) glDeleteBuffers(1, &b);
   }
-  const GLuint textures[] = {g.morph_range_texture, g.morph_entry_texture};
+  const GLuint textures[] = {g.morph_range_texture, g.morph_entry_texture, g.cloth_slot_texture};
   for (GLuint t : textures) {
     if (t != 0) glDeleteTextures(1, &t);
   }

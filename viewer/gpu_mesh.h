@@ -14,6 +14,11 @@
 // buffers, made once here: ranges (RG32I, one texel per vertex, read with gl_VertexID) and
 // entries (RGBA32F, morph_texels per entry). A mesh without targets has neither, and the shader
 // skips the morph loop for it (u_morph_channels = 0).
+//
+// A mesh with cooked cloth also gets its vertex -> particle map (R32I, one texel per vertex, read
+// with gl_VertexID: -1 for a skinned vertex, else particle * 2 + 1 where the cooker flipped the
+// vertex's normal), made once here, so the GPU path draws the mesh in one instanced call with its
+// cloth vertices taken from the simulation's output (renderer.h) instead of skinning it on the CPU.
 #pragma once
 #include <cstdint>
 #include <span>
@@ -60,12 +65,17 @@ struct GpuMesh {
   GLuint morph_range_buffer = 0, morph_range_texture = 0, morph_entry_buffer = 0, morph_entry_texture = 0;
   int morph_texels = 0;  // texels per entry: 1 positions, 2 + normals, 3 + tangents
   bool has_morphs() const { return morph_texels > 0; }
+
+  // Cloth: the vertex -> particle map (0 when the mesh has no cloth).
+  GLuint cloth_slot_buffer = 0, cloth_slot_texture = 0;
+  uint32_t cloth_particles = 0;
+  bool has_cloth() const { return cloth_slot_texture != 0; }
 };
 
 /// Uploads one mesh, and its morph targets bound through target_channel (target -> channel, as
 /// bind_morph_targets; empty: none). Errors (naming `asset_name` and the mesh) for layouts the
 /// shader cannot read: a format outside the table, integer joints missing or not integer; morph
-/// entries past GL_MAX_TEXTURE_BUFFER_SIZE.
+/// entries past GL_MAX_TEXTURE_BUFFER_SIZE; a cloth whose vertices are past the mesh.
 Result<GpuMesh> create_gpu_mesh(const MeshView& mesh, std::string_view asset_name,
                                 std::span<const int32_t> target_channel = {});
 void destroy_gpu_mesh(GpuMesh& mesh);

@@ -125,6 +125,8 @@ Status render_headless(const ViewerOptions& o, bool& cannot_run) {
         "frame)\n",
         o.frames, total.sample_ms / n, total.blend_ms / n, total.graph_ms / n, total.skin_ms / n, total.draw_ms / n,
         total.gpu_ms / n);
+    std::printf("cloth particles from the vertex shader %.0f  meshes skinned on the CPU %.0f (per frame)\n",
+                total.shader_cloth_particles / n, total.cpu_skinned_meshes / n);
   }
   destroy_offscreen(*target);
   release_scene(app.renderer);

@@ -112,6 +112,51 @@ void bind_mesh_morphs(const Renderer& r, const GpuMesh& m, size_t channels) {
   glActiveTexture(GL_TEXTURE0);
 }
 
+/// The GPU path's cloth texels (renderer.h): for each mesh with cloth whose every instance has an
+/// output, the particles' positions and normals where they are drawn (the character's motion through
+/// the world, then the crowd placement: the same operations as the CPU path's), one upload. Sets
+/// r.cloth_first per mesh (-1: drawn by the CPU path). Allocation-free once the vectors have grown.
+/// O(instances * particles).
+void upload_cloth(Renderer& r, const ViewerCloth* cloth, size_t instances, std::span<const glm::vec3> offsets,
+                  bool cpu_skinning, FrameTimings& timings) {
+  r.cloth_first.assign(r.meshes.size(), -1);
+  r.cloth_texels.clear();
+  if (cpu_skinning || cloth == nullptr || !cloth->enabled) return;
+  size_t texels = 0;
+  for (size_t m = 0; m < r.meshes.size(); ++m) {
+    const GpuMesh& g = r.meshes[m];
+    if (!g.has_cloth()) continue;
+    bool ready = instances > 0;
+    for (size_t i = 0; i < instances && ready; ++i) {
+      const ClothInstance* c = cloth->find(i, m);
+      ready = c != nullptr && c->particle_count() == g.cloth_particles && c->positions().size() == g.cloth_particles &&
+              c->normals().size() == g.cloth_particles;
+    }
+    const size_t need = 2 * instances * g.cloth_particles;
+    if (!ready || texels + need > static_cast<size_t>(r.max_texels)) continue;
+    r.cloth_first[m] = static_cast<int64_t>(texels);
+    texels += need;
+  }
+  if (texels == 0) return;
+  r.cloth_texels.resize(texels);
+  const glm::mat4& w = cloth->world;
+  const glm::mat3 turn(w);
+  for (const ClothSim& sim : cloth->sims) {  // instance-major, as find() sees them
+    if (sim.mesh >= r.meshes.size() || r.cloth_first[sim.mesh] < 0 || sim.instance >= instances) continue;
+    const glm::vec3 o = sim.instance < offsets.size() ? offsets[sim.instance] : glm::vec3(0.0f);
+    const std::span<const glm::vec3> p = sim.state.positions(), n = sim.state.normals();
+    glm::vec4* out = r.cloth_texels.data() + r.cloth_first[sim.mesh] + 2 * sim.instance * p.size();
+    for (size_t k = 0; k < p.size(); ++k) {
+      out[2 * k] = glm::vec4(glm::vec3(w * glm::vec4(p[k], 1.0f)) + o, 1.0f);
+      out[2 * k + 1] = glm::vec4(turn * n[k], 0.0f);
+    }
+    timings.shader_cloth_particles += static_cast<double>(p.size());
+  }
+  glBindBuffer(GL_TEXTURE_BUFFER, r.cloth_buffer);
+  glBufferData(GL_TEXTURE_BUFFER, static_cast<GLsizeiptr>(texels * sizeof(glm::vec4)), r.cloth_texels.data(),
+               GL_STREAM_DRAW);
+}
+
 /// Bones (joint to parent) and joints of every instance.
 void build_skeleton_lines(Renderer& r, const Scene& scene, const Animator& animator, std::span<const glm::vec3> offsets,
                           size_t& bone_vertices) {
@@ -203,11 +248,17 @@ Result<Renderer> create_renderer() {
   u.morph_weights = glGetUniformLocation(p, "u_morph_weights");
   u.morph_channels = glGetUniformLocation(p, "u_morph_channels");
   u.morph_texels = glGetUniformLocation(p, "u_morph_texels");
+  u.cloth_slots = glGetUniformLocation(p, "u_cloth_slots");
+  u.cloth_vertices = glGetUniformLocation(p, "u_cloth_vertices");
+  u.cloth_first = glGetUniformLocation(p, "u_cloth_first");
+  u.cloth_texels = glGetUniformLocation(p, "u_cloth_texels");
+  u.cloth_normals = glGetUniformLocation(p, "u_cloth_normals");
   r.line_uniforms.view_projection = glGetUniformLocation(r.line_program, "u_view_projection");
   r.line_uniforms.point_size = glGetUniformLocation(r.line_program, "u_point_size");
 
   // Texture units: 0 palette, 1 diffuse, 2 normal, 3 specular, 4 morph ranges, 5 morph entries,
-  // 6 morph weights, 7 occlusion, 8 emissive (each sampler type on its own unit, as GL requires).
+  // 6 morph weights, 7 occlusion, 8 emissive, 9 cloth slots, 10 cloth vertices (each sampler type
+  // on its own unit, as GL requires).
   glUseProgram(p);
   glUniform1i(u.palette, 0);
   glUniform1i(u.diffuse_map, 1);
@@ -218,6 +269,9 @@ Result<Renderer> create_renderer() {
   glUniform1i(u.morph_weights, 6);
   glUniform1i(u.occlusion_map, 7);
   glUniform1i(u.emissive_map, 8);
+  glUniform1i(u.cloth_slots, 9);
+  glUniform1i(u.cloth_vertices, 10);
+  glUniform1i(u.cloth_texels, 0);
   glUniform1i(u.morph_channels, 0);
   glUniform1i(u.morph_texels, 1);
   glUseProgram(0);
@@ -236,6 +290,12 @@ Result<Renderer> create_renderer() {
   glGenTextures(1, &r.morph_weight_texture);
   glBindTexture(GL_TEXTURE_BUFFER, r.morph_weight_texture);
   glTexBuffer(GL_TEXTURE_BUFFER, GL_R32F, r.morph_weight_buffer);
+  glGenBuffers(1, &r.cloth_buffer);
+  glBindBuffer(GL_TEXTURE_BUFFER, r.cloth_buffer);
+  glBufferData(GL_TEXTURE_BUFFER, sizeof(glm::vec4), nullptr, GL_STREAM_DRAW);
+  glGenTextures(1, &r.cloth_texture);
+  glBindTexture(GL_TEXTURE_BUFFER, r.cloth_texture);
+  glTexBuffer(GL_TEXTURE_BUFFER, GL_RGBA32F, r.cloth_buffer);
   glBindTexture(GL_TEXTURE_BUFFER, 0);
 
   r.lines_vao = make_line_array(r.lines_buffer);
@@ -262,12 +322,13 @@ void destroy_renderer(Renderer& r) {
   release_scene(r);
   if (r.mesh_program) glDeleteProgram(r.mesh_program);
   if (r.line_program) glDeleteProgram(r.line_program);
-  const GLuint buffers[] = {r.palette_buffer, r.morph_weight_buffer, r.lines_buffer, r.grid_buffer};
+  const GLuint buffers[] = {r.palette_buffer, r.morph_weight_buffer, r.cloth_buffer, r.lines_buffer, r.grid_buffer};
   for (GLuint b : buffers) {
     if (b) glDeleteBuffers(1, &b);
   }
   if (r.palette_texture) glDeleteTextures(1, &r.palette_texture);
   if (r.morph_weight_texture) glDeleteTextures(1, &r.morph_weight_texture);
+  if (r.cloth_texture) glDeleteTextures(1, &r.cloth_texture);
   const GLuint arrays[] = {r.lines_vao, r.grid_vao};
   for (GLuint a : arrays) {
     if (a) glDeleteVertexArrays(1, &a);
@@ -382,6 +443,7 @@ Status render_frame(Renderer& r, const Scene& scene, const Animator& animator, s
     glBufferData(GL_TEXTURE_BUFFER, static_cast<GLsizeiptr>(r.morph_weights.size() * sizeof(float)),
                  r.morph_weights.data(), GL_STREAM_DRAW);
   }
+  upload_cloth(r, cloth, instances, offsets, toggles.cpu_skinning, timings);
   timings.skin_ms += ms_since(t_skin);
 
   // ---- draw
@@ -431,6 +493,8 @@ Status render_frame(Renderer& r, const Scene& scene, const Animator& animator, s
   glUniform3f(u.light_direction, light.x, light.y, light.z);
   glActiveTexture(GL_TEXTURE6);
   glBindTexture(GL_TEXTURE_BUFFER, r.morph_weight_texture);
+  glActiveTexture(GL_TEXTURE10);
+  glBindTexture(GL_TEXTURE_BUFFER, r.cloth_texture);
   glActiveTexture(GL_TEXTURE0);
   glBindTexture(GL_TEXTURE_BUFFER, r.palette_texture);
   set_default_attributes();
@@ -449,30 +513,43 @@ Status render_frame(Renderer& r, const Scene& scene, const Animator& animator, s
       glPolygonMode(GL_FRONT_AND_BACK, GL_LINE);
       glUniform4f(u.flat_color, kWireColor.r, kWireColor.g, kWireColor.b, kWireColor.a);
     }
-    // Meshes with live cloth take the CPU path on both settings: their particles are written
-    // over CPU-skinned streams (cloth_view.h).
+    // Meshes with live cloth: on the GPU path their cloth vertices are read from r.cloth_texture
+    // (upload_cloth); one whose cloth the shader cannot read yet is skinned on the CPU with its
+    // particles written over the streams (cloth_view.h).
     const auto simulated = [&](size_t i, size_t m) { return cloth != nullptr && cloth->find(i, m) != nullptr; };
-    bool any_cloth = false;
-    for (size_t m = 0; m < r.meshes.size(); ++m) any_cloth = any_cloth || simulated(0, m);
+    const auto cpu_cloth = [&](size_t m) { return simulated(0, m) && r.cloth_first[m] < 0; };
+    bool any_cpu_cloth = false;
+    for (size_t m = 0; m < r.meshes.size(); ++m) any_cpu_cloth = any_cpu_cloth || cpu_cloth(m);
     if (!toggles.cpu_skinning) {
       glUniform1i(u.instance_texels, static_cast<GLint>(4 * r.instance_matrices));
       for (size_t m = 0; m < r.meshes.size(); ++m) {
-        if (simulated(0, m)) continue;
-        set_mesh_encoding(r, r.meshes[m], false);
-        bind_mesh_morphs(r, r.meshes[m], morphs ? channels : 0);
+        if (cpu_cloth(m)) continue;
+        const GpuMesh& g = r.meshes[m];
+        set_mesh_encoding(r, g, false);
+        bind_mesh_morphs(r, g, morphs ? channels : 0);
+        if (r.cloth_first[m] >= 0) {
+          glUniform1i(u.cloth_first, static_cast<GLint>(r.cloth_first[m]));
+          glUniform1i(u.cloth_texels, static_cast<GLint>(2 * g.cloth_particles));
+          glUniform1i(u.cloth_normals, g.has_normals ? 1 : 0);
+          glActiveTexture(GL_TEXTURE9);
+          glBindTexture(GL_TEXTURE_BUFFER, g.cloth_slot_texture);
+          glActiveTexture(GL_TEXTURE0);
+        }
         glUniform1i(u.palette_base, static_cast<GLint>(4 * r.palette_base[m]));
-        glBindVertexArray(r.meshes[m].vao);
-        draw_submeshes(r, asset.mesh(m), r.meshes[m], static_cast<GLsizei>(instances), shaded);
+        glBindVertexArray(g.vao);
+        draw_submeshes(r, asset.mesh(m), g, static_cast<GLsizei>(instances), shaded);
+        glUniform1i(u.cloth_texels, 0);
       }
     }
-    if (toggles.cpu_skinning || any_cloth) {
+    if (toggles.cpu_skinning || any_cpu_cloth) {
       // Reference path: skin_cpu per instance and mesh, drawn with the identity palette entry.
       glUniform1i(u.instance_texels, 0);
       glUniform1i(u.palette_base, static_cast<GLint>(4 * (matrices - 1)));
       glUniform1i(u.morph_channels, 0);  // morphed on the CPU
       for (size_t i = 0; i < instances; ++i) {
         for (size_t m = 0; m < r.meshes.size(); ++m) {
-          if (!toggles.cpu_skinning && !simulated(i, m)) continue;
+          if (!toggles.cpu_skinning && !cpu_cloth(m)) continue;
+          if (shaded) timings.cpu_skinned_meshes += 1.0;
           const GpuMesh& g = r.meshes[m];
           const MeshView view = asset.mesh(m);
           const auto t0 = Clock::now();

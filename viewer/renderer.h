@@ -11,6 +11,13 @@
 // per frame, beside the palettes, and meshes with targets read them in the vertex shader through
 // their entry lists (gpu_mesh.h, morphs.h). The CPU path morphs and skins those meshes with
 // morph_and_skin_cpu (apply_morphs, then the same linear blend), from vertices decoded once here.
+//
+// Simulated cloth (cloth_view.h) on the GPU path: every instance's particle output, placed where it
+// is drawn, goes into one RGBA32F texture buffer per frame (two texels a particle), and the cloth
+// mesh is drawn instanced like the others, its cloth vertices read from there by gl_VertexID
+// (gpu_mesh.h's map). The CPU work per frame is per particle, never per vertex of the mesh. A mesh
+// whose cloth has no output yet for some instance, and the --cpu-skinning path, skin it with
+// skin_cpu and write the particles over the streams (write_cloth_vertices), as before.
 #pragma once
 #include <cstdint>
 #include <span>
@@ -46,6 +53,9 @@ struct ViewToggles {
 /// late, 0 until available).
 struct FrameTimings {
   double sample_ms = 0, blend_ms = 0, graph_ms = 0, skin_ms = 0, draw_ms = 0, gpu_ms = 0;
+  // Counts added per frame: cloth particles the vertex shader read, meshes skinned by skin_cpu
+  // (instances x meshes).
+  double shader_cloth_particles = 0, cpu_skinned_meshes = 0;
 };
 
 struct LineVertex {
@@ -74,7 +84,7 @@ struct Renderer {
         view_projection, camera_position, light_direction, diffuse_color, opacity, diffuse_map, normal_map,
         specular_map, has_diffuse_map, has_normal_map, has_specular_map, flat_color, morph_ranges, morph_entries,
         morph_weights, morph_channels, morph_texels, occlusion_map, emissive_map, has_occlusion_map, has_emissive_map,
-        emissive_color;
+        emissive_color, cloth_slots, cloth_vertices, cloth_first, cloth_texels, cloth_normals;
   } mesh_uniforms{};
   struct {
     GLint view_projection, point_size;
@@ -85,6 +95,9 @@ struct Renderer {
   GLuint palette_buffer = 0, palette_texture = 0;
   // Morph weights texture buffer: R32F, instance * channels + channel.
   GLuint morph_weight_buffer = 0, morph_weight_texture = 0;
+  // Cloth output texture buffer: RGBA32F, per mesh from cloth_first[m], instance-major, two texels
+  // (position, normal) per particle; cloth_first[m] < 0: the mesh's cloth is not read by the shader.
+  GLuint cloth_buffer = 0, cloth_texture = 0;
   GLint max_texels = 0;
   GLuint lines_vao = 0, lines_buffer = 0, grid_vao = 0, grid_buffer = 0;
   GLsizei grid_vertices = 0;
@@ -107,6 +120,8 @@ struct Renderer {
   std::vector<glm::mat4> palette;
   std::vector<float> skinned_positions, skinned_normals, skinned_tangents;
   std::vector<float> morph_weights;
+  std::vector<glm::vec4> cloth_texels;
+  std::vector<int64_t> cloth_first;
   MorphScratch morph_scratch;
   std::vector<LineVertex> lines;
   OverlayGeometry overlay;  // drawn last by render_frame when not empty
