@@ -90,4 +90,15 @@ Result<GLuint> build_program(std::string_view name, const char* vertex_source, c
   return Error{std::string(name) + ": program does not link: " + log.data()};
 }
 
+void make_texture_buffer(GLenum format, const void* data, size_t bytes, GLenum usage, GLuint& buffer, GLuint& texture) {
+  glGenBuffers(1, &buffer);
+  glBindBuffer(GL_TEXTURE_BUFFER, buffer);
+  glBufferData(GL_TEXTURE_BUFFER, static_cast<GLsizeiptr>(bytes), data, usage);
+  glGenTextures(1, &texture);
+  glBindTexture(GL_TEXTURE_BUFFER, texture);
+  glTexBuffer(GL_TEXTURE_BUFFER, format, buffer);
+  glBindTexture(GL_TEXTURE_BUFFER, 0);
+  glBindBuffer(GL_TEXTURE_BUFFER, 0);
+}
+
 }  // namespace ossa::view

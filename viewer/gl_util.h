@@ -4,6 +4,7 @@
 // after every frame and exits non-zero naming what failed, so a broken driver, a shader that does
 // not compile or a bad attribute setup never produces a silently wrong screenshot.
 #pragma once
+#include <cstddef>
 #include <string>
 #include <string_view>
 
@@ -20,5 +21,10 @@ Status check_gl(std::string_view where);
 /// Errors carry the driver's log and the shader's name.
 Result<GLuint> build_program(std::string_view name, const char* vertex_source, const char* fragment_source,
                              std::string_view defines = {});
+
+/// A texture buffer of `format` over a new buffer of `bytes` bytes from `data` (null: uninitialized),
+/// with `usage` (GL_STATIC_DRAW for data made once, GL_STREAM_DRAW for data replaced each frame).
+/// Leaves GL_TEXTURE_BUFFER unbound on both targets.
+void make_texture_buffer(GLenum format, const void* data, size_t bytes, GLenum usage, GLuint& buffer, GLuint& texture);
 
 }  // namespace ossa::view

@@ -7,6 +7,7 @@
 
 #include <ossa/format/vertex_format.h>
 #include <ossa/loader/cloth_source.h>
+#include "viewer/gl_util.h"
 #include "viewer/morphs.h"
 
 namespace ossa::view {
@@ -64,18 +65,6 @@ GLuint float_stream(GLuint location, int components) {
   return b;
 }
 
-/// A texture buffer over a new buffer holding `bytes`.
-void make_texture_buffer(GLenum format, const void* data, size_t bytes, GLuint& buffer, GLuint& texture) {
-  glGenBuffers(1, &buffer);
-  glBindBuffer(GL_TEXTURE_BUFFER, buffer);
-  glBufferData(GL_TEXTURE_BUFFER, static_cast<GLsizeiptr>(bytes), data, GL_STATIC_DRAW);
-  glGenTextures(1, &texture);
-  glBindTexture(GL_TEXTURE_BUFFER, texture);
-  glTexBuffer(GL_TEXTURE_BUFFER, format, buffer);
-  glBindTexture(GL_TEXTURE_BUFFER, 0);
-  glBindBuffer(GL_TEXTURE_BUFFER, 0);
-}
-
 /// The mesh's morph entry lists as two texture buffers (morphs.h build_morph_entries).
 Status upload_morphs(GpuMesh& g, const MeshView& mesh, std::string_view asset_name,
                      std::span<const int32_t> target_channel) {
@@ -88,10 +77,10 @@ Status upload_morphs(GpuMesh& g, const MeshView& mesh, std::string_view asset_na
     return Error{where(mesh, asset_name) + ": " + std::to_string(texels) +
                  " morph texels exceed this GL's texture buffer (" + std::to_string(max_texels) + " texels)"};
   }
-  make_texture_buffer(GL_RG32I, e.ranges.data(), e.ranges.size() * sizeof(int32_t), g.morph_range_buffer,
-                      g.morph_range_texture);
-  make_texture_buffer(GL_RGBA32F, e.texels.data(), e.texels.size() * sizeof(float), g.morph_entry_buffer,
-                      g.morph_entry_texture);
+  make_texture_buffer(GL_RG32I, e.ranges.data(), e.ranges.size() * sizeof(int32_t), GL_STATIC_DRAW,
+                      g.morph_range_buffer, g.morph_range_texture);
+  make_texture_buffer(GL_RGBA32F, e.texels.data(), e.texels.size() * sizeof(float), GL_STATIC_DRAW,
+                      g.morph_entry_buffer, g.morph_entry_texture);
   g.morph_texels = e.texels_per_entry;
   return {};
 }
@@ -113,7 +102,8 @@ Status upload_cloth_slots(GpuMesh& g, const MeshView& mesh, std::string_view ass
     const bool flipped = k < source.flipped.size() && source.flipped[k] != 0;
     slots[v] = static_cast<int32_t>(2 * p + (flipped ? 1u : 0u));
   }
-  make_texture_buffer(GL_R32I, slots.data(), slots.size() * sizeof(int32_t), g.cloth_slot_buffer, g.cloth_slot_texture);
+  make_texture_buffer(GL_R32I, slots.data(), slots.size() * sizeof(int32_t), GL_STATIC_DRAW, g.cloth_slot_buffer,
+                      g.cloth_slot_texture);
   g.cloth_particles = static_cast<uint32_t>(source.particle_count());
   return {};
 }

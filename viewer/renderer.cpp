@@ -276,27 +276,10 @@ Result<Renderer> create_renderer() {
   glUniform1i(u.morph_texels, 1);
   glUseProgram(0);
 
-  glGenBuffers(1, &r.palette_buffer);
-  glBindBuffer(GL_TEXTURE_BUFFER, r.palette_buffer);
-  glBufferData(GL_TEXTURE_BUFFER, sizeof(glm::mat4), nullptr, GL_STREAM_DRAW);
-  glGenTextures(1, &r.palette_texture);
-  glBindTexture(GL_TEXTURE_BUFFER, r.palette_texture);
-  glTexBuffer(GL_TEXTURE_BUFFER, GL_RGBA32F, r.palette_buffer);
-  glBindTexture(GL_TEXTURE_BUFFER, 0);
+  make_texture_buffer(GL_RGBA32F, nullptr, sizeof(glm::mat4), GL_STREAM_DRAW, r.palette_buffer, r.palette_texture);
   glGetIntegerv(GL_MAX_TEXTURE_BUFFER_SIZE, &r.max_texels);
-  glGenBuffers(1, &r.morph_weight_buffer);
-  glBindBuffer(GL_TEXTURE_BUFFER, r.morph_weight_buffer);
-  glBufferData(GL_TEXTURE_BUFFER, sizeof(float), nullptr, GL_STREAM_DRAW);
-  glGenTextures(1, &r.morph_weight_texture);
-  glBindTexture(GL_TEXTURE_BUFFER, r.morph_weight_texture);
-  glTexBuffer(GL_TEXTURE_BUFFER, GL_R32F, r.morph_weight_buffer);
-  glGenBuffers(1, &r.cloth_buffer);
-  glBindBuffer(GL_TEXTURE_BUFFER, r.cloth_buffer);
-  glBufferData(GL_TEXTURE_BUFFER, sizeof(glm::vec4), nullptr, GL_STREAM_DRAW);
-  glGenTextures(1, &r.cloth_texture);
-  glBindTexture(GL_TEXTURE_BUFFER, r.cloth_texture);
-  glTexBuffer(GL_TEXTURE_BUFFER, GL_RGBA32F, r.cloth_buffer);
-  glBindTexture(GL_TEXTURE_BUFFER, 0);
+  make_texture_buffer(GL_R32F, nullptr, sizeof(float), GL_STREAM_DRAW, r.morph_weight_buffer, r.morph_weight_texture);
+  make_texture_buffer(GL_RGBA32F, nullptr, sizeof(glm::vec4), GL_STREAM_DRAW, r.cloth_buffer, r.cloth_texture);
 
   r.lines_vao = make_line_array(r.lines_buffer);
   r.grid_vao = make_line_array(r.grid_buffer);
