@@ -94,7 +94,7 @@ ParsedOptions parse_options(int argc, const char* const* argv) {
       ->check(CLI::Range(1, 100000));
   app.add_option("--screenshot", o.screenshot, "headless: write the last frame to this PNG");
   app.add_flag("--first-frame-time", o.first_frame_time, "print first-frame-ms once the first frame is finished");
-  app.add_flag("--stats", o.stats, "headless: print the average frame-time split");
+  app.add_flag("--stats", o.stats, "headless: print the average frame-time split and how cloth was drawn");
   app.add_option("--graph", o.graph, "drive the character with the animation graph of this name");
   app.add_option("--set,--param", o.set,
                  "graph parameter start value, NAME=VALUE (a trigger: NAME; a vector: NAME=X,Y,Z); repeatable")
