@@ -112,6 +112,12 @@ void bind_mesh_morphs(const Renderer& r, const GpuMesh& m, size_t channels) {
   glActiveTexture(GL_TEXTURE0);
 }
 
+/// Where a cloth particle is drawn: the character's motion through the world `w`, then the crowd
+/// placement `o`. One definition for both skinning paths, so they draw the same bits.
+glm::vec3 drawn_cloth_position(const glm::mat4& w, const glm::vec3& o, const glm::vec3& p) {
+  return glm::vec3(w * glm::vec4(p, 1.0f)) + o;
+}
+
 /// The GPU path's cloth texels (renderer.h): for each mesh with cloth whose every instance has an
 /// output, the particles' positions and normals where they are drawn (the character's motion through
 /// the world, then the crowd placement: the same operations as the CPU path's), one upload. Sets
@@ -147,7 +153,7 @@ void upload_cloth(Renderer& r, const ViewerCloth* cloth, size_t instances, std::
     const std::span<const glm::vec3> p = sim.state.positions(), n = sim.state.normals();
     glm::vec4* out = r.cloth_texels.data() + r.cloth_first[sim.mesh] + 2 * sim.instance * p.size();
     for (size_t k = 0; k < p.size(); ++k) {
-      out[2 * k] = glm::vec4(glm::vec3(w * glm::vec4(p[k], 1.0f)) + o, 1.0f);
+      out[2 * k] = glm::vec4(drawn_cloth_position(w, o, p[k]), 1.0f);
       out[2 * k + 1] = glm::vec4(turn * n[k], 0.0f);
     }
     timings.shader_cloth_particles += static_cast<double>(p.size());
@@ -553,16 +559,17 @@ Status render_frame(Renderer& r, const Scene& scene, const Animator& animator, s
             // Then where it is drawn: its motion through the world (cloth_view.h), the crowd placement.
             const glm::vec3 o = i < offsets.size() ? offsets[i] : glm::vec3(0.0f);
             const glm::mat4& w = cloth->world;
+            const glm::mat3 turn(w);
             const bool normals = r.skinned_normals.size() == r.skinned_positions.size();
             for (const uint32_t cv : c->source.vertices) {
               float* p = &r.skinned_positions[3 * static_cast<size_t>(cv)];
-              const glm::vec3 q = glm::vec3(w * glm::vec4(p[0], p[1], p[2], 1.0f)) + o;
+              const glm::vec3 q = drawn_cloth_position(w, o, glm::vec3(p[0], p[1], p[2]));
               p[0] = q.x;
               p[1] = q.y;
               p[2] = q.z;
               if (!normals) continue;
               float* nv = &r.skinned_normals[3 * static_cast<size_t>(cv)];
-              const glm::vec3 turned = glm::mat3(w) * glm::vec3(nv[0], nv[1], nv[2]);
+              const glm::vec3 turned = turn * glm::vec3(nv[0], nv[1], nv[2]);
               nv[0] = turned.x;
               nv[1] = turned.y;
               nv[2] = turned.z;
