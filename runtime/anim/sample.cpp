@@ -17,7 +17,8 @@
 //      sign fix, write the pose. It is written with vector extensions, and on x86-64 compiled
 //      twice (AVX2 and the SSE2 baseline, picked per call: internal/vector_clones.h), so the
 //      default build still runs on any x86-64. A block with no animated channel of a kind copies that
-//      kind's fixed values instead of interpolating them.
+//      kind's fixed values instead of interpolating them; a block a joint filter keeps no joint of
+//      is skipped.
 // Rotations are stored with one component >= 0 (clip_codec.h drops it), so two neighbouring keys
 // may lie in opposite hemispheres; the sign fix in pass 2 (flip b when dot(a, b) < 0) keeps the
 // blend on the short arc. It is done per sample rather than at decode time so that a cached pair
@@ -63,6 +64,9 @@ namespace {
 
 constexpr uint32_t kNoCursor = std::numeric_limits<uint32_t>::max();
 constexpr float kInf = std::numeric_limits<float>::infinity();
+
+/// Per 8-joint block flags (State::block_kinds): an animated channel of a kind, or no kept joint.
+constexpr uint8_t kAnimatedT = 1, kAnimatedR = 2, kAnimatedS = 4, kSkipped = 8;
 
 /// Components of each channel kind in a pose (pose.h order: T xyz, R xyzw, S xyz).
 constexpr uint32_t kFirstComponent[3] = {kTx, kRx, kSx};
@@ -130,7 +134,8 @@ struct SamplingCache::State {
   float* start = nullptr;       // per kind: frame of k0
   float* inv_length = nullptr;  // per kind: 1 / (frame of k1 - frame of k0); 0 for fixed channels
   // Per 8-joint block: bit `kind` set when some joint of the block has an animated channel of
-  // that kind. Pass 2 interpolates only those; the rest never change and are copied.
+  // that kind. Pass 2 interpolates only those; the rest never change and are copied. kSkipped: a
+  // joint filter keeps none of the block's joints, and pass 2 leaves it alone.
   std::vector<uint8_t> block_kinds;
   const uint8_t* kinds = nullptr;  // block_kinds, or a prototype's
 
@@ -375,8 +380,6 @@ struct Lanes {
   uint32_t stride;
 };
 
-constexpr uint8_t kAnimatedT = 1, kAnimatedR = 2, kAnimatedS = 4;
-
 OSSA_INLINE static void interpolate_nlerp_body(const Lanes& l, float frame) {
   const size_t n = l.stride;
   const float* k0 = l.k0;
@@ -390,6 +393,7 @@ OSSA_INLINE static void interpolate_nlerp_body(const Lanes& l, float frame) {
     // it: copy them. Real rigs have few animated translations and scales, and runs of joints
     // (fingers, props) that a clip leaves alone.
     const uint8_t kinds = l.block_kinds[b];
+    if (kinds & kSkipped) continue;  // a joint filter keeps no joint of this block
     const auto copy = [&](size_t c) { store8(out + c * n + j, load8(l.fixed + c * n + j)); };
     const auto lerp = [&](size_t c, const F8& wa, const F8& wb) {
       // a * (1 - w) + b * w is exact at both ends (w = 0 gives a, w = 1 gives b).
@@ -451,6 +455,7 @@ void interpolate_slerp(const Lanes& l, float frame) {
   interpolate_nlerp(l, frame);  // T, S, and an nlerp R the loop below replaces
   const uint32_t stride = l.stride;
   for (uint32_t j = 0; j < stride; ++j) {
+    if (l.block_kinds[j / kPoseLanes] & kSkipped) continue;
     float w = (frame - l.start[stride + j]) * l.inv_length[stride + j];
     w = w < 0.0f ? 0.0f : (w > 1.0f ? 1.0f : w);
     float a[4], b[4];
@@ -494,9 +499,11 @@ Result<SamplingCache> make_sampling_cache(const ClipView& clip, const SkeletonVi
   const size_t stride = s->stride;
   // Runs: channels that address the same key-frame range share one, in order of first use;
   // tracks are grouped by run. A filter drops the channels of the joints it leaves out (and runs
-  // left without a channel), but not their blocks' kinds: pass 2 then treats every lane as the
-  // unfiltered cache does, which keeps the kept joints' bits.
-  s->block_kinds.assign(s->stride / kPoseLanes, 0);
+  // left without a channel), but not the kinds of blocks it keeps a joint of: pass 2 then treats
+  // every lane of those as the unfiltered cache does, which keeps the kept joints' bits. A block it
+  // keeps no joint of is left out of pass 2 (kSkipped): a filter pays for the blocks it shows only.
+  s->block_kinds.assign(s->stride / kPoseLanes, joints.empty() ? 0 : kSkipped);
+  for (uint32_t j = 0; j < joints.size(); ++j) s->block_kinds[j / kPoseLanes] &= joints[j] != 0 ? 0 : 0xff;
   std::vector<Run> runs;
   std::vector<const fb::AnimatedChannel*> animated;
   for (const fb::AnimatedChannel& a : clip.animated()) {
@@ -632,7 +639,7 @@ void sample(const ClipView& clip, float time, const SampleOptions& options, Samp
     s.all_leave = all_leave;
   }
 
-  // Pass 2: every joint.
+  // Pass 2: every joint (of the blocks a joint filter keeps).
   const Lanes lanes{s.k0, s.fixed, s.k1, s.start, s.inv_length, s.kinds, out.base, s.stride};
   if (options.rotation == RotationInterpolation::Slerp) interpolate_slerp(lanes, frame);
   else interpolate_nlerp(lanes, frame);

@@ -73,6 +73,12 @@ void collect_events(State& s, const ClipView& clip, uint16_t clip_index, uint16_
   down(t1, d, false, false);
 }
 
+/// The cache node `n` samples with: filtered to what the covering slot shows while it hides the
+/// rest from this node (Impl::node_hidden), else the whole one.
+SamplingCache& cache_of(State& s, uint16_t n, uint32_t index) {
+  return s.hidden >= 0 && s.def->node_hidden[n] == s.hidden ? s.hidden_caches[index] : s.caches[index];
+}
+
 float param_or(const State& s, int16_t parameter, float fallback) {
   return parameter >= 0 ? s.params[static_cast<size_t>(parameter)] : fallback;
 }
@@ -113,7 +119,7 @@ void evaluate_clip(State& s, uint16_t n, const NodeInfo& info, const Advance& ad
   if (dominant) collect_events(s, clip, c.clip(), n, t0, time, loops, rate >= 0.0f, c.loop());
   SampleOptions options;
   options.loop = c.loop();
-  sample(clip, time, options, s.caches[info.caches], out);
+  sample(clip, time, options, cache_of(s, n, info.caches), out);
   clip_weights(s, c.clip(), time, ow);
 }
 
@@ -194,7 +200,7 @@ void evaluate_blend_space(State& s, uint16_t n, const NodeInfo& info, const Adva
     const float t0 = p0 * d, t1 = p1 * d;
     if (dominant && k == leader) collect_events(s, clip, smp.clip(), n, t0, t1, loops, b.rate() >= 0.0f, b.loop());
     PoseSpan target = active == 1 ? out : s.scratch->poses[depth + k].span();
-    sample(clip, t1, options, s.caches[info.caches + indices[k]], target);
+    sample(clip, t1, options, cache_of(s, n, info.caches + indices[k]), target);
     poses[k] = target;
     // Weights: the first sample's into ow, the others added in with their share.
     if (!ow.empty()) {

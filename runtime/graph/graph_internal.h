@@ -194,6 +194,19 @@ struct GraphDefinition::Impl {
   /// layer weighs and the layer lies under that slot with no node keeping poses or reading model
   /// space on any way there (its blend is then seen only on the slot's shown lanes).
   std::vector<std::vector<uint8_t>> layer_covered;
+  /// Parallel to slot_masks: 1 on the joints the mask leaves out (what the slot shows of its input at
+  /// full weight): the joint filter of the sampling caches its input samples with while hidden.
+  std::vector<std::vector<uint8_t>> slot_visible;
+  /// Per node: the slot mask under which it may leave the mask's joints out (-1: never). A clip or a
+  /// blend space then samples with State::hidden_caches; a machine evaluates its states on the shown
+  /// lanes and keeps its history by replaying them (graph_machine.cpp). Set for nodes a masked
+  /// override slot reaches with nothing on the way that keeps poses or reads model space, but for
+  /// machines whose states hold only clips, blend spaces and blends (hidden_machine).
+  std::vector<int32_t> node_hidden;
+  /// Per clip: the prototype of its caches filtered by slot_visible[hidden_prototype_mask[clip]]
+  /// (-1: none; one mask per clip, the first that needs one).
+  std::vector<SamplingCache> hidden_prototypes;
+  std::vector<int32_t> hidden_prototype_mask;
   std::vector<graph_detail::MontageInfo> montages;
   std::vector<graph_detail::TrackInfo> tracks;
   std::vector<graph_detail::SegmentInfo> segments;
@@ -218,6 +231,27 @@ struct InertialChannel {
   float x0 = 0.0f, v0 = 0.0f, a0 = 0.0f, t1 = 0.0f;
 };
 
+/// What a machine's update changes of its own scalars: kept per hidden update (MachineJournal) so
+/// that its output can be made again whole (graph_machine.cpp).
+struct MachineClock {
+  int current = 0, source = -1, transition = -1;
+  fb::TransitionMode mode = fb::TransitionMode::Crossfade;
+  float elapsed = 0.0f, duration = 0.0f;
+  double normalized = 0.0, normalized_before = 0.0;
+  bool looping = true, inertial = false;
+  float inertial_elapsed = 0.0f, inertial_duration = 0.0f;
+};
+
+/// One update a machine evaluated on a covering slot's shown lanes only: the instance's scalars and
+/// the machine's clock as its states were evaluated, and how it advanced.
+struct MachineJournal {
+  uint64_t update = 0;  // 0: empty
+  float dt = 0.0f, phase = 0.0f, weight = 0.0f;
+  bool synced = false;
+  MachineClock clock;
+  std::vector<float> values;  // State::values
+};
+
 struct MachineState {
   int current = 0;      // the state being entered / played
   int source = -1;      // a running crossfade's source state
@@ -238,6 +272,15 @@ struct MachineState {
   float last_dt = 0.0f;
   uint64_t last_update = 0, before_last_update = 0;  // update counter stamps; 0 = never
   bool entered = false;                              // false: enter the entry state at the next evaluation
+  // A machine a covering slot may hide joints of (Impl::node_hidden): which history buffers hold
+  // shown lanes only, the journals of those updates, the offset channels before the last capture
+  // (and its update), and the buffers a replay uses. Empty for other machines.
+  bool last_partial = false, before_last_partial = false;
+  uint32_t skipped_joints = 0;  // joints left out in the last update
+  uint64_t capture_update = 0;
+  MachineJournal journal[2];
+  std::vector<InertialChannel> prev_translation, prev_rotation;
+  std::vector<float> replay_values, replay_weights;
 };
 
 }  // namespace graph_detail
@@ -325,6 +368,9 @@ struct GraphInstance::State {
   // marked in Impl::layer_covered for it leave those joints unblended (graph_slot.cpp).
   int32_t hidden = -1;
   glm::vec3 root_motion_up{0.0f, 1.0f, 0.0f};
+  // Parallel to caches: for the clips and blend spaces of Impl::node_hidden, a cache filtered to
+  // what their slot shows, sampled with while State::hidden is that slot's mask (else empty).
+  std::vector<SamplingCache> hidden_caches;
 };
 
 namespace graph_detail {
@@ -437,6 +483,9 @@ inline void set_rotation(PoseSpan p, uint32_t j, const glm::quat& q) {
 /// leaves the cache to what the next character reads. The caller fences (update() does, once).
 /// O(stride).
 void stream_pose(ConstPoseSpan from, PoseSpan to);
+/// stream_pose for the lanes [first, last) of each range (whole blocks of kPoseLanes) only.
+/// O(lanes copied).
+void stream_lanes(ConstPoseSpan from, PoseSpan to, const std::vector<std::pair<uint32_t, uint32_t>>& lanes);
 
 /// Scratch needed by a subtree beyond `out` (graph_definition.cpp computes it once).
 uint32_t scratch_needed(const GraphDefinition::Impl& def, uint16_t n);

@@ -11,6 +11,12 @@
 // length, a rotation angle about a fixed axis) follows the quintic with x(0) = x0, x'(0) = v0 (the
 // source's velocity along the offset, from the last two outputs, clamped so it never grows) and
 // x = x' = x'' = 0 at t1 = min(duration, -5 x0 / v0). Scales are not inertialized (they switch).
+//
+// Under a slot showing its montages over some joints at full weight, a machine whose states hold
+// only clips, blend spaces and blends evaluates just the lanes the slot shows; its history then
+// lacks the rest, so each such update is journaled (the instance's scalars, about 30 floats for
+// Pab, and the machine's clock), and a capture that needs that history first replays those updates
+// on every joint (replay_history).
 #include <algorithm>
 #include <cmath>
 
@@ -157,23 +163,32 @@ void capture_offset(State& s, MachineState& m, ConstPoseSpan now, float duration
 
 }  // namespace
 
-void apply_offset(const State& s, const MachineState& m, PoseSpan out) {
-  const float t = m.inertial_elapsed;
+namespace {
+
+/// Adds the offsets of channels `translation` and `rotation` (one per joint) at time t.
+void apply_channels(const State& s, const InertialChannel* translation, const InertialChannel* rotation, float t,
+                    PoseSpan out) {
   for (uint32_t j = 0; j < s.def->joints; ++j) {
-    const InertialChannel& ct = m.translation[j];
+    const InertialChannel& ct = translation[j];
     if (ct.x0 > 0.0f) {
       const float x = quintic(ct, t);
       out[kTx][j] += ct.direction.x * x;
       out[kTy][j] += ct.direction.y * x;
       out[kTz][j] += ct.direction.z * x;
     }
-    const InertialChannel& cr = m.rotation[j];
+    const InertialChannel& cr = rotation[j];
     if (cr.x0 > 0.0f) {
       const float x = quintic(cr, t);
       if (x == 0.0f) continue;
       set_rotation(out, j, glm::angleAxis(x, cr.direction) * rotation_at(out, j));
     }
   }
+}
+
+}  // namespace
+
+void apply_offset(const State& s, const MachineState& m, PoseSpan out) {
+  apply_channels(s, m.translation.data(), m.rotation.data(), m.inertial_elapsed, out);
 }
 
 namespace {
@@ -227,6 +242,8 @@ void restart_machine(State& s, uint16_t machine) {
   m.elapsed = m.duration = 0.0f;
   m.inertial = false;
   m.last_update = m.before_last_update = 0;
+  m.last_partial = m.before_last_partial = false;
+  m.skipped_joints = 0;
 }
 
 Cycle machine_cycle(const State& s, uint16_t machine) {
@@ -250,20 +267,32 @@ void set_machine_phase(State& s, uint16_t machine, float p) {
   m.normalized = m.normalized_before = p;
 }
 
-void evaluate_machine(State& s, uint16_t n, const Advance& advance, float weight, bool dominant, PoseSpan out,
-                      std::span<float> ow, uint32_t depth) {
-  const NodeInfo& info = s.def->nodes[n];
-  MachineState& m = s.machines[info.machine];
-  const MachineInfo& mi = s.def->machines[info.machine];
-  if (!m.entered) {
-    m.entered = true;
-    enter_state(s, m, mi, mi.fb->entry());
-  }
+namespace {
 
-  float capture_duration = 0.0f;
-  const bool capture = try_transition(s, m, mi, &capture_duration);
+MachineClock clock_of(const MachineState& m) {
+  return MachineClock{m.current, m.source,   m.transition,       m.mode,
+                      m.elapsed, m.duration, m.normalized,       m.normalized_before,
+                      m.looping, m.inertial, m.inertial_elapsed, m.inertial_duration};
+}
 
-  // Advance and evaluate.
+void set_clock(MachineState& m, const MachineClock& c) {
+  m.current = c.current;
+  m.source = c.source;
+  m.transition = c.transition;
+  m.mode = c.mode;
+  m.elapsed = c.elapsed;
+  m.duration = c.duration;
+  m.normalized = c.normalized;
+  m.normalized_before = c.normalized_before;
+  m.looping = c.looping;
+  m.inertial = c.inertial;
+  m.inertial_elapsed = c.inertial_elapsed;
+  m.inertial_duration = c.inertial_duration;
+}
+
+/// Advances the playing states and evaluates them into out (both sides of a crossfade).
+void evaluate_states(State& s, MachineState& m, const MachineInfo& mi, const Advance& advance, float weight,
+                     bool dominant, PoseSpan out, std::span<float> ow, uint32_t depth) {
   const uint16_t target = state_node(mi, m.current);
   float normalized_step = 0.0f;
   if (m.source >= 0) {
@@ -295,8 +324,87 @@ void evaluate_machine(State& s, uint16_t n, const Advance& advance, float weight
   }
   m.normalized_before = m.normalized;
   m.normalized += normalized_step;
+}
+
+/// Makes the history buffers that hold a covering slot's shown lanes only whole again, before a
+/// capture reads them: the states are evaluated on every joint once more as they were in those
+/// updates (their journals). Exact: the states are pure (hidden_machine in graph_slot.cpp), so
+/// their output is a function of the instance's scalars, the clock and the advance, all of them
+/// journaled, and a sampling cache samples exactly from any cursor. The offset applied then is
+/// the channels of that update (the ones before the last capture for an update before it). No
+/// event fires again; everything else is put back as it was.
+void replay_history(State& s, MachineState& m, const MachineInfo& mi, uint32_t depth, bool before_too) {
+  std::copy(s.values.begin(), s.values.end(), m.replay_values.begin());
+  const MachineClock now = clock_of(m);
+  const int32_t hidden = s.hidden;
+  s.hidden = -1;
+  const auto replay = [&](uint64_t update, Pose& into) {
+    const MachineJournal& j = m.journal[update & 1];
+    if (j.update != update) return false;
+    std::copy(j.values.begin(), j.values.end(), s.values.begin());
+    set_clock(m, j.clock);
+    Advance a;
+    a.dt = j.dt;
+    a.phase = j.phase;
+    a.synced = j.synced;
+    evaluate_states(s, m, mi, a, j.weight, false, into.span(), m.replay_weights, depth);
+    if (j.clock.inertial && j.clock.inertial_elapsed + j.dt < j.clock.inertial_duration) {
+      const bool older = update < m.capture_update;
+      apply_channels(s, (older ? m.prev_translation : m.translation).data(),
+                     (older ? m.prev_rotation : m.rotation).data(), j.clock.inertial_elapsed + j.dt, into.span());
+    }
+    return true;
+  };
+  if (before_too && m.before_last_partial && replay(m.before_last_update, m.before_last)) m.before_last_partial = false;
+  if (m.last_partial && replay(m.last_update, m.last)) m.last_partial = false;
+  std::copy(m.replay_values.begin(), m.replay_values.end(), s.values.begin());
+  set_clock(m, now);
+  s.hidden = hidden;
+}
+
+}  // namespace
+
+void evaluate_machine(State& s, uint16_t n, const Advance& advance, float weight, bool dominant, PoseSpan out,
+                      std::span<float> ow, uint32_t depth) {
+  const NodeInfo& info = s.def->nodes[n];
+  MachineState& m = s.machines[info.machine];
+  const MachineInfo& mi = s.def->machines[info.machine];
+  if (!m.entered) {
+    m.entered = true;
+    enter_state(s, m, mi, mi.fb->entry());
+  }
+
+  float capture_duration = 0.0f;
+  const bool capture = try_transition(s, m, mi, &capture_duration);
+  if (capture && (m.last_partial || m.before_last_partial)) replay_history(s, m, mi, depth, true);
+
+  // Under a slot that shows its montages over some joints at full weight, a pure machine evaluates
+  // only the lanes the slot shows (its clips sample filtered caches), unless it captures an offset
+  // now, which needs every joint of this pose; it journals the update to replay it if a later
+  // capture needs it whole.
+  const int32_t hidden = s.hidden;
+  const bool hide = hidden >= 0 && s.def->node_hidden[n] == hidden && !capture;
+  if (hide) {
+    MachineJournal& j = m.journal[s.update_counter & 1];
+    j.update = s.update_counter;
+    j.dt = advance.dt;
+    j.phase = advance.phase;
+    j.synced = advance.synced;
+    j.weight = weight;
+    j.clock = clock_of(m);
+    std::copy(s.values.begin(), s.values.end(), j.values.begin());
+  } else {
+    s.hidden = -1;
+  }
+  evaluate_states(s, m, mi, advance, weight, dominant, out, ow, depth);
+  s.hidden = hidden;
 
   if (capture) {
+    if (!m.prev_translation.empty()) {  // a replay of an update before this one applies these
+      std::copy(m.translation.begin(), m.translation.end(), m.prev_translation.begin());
+      std::copy(m.rotation.begin(), m.rotation.end(), m.prev_rotation.begin());
+      m.capture_update = s.update_counter;
+    }
     capture_offset(s, m, out, capture_duration);
     // Morph weights: the jump at the switch, decayed linearly over the same duration.
     for (size_t c = 0; c < ow.size(); ++c) m.weight_offset[c] = m.last_weights[c] - ow[c];
@@ -316,8 +424,19 @@ void evaluate_machine(State& s, uint16_t n, const Advance& advance, float weight
 
   // Keep this output for a later capture: the older buffer becomes the newest.
   std::swap(m.last, m.before_last);
+  std::swap(m.last_partial, m.before_last_partial);
   m.before_last_update = m.last_update;
-  stream_pose(out, m.last);
+  if (hide) {
+    const auto& lanes = s.def->slot_shown_lanes[static_cast<size_t>(hidden)];
+    stream_lanes(out, m.last, lanes);
+    uint32_t shown = 0;
+    for (const auto& [first, last] : lanes) shown += std::min(last, s.def->joints) - first;
+    m.skipped_joints = s.def->joints - shown;
+  } else {
+    stream_pose(out, m.last);
+    m.skipped_joints = 0;
+  }
+  m.last_partial = hide;
   m.last_update = s.update_counter;
   m.last_dt = advance.dt;
 }
@@ -337,6 +456,7 @@ MachineStatus GraphInstance::machine_status(size_t machine) const {
   out.duration = m.duration;
   out.transition = m.transition;
   out.inertial_remaining = m.inertial ? m.inertial_duration - m.inertial_elapsed : 0.0f;
+  out.skipped_joints = m.skipped_joints;
   return out;
 }
 

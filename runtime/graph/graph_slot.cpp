@@ -17,11 +17,13 @@
 //
 // What nobody will see is not computed, where that keeps every seen bit: a masked slot samples its
 // montages' clips for the joints it shows only (a filtered sampling cache, slot_shown_joints), and
-// while a masked override at full weight evaluates its input, State::hidden names its mask, so a
-// layer of that input whose mask the slot covers blends only the lanes the slot shows (graph_eval.cpp).
-// Only layers reached with no node that keeps poses (a machine's history, a slot's, spring and foot
-// lock state) or reads model space (procedural nodes) on the way are marked (mark_reach).
-// bind_slots decodes the slot nodes for the definition.
+// while a masked override at full weight evaluates its input, State::hidden names its mask, so what
+// that input computes is the lanes the slot shows: a layer whose mask the slot covers blends only
+// those (graph_eval.cpp), a clip or blend space samples a cache filtered to them, and a machine of
+// pure states evaluates them and replays its history whole when a capture needs it
+// (graph_machine.cpp). Only nodes reached with nothing on the way that keeps poses (another
+// machine's history, a slot's, spring and foot lock state) or reads model space (procedural nodes)
+// are marked (mark_reach, Impl::node_hidden). bind_slots decodes the slot nodes for the definition.
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -224,9 +226,52 @@ void evaluate_slot(State& s, uint16_t n, const Advance& advance, float weight, b
 
 namespace {
 
+/// Whether everything node `n` reaches is a clip, a blend space or a blend (no node that keeps
+/// poses, reads model space or plays another rig): what a machine's states must be for it to leave
+/// a covering slot's joints out and still replay its history whole.
+bool pure_subtree(const GraphDefinition::Impl& d, uint16_t n, uint32_t depth = 0) {
+  if (depth > d.nodes.size()) return false;  // validation proved the graph acyclic; stay bounded anyway
+  const NodeInfo& info = d.nodes[n];
+  const auto go = [&](uint16_t child) { return pure_subtree(d, child, depth + 1); };
+  switch (info.kind) {
+    case Kind::Clip:
+    case Kind::BlendSpace: return true;
+    case Kind::BlendAlpha: {
+      const auto* t = static_cast<const fb::BlendAlphaNode*>(info.table);
+      return go(t->a()) && go(t->b());
+    }
+    case Kind::Select:
+      for (uint16_t c : *static_cast<const fb::SelectNode*>(info.table)->children())
+        if (!go(c)) return false;
+      return true;
+    case Kind::Layered: {
+      const auto* t = static_cast<const fb::LayeredBlendNode*>(info.table);
+      if (!go(t->base())) return false;
+      for (const fb::Layer* layer : *t->layers())
+        if (!go(layer->node())) return false;
+      return true;
+    }
+    case Kind::Additive: {
+      const auto* t = static_cast<const fb::AdditiveNode*>(info.table);
+      return go(t->base()) && go(t->additive());
+    }
+    case Kind::Morph: return go(static_cast<const fb::MorphWeightsNode*>(info.table)->input());
+    default: return false;
+  }
+}
+
+/// Whether machine node `n` may evaluate a covering slot's shown lanes only (graph_machine.cpp).
+bool hidden_machine(const GraphDefinition::Impl& d, const NodeInfo& info) {
+  for (const fb::State* st : *d.machines[info.machine].fb->states())
+    if (!pure_subtree(d, st->node())) return false;
+  return true;
+}
+
 /// Marks what node `n` reaches, itself included: in `open` what it reaches with no node that keeps
 /// poses or reads model space on the way (a layer there may leave a covering slot's joints
-/// unblended), in `closed` what it reaches through one (it may not: that node needs whole poses).
+/// unblended, a clip need not sample them), in `closed` what it reaches through one (it may not:
+/// that node needs whole poses). A machine whose states are pure (hidden_machine) keeps the way
+/// open: it makes its history whole by replaying it when a capture needs it.
 void mark_reach(const GraphDefinition::Impl& d, uint16_t n, bool through, std::vector<uint8_t>& open,
                 std::vector<uint8_t>& closed) {
   std::vector<uint8_t>& seen = through ? closed : open;
@@ -260,9 +305,11 @@ void mark_reach(const GraphDefinition::Impl& d, uint16_t n, bool through, std::v
       return;
     }
     case Kind::Morph: return go(static_cast<const fb::MorphWeightsNode*>(info.table)->input(), false);
-    case Kind::Machine:
-      for (const fb::State* st : *d.machines[info.machine].fb->states()) go(st->node(), true);
+    case Kind::Machine: {
+      const bool keeps = !hidden_machine(d, info);
+      for (const fb::State* st : *d.machines[info.machine].fb->states()) go(st->node(), keeps);
       return;
+    }
     case Kind::Slot: return go(static_cast<const fb::SlotNode*>(info.table)->input(), true);
     case Kind::TwoBoneIk:
     case Kind::Aim:
@@ -316,8 +363,11 @@ void bind_slots(GraphDefinition::Impl& d) {
         if (!shown.empty() && shown.back().second == j) shown.back().second = j + kPoseLanes;
         else shown.emplace_back(j, j + kPoseLanes);
       }
+      std::vector<uint8_t> visible(d.joints, 0);
+      for (uint32_t j = 0; j < d.joints; ++j) visible[j] = mask[j] > 0.0f ? 0 : 1;
       slot.mask = static_cast<int32_t>(d.slot_masks.size());
       slot.mesh_space = t->mesh_space_rotation() && !slot.additive;
+      d.slot_visible.push_back(std::move(visible));
       d.slot_shown_lanes.push_back(std::move(shown));
       d.slot_ranges.push_back(std::move(ranges));
       d.slot_masks.push_back(std::move(mask));
@@ -327,6 +377,8 @@ void bind_slots(GraphDefinition::Impl& d) {
     d.slots.push_back(slot);
   }
   d.layer_covered.assign(d.masks.size(), std::vector<uint8_t>(d.slot_masks.size(), 0));
+  d.node_hidden.assign(d.nodes.size(), -1);
+  constexpr int32_t kConflict = -2;  // reached hidden by two masks: by neither
   for (const SlotInfo& slot : d.slots) {
     if (slot.mask < 0) continue;
     std::vector<uint8_t> open(d.nodes.size(), 0), closed(d.nodes.size(), 0);
@@ -334,7 +386,13 @@ void bind_slots(GraphDefinition::Impl& d) {
     const std::vector<float>& mask = d.slot_masks[static_cast<size_t>(slot.mask)];
     for (size_t n = 0; n < d.nodes.size(); ++n) {
       const NodeInfo& info = d.nodes[n];
-      if (info.kind != Kind::Layered || !open[n] || closed[n]) continue;
+      if (!open[n] || closed[n]) continue;
+      const bool samples = (info.kind == Kind::Clip && info.held < 0) || info.kind == Kind::BlendSpace;
+      if (!slot.additive && (samples || info.kind == Kind::Machine)) {
+        int32_t& h = d.node_hidden[n];
+        h = h == -1 || h == slot.mask ? slot.mask : kConflict;
+      }
+      if (info.kind != Kind::Layered) continue;
       const auto* t = static_cast<const fb::LayeredBlendNode*>(info.table);
       for (uint32_t k = 0; k < t->layers()->size(); ++k) {
         const std::vector<float>& layer = d.masks[info.aux + k];
@@ -342,6 +400,34 @@ void bind_slots(GraphDefinition::Impl& d) {
         for (uint32_t j = 0; j < d.joints && covered; ++j) covered = !(layer[j] > 0.0f) || mask[j] > 0.0f;
         d.layer_covered[info.aux + k][static_cast<size_t>(slot.mask)] = covered ? 1 : 0;
       }
+    }
+  }
+  // Filtered prototypes for the clips sampled hidden: one mask per clip (a node whose clip has
+  // another mask's prototype is not sampled hidden, it samples whole).
+  d.hidden_prototypes.resize(d.clips.size());
+  d.hidden_prototype_mask.assign(d.clips.size(), -1);
+  for (size_t n = 0; n < d.nodes.size(); ++n) {
+    int32_t& h = d.node_hidden[n];
+    if (h == kConflict) h = -1;
+    const NodeInfo& info = d.nodes[n];
+    if (h < 0 || info.kind == Kind::Machine) continue;
+    std::vector<uint16_t> clips;
+    if (info.kind == Kind::Clip) clips.push_back(static_cast<const fb::ClipNode*>(info.table)->clip());
+    else
+      for (const fb::BlendSample* smp : *static_cast<const fb::BlendSpaceNode*>(info.table)->samples())
+        clips.push_back(smp->clip());
+    for (const uint16_t c : clips)
+      if (d.hidden_prototype_mask[c] != -1 && d.hidden_prototype_mask[c] != h) h = -1;
+    if (h < 0) continue;
+    for (const uint16_t c : clips) {
+      if (d.hidden_prototype_mask[c] == h) continue;
+      auto prototype = make_sampling_cache(d.clips[c], d.skeleton, nullptr, d.slot_visible[static_cast<size_t>(h)]);
+      if (!prototype) {  // the clip was bound to this rig with these very checks: cannot happen
+        h = -1;
+        break;
+      }
+      d.hidden_prototypes[c] = std::move(*prototype);
+      d.hidden_prototype_mask[c] = h;
     }
   }
 }

@@ -145,11 +145,12 @@ TEST(Slot, MaskedSlotChangesOnlyTheMaskedJoints) {
   }
 }
 
-TEST(Slot, LayersUnderAMachineStayWholeForItsHistory) {
+TEST(Slot, MachineUnderACoveringSlotReplaysItsHistoryWhole) {
   // Under a slot covering Spine1's subtree at full weight, a machine's states layer crossarms on that
-  // subtree. The machine keeps its last outputs for an inertialization, so those layers must blend
-  // every joint: the montage is stopped and the machine inertializes in the same update, and once the
-  // montage has ended the pose is bit for bit the one of a character that never played it.
+  // subtree. The machine evaluates the slot's shown lanes only, and keeps its last outputs for an
+  // inertialization: the montage is stopped and the machine inertializes in the same update, which
+  // replays the two updates before on every joint, and once the montage has ended the pose is bit for
+  // bit the one of a character that never played it (without the replay, update 14 differs).
   NEED_RIG();
   const int spine1 = rig->joint("Spine1");
   ASSERT_GE(spine1, 0);
@@ -184,6 +185,10 @@ TEST(Slot, LayersUnderAMachineStayWholeForItsHistory) {
     ref.inst->update(1.0f / 60.0f);
   }
   ASSERT_GE(p.inst->montage_status(0).weight, 1.0f);
+  // The machine's states are pure (clips and layers), so under the montage it evaluates only the
+  // lanes the slot shows: Spine1's subtree fills 6 of Pab's 9 blocks of 8 joints.
+  EXPECT_EQ(p.inst->machine_status(0).skipped_joints, 48u);
+  EXPECT_EQ(ref.inst->machine_status(0).skipped_joints, 0u);
   ASSERT_TRUE(p.inst->stop_montage("arms"));
   p.inst->set_trigger(go);
   ref.inst->set_trigger(go);
@@ -401,6 +406,73 @@ TEST(Slot, PabSamplePlaysItsUpperBodyMontageOverLocomotion) {
     EXPECT_TRUE(ended);
     EXPECT_TRUE(same_bits(with->pose(), without->pose())) << "after the montage the graph's own pose is back";
   }
+}
+
+TEST(Slot, PabLocomotionUnderTheMontageSkipsHiddenJointsAndStaysExact) {
+  // The Pab sample's locomotion machine (blend space, sprint, pose; inertializations and crossfades)
+  // under its upper-body slot: two characters get one random schedule of speeds, triggers and the
+  // crossed_arms layer, and one of them plays, stops and replays the montage at random (some stops
+  // in the update a transition fires). At every update the joints the slot leaves out are bit for
+  // bit the other's, and whenever no montage plays the whole pose is; meanwhile the machine skipped
+  // the hidden joints, and transitions fired right after it had (without the replay of its history
+  // for their inertializations, the whole poses differ).
+  const Asset* sample = pab_sample();
+  if (!sample) GTEST_SKIP() << "assets/Pab/pab.graph.json not found or did not cook";
+  auto def = GraphDefinition::create(*sample, "pab");
+  ASSERT_TRUE(def.ok()) << def.error().message;
+  std::vector<float> mask(def->joint_count(), 0.0f);
+  build_joint_mask(def->skeleton().parents(), def->skeleton().find_joint("Spine1"), -1, mask);
+  auto with = GraphInstance::create(*def), without = GraphInstance::create(*def);
+  ASSERT_TRUE(with.ok() && without.ok());
+  const int speed = def->find_parameter("speed"), strike = def->find_parameter("strike_pose"),
+            crossed = def->find_parameter("crossed_arms");
+  for (GraphInstance* inst : {&*with, &*without})
+    for (const char* off : {"foot_lock", "feet_on_ground"}) inst->set_float(def->find_parameter(off), 0.0f);
+  std::mt19937 rng(2026);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  int skipped = 0, after_skipping = 0, whole = 0;
+  bool was_skipping = false;
+  for (int f = 0; f < 60 * 60; ++f) {
+    const float r = u(rng);
+    const bool change = r < 0.05f;
+    const float v = u(rng) < 0.15f ? 0.0f : 7.0f * u(rng);
+    const bool trigger = u(rng) < 0.01f, toggle = u(rng) < 0.01f, layer_on = u(rng) < 0.5f;
+    for (GraphInstance* inst : {&*with, &*without}) {
+      if (change) inst->set_float(speed, v);
+      if (trigger) inst->set_trigger(strike);
+      if (toggle) inst->set_bool(crossed, layer_on);
+    }
+    const bool playing = with->montage_playing(0);
+    const int transition_before = with->machine_status(0).transition;
+    if (!playing && u(rng) < 0.02f) {
+      ASSERT_TRUE(with->play_montage("cross_arms"));
+    }
+    if (playing && !with->montage_status(0).blending_out && (u(rng) < 0.01f || (change && u(rng) < 0.2f))) {
+      ASSERT_TRUE(with->stop_montage("cross_arms", u(rng) < 0.3f ? 0.0f : -1.0f));
+    }
+    const float dt = u(rng) < 0.02f ? 0.3f : 1.0f / 60.0f;  // now and then a long frame
+    with->update(dt);
+    without->update(dt);
+    const MachineStatus st = with->machine_status(0);
+    const bool fired = st.transition != transition_before && st.transition >= 0 && st.elapsed <= dt;
+    skipped += st.skipped_joints > 0;
+    after_skipping += was_skipping && fired;  // an inertialization then replays the updates before
+    was_skipping = st.skipped_joints > 0;
+    for (uint32_t j = 0; j < def->joint_count(); ++j) {
+      if (mask[j] == 0.0f) {
+        ASSERT_TRUE(same_joint(with->pose(), without->pose(), j)) << "joint " << j << " update " << f;
+      }
+    }
+    if (!with->montage_playing(0)) {
+      ASSERT_TRUE(same_bits(with->pose(), without->pose())) << "no montage, update " << f;
+      ++whole;
+    }
+  }
+  EXPECT_GT(skipped, 600);
+  EXPECT_GT(after_skipping, 5);
+  EXPECT_GT(whole, 600);
+  std::printf("updates skipping hidden joints %d, transitions fired right after one %d, whole poses compared %d\n",
+              skipped, after_skipping, whole);
 }
 
 }  // namespace

@@ -12,6 +12,7 @@
 // cooked by ossa-cook against its skeleton, as bench/bench_fixture.cpp does) checks real data.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -561,8 +562,9 @@ TEST(SamplePab, CacheIsInvisibleOnEveryClipAtEveryRate) {
 
 TEST(SamplePab, JointFilterKeepsTheKeptJointsBitsAndDecodesNothingElse) {
   // A filtered cache (a masked slot's: Spine1's subtree, then the rest) samples every kept joint
-  // bit for bit as the full cache does, at every rate; the joints it drops hold their bind pose,
-  // so it decoded none of their keys.
+  // bit for bit as the full cache does, at every rate; the joints it drops hold their bind pose
+  // in a block it keeps a joint of (so it decoded none of their keys), and a block it keeps none
+  // of is not written at all.
   REQUIRE_PAB();
   (void)clip;
   auto a = Asset::open((test::fixtures_dir() / "Pab" / "crossarms.ossa").string());
@@ -577,11 +579,30 @@ TEST(SamplePab, JointFilterKeepsTheKeptJointsBitsAndDecodesNothingElse) {
       if (k == spine1) upper[j] = 1;
     rest[j] = upper[j] == 0;
   }
-  auto bind_cache = make_sampling_cache(arms, skeleton, nullptr, none);
-  ASSERT_TRUE(bind_cache.ok());
+  // What a dropped joint holds (bind values, or the clip's constants): sampled with filters that
+  // keep one joint per block (the first, or the second), each read where it drops the joint.
   Pose bind_pose(joints);
-  sample(arms, 1.0f, SampleOptions{}, *bind_cache, bind_pose);
+  for (uint32_t keep = 0; keep < 2; ++keep) {
+    std::vector<uint8_t> one(joints, 0);
+    for (uint32_t j = keep; j < joints; j += kPoseLanes) one[j] = 1;
+    auto one_cache = make_sampling_cache(arms, skeleton, nullptr, one);
+    ASSERT_TRUE(one_cache.ok());
+    Pose single(joints);
+    sample(arms, 1.0f, SampleOptions{}, *one_cache, single);
+    for (uint32_t j = 0; j < joints; ++j)
+      if ((j % kPoseLanes == 0) == (keep == 1))
+        for (uint32_t k = 0; k < kPoseComponents; ++k)
+          bind_pose.span()[PoseComponent(k)][j] = single.span()[PoseComponent(k)][j];
+  }
   const ConstPoseSpan bind = bind_pose.span();
+  {  // a filter keeping no joint writes nothing
+    auto nothing = make_sampling_cache(arms, skeleton, nullptr, none);
+    ASSERT_TRUE(nothing.ok());
+    Pose untouched(joints);
+    std::memcpy(untouched.span().base, bind.base, sizeof(float) * kPoseComponents * bind.stride);
+    sample(arms, 1.0f, SampleOptions{}, *nothing, untouched);
+    EXPECT_EQ(std::memcmp(untouched.span().base, bind.base, sizeof(float) * kPoseComponents * bind.stride), 0);
+  }
   int dropped_animated = 0;
   for (const std::vector<uint8_t>* filter : {&upper, &rest}) {
     auto prototype = make_sampling_cache(arms, skeleton, nullptr, *filter);
@@ -592,13 +613,22 @@ TEST(SamplePab, JointFilterKeepsTheKeptJointsBitsAndDecodesNothingElse) {
       ASSERT_TRUE(filtered.ok()) << filtered.error().message;
       Pose got_pose(joints), want_pose(joints);
       const ConstPoseSpan got = got_pose.span(), want = want_pose.span();
+      std::vector<uint8_t> block_kept(got_pose.span().stride / kPoseLanes, 0);
+      for (uint32_t j = 0; j < joints; ++j) block_kept[j / kPoseLanes] |= (*filter)[j];
+      ASSERT_NE(std::count(block_kept.begin(), block_kept.end(), 0), 0) << "some block has no kept joint";
       for (const float t : playback(arms, rate, 300, true, 0.2f)) {
+        for (uint32_t k = 0; k < kPoseComponents; ++k)  // a value no sample writes
+          std::fill_n(got_pose.span()[PoseComponent(k)], got_pose.span().stride, 7.25f);
         sample(arms, t, SampleOptions{}, *filtered, got_pose);
         sample(arms, t, SampleOptions{}, full, want_pose);
         for (uint32_t j = 0; j < joints; ++j) {
           const ConstPoseSpan expected = (*filter)[j] ? want : bind;
           for (uint32_t k = 0; k < kPoseComponents; ++k) {
             const auto c = PoseComponent(k);
+            if (!block_kept[j / kPoseLanes]) {
+              ASSERT_EQ(got[c][j], 7.25f) << "joint " << j << " of a block without a kept joint was written";
+              continue;
+            }
             ASSERT_EQ(std::memcmp(&got[c][j], &expected[c][j], sizeof(float)), 0)
                 << "joint " << j << " component " << k << " at t=" << t << " rate " << rate;
             dropped_animated += !(*filter)[j] && std::memcmp(&got[c][j], &want[c][j], sizeof(float)) != 0;

@@ -55,8 +55,10 @@ class SamplingCache {
 /// each cache keeps only its cursors and decoded key pairs. O(joints + animated channels).
 /// `joints` (optional, one entry per joint): decode only the animated channels of the joints with
 /// a non-zero entry (a masked slot, which shows some joints of a clip, pays for their keys only).
-/// Every kept joint samples bit for bit as without the filter; a dropped joint's animated channels
-/// hold their bind values. It must outlive the cache, and a prototype must have the very same span.
+/// Every kept joint samples bit for bit as without the filter. sample() leaves the output's lanes
+/// of an 8-joint block (kPoseLanes) with no kept joint as they were; in a block with one, a dropped
+/// joint's animated channels hold their bind values. So a filter showing a few joints of a large rig
+/// costs their blocks only. It must outlive the cache, and a prototype must have the very same span.
 Result<SamplingCache> make_sampling_cache(const ClipView& clip, const SkeletonView& skeleton,
                                           const SamplingCache* prototype = nullptr,
                                           std::span<const uint8_t> joints = {});

@@ -132,6 +132,9 @@ struct MachineStatus {
   float duration = 0.0f;            // that transition's duration (0 when none ever ran)
   int transition = -1;              // index of the running transition, -1 when none
   float inertial_remaining = 0.0f;  // seconds left on an inertialization offset (0: none)
+  // Joints the machine left unevaluated in the last update because a slot above it showed its
+  // montages over them at full weight (0: it evaluated every joint). What is seen stays bit for bit.
+  uint32_t skipped_joints = 0;
 };
 
 /// The immutable, shared part. Build once per (graph, clip sources); it must outlive its instances
