@@ -165,11 +165,7 @@ Result<GraphInstance> GraphInstance::create(const GraphDefinition& definition, s
     const int32_t h = d.node_hidden.empty() ? -1 : d.node_hidden[n];
     if (h < 0 || info.kind == Kind::Machine) continue;
     if (s->hidden_caches.empty()) s->hidden_caches.resize(d.cache_count);
-    std::vector<uint16_t> clips;
-    if (info.kind == Kind::Clip) clips.push_back(static_cast<const fb::ClipNode*>(info.table)->clip());
-    else
-      for (const fb::BlendSample* smp : *static_cast<const fb::BlendSpaceNode*>(info.table)->samples())
-        clips.push_back(smp->clip());
+    const std::vector<uint16_t> clips = sampled_clips(info);
     for (size_t k = 0; k < clips.size(); ++k) {
       auto cache = make_sampling_cache(d.clips[clips[k]], d.skeleton, &d.hidden_prototypes[clips[k]],
                                        d.slot_visible[static_cast<size_t>(h)]);

@@ -431,6 +431,8 @@ void evaluate_slot(GraphInstance::State& s, uint16_t n, const Advance& advance, 
 Status bind_montages(GraphDefinition::Impl& d, const std::string& where);
 /// Decodes the slot nodes (graph_slot.cpp): their names, groups, masks, mask ranges and chains.
 void bind_slots(GraphDefinition::Impl& d);
+/// The clips a clip node (one) or a blend space (one per sample, in order) samples, with a cache each.
+std::vector<uint16_t> sampled_clips(const NodeInfo& info);
 /// The joints the slot nodes named `slot` read from a montage's pose (ossa/anim/sample.h's joint
 /// filter): their masks and mesh-space chains; empty (every joint) when one of them has no mask.
 std::vector<uint8_t> slot_shown_joints(const GraphDefinition::Impl& d, uint16_t slot);

@@ -333,7 +333,7 @@ void evaluate_states(State& s, MachineState& m, const MachineInfo& mi, const Adv
 /// journaled, and a sampling cache samples exactly from any cursor. The offset applied then is
 /// the channels of that update (the ones before the last capture for an update before it). No
 /// event fires again; everything else is put back as it was.
-void replay_history(State& s, MachineState& m, const MachineInfo& mi, uint32_t depth, bool before_too) {
+void replay_history(State& s, MachineState& m, const MachineInfo& mi, uint32_t depth) {
   std::copy(s.values.begin(), s.values.end(), m.replay_values.begin());
   const MachineClock now = clock_of(m);
   const int32_t hidden = s.hidden;
@@ -355,7 +355,7 @@ void replay_history(State& s, MachineState& m, const MachineInfo& mi, uint32_t d
     }
     return true;
   };
-  if (before_too && m.before_last_partial && replay(m.before_last_update, m.before_last)) m.before_last_partial = false;
+  if (m.before_last_partial && replay(m.before_last_update, m.before_last)) m.before_last_partial = false;
   if (m.last_partial && replay(m.last_update, m.last)) m.last_partial = false;
   std::copy(m.replay_values.begin(), m.replay_values.end(), s.values.begin());
   set_clock(m, now);
@@ -376,7 +376,7 @@ void evaluate_machine(State& s, uint16_t n, const Advance& advance, float weight
 
   float capture_duration = 0.0f;
   const bool capture = try_transition(s, m, mi, &capture_duration);
-  if (capture && (m.last_partial || m.before_last_partial)) replay_history(s, m, mi, depth, true);
+  if (capture && (m.last_partial || m.before_last_partial)) replay_history(s, m, mi, depth);
 
   // Under a slot that shows its montages over some joints at full weight, a pure machine evaluates
   // only the lanes the slot shows (its clips sample filtered caches), unless it captures an offset

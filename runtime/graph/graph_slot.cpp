@@ -411,11 +411,7 @@ void bind_slots(GraphDefinition::Impl& d) {
     if (h == kConflict) h = -1;
     const NodeInfo& info = d.nodes[n];
     if (h < 0 || info.kind == Kind::Machine) continue;
-    std::vector<uint16_t> clips;
-    if (info.kind == Kind::Clip) clips.push_back(static_cast<const fb::ClipNode*>(info.table)->clip());
-    else
-      for (const fb::BlendSample* smp : *static_cast<const fb::BlendSpaceNode*>(info.table)->samples())
-        clips.push_back(smp->clip());
+    const std::vector<uint16_t> clips = sampled_clips(info);
     for (const uint16_t c : clips)
       if (d.hidden_prototype_mask[c] != -1 && d.hidden_prototype_mask[c] != h) h = -1;
     if (h < 0) continue;
@@ -430,6 +426,15 @@ void bind_slots(GraphDefinition::Impl& d) {
       d.hidden_prototype_mask[c] = h;
     }
   }
+}
+
+std::vector<uint16_t> sampled_clips(const NodeInfo& info) {
+  if (info.kind == Kind::Clip) return {static_cast<const fb::ClipNode*>(info.table)->clip()};
+  std::vector<uint16_t> clips;
+  if (info.kind == Kind::BlendSpace)
+    for (const fb::BlendSample* smp : *static_cast<const fb::BlendSpaceNode*>(info.table)->samples())
+      clips.push_back(smp->clip());
+  return clips;
 }
 
 /// The joints the slot nodes named `slot` read from a montage's pose: their masks and the chains a
