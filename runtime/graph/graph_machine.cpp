@@ -14,7 +14,7 @@
 //
 // Under a slot showing its montages over some joints at full weight, a machine whose states hold
 // only clips, blend spaces and blends evaluates just the lanes the slot shows; its history then
-// lacks the rest, so each such update is journaled (the instance's scalars, about 30 floats for
+// lacks the rest, so each such update is journaled (the instance's scalars, a few hundred bytes for
 // Pab, and the machine's clock), and a capture that needs that history first replays those updates
 // on every joint (replay_history).
 #include <algorithm>
