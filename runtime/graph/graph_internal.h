@@ -231,14 +231,19 @@ struct InertialChannel {
   float x0 = 0.0f, v0 = 0.0f, a0 = 0.0f, t1 = 0.0f;
 };
 
-/// What a machine's update changes of its own scalars: kept per hidden update (MachineJournal) so
-/// that its output can be made again whole (graph_machine.cpp).
+/// A machine's scalars that its update changes: the state played, the transition, the clocks.
+/// Kept apart (MachineState's base) so a hidden update can journal them in one copy (MachineJournal).
 struct MachineClock {
-  int current = 0, source = -1, transition = -1;
+  int current = 0;      // the state being entered / played
+  int source = -1;      // a running crossfade's source state
+  int transition = -1;  // running transition index
   fb::TransitionMode mode = fb::TransitionMode::Crossfade;
   float elapsed = 0.0f, duration = 0.0f;
-  double normalized = 0.0, normalized_before = 0.0;
-  bool looping = true, inertial = false;
+  double normalized = 0.0;         // the current state's normalized time since it was entered
+  double normalized_before = 0.0;  // ... at the start of the last update
+  bool looping = true;             // whether the current state's leader loops
+  // Inertialization: the offset kept when the machine switched discontinuously.
+  bool inertial = false;
   float inertial_elapsed = 0.0f, inertial_duration = 0.0f;
 };
 
@@ -252,19 +257,8 @@ struct MachineJournal {
   std::vector<float> values;  // State::values
 };
 
-struct MachineState {
-  int current = 0;      // the state being entered / played
-  int source = -1;      // a running crossfade's source state
-  int transition = -1;  // running transition index
-  fb::TransitionMode mode = fb::TransitionMode::Crossfade;
-  float elapsed = 0.0f, duration = 0.0f;
-  double normalized = 0.0;         // the current state's normalized time since it was entered
-  double normalized_before = 0.0;  // ... at the start of the last update
-  bool looping = true;             // whether the current state's leader loops
-  // Inertialization: the offset kept when the machine switched discontinuously.
-  bool inertial = false;
-  float inertial_elapsed = 0.0f, inertial_duration = 0.0f;
-  std::vector<InertialChannel> translation, rotation;  // per joint
+struct MachineState : MachineClock {
+  std::vector<InertialChannel> translation, rotation;  // per joint: the inertialization's offset
   // The last two outputs (for the offset and its velocity) and when they were made.
   Pose last, before_last;
   // Morph weights: the last output's, and the offset an inertialization decays (linearly).

@@ -269,27 +269,6 @@ void set_machine_phase(State& s, uint16_t machine, float p) {
 
 namespace {
 
-MachineClock clock_of(const MachineState& m) {
-  return MachineClock{m.current, m.source,   m.transition,       m.mode,
-                      m.elapsed, m.duration, m.normalized,       m.normalized_before,
-                      m.looping, m.inertial, m.inertial_elapsed, m.inertial_duration};
-}
-
-void set_clock(MachineState& m, const MachineClock& c) {
-  m.current = c.current;
-  m.source = c.source;
-  m.transition = c.transition;
-  m.mode = c.mode;
-  m.elapsed = c.elapsed;
-  m.duration = c.duration;
-  m.normalized = c.normalized;
-  m.normalized_before = c.normalized_before;
-  m.looping = c.looping;
-  m.inertial = c.inertial;
-  m.inertial_elapsed = c.inertial_elapsed;
-  m.inertial_duration = c.inertial_duration;
-}
-
 /// Advances the playing states and evaluates them into out (both sides of a crossfade).
 void evaluate_states(State& s, MachineState& m, const MachineInfo& mi, const Advance& advance, float weight,
                      bool dominant, PoseSpan out, std::span<float> ow, uint32_t depth) {
@@ -335,14 +314,14 @@ void evaluate_states(State& s, MachineState& m, const MachineInfo& mi, const Adv
 /// event fires again; everything else is put back as it was.
 void replay_history(State& s, MachineState& m, const MachineInfo& mi, uint32_t depth) {
   std::copy(s.values.begin(), s.values.end(), m.replay_values.begin());
-  const MachineClock now = clock_of(m);
+  const MachineClock now = m;
   const int32_t hidden = s.hidden;
   s.hidden = -1;
   const auto replay = [&](uint64_t update, Pose& into) {
     const MachineJournal& j = m.journal[update & 1];
     if (j.update != update) return false;
     std::copy(j.values.begin(), j.values.end(), s.values.begin());
-    set_clock(m, j.clock);
+    static_cast<MachineClock&>(m) = j.clock;
     Advance a;
     a.dt = j.dt;
     a.phase = j.phase;
@@ -358,7 +337,7 @@ void replay_history(State& s, MachineState& m, const MachineInfo& mi, uint32_t d
   if (m.before_last_partial && replay(m.before_last_update, m.before_last)) m.before_last_partial = false;
   if (m.last_partial && replay(m.last_update, m.last)) m.last_partial = false;
   std::copy(m.replay_values.begin(), m.replay_values.end(), s.values.begin());
-  set_clock(m, now);
+  static_cast<MachineClock&>(m) = now;
   s.hidden = hidden;
 }
 
@@ -391,7 +370,7 @@ void evaluate_machine(State& s, uint16_t n, const Advance& advance, float weight
     j.phase = advance.phase;
     j.synced = advance.synced;
     j.weight = weight;
-    j.clock = clock_of(m);
+    j.clock = m;
     std::copy(s.values.begin(), s.values.end(), j.values.begin());
   } else {
     s.hidden = -1;
