@@ -12,13 +12,13 @@
 //      and then one test and one cursor serve them all), one compare of the frame position
 //      against the range its cached key pair covers; only a run that left its range moves its
 //      cursor (forward by one: keep k1 as the new k0 and decode one key per channel; otherwise a
-//      short walk or a binary search on key_frames) and decodes (ossa/format/clip_codec.h);
+//      dense run's pair is the frame itself, and a sparse one walks at most 15 keys from its seek
+//      index, so a seek costs the same in a long clip) and decodes (ossa/format/clip_codec.h);
 //   2. one loop over all joints (SoA, 8-lane blocks): lerp T and S, nlerp R with the shortest-arc
-//      sign fix, write the pose. It is written with vector extensions, and on x86-64 compiled
-//      twice (AVX2 and the SSE2 baseline, picked per call: internal/vector_clones.h), so the
-//      default build still runs on any x86-64. A block with no animated channel of a kind copies that
-//      kind's fixed values instead of interpolating them; a block a joint filter keeps no joint of
-//      is skipped.
+//      sign fix, write the pose (anim/sample_interpolate.cpp: vector code, on x86-64 compiled
+//      for AVX2 and the SSE2 baseline, picked per call, so the default build runs on any x86-64).
+//      A block with no animated channel of a kind copies that kind's fixed values instead of
+//      interpolating them; a block a joint filter keeps no joint of is skipped.
 // Rotations are stored with one component >= 0 (clip_codec.h drops it), so two neighbouring keys
 // may lie in opposite hemispheres; the sign fix in pass 2 (flip b when dot(a, b) < 0) keeps the
 // blend on the short arc. It is done per sample rather than at decode time so that a cached pair
@@ -33,8 +33,10 @@
 // and the cache was made for this clip and a skeleton with its hash and joint count
 // (check_clip_binding), so no check is repeated per sample.
 //
-// Cost: make_sampling_cache O(joints + animated channels), a few allocations; sample O(joints +
-// runs) + O(keys passed), no allocation; reset O(runs). advance_time is advance_time.cpp.
+// Cost: make_sampling_cache O(joints + animated channels + keys of sparse runs), a few allocations
+// (a seek index of 2 bytes per 16 frames per sparse run, shared with a prototype); sample O(joints
+// + runs) + O(keys passed, at most 15 per run on a seek), no allocation; reset O(runs).
+// advance_time is advance_time.cpp.
 #include <ossa/anim/sample.h>
 
 #include <algorithm>
@@ -57,16 +59,16 @@
 #include <ossa/format/clip_codec.h>
 #include "internal/float_env.h"
 #include "internal/memory.h"
-#include "internal/vector_clones.h"
+#include "internal/sample_lanes.h"
 
 namespace ossa {
 namespace {
 
+using detail::kSkipped;
+using detail::normalize4;
+
 constexpr uint32_t kNoCursor = std::numeric_limits<uint32_t>::max();
 constexpr float kInf = std::numeric_limits<float>::infinity();
-
-/// Per 8-joint block flags (State::block_kinds): an animated channel of a kind, or no kept joint.
-constexpr uint8_t kAnimatedT = 1, kAnimatedR = 2, kAnimatedS = 4, kSkipped = 8;
 
 /// Components of each channel kind in a pose (pose.h order: T xyz, R xyzw, S xyz).
 constexpr uint32_t kFirstComponent[3] = {kTx, kRx, kSx};
@@ -102,11 +104,17 @@ struct Track {
   uint32_t weight_index = 0;          // kind * stride + joint, into start / inv_length
 };
 
+/// Frames per entry of a sparse run's seek index (Run::seek): 16, so a seek walks at most 15 keys.
+constexpr uint32_t kSeekShift = 4;
+
 /// Animated channels sharing one key-frame list, and the cursor they share: the pair (cursor,
 /// cursor + 1) is valid while enter <= frame < leave (leave is +inf for the last pair, which also
 /// covers the last frame).
 struct Run {
   const uint16_t* frames = nullptr;
+  // Sparse runs: seek[b] is the pair around frame b << kSeekShift (make_seek_index). Null for a
+  // dense run, a key on every frame (key_count == frame_count), whose pair is the frame itself.
+  const uint16_t* seek = nullptr;
   uint32_t key_count = 0;
   uint32_t cursor = kNoCursor;
   float enter = kInf;
@@ -149,6 +157,8 @@ struct SamplingCache::State {
   std::vector<Track> tracks;  // grouped by run
   // What move_run reads: tracks, or a prototype's (identical: they depend on the clip, rig and filter only).
   const Track* track_data = nullptr;
+  // The sparse runs' seek indexes, one after another (Run::seek points into this or a prototype's).
+  std::vector<uint16_t> seek_index;
   // The joint filter the cache was made with (empty: every joint), compared with a prototype's.
   std::span<const uint8_t> filter;
 };
@@ -185,11 +195,6 @@ void set_fixed(State& s, uint32_t joint, uint32_t kind, const float* value) {
   s.inv_length[kind * s.stride + joint] = 0.0f;
 }
 
-void normalize4(float* q) {
-  const float n = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
-  for (int c = 0; c < 4; ++c) q[c] /= n;
-}
-
 Track make_track(const fb::AnimatedChannel& ch, uint32_t stride) {
   Track t;
   t.bit_offset = ch.bit_offset();
@@ -211,37 +216,115 @@ Track make_track(const fb::AnimatedChannel& ch, uint32_t stride) {
   return t;
 }
 
-/// Decodes key `key` of a track into the k0 or k1 array: ossa/format/clip_codec.h's decode_key and
-/// rotation_from_stored, specialized to the precomputed record. On x86-64 the three components
-/// are dequantized in one SSE register (one division instead of three); each lane performs the
-/// same IEEE operations as the scalar code (lo + extent * (q / qmax)), so results are identical.
+// Key decodes: ossa/format/clip_codec.h's decode_key and rotation_from_stored, specialized to the
+// precomputed record, with the same bits: on x86-64 the three components are dequantized in one
+// SSE register (one division instead of three), each lane performing the scalar code's IEEE
+// operations (lo + extent * (q / qmax)) in its order.
+#if defined(__SSE2__)
+/// Key `key` of a quantized track as (x, y, z, 0): its three stored components, dequantized.
+inline __m128 dequantized(const Track& t, const uint8_t* stream, uint32_t key) {
+  const uint64_t packed = read_bits(stream, t.bit_offset + key_bits(t.bits) * key, 3 * t.bits);
+  const auto mask = static_cast<uint32_t>(quant_max(t.bits));
+  // q < 2^19 fits a signed 32-bit lane, so the signed conversion is exact.
+  const auto q0 = static_cast<int>(static_cast<uint32_t>(packed) & mask);
+  const auto q1 = static_cast<int>(static_cast<uint32_t>(packed >> t.bits) & mask);
+  const auto q2 = static_cast<int>(static_cast<uint32_t>(packed >> (2 * t.bits)) & mask);
+  const __m128 f = _mm_div_ps(_mm_cvtepi32_ps(_mm_setr_epi32(q0, q1, q2, 0)), _mm_set1_ps(t.qmax));
+  return _mm_add_ps(_mm_loadu_ps(t.lo), _mm_mul_ps(_mm_loadu_ps(t.extent), f));
+}
+
+/// Key `key` of any track, its three stored components in lanes 0..2 (lane 3: 0, or the bits
+/// after a raw key, never used; validation keeps 8 padding bytes after the last key, so the 16-byte
+/// read of a raw key stays inside the stream).
+inline __m128 stored(const Track& t, const uint8_t* stream, uint32_t key) {
+  if (t.bits == kRawFloatBits)
+    return _mm_loadu_ps(reinterpret_cast<const float*>(stream + (t.bit_offset >> 3) + 12ull * key));
+  return dequantized(t, stream, key);
+}
+
+/// Writes the three stored components where the record says they go (through memory: a 16-byte
+/// store forwards to the 4-byte loads, cheaper than shuffling each lane out).
+inline void put(const Track& t, __m128 v, float* keys) {
+  float x[4];
+  _mm_storeu_ps(x, v);
+  keys[t.offset[0]] = x[0];
+  keys[t.offset[1]] = x[1];
+  keys[t.offset[2]] = x[2];
+}
+
+/// Decodes key `key` of a track into the k0 or k1 array.
 inline void decode(const Track& t, const uint8_t* stream, uint32_t key, float* keys) {
   float v[4];
+  if (t.bits == kRawFloatBits) std::memcpy(v, stream + (t.bit_offset >> 3) + 12ull * key, 12);
+  else _mm_storeu_ps(v, dequantized(t, stream, key));
+  keys[t.offset[0]] = v[0];
+  keys[t.offset[1]] = v[1];
+  keys[t.offset[2]] = v[2];
+  if (t.rotation) keys[t.offset[3]] = rotation_w(v);
+}
+
+/// rotation_w of two stored keys at once (lanes 0 and 1): its operations, lane for lane, in its
+/// order, with one square root for both.
+inline __m128 rotation_w2(__m128 a, __m128 b) {
+  const __m128 xy = _mm_unpacklo_ps(a, b);  // xa xb ya yb
+  const __m128 z = _mm_unpackhi_ps(a, b);   // za zb 0 0
+  const __m128 sq = _mm_mul_ps(xy, xy);
+  const __m128 w2 = _mm_sub_ps(_mm_sub_ps(_mm_sub_ps(_mm_set1_ps(1.0f), sq), _mm_movehl_ps(sq, sq)), _mm_mul_ps(z, z));
+  return _mm_and_ps(_mm_sqrt_ps(w2), _mm_cmpgt_ps(w2, _mm_setzero_ps()));  // w2 <= 0: 0
+}
+
+/// Keys `key` and `key + 1` of a track into k0 and k1 (a seek).
+inline void decode_pair(const Track& t, const uint8_t* stream, uint32_t key, float* k0, float* k1) {
+  const __m128 a = stored(t, stream, key), b = stored(t, stream, key + 1);
+  put(t, a, k0);
+  put(t, b, k1);
+  if (!t.rotation) return;
+  float w[4];
+  _mm_storeu_ps(w, rotation_w2(a, b));
+  k0[t.offset[3]] = w[0];
+  k1[t.offset[3]] = w[1];
+}
+
+/// Key `key` of two tracks into `keys` (forward playback).
+inline void decode_two(const Track& ta, const Track& tb, const uint8_t* stream, uint32_t key, float* keys) {
+  const __m128 a = stored(ta, stream, key), b = stored(tb, stream, key);
+  put(ta, a, keys);
+  put(tb, b, keys);
+  if (!(ta.rotation || tb.rotation)) return;
+  float w[4];
+  _mm_storeu_ps(w, rotation_w2(a, b));
+  if (ta.rotation) keys[ta.offset[3]] = w[0];
+  if (tb.rotation) keys[tb.offset[3]] = w[1];
+}
+#else
+inline void decode(const Track& t, const uint8_t* stream, uint32_t key, float* keys) {
+  float v[3];
   if (t.bits == kRawFloatBits) {
     std::memcpy(v, stream + (t.bit_offset >> 3) + 12ull * key, 12);
   } else {
     const uint64_t packed = read_bits(stream, t.bit_offset + key_bits(t.bits) * key, 3 * t.bits);
     const auto mask = static_cast<uint32_t>(quant_max(t.bits));
-    const auto q0 = static_cast<uint32_t>(packed) & mask;
-    const auto q1 = static_cast<uint32_t>(packed >> t.bits) & mask;
-    const auto q2 = static_cast<uint32_t>(packed >> (2 * t.bits)) & mask;
-#if defined(__SSE2__)
-    // q < 2^19 fits a signed 32-bit lane, so the signed conversion is exact.
-    const __m128 q =
-        _mm_cvtepi32_ps(_mm_setr_epi32(static_cast<int>(q0), static_cast<int>(q1), static_cast<int>(q2), 0));
-    const __m128 r =
-        _mm_add_ps(_mm_loadu_ps(t.lo), _mm_mul_ps(_mm_loadu_ps(t.extent), _mm_div_ps(q, _mm_set1_ps(t.qmax))));
-    _mm_storeu_ps(v, r);
-#else
-    const uint32_t q[3] = {q0, q1, q2};
-    for (uint32_t c = 0; c < 3; ++c) v[c] = t.lo[c] + t.extent[c] * (static_cast<float>(q[c]) / t.qmax);
-#endif
+    for (uint32_t c = 0; c < 3; ++c) {
+      const uint32_t q = static_cast<uint32_t>(packed >> (c * t.bits)) & mask;
+      v[c] = t.lo[c] + t.extent[c] * (static_cast<float>(q) / t.qmax);
+    }
   }
   keys[t.offset[0]] = v[0];
   keys[t.offset[1]] = v[1];
   keys[t.offset[2]] = v[2];
   if (t.rotation) keys[t.offset[3]] = rotation_w(v);
 }
+
+inline void decode_pair(const Track& t, const uint8_t* stream, uint32_t key, float* k0, float* k1) {
+  decode(t, stream, key, k0);
+  decode(t, stream, key + 1, k1);
+}
+
+inline void decode_two(const Track& ta, const Track& tb, const uint8_t* stream, uint32_t key, float* keys) {
+  decode(ta, stream, key, keys);
+  decode(tb, stream, key, keys);
+}
+#endif
 
 /// 1 / gap for the key gaps real clips have (a few frames), so moving a cursor costs no division.
 struct Reciprocals {
@@ -256,24 +339,37 @@ inline float inverse_gap(uint32_t f0, uint32_t f1) {
   return gap < 64 ? kReciprocals.r[gap] : 1.0f / static_cast<float>(gap);
 }
 
-/// The key pair of a run around `frame`: forward by one key (the common case in forward
-/// playback) or a few keys by walking, anything else (a seek, a loop, reverse play) by binary
-/// search. Returns k with frames[k] <= frame < frames[k + 1], or the last pair at the last frame.
+/// The key pair of a run around `frame` (in [0, last frame]): k with frames[k] <= frame <
+/// frames[k + 1], or the last pair at the last frame (or the first before a first key past 0). A
+/// dense run's pair is the frame's whole part. A sparse run walks forward from its seek index's
+/// entry for the frame's 16-frame block, or from the next pair when playback moved forward past
+/// it (the common case: one step): at most 15 keys whatever the clip's length, where a binary
+/// search over a long clip's keys would cost a dozen mispredicted branches.
 inline uint32_t find_pair(const Run& r, float frame) {
-  const uint16_t* frames = r.frames;
   const uint32_t n = r.key_count;
-  const auto after = [](float f, uint16_t key_frame) { return f < static_cast<float>(key_frame); };
+  const auto whole = static_cast<uint32_t>(frame);
   uint32_t k;
-  if (r.cursor != kNoCursor && frame >= r.leave) {
-    k = r.cursor + 1;
-    for (int step = 0; step < 4 && k + 2 < n && frame >= static_cast<float>(frames[k + 1]); ++step) ++k;
-    if (k + 2 < n && frame >= static_cast<float>(frames[k + 1]))
-      k = static_cast<uint32_t>(std::upper_bound(frames + k, frames + n, frame, after) - frames) - 1;
+  if (!r.seek) {
+    k = whole;  // frames[k] == k
   } else {
-    const uint16_t* hit = std::upper_bound(frames, frames + n, frame, after);
-    k = hit == frames ? 0 : static_cast<uint32_t>(hit - frames) - 1;
+    k = r.seek[whole >> kSeekShift];
+    if (r.cursor != kNoCursor && frame >= r.leave && r.cursor + 1 > k) k = r.cursor + 1;
+    const uint16_t* frames = r.frames;
+    while (k + 2 < n && frame >= static_cast<float>(frames[k + 1])) ++k;
   }
   return k > n - 2 ? n - 2 : k;
+}
+
+/// Appends a sparse run's seek index to `index`: for each 16-frame block b of the clip's
+/// `frame_count` frames, the pair around frame b << kSeekShift (as find_pair defines it). O(keys +
+/// blocks); 2 bytes per 16 frames.
+void make_seek_index(const uint16_t* frames, uint32_t key_count, uint32_t frame_count, std::vector<uint16_t>& index) {
+  uint32_t k = 0;
+  for (uint32_t b = 0; b <= (frame_count - 1) >> kSeekShift; ++b) {
+    const uint32_t f = b << kSeekShift;
+    while (k + 2 < key_count && f >= frames[k + 1]) ++k;
+    index.push_back(static_cast<uint16_t>(k));
+  }
 }
 
 /// Moves a run that left its key pair to the pair around `frame`, decoding what changed: one key
@@ -288,19 +384,26 @@ void move_run(State& s, Run& r, float frame) {
   const auto f0 = static_cast<float>(r.frames[k]);
   const float inv = inverse_gap(r.frames[k], r.frames[k + 1]);
   if (r.cursor != kNoCursor && k == r.cursor + 1) {
-    for (; t != end; ++t) {
-      k0[t->offset[0]] = k1[t->offset[0]];
-      k0[t->offset[1]] = k1[t->offset[1]];
-      k0[t->offset[2]] = k1[t->offset[2]];
-      if (t->rotation) k0[t->offset[3]] = k1[t->offset[3]];
+    const auto shift = [&](const Track& x) {  // k1 becomes k0
+      k0[x.offset[0]] = k1[x.offset[0]];
+      k0[x.offset[1]] = k1[x.offset[1]];
+      k0[x.offset[2]] = k1[x.offset[2]];
+      if (x.rotation) k0[x.offset[3]] = k1[x.offset[3]];
+      s.start[x.weight_index] = f0;
+      s.inv_length[x.weight_index] = inv;
+    };
+    for (; end - t >= 2; t += 2) {
+      shift(t[0]);
+      shift(t[1]);
+      decode_two(t[0], t[1], stream, k + 1, k1);
+    }
+    if (t != end) {
+      shift(*t);
       decode(*t, stream, k + 1, k1);
-      s.start[t->weight_index] = f0;
-      s.inv_length[t->weight_index] = inv;
     }
   } else if (k != r.cursor) {
     for (; t != end; ++t) {
-      decode(*t, stream, k, k0);
-      decode(*t, stream, k + 1, k1);
+      decode_pair(*t, stream, k, k0, k1);
       s.start[t->weight_index] = f0;
       s.inv_length[t->weight_index] = inv;
     }
@@ -308,175 +411,6 @@ void move_run(State& s, Run& r, float frame) {
   r.cursor = k;
   r.enter = f0;
   r.leave = k + 2 == r.key_count ? kInf : static_cast<float>(r.frames[k + 1]);
-}
-
-// ---- pass 2: the per-joint interpolation -------------------------------------------------------
-//
-// Written with GCC/Clang vector extensions over 8-lane blocks (stride is a multiple of kPoseLanes)
-// rather than left to the auto-vectorizer: at -O2 GCC will not vectorize a loop that calls sqrt
-// (it must keep errno) or that has selects it cannot if-convert under trapping math, and both are
-// in an nlerp. The same source compiles to one 256-bit op per line in the AVX2 clone and to two
-// SSE2 ops in the baseline clone (vector_clones.h picks per call), or to scalar code elsewhere.
-
-// The helpers take and return 32-byte vectors by value, which GCC warns changes the ABI between
-// AVX and non-AVX callers; they are always inlined into this file's kernels, so no ABI is involved.
-// (Clang honours the GCC spelling.)
-#if defined(__GNUC__)
-#pragma GCC diagnostic ignored "-Wpsabi"
-#endif
-
-using F8 = float __attribute__((vector_size(32)));
-using I8 = int32_t __attribute__((vector_size(32)));
-
-OSSA_INLINE F8 load8(const float* p) {
-  F8 v;
-  std::memcpy(&v, p, sizeof v);  // one unaligned vector load
-  return v;
-}
-OSSA_INLINE void store8(float* p, const F8& v) { std::memcpy(p, &v, sizeof v); }
-OSSA_INLINE F8 splat8(float x) { return F8{x, x, x, x, x, x, x, x}; }
-OSSA_INLINE F8 select8(const I8& mask, const F8& a, const F8& b) {  // mask lanes are 0 or -1
-  I8 ai, bi;
-  std::memcpy(&ai, &a, sizeof ai);
-  std::memcpy(&bi, &b, sizeof bi);
-  const I8 r = (ai & mask) | (bi & ~mask);
-  F8 out;
-  std::memcpy(&out, &r, sizeof out);
-  return out;
-}
-OSSA_INLINE F8 clamp01(const F8& x) {
-  const F8 zero = splat8(0.0f), one = splat8(1.0f);
-  const F8 w = select8(x < zero, zero, x);
-  return select8(w > one, one, w);
-}
-/// 1 / sqrt(x) for x >= ~1/2 in plain IEEE float arithmetic (pose_ops.cpp's rsqrt, eight lanes):
-/// a bit-trick estimate, two Newton steps and a correction step, <= 1.7 ulp, exact for x == 1.
-/// Replaces one / sqrt8(x), whose square roots and division sat on the nlerp's critical path
-/// (~40% of the kernel's samples on Zen 5); no FMA, so both compiled copies agree bit for bit.
-OSSA_INLINE F8 rsqrt8(const F8& x) {
-  I8 bits;
-  std::memcpy(&bits, &x, sizeof bits);
-  bits = 0x5f375a86 - (bits >> 1);  // x > 0: the arithmetic shift is the logical one
-  F8 y;
-  std::memcpy(&y, &bits, sizeof y);
-  const F8 half = x * 0.5f;
-  y = y * (1.5f - half * y * y);
-  y = y * (1.5f - half * y * y);
-  y = y + y * (0.5f - half * y * y);
-  return y;
-}
-
-// The kernel below is compiled for AVX2 and the baseline and picked per call
-// (internal/vector_clones.h: OSSA_VECTOR_DISPATCH; ossa/anim/vector_isa.h selects).
-
-struct Lanes {
-  const float* k0;
-  const float* fixed;  // where blocks without an animated channel of a kind are copied from
-  const float* k1;
-  const float* start;
-  const float* inv_length;
-  const uint8_t* block_kinds;
-  float* out;
-  uint32_t stride;
-};
-
-OSSA_INLINE static void interpolate_nlerp_body(const Lanes& l, float frame) {
-  const size_t n = l.stride;
-  const float* k0 = l.k0;
-  const float* k1 = l.k1;
-  const float* start = l.start;
-  const float* inv = l.inv_length;
-  float* out = l.out;
-  const F8 f = splat8(frame), one = splat8(1.0f), zero = splat8(0.0f);
-  for (size_t j = 0, b = 0; j < n; j += kPoseLanes, ++b) {
-    // A block whose joints have no animated channel of a kind holds fixed values (k0 == k1) for
-    // it: copy them. Real rigs have few animated translations and scales, and runs of joints
-    // (fingers, props) that a clip leaves alone.
-    const uint8_t kinds = l.block_kinds[b];
-    if (kinds & kSkipped) continue;  // a joint filter keeps no joint of this block
-    const auto copy = [&](size_t c) { store8(out + c * n + j, load8(l.fixed + c * n + j)); };
-    const auto lerp = [&](size_t c, const F8& wa, const F8& wb) {
-      // a * (1 - w) + b * w is exact at both ends (w = 0 gives a, w = 1 gives b).
-      store8(out + c * n + j, load8(k0 + c * n + j) * wa + load8(k1 + c * n + j) * wb);
-    };
-    if (kinds & kAnimatedT) {
-      const F8 wt = clamp01((f - load8(start + j)) * load8(inv + j));
-      const F8 at = one - wt;
-      lerp(kTx, at, wt);
-      lerp(kTy, at, wt);
-      lerp(kTz, at, wt);
-    } else {
-      copy(kTx);
-      copy(kTy);
-      copy(kTz);
-    }
-    if (kinds & kAnimatedS) {
-      const F8 ws = clamp01((f - load8(start + 2 * n + j)) * load8(inv + 2 * n + j));
-      const F8 as = one - ws;
-      lerp(kSx, as, ws);
-      lerp(kSy, as, ws);
-      lerp(kSz, as, ws);
-    } else {
-      copy(kSx);
-      copy(kSy);
-      copy(kSz);
-    }
-    if (!(kinds & kAnimatedR)) {
-      copy(kRx);
-      copy(kRy);
-      copy(kRz);
-      copy(kRw);
-      continue;
-    }
-    const F8 wr = clamp01((f - load8(start + n + j)) * load8(inv + n + j));
-    const F8 ax = load8(k0 + kRx * n + j), ay = load8(k0 + kRy * n + j), az = load8(k0 + kRz * n + j),
-             aw = load8(k0 + kRw * n + j);
-    const F8 bx = load8(k1 + kRx * n + j), by = load8(k1 + kRy * n + j), bz = load8(k1 + kRz * n + j),
-             bw = load8(k1 + kRw * n + j);
-    // Shortest arc: b's weight takes dot(a, b)'s sign (keys are stored with one component >= 0).
-    const F8 dot = ax * bx + ay * by + az * bz + aw * bw;
-    const F8 wb = select8(dot < zero, -wr, wr);
-    const F8 wa = one - wr;
-    const F8 rx = ax * wa + bx * wb, ry = ay * wa + by * wb, rz = az * wa + bz * wb, rw = aw * wa + bw * wb;
-    // Both keys are unit (up to quantization) and on one hemisphere, so |r|^2 >= ~1/2.
-    const F8 scale = rsqrt8(rx * rx + ry * ry + rz * rz + rw * rw);
-    store8(out + kRx * n + j, rx * scale);
-    store8(out + kRy * n + j, ry * scale);
-    store8(out + kRz * n + j, rz * scale);
-    store8(out + kRw * n + j, rw * scale);
-  }
-}
-
-OSSA_VECTOR_DISPATCH(interpolate_nlerp, (const Lanes& l, float frame), (l, frame))
-
-/// Slerp variant (an option, not the hot path): translations and scales as above, rotations at
-/// constant angular velocity, falling back to nlerp where the keys are nearly equal.
-void interpolate_slerp(const Lanes& l, float frame) {
-  interpolate_nlerp(l, frame);  // T, S, and an nlerp R the loop below replaces
-  const uint32_t stride = l.stride;
-  for (uint32_t j = 0; j < stride; ++j) {
-    if (l.block_kinds[j / kPoseLanes] & kSkipped) continue;
-    float w = (frame - l.start[stride + j]) * l.inv_length[stride + j];
-    w = w < 0.0f ? 0.0f : (w > 1.0f ? 1.0f : w);
-    float a[4], b[4];
-    for (uint32_t c = 0; c < 4; ++c) {
-      a[c] = l.k0[(kRx + c) * stride + j];
-      b[c] = l.k1[(kRx + c) * stride + j];
-    }
-    float d = a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3];
-    if (d < 0.0f) {
-      d = -d;
-      for (float& v : b) v = -v;
-    }
-    if (d > 0.9995f) continue;  // nearly parallel: the nlerp above is as exact and stable
-    const float theta = std::acos(d);
-    const float inv_sin = 1.0f / std::sin(theta);
-    const float wa = std::sin((1.0f - w) * theta) * inv_sin, wb = std::sin(w * theta) * inv_sin;
-    float r[4];
-    for (uint32_t c = 0; c < 4; ++c) r[c] = a[c] * wa + b[c] * wb;
-    normalize4(r);  // keys are unit only up to quantization
-    for (uint32_t c = 0; c < 4; ++c) l.out[(kRx + c) * stride + j] = r[c];
-  }
 }
 
 }  // namespace
@@ -562,6 +496,15 @@ Result<SamplingCache> make_sampling_cache(const ClipView& clip, const SkeletonVi
     r.first_track = next;
     next += r.track_count;
   }
+  // Seek indexes for the sparse runs; a dense run (a key on every frame) needs none.
+  std::vector<size_t> seek_at(runs.size(), 0);
+  for (size_t i = 0; i < runs.size(); ++i) {
+    if (runs[i].key_count == clip.frame_count()) continue;
+    seek_at[i] = s->seek_index.size();
+    make_seek_index(runs[i].frames, runs[i].key_count, clip.frame_count(), s->seek_index);
+  }
+  for (size_t i = 0; i < runs.size(); ++i)
+    if (runs[i].key_count != clip.frame_count()) runs[i].seek = s->seek_index.data() + seek_at[i];
   static_assert(std::is_trivially_copyable_v<Run>);
   s->runs = reinterpret_cast<Run*>(s->block.data + floats);
   s->run_count = static_cast<uint32_t>(runs.size());
@@ -584,6 +527,9 @@ Result<SamplingCache> make_sampling_cache(const ClipView& clip, const SkeletonVi
     s->fixed = prototype->state()->fixed;
     s->track_data = prototype->state()->track_data;
     s->kinds = prototype->state()->kinds;
+    for (uint32_t i = 0; i < s->run_count; ++i) s->runs[i].seek = prototype->state()->runs[i].seek;
+    s->seek_index.clear();
+    s->seek_index.shrink_to_fit();
     s->tracks.clear();
     s->tracks.shrink_to_fit();
     s->block_kinds.clear();
@@ -640,9 +586,9 @@ void sample(const ClipView& clip, float time, const SampleOptions& options, Samp
   }
 
   // Pass 2: every joint (of the blocks a joint filter keeps).
-  const Lanes lanes{s.k0, s.fixed, s.k1, s.start, s.inv_length, s.kinds, out.base, s.stride};
-  if (options.rotation == RotationInterpolation::Slerp) interpolate_slerp(lanes, frame);
-  else interpolate_nlerp(lanes, frame);
+  const detail::SampleLanes lanes{s.k0, s.fixed, s.k1, s.start, s.inv_length, s.kinds, out.base, s.stride};
+  if (options.rotation == RotationInterpolation::Slerp) detail::interpolate_slerp(lanes, frame);
+  else detail::interpolate_nlerp(lanes, frame);
 }
 
 }  // namespace ossa

@@ -222,6 +222,49 @@ TEST(Sample, FrameTimesReproduceDecodedKeys) {
   }
 }
 
+TEST(Sample, KeyFramesGiveTheFormatsDecodedTranslationsAndScalesBitForBit) {
+  // At a key's frame a translation or scale is that key exactly (lerp weight 0), so the sampler's
+  // decode must give clip_codec.h's decode_key bits, on every valid synthetic clip and Pab's clips.
+  std::vector<test::SyntheticSpec> specs;
+  for (const auto& [name, spec] : test::valid_variants())
+    if (!spec.clips.empty() && spec.skeleton && !spec.clips[0].skeleton_hash) specs.push_back(spec);
+  std::vector<Asset> assets;
+  for (const test::SyntheticSpec& spec : specs) assets.push_back(load(spec).asset);
+  std::vector<std::pair<ClipView, SkeletonView>> clips;
+  for (const Asset& a : assets) clips.emplace_back(a.clip(0), a.skeleton());
+  auto rig = Asset::open((test::fixtures_dir() / "Pab" / "skeleton.ossa").string());
+  ASSERT_TRUE(rig.ok()) << rig.error().message;
+  for (const char* name : {"walk", "jog", "run", "crossarms"}) {
+    auto a = Asset::open((test::fixtures_dir() / "Pab" / (std::string(name) + ".ossa")).string());
+    ASSERT_TRUE(a.ok()) << a.error().message;
+    assets.push_back(std::move(*a));
+  }
+  for (size_t i = specs.size(); i < assets.size(); ++i) clips.emplace_back(assets[i].clip(0), rig->skeleton());
+  size_t checked = 0;
+  for (const auto& [clip, skeleton] : clips) {
+    SamplingCache cache = cache_for(clip, skeleton);
+    Pose pose(static_cast<uint32_t>(skeleton.joint_count()));
+    for (const fb::AnimatedChannel& a : clip.animated()) {
+      if (a.channel() == fb::Channel::Rotation) continue;
+      const float lo[3] = {a.range_min().x(), a.range_min().y(), a.range_min().z()};
+      const float ex[3] = {a.range_extent().x(), a.range_extent().y(), a.range_extent().z()};
+      for (uint32_t k = 0; k < a.key_count(); ++k) {
+        const uint16_t frame = clip.key_frames()[a.first_key() + k];
+        sample(clip, static_cast<float>(frame) / clip.sample_rate(), SampleOptions{.loop = false}, cache, pose);
+        float v[3];
+        decode_key(clip.key_values().data(), a.bit_offset(), a.bits(), lo, ex, k, v);
+        for (uint32_t c = 0; c < 3; ++c) {
+          const float got = pose.span()[static_cast<PoseComponent>(first_component(a.channel()) + c)][a.joint()];
+          ASSERT_EQ(std::memcmp(&got, &v[c], sizeof got), 0)
+              << clip.name() << " joint " << a.joint() << " key " << k << " component " << c;
+          ++checked;
+        }
+      }
+    }
+  }
+  EXPECT_GT(checked, 1000u);
+}
+
 TEST(Sample, AbsentAndConstantChannelsHoldTheirValues) {
   const Loaded f = load({});
   SamplingCache cache = cache_for(f.clip(), f.skeleton());
@@ -278,6 +321,62 @@ SyntheticSpec hemisphere_spec(uint8_t bits) {
   r.values = {{static_cast<float>(std::sin(a0)), 0, 0}, {static_cast<float>(-std::sin(a1)), 0, 0}};
   c.animated.push_back(r);
   return spec;
+}
+
+TEST(Sample, SeeksFindTheKeyPairInALongClipWithSparseAndDenseRuns) {
+  // 200 frames, so a sparse run's seek index has 13 blocks of 16 frames: keys on block starts and
+  // just past them, a 42-frame gap over empty blocks, a run that ends its keys early, a dense run
+  // (a key on every frame), one that misses a single frame (a seek walks 15 keys) and a raw-float
+  // one. Every frame, every half frame, each block's edges,
+  // and random times, sampled in an order that jumps back and forth through one cache, must give
+  // the pose of the key pair found by a plain walk over the keys (reference_pose).
+  test::SyntheticSpec spec;
+  test::SyntheticClip& c = spec.clips[0];
+  c.frame_count = 200;
+  c.constants.clear();
+  const auto channel = [](uint16_t joint, fb::Channel ch, uint8_t bits, std::vector<uint16_t> frames) {
+    test::SyntheticAnimated a;
+    a.joint = joint;
+    a.channel = ch;
+    a.bits = bits;
+    for (size_t k = 0; k < frames.size(); ++k) {
+      const float x = 0.3f * std::sin(0.7f * static_cast<float>(k)) + 0.01f * static_cast<float>(frames[k]);
+      a.values.push_back(ch == fb::Channel::Rotation ? std::array<float, 3>{0.0f, 0.5f * std::sin(x), 0.0f}
+                                                     : std::array<float, 3>{x, 1.0f - x, 0.5f * x});
+    }
+    a.frames = std::move(frames);
+    return a;
+  };
+  std::vector<uint16_t> every(200);
+  for (uint16_t k = 0; k < 200; ++k) every[k] = k;
+  std::vector<uint16_t> almost_every = every;  // sparse, yet 15 keys past some block starts
+  almost_every.erase(almost_every.begin() + 100);
+  c.animated = {channel(0, fb::Channel::Translation, 10, {0, 2, 4, 6, 8, 10, 12, 14, 16, 18, 20, 22, 24, 199}),
+                channel(1, fb::Channel::Rotation, 14, every),
+                channel(2, fb::Channel::Rotation, 12, {0, 5, 31, 100, 120, 121, 122, 199}),
+                channel(2, fb::Channel::Scale, 16, almost_every),
+                channel(3, fb::Channel::Translation, 16, {0, 1, 15, 16, 17, 32, 33, 47, 48, 90, 91, 150, 199}),
+                channel(3, fb::Channel::Scale, 32, {0, 64, 65, 199})};
+  const Loaded f = load(spec);
+  const ClipView clip = f.clip();
+  SamplingCache cache = cache_for(clip, f.skeleton());
+  Pose pose(static_cast<uint32_t>(f.skeleton().joint_count()));
+  std::vector<double> frames;
+  for (int k = 0; k < 200; ++k) frames.insert(frames.end(), {double(k), k + 0.5, k + 0.99});
+  for (int b = 16; b < 200; b += 16) frames.insert(frames.end(), {b - 0.01, double(b), b + 0.01});
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> u(0.0, 199.0);
+  for (int i = 0; i < 400; ++i) frames.push_back(u(rng));
+  std::shuffle(frames.begin(), frames.end(), rng);
+  const size_t half = frames.size() / 2;
+  frames.insert(frames.end(), frames.begin(), frames.begin() + static_cast<std::ptrdiff_t>(half));
+  std::sort(frames.begin() + static_cast<std::ptrdiff_t>(half), frames.end());  // forward playback too
+  for (const double frame : frames) {
+    const float t = static_cast<float>(frame / clip.sample_rate());
+    sample(clip, t, SampleOptions{.loop = false}, cache, pose);
+    const auto ref = reference_pose(clip, f.skeleton(), wrapped_frame(clip, t, false));
+    ASSERT_LT(max_difference(pose, ref), 2e-6) << "frame " << frame;
+  }
 }
 
 TEST(Sample, RotationKeysInOppositeHemispheresTakeTheShortArc) {

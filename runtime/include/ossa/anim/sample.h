@@ -3,8 +3,9 @@
 // The seed blog's idea, done for compressed data: each animated channel keeps a cursor (the key
 // pair around the last sampled time) and the two keys already decoded, in a SamplingCache. Forward
 // playback then only decodes a key when time passes it, and each channel's keys are read in
-// memory order; a seek, a loop or reverse play moves the cursor (a short walk, or a binary search
-// for a far jump) and stays exact. Per frame the work left is one interpolation per joint over
+// memory order; a seek, a loop or reverse play moves the cursor (to the frame itself where a
+// channel has a key on every frame, else a walk of at most 15 keys from a seek index of one entry
+// per 16 frames) and stays exact. Per frame the work left is one interpolation per joint over
 // SoA arrays: constants and bind-pose channels sit in the cache as key pairs that never change, so
 // the interpolation loop has no per-channel branches.
 //
@@ -52,7 +53,8 @@ class SamplingCache {
 /// `prototype` (optional): a cache of the same clip and rig, never used for sampling, that must
 /// outlive this one; what never changes (constant and bind channels, and each animated channel's
 /// decode record) is then read from it, so many characters playing one clip share it in cache and
-/// each cache keeps only its cursors and decoded key pairs. O(joints + animated channels).
+/// each cache keeps only its cursors and decoded key pairs (and the seek index: 2 bytes per 16
+/// frames of each channel with fewer keys than frames). O(joints + animated channels + their keys).
 /// `joints` (optional, one entry per joint): decode only the animated channels of the joints with
 /// a non-zero entry (a masked slot, which shows some joints of a clip, pays for their keys only).
 /// Every kept joint samples bit for bit as without the filter. sample() leaves the output's lanes
@@ -67,7 +69,7 @@ Result<SamplingCache> make_sampling_cache(const ClipView& clip, const SkeletonVi
 void reset(SamplingCache& cache);
 
 /// Samples `clip` at `time` seconds into `out` (out.joint_count == the skeleton's). Forward
-/// playback: O(joints) + O(keys passed). Allocation-free.
+/// playback: O(joints) + O(keys passed); a seek: O(joints + animated channels). Allocation-free.
 void sample(const ClipView& clip, float time, const SampleOptions& options, SamplingCache& cache, PoseSpan out);
 
 /// Time after advancing by dt * rate (rate may be negative), wrapped into [0, duration) when
