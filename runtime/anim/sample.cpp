@@ -341,10 +341,10 @@ inline float inverse_gap(uint32_t f0, uint32_t f1) {
 
 /// The key pair of a run around `frame` (in [0, last frame]): k with frames[k] <= frame <
 /// frames[k + 1], or the last pair at the last frame (or the first before a first key past 0). A
-/// dense run's pair is the frame's whole part. A sparse run walks forward from its seek index's
-/// entry for the frame's 16-frame block, or from the next pair when playback moved forward past
-/// it (the common case: one step): at most 15 keys whatever the clip's length, where a binary
-/// search over a long clip's keys would cost a dozen mispredicted branches.
+/// dense run's pair is the frame's whole part. A sparse run takes the next pair when playback moved
+/// forward into it (the common case: one compare, the index untouched); otherwise it walks forward
+/// from its seek index's entry for the frame's 16-frame block: at most 15 keys whatever the clip's
+/// length, where a binary search over a long clip's keys would cost a dozen mispredicted branches.
 inline uint32_t find_pair(const Run& r, float frame) {
   const uint32_t n = r.key_count;
   const auto whole = static_cast<uint32_t>(frame);
@@ -352,10 +352,12 @@ inline uint32_t find_pair(const Run& r, float frame) {
   if (!r.seek) {
     k = whole;  // frames[k] == k
   } else {
-    k = r.seek[whole >> kSeekShift];
-    if (r.cursor != kNoCursor && frame >= r.leave && r.cursor + 1 > k) k = r.cursor + 1;
     const uint16_t* frames = r.frames;
-    while (k + 2 < n && frame >= static_cast<float>(frames[k + 1])) ++k;
+    k = r.cursor != kNoCursor && frame >= r.leave ? r.cursor + 1 : 0;
+    if (k + 2 < n && frame >= static_cast<float>(frames[k + 1])) {  // past that pair: from the index
+      k = std::max<uint32_t>(k, r.seek[whole >> kSeekShift]);
+      while (k + 2 < n && frame >= static_cast<float>(frames[k + 1])) ++k;
+    }
   }
   return k > n - 2 ? n - 2 : k;
 }
