@@ -498,15 +498,25 @@ Result<SamplingCache> make_sampling_cache(const ClipView& clip, const SkeletonVi
     r.first_track = next;
     next += r.track_count;
   }
+  // Same clip, rig and filter as the prototype: identical fixed blocks, decode records and seek
+  // indexes, read from it. Only the cursors and the decoded key pairs stay per instance.
+  const State* shared = prototype && prototype->state() && prototype->state()->clip == s->clip &&
+                                prototype->state()->joint_count == s->joint_count &&
+                                prototype->state()->filter.data() == joints.data() &&
+                                prototype->state()->filter.size() == joints.size()
+                            ? prototype->state()
+                            : nullptr;
   // Seek indexes for the sparse runs; a dense run (a key on every frame) needs none.
   std::vector<size_t> seek_at(runs.size(), 0);
-  for (size_t i = 0; i < runs.size(); ++i) {
+  for (size_t i = 0; i < runs.size() && !shared; ++i) {
     if (runs[i].key_count == clip.frame_count()) continue;
     seek_at[i] = s->seek_index.size();
     make_seek_index(runs[i].frames, runs[i].key_count, clip.frame_count(), s->seek_index);
   }
-  for (size_t i = 0; i < runs.size(); ++i)
-    if (runs[i].key_count != clip.frame_count()) runs[i].seek = s->seek_index.data() + seek_at[i];
+  for (size_t i = 0; i < runs.size(); ++i) {
+    if (shared) runs[i].seek = shared->runs[i].seek;
+    else if (runs[i].key_count != clip.frame_count()) runs[i].seek = s->seek_index.data() + seek_at[i];
+  }
   static_assert(std::is_trivially_copyable_v<Run>);
   s->runs = reinterpret_cast<Run*>(s->block.data + floats);
   s->run_count = static_cast<uint32_t>(runs.size());
@@ -521,17 +531,10 @@ Result<SamplingCache> make_sampling_cache(const ClipView& clip, const SkeletonVi
   s->fixed = s->k0;
   s->track_data = s->tracks.data();
   s->kinds = s->block_kinds.data();
-  if (prototype && prototype->state() && prototype->state()->clip == s->clip &&
-      prototype->state()->joint_count == s->joint_count && prototype->state()->filter.data() == joints.data() &&
-      prototype->state()->filter.size() == joints.size()) {
-    // Same clip, rig and filter: identical fixed blocks and decode records. Only the cursors and
-    // the decoded key pairs stay per instance.
-    s->fixed = prototype->state()->fixed;
-    s->track_data = prototype->state()->track_data;
-    s->kinds = prototype->state()->kinds;
-    for (uint32_t i = 0; i < s->run_count; ++i) s->runs[i].seek = prototype->state()->runs[i].seek;
-    s->seek_index.clear();
-    s->seek_index.shrink_to_fit();
+  if (shared) {
+    s->fixed = shared->fixed;
+    s->track_data = shared->track_data;
+    s->kinds = shared->kinds;
     s->tracks.clear();
     s->tracks.shrink_to_fit();
     s->block_kinds.clear();

@@ -377,6 +377,19 @@ TEST(Sample, SeeksFindTheKeyPairInALongClipWithSparseAndDenseRuns) {
     const auto ref = reference_pose(clip, f.skeleton(), wrapped_frame(clip, t, false));
     ASSERT_LT(max_difference(pose, ref), 2e-6) << "frame " << frame;
   }
+  // A cache made with a prototype reads the prototype's seek indexes: the same bits.
+  auto prototype = make_sampling_cache(clip, f.skeleton());
+  ASSERT_TRUE(prototype.ok()) << prototype.error().message;
+  auto shared = make_sampling_cache(clip, f.skeleton(), &*prototype);
+  ASSERT_TRUE(shared.ok()) << shared.error().message;
+  SamplingCache own = cache_for(clip, f.skeleton());
+  Pose other(static_cast<uint32_t>(f.skeleton().joint_count()));
+  for (const double frame : frames) {
+    const float t = static_cast<float>(frame / clip.sample_rate());
+    sample(clip, t, SampleOptions{.loop = false}, *shared, pose);
+    sample(clip, t, SampleOptions{.loop = false}, own, other);
+    ASSERT_TRUE(same_bits(pose, other)) << "frame " << frame;
+  }
 }
 
 TEST(Sample, RotationKeysInOppositeHemispheresTakeTheShortArc) {
