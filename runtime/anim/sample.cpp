@@ -233,12 +233,13 @@ inline __m128 dequantized(const Track& t, const uint8_t* stream, uint32_t key) {
   return _mm_add_ps(_mm_loadu_ps(t.lo), _mm_mul_ps(_mm_loadu_ps(t.extent), f));
 }
 
-/// Key `key` of any track, its three stored components in lanes 0..2 (lane 3: 0, or the bits
-/// after a raw key, never used; validation keeps 8 padding bytes after the last key, so the 16-byte
-/// read of a raw key stays inside the stream).
+/// Key `key` of any track as (x, y, z, 0): its three stored components. A raw key is read as 16
+/// bytes (validation keeps 8 padding bytes after the last key, so the read stays inside the stream)
+/// and the bytes after it are cleared, so no arithmetic on lane 3 can raise a floating-point flag.
 inline __m128 stored(const Track& t, const uint8_t* stream, uint32_t key) {
   if (t.bits == kRawFloatBits)
-    return _mm_loadu_ps(reinterpret_cast<const float*>(stream + (t.bit_offset >> 3) + 12ull * key));
+    return _mm_and_ps(_mm_loadu_ps(reinterpret_cast<const float*>(stream + (t.bit_offset >> 3) + 12ull * key)),
+                      _mm_castsi128_ps(_mm_setr_epi32(-1, -1, -1, 0)));
   return dequantized(t, stream, key);
 }
 
@@ -270,7 +271,9 @@ inline __m128 rotation_w2(__m128 a, __m128 b) {
   const __m128 z = _mm_unpackhi_ps(a, b);   // za zb 0 0
   const __m128 sq = _mm_mul_ps(xy, xy);
   const __m128 w2 = _mm_sub_ps(_mm_sub_ps(_mm_sub_ps(_mm_set1_ps(1.0f), sq), _mm_movehl_ps(sq, sq)), _mm_mul_ps(z, z));
-  return _mm_and_ps(_mm_sqrt_ps(w2), _mm_cmpgt_ps(w2, _mm_setzero_ps()));  // w2 <= 0: 0
+  // w2 <= 0 gives 0, as rotation_w's test does; clamping first keeps a negative (or another lane's
+  // unused value) out of the square root, which would raise invalid-operation.
+  return _mm_sqrt_ps(_mm_max_ps(w2, _mm_setzero_ps()));
 }
 
 /// Keys `key` and `key + 1` of a track into k0 and k1 (a seek).

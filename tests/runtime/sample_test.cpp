@@ -32,6 +32,10 @@
 #include <ossa/anim/vector_isa.h>
 #include "test_files.h"
 
+#if defined(__SSE2__)
+#include <xmmintrin.h>
+#endif
+
 namespace ossa {
 namespace {
 
@@ -538,6 +542,55 @@ std::vector<float> random_times(const ClipView& clip, int n, uint32_t seed) {
   for (int i = 0; i < n; ++i) times.push_back(u(rng));
   return times;
 }
+
+#if defined(__SSE2__)
+TEST(Sample, RebuildingARotationRaisesNoInvalidOperation) {
+  // Quantized rotation keys whose three stored components square to just over 1 (w2 < 0: the
+  // rebuilt component is 0), next to a raw-float one: forward playback, seeks and loops must not
+  // take a square root of a negative number or compute on bytes past a key, so a caller that
+  // unmasks the invalid-operation exception (a debug build catching NaNs) is never trapped. The
+  // sticky flag is what this checks (with FTZ / DAZ set first, which sample() then leaves as is).
+  test::SyntheticSpec spec;
+  test::SyntheticClip& c = spec.clips[0];
+  c.frame_count = 40;
+  c.constants.clear();
+  test::SyntheticAnimated over;
+  over.joint = 1;
+  over.channel = fb::Channel::Rotation;
+  over.bits = 19;
+  test::SyntheticAnimated raw = over;
+  raw.joint = 2;
+  raw.bits = 32;
+  for (uint16_t k = 0; k < 40; k += 3) {
+    over.frames.push_back(k);
+    over.values.push_back({0.57736f, 0.57736f, k % 2 ? 0.57737f : 0.57735f});
+    raw.frames.push_back(k);
+    raw.values.push_back({0.1f, 0.2f * static_cast<float>(k % 4), 0.3f});
+  }
+  over.frames.back() = raw.frames.back() = 39;
+  test::SyntheticAnimated after = raw;  // quantized bits after the raw keys
+  after.joint = 3;
+  after.channel = fb::Channel::Translation;
+  after.bits = 19;
+  c.animated = {over, raw, after};
+  const Loaded f = load(spec);
+  const ClipView clip = f.clip();
+  SamplingCache cache = cache_for(clip, f.skeleton());
+  Pose pose(static_cast<uint32_t>(f.skeleton().joint_count()));
+  const unsigned original = _mm_getcsr();
+  std::vector<float> times = playback(clip, 1.0f, 200, true);
+  const std::vector<float> seeks = random_times(clip, 200, 23);
+  times.insert(times.end(), seeks.begin(), seeks.end());
+  for (const float t : times) {
+    _mm_setcsr((original & ~0x3fu) | 0x8040u);  // FTZ / DAZ already on: sample() then keeps the flags
+    sample(clip, t, {}, cache, pose);
+    const unsigned flags = _mm_getcsr() & 0x3fu;
+    _mm_setcsr(original);
+    ASSERT_EQ(flags & 0x1u, 0u) << "invalid operation at t=" << t;
+  }
+  EXPECT_EQ(get_transform(pose, 1).rotation.w, 0.0f);  // the keys' rebuilt component
+}
+#endif
 
 TEST(Sample, CacheIsInvisibleOnSyntheticClips) {
   for (const auto& [name, spec] : test::valid_variants()) {
