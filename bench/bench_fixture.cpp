@@ -48,11 +48,11 @@ std::unique_ptr<BenchData> load() {
   cook::CookOptions bound;
   bound.reference = &*reference;
   bound.reference_name = "skeleton.ossa";
-  for (const char* name : {"walk", "jog", "run", "arnaud"})
+  for (const char* name : {"walk", "jog", "run", "arnaud", "crossarms"})
     cook_or_die(pab / (std::string(name) + ".fbx"), dir / (std::string(name) + ".ossa"), bound);
-  auto data = std::unique_ptr<BenchData>(
-      new BenchData{open_or_die(dir / "skeleton.ossa"), open_or_die(dir / "walk.ossa"), open_or_die(dir / "jog.ossa"),
-                    open_or_die(dir / "run.ossa"), open_or_die(dir / "arnaud.ossa")});
+  auto data = std::unique_ptr<BenchData>(new BenchData{
+      open_or_die(dir / "skeleton.ossa"), open_or_die(dir / "walk.ossa"), open_or_die(dir / "jog.ossa"),
+      open_or_die(dir / "run.ossa"), open_or_die(dir / "arnaud.ossa"), open_or_die(dir / "crossarms.ossa")});
   std::error_code ec;
   fs::remove_all(dir, ec);  // the mappings stay valid after unlink
   return data;

@@ -19,6 +19,8 @@
 //                over dense float keys, run with flush-to-zero, so its cost cannot move with ossa's)
 //   sample.noisy the same on a rig whose rest pose holds +-7.7e-34 for its zeros (noisy_rest_copy:
 //                a file cooked elsewhere); 1.9x sample.plain's ratio if the runtime's arithmetic meets them
+//   sample.seek  random times over Pab's long crossed-arms clip, a jump every call / plain_sample at the
+//                same times (a direct frame lookup): what the seek index buys, against a binary search
 //   frame.plain  3 samples + blend_n + local_to_model + palette / the plain references of each
 //   skin.plain   skin_cpu positions + normals / plain_skin (4 influences per vertex, scalar)
 //   verify       Asset::borrow of bytes in memory (verify + every semantic check) / one plain pass
@@ -189,6 +191,35 @@ bool plain_rows(int trials, const ossa::bench::BenchData& data, std::vector<Row>
   sample_row("sample.plain", *caches[0], limit_for(0.63, 1.1));
   sample_row("sample.noisy", *caches[3],
              limit_for(0.63, 1.1));  // the same; a runtime without FTZ/DAZ alone fails this row
+  {
+    // Seeks: the long crossed-arms clip at random times, so every call jumps and finds each
+    // channel's key pair afresh, against plain_sample's direct frame lookup at the same times.
+    const ossa::ClipView long_clip = data.crossarms.clip(0);
+    const ossa::bench::PlainClip plain_long = ossa::bench::plain_clip(long_clip, skeleton);
+    auto cache = ossa::make_sampling_cache(long_clip, skeleton);
+    if (!cache) {
+      std::fprintf(stderr, "ossa-bench-guard: %s\n", cache.error().message.c_str());
+      return false;
+    }
+    std::mt19937 gen(41);
+    std::uniform_real_distribution<float> at(0.0f, long_clip.duration());
+    std::vector<float> jumps(256);
+    for (float& x : jumps) x = at(gen);
+    const auto [ossa_s, plain_s] = interleaved_min(
+        trials, 64,
+        [&] {
+          ossa::sample(long_clip, jumps[i++ & 255], {}, *cache, poses[0]);
+          g_sink = g_sink + static_cast<uint32_t>(poses[0].span().base[0]);
+        },
+        [&] {
+          flushed([&] { ossa::bench::plain_sample(plain_long, jumps[k++ & 255], local[0].data()); });
+          g_sink = g_sink + static_cast<uint32_t>(local[0][0].t[0]);
+        });
+    // AMD Zen 5: 1.57-1.64, also with stress-ng on both cores; 2.43-2.50 for 88e7980 (a binary search
+    // over each run's keys per seek) with this row built against it. Intel: not measured yet, so its
+    // limit only catches a gross regression (a linear walk over the keys).
+    rows.push_back({"sample.seek", ossa_s * 1e9, plain_s * 1e9, limit_for(2.05, 3.0)});
+  }
 
   const std::span<const int16_t> parents = skeleton.parents();
   const ossa::ConstPoseSpan inputs[3] = {poses[0], poses[1], poses[2]};
