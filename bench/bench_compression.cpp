@@ -59,7 +59,7 @@ int usage() {
 }
 
 /// Bits of one channel's keys in key_values (raw floats start byte-aligned: up to 7 bits more each).
-uint64_t value_bits(const CompressedAnimated& a) { return a.key_count * ossa::key_bits(a.bits); }
+uint64_t value_bits(const CompressedAnimated& a) { return a.key_count * a.bits.total(); }
 
 /// --breakdown: where cooked_bytes go (see the header comment).
 void print_breakdown(const CompressedClip& c) {
@@ -78,7 +78,7 @@ void print_breakdown(const CompressedClip& c) {
   uint64_t every_keys = 0, reduced_keys = 0, every_bits = 0, reduced_bits = 0;
   std::set<uint32_t> every_runs, reduced_runs;  // first_key of the key-frame runs each group reads
   uint64_t reduced_run_frames = 0;
-  std::map<uint32_t, uint32_t> bits_used[3];  // per channel kind: bits -> channels
+  std::map<uint32_t, uint32_t> bits_used[3];  // per channel kind: bits per key -> channels
   for (const CompressedAnimated& a : c.animated) {
     if (a.key_count == frames) {
       ++every_channels;
@@ -91,7 +91,7 @@ void print_breakdown(const CompressedClip& c) {
       reduced_bits += value_bits(a);
       if (reduced_runs.insert(a.first_key).second) reduced_run_frames += a.key_count;
     }
-    if (a.channel < 3) ++bits_used[a.channel][a.bits];
+    if (a.channel < 3) ++bits_used[a.channel][static_cast<uint32_t>(a.bits.total())];
   }
   std::printf(
       "# %s: keyed at every frame: %zu channels, %llu keys, %.0f B of values, %zu run(s) of %u frames;"
@@ -102,7 +102,7 @@ void print_breakdown(const CompressedClip& c) {
       static_cast<unsigned long long>(reduced_channels) * frames, static_cast<double>(reduced_bits) / 8.0,
       static_cast<unsigned long long>(reduced_run_frames * sizeof(uint16_t)), reduced_runs.size());
   static const char* const kKinds[3] = {"translation", "rotation", "scale"};
-  std::printf("# %s: bits (bits:channels):", name);
+  std::printf("# %s: bits per key (bits:channels):", name);
   for (int k = 0; k < 3; ++k) {
     std::printf(" %s", kKinds[k]);
     if (bits_used[k].empty()) std::printf(" -");

@@ -123,7 +123,7 @@ function(check_breakdown file)
     math(EXPR i "${i} + 1")
     list(GET lines ${i} bits)
     if(NOT groups MATCHES "^# ${clip}: keyed at every frame: " OR
-       NOT bits MATCHES "^# ${clip}: bits \\(bits:channels\\): translation ")
+       NOT bits MATCHES "^# ${clip}: bits per key \\(bits:channels\\): translation ")
       message(FATAL_ERROR "breakdown of '${clip}' is\n  ${groups}\n  ${bits}")
     endif()
     math(EXPR i "${i} + 1")

@@ -46,14 +46,16 @@
 //    near 0 somewhere (a leg swinging through a half turn drops x, not w), and each key is stored
 //    with that component >= 0 (consecutive keys may then be on opposite hemispheres, which the
 //    runtime's shortest-arc nlerp undoes). For each bit count b in 1..kMaxQuantBits (19) the
-//    values at every frame are range-quantized per component (the dropped component rebuilt from
-//    the other three exactly as decoded); a b whose quantized frames alone break the
-//    budget is skipped; otherwise greedy key removal runs on the quantized values: from each kept
-//    key, the furthest next key whose linear interpolation (normalized lerp on the shortest arc for
-//    rotations: what the runtime does) keeps every frame in between within budget, found by
-//    doubling then bisection (O(frames log gap) checks, instead of O(frames^2) for Douglas-Peucker
-//    on long mocap clips). A reduced key set costs keys * (3b + 16) bits (16 for its key frame);
-//    keys at every frame cost frames * 3b, their key frames being one run shared by all such
+//    values at every frame are range-quantized per component, the component of widest range in b
+//    bits and each other one in the fewest whose step is no coarser (key_widths: a knee's quiet
+//    components take a few bits), the dropped component rebuilt from the other three exactly as
+//    decoded; a b whose quantized frames alone break the budget is skipped; otherwise greedy key
+//    removal runs on the quantized values: from each kept key, the furthest next key whose linear
+//    interpolation (normalized lerp on the shortest arc for rotations: what the runtime does)
+//    keeps every frame in between within budget, found by doubling then bisection (O(frames log
+//    gap) checks, instead of O(frames^2) for Douglas-Peucker on long mocap clips). With W the
+//    three widths summed, a reduced key set costs keys * (W + 16) bits (16 for its key frame);
+//    keys at every frame cost frames * W, their key frames being one run shared by all such
 //    channels. The cheapest (b, keys) wins; the search stops when no larger b can beat it. 32-bit
 //    raw floats are the escape when no b holds the budget (a root translation over tens of metres
 //    at a 0.03 mm budget, a root rotation through a full turn, which no dropped component avoids).
@@ -299,7 +301,7 @@ Status pack(const ClipLayout& layout, uint32_t joints, uint32_t frames, Compress
       CompressedAnimated a;
       a.joint = static_cast<uint16_t>(j);
       a.channel = static_cast<uint8_t>(ch);
-      a.bits = static_cast<uint8_t>(p.bits);
+      a.bits = p.widths;
       a.dropped = static_cast<uint8_t>(ch == kRotation ? p.dropped : 0);  // 0 for other channels
       a.key_count = static_cast<uint32_t>(p.frames.size());
       if (p.frames.size() == frames && every_frame_run >= 0) {
@@ -310,17 +312,17 @@ Status pack(const ClipLayout& layout, uint32_t joints, uint32_t frames, Compress
         a.first_key = it->second;
         if (p.frames.size() == frames) every_frame_run = it->second;
       }
-      if (p.bits == kRawFloatBits) writer.align_byte();
+      if (p.widths.raw()) writer.align_byte();
       if (writer.bit_size() > std::numeric_limits<uint32_t>::max()) {
         return Error{"clip '" + out.name + "': compressed keys exceed 4 Gbit"};
       }
       a.bit_offset = static_cast<uint32_t>(writer.bit_size());
       for (int c = 0; c < 3; ++c) {
-        a.range_min[c] = p.bits == kRawFloatBits ? 0.0f : p.range_min[c];
-        a.range_extent[c] = p.bits == kRawFloatBits ? 0.0f : p.range_extent[c];
+        a.range_min[c] = p.widths.raw() ? 0.0f : p.range_min[c];
+        a.range_extent[c] = p.widths.raw() ? 0.0f : p.range_extent[c];
       }
       for (const uint16_t f : p.frames)
-        for (int c = 0; c < 3; ++c) writer.write(p.codes[f][c], p.bits);
+        for (int c = 0; c < 3; ++c) writer.write(p.codes[f][c], p.widths.c[c]);
       out.animated.push_back(a);
     }
   }

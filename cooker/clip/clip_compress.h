@@ -17,6 +17,7 @@
 #include "cooker/model/cook_options.h"
 #include "cooker/clip/morph_weights.h"
 #include "cooker/model/source_scene.h"
+#include <ossa/format/clip_codec.h>
 #include <ossa/format/result.h>
 
 namespace ossa::cook {
@@ -30,7 +31,7 @@ struct CompressedConstant {
 struct CompressedAnimated {
   uint16_t joint = 0;
   uint8_t channel = 0;
-  uint8_t bits = 0;     // 1..kMaxQuantBits (19) or 32
+  KeyWidths bits;       // per stored component: 1..kMaxQuantBits (19) each, or all 32
   uint8_t dropped = 3;  // rotations: the component not stored (ossa/format/clip_codec.h)
   uint32_t first_key = 0;
   uint32_t key_count = 0;

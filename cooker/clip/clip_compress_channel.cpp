@@ -185,12 +185,12 @@ uint32_t float_bits(float f) {
   return u;
 }
 
-glm::vec4 decode_code(uint32_t channel, uint32_t dropped, uint32_t bits, const float lo[3], const float extent[3],
-                      const Code& code) {
+glm::vec4 decode_code(uint32_t channel, uint32_t dropped, const KeyWidths& bits, const float lo[3],
+                      const float extent[3], const Code& code) {
   float xyz[3];
   for (int c = 0; c < 3; ++c) {
-    if (bits == kRawFloatBits) std::memcpy(&xyz[c], &code[c], 4);
-    else xyz[c] = dequantize(code[c], lo[c], extent[c], bits);
+    if (bits.raw()) std::memcpy(&xyz[c], &code[c], 4);
+    else xyz[c] = dequantize(code[c], lo[c], extent[c], bits.c[c]);
   }
   return key_sample(channel, dropped, xyz);
 }
@@ -233,8 +233,9 @@ Code encode_rotation_raw(const glm::vec4& ref, const glm::vec4& stored, uint32_t
   constexpr int kSecondUlps = 8, kSolvedUlps = 2;
   const Metric angle{kRotation, 1.0};
   const float zero[3] = {0, 0, 0};
+  const KeyWidths raw = KeyWidths::uniform(kRawFloatBits);
   Code best = {float_bits(stored.x), float_bits(stored.y), float_bits(stored.z)};
-  double best_error = channel_error(angle, ref, decode_code(kRotation, dropped, kRawFloatBits, zero, zero, best));
+  double best_error = channel_error(angle, ref, decode_code(kRotation, dropped, raw, zero, zero, best));
   for (int adj = 0; adj < 3 && best_error > good_enough; ++adj) {
     for (int other = 0; other < 3; ++other) {
       if (other == adj) continue;
@@ -245,7 +246,7 @@ Code encode_rotation_raw(const glm::vec4& ref, const glm::vec4& stored, uint32_t
         for (int d = -kSolvedUlps; d <= kSolvedUlps; ++d) {
           xyz[adj] = nudge(solved, d);
           const Code code = {float_bits(xyz[0]), float_bits(xyz[1]), float_bits(xyz[2])};
-          const double e = channel_error(angle, ref, decode_code(kRotation, dropped, kRawFloatBits, zero, zero, code));
+          const double e = channel_error(angle, ref, decode_code(kRotation, dropped, raw, zero, zero, code));
           if (e < best_error) {
             best_error = e;
             best = code;
@@ -259,19 +260,20 @@ Code encode_rotation_raw(const glm::vec4& ref, const glm::vec4& stored, uint32_t
 
 /// Quantized: the nearest lattice point, or when that misses `budget`, the best lattice point
 /// around the one that solves for each component in turn.
-Code encode_quantized(const Metric& m, const glm::vec4& ref, const glm::vec4& stored, uint32_t dropped, uint32_t bits,
-                      const float lo[3], const float extent[3], double budget) {
+Code encode_quantized(const Metric& m, const glm::vec4& ref, const glm::vec4& stored, uint32_t dropped,
+                      const KeyWidths& bits, const float lo[3], const float extent[3], double budget) {
   Code best;
-  for (int c = 0; c < 3; ++c) best[c] = quantize(stored[c], lo[c], extent[c], bits);
+  for (int c = 0; c < 3; ++c) best[c] = quantize(stored[c], lo[c], extent[c], bits.c[c]);
   if (m.channel != kRotation) return best;
   double best_error = channel_error(m, ref, decode_code(kRotation, dropped, bits, lo, extent, best));
   if (best_error <= budget) return best;
   const Code nearest = best;
-  const auto qmax = static_cast<int64_t>(quant_max(bits));
+  const int64_t qmax[3] = {quant_max(bits.c[0]), quant_max(bits.c[1]), quant_max(bits.c[2])};
   for (int adj = 0; adj < 3; ++adj) {
     float xyz[3];
-    for (int c = 0; c < 3; ++c) xyz[c] = dequantize(nearest[c], lo[c], extent[c], bits);
-    const auto center = static_cast<int64_t>(quantize(solve_component(xyz, adj, stored.w), lo[adj], extent[adj], bits));
+    for (int c = 0; c < 3; ++c) xyz[c] = dequantize(nearest[c], lo[c], extent[c], bits.c[c]);
+    const auto center =
+        static_cast<int64_t>(quantize(solve_component(xyz, adj, stored.w), lo[adj], extent[adj], bits.c[adj]));
     const int a = (adj + 1) % 3, b = (adj + 2) % 3;
     for (int64_t d = -2; d <= 2; ++d) {
       for (int64_t da = -1; da <= 1; ++da) {
@@ -279,7 +281,7 @@ Code encode_quantized(const Metric& m, const glm::vec4& ref, const glm::vec4& st
           Code code = nearest;
           const int64_t qa = static_cast<int64_t>(nearest[a]) + da, qb = static_cast<int64_t>(nearest[b]) + db;
           const int64_t qc = center + d;
-          if (qa < 0 || qa > qmax || qb < 0 || qb > qmax || qc < 0 || qc > qmax) continue;
+          if (qa < 0 || qa > qmax[a] || qb < 0 || qb > qmax[b] || qc < 0 || qc > qmax[adj]) continue;
           code[a] = static_cast<uint32_t>(qa);
           code[b] = static_cast<uint32_t>(qb);
           code[adj] = static_cast<uint32_t>(qc);
@@ -312,6 +314,7 @@ ChannelPlan animate_lossless(uint32_t channel, const glm::vec4* ref, uint32_t n)
   ChannelPlan plan;
   plan.kind = Kind::Animated;
   plan.bits = kRawFloatBits;
+  plan.widths = KeyWidths::uniform(kRawFloatBits);
   plan.dropped = channel == kRotation ? choose_dropped(ref, n) : 0;
   plan.codes = raw_codes(channel, plan.dropped, ref, n);
   plan.frames.resize(n);
@@ -320,6 +323,19 @@ ChannelPlan animate_lossless(uint32_t channel, const glm::vec4* ref, uint32_t n)
 }
 
 }  // namespace
+
+KeyWidths key_widths(uint32_t bits, const float extent[3]) {
+  if (bits == kRawFloatBits) return KeyWidths::uniform(kRawFloatBits);
+  const double widest = std::max({double{extent[0]}, double{extent[1]}, double{extent[2]}});
+  const double step = widest / quant_max(bits);
+  KeyWidths w;
+  for (int c = 0; c < 3; ++c) {
+    uint32_t b = 1;
+    while (b<bits&& double{extent[c]} / quant_max(b)> step) ++b;
+    w.c[c] = b;
+  }
+  return w;
+}
 
 ChannelPlan plan_lossless(uint32_t channel, const glm::vec4* ref, uint32_t n, const glm::vec4& bind) {
   ChannelPlan plan;
@@ -384,21 +400,23 @@ ChannelPlan encode_animated(const Metric& m, const glm::vec4* target, uint32_t n
   // Raw floats: the fallback, and (its key count) the floor no bit count can go below.
   std::vector<glm::vec4> dec(n);
   plan.bits = kRawFloatBits;
+  plan.widths = KeyWidths::uniform(kRawFloatBits);
   plan.codes = raw_codes(m.channel, plan.dropped, target, n);
   for (uint32_t f = 0; f < n; ++f) {
-    dec[f] = decode_code(m.channel, plan.dropped, kRawFloatBits, plan.range_min, plan.range_extent, plan.codes[f]);
+    dec[f] = decode_code(m.channel, plan.dropped, plan.widths, plan.range_min, plan.range_extent, plan.codes[f]);
   }
   // Keys at every frame share one run of key_frames with every other such channel (pack), so
   // their frames cost nothing; a reduced set pays kKeyFrameBits per key.
   std::vector<uint16_t> all_frames(n);
   for (uint32_t f = 0; f < n; ++f) all_frames[f] = static_cast<uint16_t>(f);
   uint64_t best_cost = std::numeric_limits<uint64_t>::max();
-  auto consider = [&](uint32_t bits, std::vector<uint16_t> frames) {
-    const uint64_t all_cost = n * 3ull * bits;
-    const uint64_t reduced_cost = frames.size() * (3ull * bits + kKeyFrameBits);
+  auto consider = [&](uint32_t bits, const KeyWidths& widths, std::vector<uint16_t> frames) {
+    const uint64_t all_cost = n * widths.total();
+    const uint64_t reduced_cost = frames.size() * (widths.total() + kKeyFrameBits);
     if (std::min(all_cost, reduced_cost) >= best_cost) return false;
     best_cost = std::min(all_cost, reduced_cost);
     plan.bits = bits;
+    plan.widths = widths;
     plan.frames = all_cost <= reduced_cost ? all_frames : std::move(frames);
     return true;
   };
@@ -411,20 +429,23 @@ ChannelPlan encode_animated(const Metric& m, const glm::vec4* target, uint32_t n
   };
   std::vector<uint16_t> raw_frames = reduce();
   const size_t floor_keys = raw_frames.size();
-  consider(kRawFloatBits, std::move(raw_frames));
+  consider(kRawFloatBits, plan.widths, std::move(raw_frames));
 
+  // Widths grow with bits, so the first bit count whose cheapest possible cost cannot beat the
+  // best found ends the search.
   std::vector<Code> codes(n);
   for (uint32_t bits = 1; bits <= kMaxQuantBits; ++bits) {
-    const uint64_t lowest = std::min<uint64_t>(n * 3ull * bits, floor_keys * (3ull * bits + kKeyFrameBits));
+    const KeyWidths widths = key_widths(bits, plan.range_extent);
+    const uint64_t lowest = std::min<uint64_t>(n * widths.total(), floor_keys * (widths.total() + kKeyFrameBits));
     if (lowest >= best_cost) break;
     bool holds = true;
     for (uint32_t f = 0; f < n && holds; ++f) {
       codes[f] =
-          encode_quantized(m, target[f], stored[f], plan.dropped, bits, plan.range_min, plan.range_extent, tolerance);
-      dec[f] = decode_code(m.channel, plan.dropped, bits, plan.range_min, plan.range_extent, codes[f]);
+          encode_quantized(m, target[f], stored[f], plan.dropped, widths, plan.range_min, plan.range_extent, tolerance);
+      dec[f] = decode_code(m.channel, plan.dropped, widths, plan.range_min, plan.range_extent, codes[f]);
       holds = channel_error(m, target[f], dec[f]) <= tolerance;
     }
-    if (holds && consider(bits, reduce())) plan.codes = codes;
+    if (holds && consider(bits, widths, reduce())) plan.codes = codes;
   }
   return plan;
 }
@@ -437,14 +458,16 @@ ChannelPlan refit_animated(const Metric& m, const glm::vec4* target, uint32_t n,
   plan.frames = std::move(frames);
   plan.dropped = m.channel == kRotation ? choose_dropped(target, n) : 0;
   if (bits == kRawFloatBits) {
+    plan.widths = KeyWidths::uniform(kRawFloatBits);
     plan.codes = raw_codes(m.channel, plan.dropped, target, n);
     return plan;
   }
   const std::vector<glm::vec4> stored = stored_with_range(m.channel, target, n, plan);
+  plan.widths = key_widths(bits, plan.range_extent);
   plan.codes.resize(n);
   for (uint32_t f = 0; f < n; ++f)
-    plan.codes[f] =
-        encode_quantized(m, target[f], stored[f], plan.dropped, bits, plan.range_min, plan.range_extent, tolerance);
+    plan.codes[f] = encode_quantized(m, target[f], stored[f], plan.dropped, plan.widths, plan.range_min,
+                                     plan.range_extent, tolerance);
   return plan;
 }
 
@@ -457,11 +480,11 @@ void decode_plan(const ChannelPlan& plan, uint32_t channel, uint32_t n, const gl
     return;
   }
   glm::vec4 prev =
-      decode_code(channel, plan.dropped, plan.bits, plan.range_min, plan.range_extent, plan.codes[plan.frames[0]]);
+      decode_code(channel, plan.dropped, plan.widths, plan.range_min, plan.range_extent, plan.codes[plan.frames[0]]);
   out[0] = prev;
   for (size_t k = 1; k < plan.frames.size(); ++k) {
     const glm::vec4 next =
-        decode_code(channel, plan.dropped, plan.bits, plan.range_min, plan.range_extent, plan.codes[plan.frames[k]]);
+        decode_code(channel, plan.dropped, plan.widths, plan.range_min, plan.range_extent, plan.codes[plan.frames[k]]);
     const uint32_t f0 = plan.frames[k - 1], f1 = plan.frames[k];
     const float inv_length = 1.0f / static_cast<float>(f1 - f0);
     for (uint32_t f = f0; f <= f1; ++f)
@@ -473,7 +496,7 @@ void decode_plan(const ChannelPlan& plan, uint32_t channel, uint32_t n, const gl
 std::vector<glm::vec4> decode_codes(const ChannelPlan& plan, uint32_t channel, uint32_t n) {
   std::vector<glm::vec4> out(n);
   for (uint32_t f = 0; f < n; ++f)
-    out[f] = decode_code(channel, plan.dropped, plan.bits, plan.range_min, plan.range_extent, plan.codes[f]);
+    out[f] = decode_code(channel, plan.dropped, plan.widths, plan.range_min, plan.range_extent, plan.codes[f]);
   return out;
 }
 

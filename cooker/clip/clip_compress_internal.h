@@ -43,13 +43,14 @@ struct Metric {
   double lever = 1.0;
 };
 
-/// One key as stored: three quantized components, or three raw float bit patterns (bits == 32).
+/// One key as stored: three quantized components, or three raw float bit patterns (widths of 32).
 using Code = std::array<uint32_t, 3>;
 
 struct ChannelPlan {
   Kind kind = Kind::Bind;
   glm::vec4 constant{0.0f};
-  uint32_t bits = 0;             // animated: 1..kMaxQuantBits or 32
+  uint32_t bits = 0;             // animated: 1..kMaxQuantBits or 32, the widest component's width
+  KeyWidths widths;              // animated: each stored component's (key_widths(bits, range_extent))
   uint32_t dropped = 0;          // animated rotation: the component not stored (0..3)
   std::vector<uint16_t> frames;  // animated: kept key frames
   std::vector<Code> codes;       // animated: every frame's key as it would be stored
@@ -57,6 +58,11 @@ struct ChannelPlan {
 };
 
 bool all_equal(const glm::vec4* v, uint32_t n, const glm::vec4& value);
+/// The stored widths for a channel quantized at `bits` (1..kMaxQuantBits) whose stored components
+/// span `extent`: the widest component takes `bits`, each other one the fewest bits (at least 1)
+/// whose step, extent / (2^w - 1), is no coarser than the widest one's; raw floats (32) stay 32
+/// for all three. A channel's budget is then still checked on its keys as stored (step 5).
+KeyWidths key_widths(uint32_t bits, const float extent[3]);
 /// A channel cooked losslessly: bind, constant, or raw floats at every frame.
 ChannelPlan plan_lossless(uint32_t channel, const glm::vec4* ref, uint32_t n, const glm::vec4& bind);
 /// Step 4: bind or constant when the source (`ref`) allows it within `tolerance`; otherwise a plan

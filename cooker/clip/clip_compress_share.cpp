@@ -88,7 +88,7 @@ std::vector<bool> share_key_lists(std::vector<ChannelPlan>& plans, std::span<con
     }
     Group& g = groups[it->second];
     g.members.push_back(static_cast<uint32_t>(members.size()));
-    g.value_bits += key_bits(p.bits);
+    g.value_bits += p.widths.total();
     members.push_back(std::move(m));
   }
   for (Member& m : members) {

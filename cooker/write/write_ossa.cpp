@@ -147,8 +147,11 @@ Offset<fb::Clip> write_clip(FlatBufferBuilder& fbb, const CompressedClip& clip, 
   std::vector<fb::AnimatedChannel> animated;
   animated.reserve(clip.animated.size());
   for (const CompressedAnimated& a : clip.animated) {
-    animated.emplace_back(a.joint, static_cast<fb::Channel>(a.channel), a.bits, a.dropped, a.first_key, a.key_count,
-                          a.bit_offset, fb::Vec3(a.range_min[0], a.range_min[1], a.range_min[2]),
+    const uint8_t bits[3] = {static_cast<uint8_t>(a.bits.c[0]), static_cast<uint8_t>(a.bits.c[1]),
+                             static_cast<uint8_t>(a.bits.c[2])};
+    animated.emplace_back(a.joint, static_cast<fb::Channel>(a.channel), flatbuffers::span<const uint8_t, 3>(bits),
+                          a.dropped, a.first_key, a.key_count, a.bit_offset,
+                          fb::Vec3(a.range_min[0], a.range_min[1], a.range_min[2]),
                           fb::Vec3(a.range_extent[0], a.range_extent[1], a.range_extent[2]));
   }
   const auto constants_v = fbb.CreateVectorOfStructs(constants);

@@ -95,9 +95,12 @@ struct AlignedFloats {
 /// cache creation so the hot path reads one flat record.
 struct Track {
   uint64_t bit_offset = 0;
-  uint32_t bits = 0;           // 1..19, or 32 (raw floats)
-  float qmax = 0.0f;           // 2^bits - 1
-  float lo[4] = {0, 0, 0, 0};  // 4 wide (the 4th unused) for one SSE load
+  uint32_t key_bits = 0;         // bits per key: the three widths summed (96: raw floats)
+  bool raw = false;              // raw floats
+  uint8_t shift[3] = {0, 0, 0};  // each component's bit position in a key
+  uint32_t mask[3] = {0, 0, 0};  // 2^width - 1
+  float qmax[4] = {1, 1, 1, 1};  // the same as floats, 4 wide for one SSE load
+  float lo[4] = {0, 0, 0, 0};    // 4 wide (the 4th unused) for one SSE load
   float extent[4] = {0, 0, 0, 0};
   bool rotation = false;
   uint32_t offset[4] = {0, 0, 0, 0};  // where components go in k0 / k1 (offset[3]: a rotation's rebuilt one)
@@ -198,8 +201,14 @@ void set_fixed(State& s, uint32_t joint, uint32_t kind, const float* value) {
 Track make_track(const fb::AnimatedChannel& ch, uint32_t stride) {
   Track t;
   t.bit_offset = ch.bit_offset();
-  t.bits = ch.bits();
-  t.qmax = t.bits == kRawFloatBits ? 0.0f : static_cast<float>(quant_max(t.bits));
+  const KeyWidths w = widths_of(ch);
+  t.key_bits = static_cast<uint32_t>(w.total());
+  t.raw = w.raw();
+  for (uint32_t c = 0; c < 3 && !t.raw; ++c) {
+    t.shift[c] = static_cast<uint8_t>(w.shift(c));
+    t.mask[c] = quant_max(w.c[c]);
+    t.qmax[c] = static_cast<float>(t.mask[c]);
+  }
   t.lo[0] = ch.range_min().x(), t.lo[1] = ch.range_min().y(), t.lo[2] = ch.range_min().z();
   t.extent[0] = ch.range_extent().x(), t.extent[1] = ch.range_extent().y(), t.extent[2] = ch.range_extent().z();
   const auto kind = static_cast<uint32_t>(ch.channel());
@@ -223,13 +232,12 @@ Track make_track(const fb::AnimatedChannel& ch, uint32_t stride) {
 #if defined(__SSE2__)
 /// Key `key` of a quantized track as (x, y, z, 0): its three stored components, dequantized.
 inline __m128 dequantized(const Track& t, const uint8_t* stream, uint32_t key) {
-  const uint64_t packed = read_bits(stream, t.bit_offset + key_bits(t.bits) * key, 3 * t.bits);
-  const auto mask = static_cast<uint32_t>(quant_max(t.bits));
+  const uint64_t packed = read_bits(stream, t.bit_offset + uint64_t{t.key_bits} * key, t.key_bits);
   // q < 2^19 fits a signed 32-bit lane, so the signed conversion is exact.
-  const auto q0 = static_cast<int>(static_cast<uint32_t>(packed) & mask);
-  const auto q1 = static_cast<int>(static_cast<uint32_t>(packed >> t.bits) & mask);
-  const auto q2 = static_cast<int>(static_cast<uint32_t>(packed >> (2 * t.bits)) & mask);
-  const __m128 f = _mm_div_ps(_mm_cvtepi32_ps(_mm_setr_epi32(q0, q1, q2, 0)), _mm_set1_ps(t.qmax));
+  const auto q0 = static_cast<int>(static_cast<uint32_t>(packed) & t.mask[0]);
+  const auto q1 = static_cast<int>(static_cast<uint32_t>(packed >> t.shift[1]) & t.mask[1]);
+  const auto q2 = static_cast<int>(static_cast<uint32_t>(packed >> t.shift[2]) & t.mask[2]);
+  const __m128 f = _mm_div_ps(_mm_cvtepi32_ps(_mm_setr_epi32(q0, q1, q2, 0)), _mm_loadu_ps(t.qmax));
   return _mm_add_ps(_mm_loadu_ps(t.lo), _mm_mul_ps(_mm_loadu_ps(t.extent), f));
 }
 
@@ -237,7 +245,7 @@ inline __m128 dequantized(const Track& t, const uint8_t* stream, uint32_t key) {
 /// bytes (validation keeps 8 padding bytes after the last key, so the read stays inside the stream)
 /// and the bytes after it are cleared, so no arithmetic on lane 3 can raise a floating-point flag.
 inline __m128 stored(const Track& t, const uint8_t* stream, uint32_t key) {
-  if (t.bits == kRawFloatBits)
+  if (t.raw)
     return _mm_and_ps(_mm_loadu_ps(reinterpret_cast<const float*>(stream + (t.bit_offset >> 3) + 12ull * key)),
                       _mm_castsi128_ps(_mm_setr_epi32(-1, -1, -1, 0)));
   return dequantized(t, stream, key);
@@ -256,7 +264,7 @@ inline void put(const Track& t, __m128 v, float* keys) {
 /// Decodes key `key` of a track into the k0 or k1 array.
 inline void decode(const Track& t, const uint8_t* stream, uint32_t key, float* keys) {
   float v[4];
-  if (t.bits == kRawFloatBits) std::memcpy(v, stream + (t.bit_offset >> 3) + 12ull * key, 12);
+  if (t.raw) std::memcpy(v, stream + (t.bit_offset >> 3) + 12ull * key, 12);
   else _mm_storeu_ps(v, dequantized(t, stream, key));
   keys[t.offset[0]] = v[0];
   keys[t.offset[1]] = v[1];
@@ -302,14 +310,13 @@ inline void decode_two(const Track& ta, const Track& tb, const uint8_t* stream, 
 #else
 inline void decode(const Track& t, const uint8_t* stream, uint32_t key, float* keys) {
   float v[3];
-  if (t.bits == kRawFloatBits) {
+  if (t.raw) {
     std::memcpy(v, stream + (t.bit_offset >> 3) + 12ull * key, 12);
   } else {
-    const uint64_t packed = read_bits(stream, t.bit_offset + key_bits(t.bits) * key, 3 * t.bits);
-    const auto mask = static_cast<uint32_t>(quant_max(t.bits));
+    const uint64_t packed = read_bits(stream, t.bit_offset + uint64_t{t.key_bits} * key, t.key_bits);
     for (uint32_t c = 0; c < 3; ++c) {
-      const uint32_t q = static_cast<uint32_t>(packed >> (c * t.bits)) & mask;
-      v[c] = t.lo[c] + t.extent[c] * (static_cast<float>(q) / t.qmax);
+      const uint32_t q = static_cast<uint32_t>(packed >> t.shift[c]) & t.mask[c];
+      v[c] = t.lo[c] + t.extent[c] * (static_cast<float>(q) / t.qmax[c]);
     }
   }
   keys[t.offset[0]] = v[0];

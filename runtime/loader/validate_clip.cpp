@@ -143,20 +143,26 @@ Status Validator::check_clip(const fb::Clip& c, size_t clip_index) {
       return fail(where,
                   cl() + format(": last key is at frame %u, must be the last frame %u", f[n - 1], frame_count - 1));
 
-    // Bits: inside key_values, minus the padding.
-    const uint32_t bits = ch.bits();
-    if (!((bits >= 1 && bits <= kMaxQuantBits) || bits == kRawFloatBits))
-      return fail(where, cl() + format(" has %u bits per component; must be 1..%u or 32", bits, kMaxQuantBits));
+    // Bits: a width per component, each 1..19, or raw floats (all three 32); inside key_values,
+    // minus the padding.
+    const KeyWidths widths = widths_of(ch);
+    const bool raw = widths.raw();
+    bool widths_ok = true;
+    for (const uint32_t w : widths.c)
+      widths_ok = widths_ok && (raw ? w == kRawFloatBits : w >= 1 && w <= kMaxQuantBits);
+    if (!widths_ok)
+      return fail(where, cl() + format(" has %u, %u, %u bits for its components; each must be 1..%u, or all three 32",
+                                       widths.c[0], widths.c[1], widths.c[2], kMaxQuantBits));
     // Rotations name the component they leave out (0..3). Other channels ignore the field (the
     // schema asks writers for 0 there, but nothing reads it, so a reader need not insist).
     const bool rotation = ch.channel() == fb::Channel::Rotation;
     if (rotation && ch.dropped() > 3)
       return fail(where, cl() + format(" has dropped component %u; must be 0..3 (x, y, z, w)", ch.dropped()));
     const uint64_t offset = ch.bit_offset();
-    if (bits == kRawFloatBits && offset % 8 != 0)
+    if (raw && offset % 8 != 0)
       return fail(where, cl() + format(": raw-float keys start at bit %llu, not on a byte boundary",
                                        static_cast<unsigned long long>(offset)));
-    const uint64_t end = offset + key_bits(bits) * n;
+    const uint64_t end = offset + widths.total() * n;
     if (end > value_bits)
       return fail(where, cl() + format(" needs key value bits [%llu, %llu), the clip has %llu (before padding)",
                                        static_cast<unsigned long long>(offset), static_cast<unsigned long long>(end),
@@ -167,7 +173,7 @@ Status Validator::check_clip(const fb::Clip& c, size_t clip_index) {
     const fb::Vec3& lo = ch.range_min();
     const fb::Vec3& ex = ch.range_extent();
     const float los[3] = {lo.x(), lo.y(), lo.z()}, exs[3] = {ex.x(), ex.y(), ex.z()};
-    if (bits != kRawFloatBits) {
+    if (!raw) {
       for (int i = 0; i < 3; ++i) {
         if (!bounded(los[i]) || !bounded(exs[i]) || !(exs[i] >= 0.0f) || !bounded(los[i] + exs[i]))
           return fail(where, cl() + format(": range min %s extent %s must be finite (within 1e7) with extents >= 0",
@@ -179,10 +185,10 @@ Status Validator::check_clip(const fb::Clip& c, size_t clip_index) {
     } else {
       // Raw floats carry their own values: scan them (O(keys), once, at load).
       if (!spend(static_cast<uint64_t>(n) * 12)) return over_budget(where);
-      const uint8_t* raw = values + offset / 8;
+      const uint8_t* raw_keys = values + offset / 8;
       for (uint32_t i = 0; i < n; ++i) {
         float v[3];
-        std::memcpy(v, raw + 12ull * i, sizeof v);
+        std::memcpy(v, raw_keys + 12ull * i, sizeof v);
         for (int j = 0; j < 3; ++j) {
           if (!bounded(v[j])) return fail(where, cl() + format(": raw key %u is not finite (or beyond 1e7)", i));
           if (rotation && std::fabs(v[j]) > kRotationComponentLimit)

@@ -249,16 +249,19 @@ void expect_well_formed(const CompressedClip& c) {
     EXPECT_EQ(c.key_frames[a.first_key + a.key_count - 1], c.grid.frame_count - 1);
     for (uint32_t k = 1; k < a.key_count; ++k)
       EXPECT_LT(c.key_frames[a.first_key + k - 1], c.key_frames[a.first_key + k]);
-    EXPECT_TRUE((a.bits >= 1 && a.bits <= kMaxQuantBits) || a.bits == kRawFloatBits) << int(a.bits);
+    for (const uint32_t w : a.bits.c) {
+      EXPECT_TRUE(a.bits.raw() ? w == kRawFloatBits : w >= 1 && w <= kMaxQuantBits)
+          << a.bits.c[0] << " " << a.bits.c[1] << " " << a.bits.c[2];
+    }
     if (a.channel == kR) {
       EXPECT_LE(a.dropped, 3u);
     } else {
       EXPECT_EQ(a.dropped, 0u) << "only rotations drop a component";
     }
-    if (a.bits == kRawFloatBits) {
+    if (a.bits.raw()) {
       EXPECT_EQ(a.bit_offset % 8, 0u);
     }
-    EXPECT_LE(a.bit_offset + key_bits(a.bits) * a.key_count, 8ull * (c.key_values.size() - kKeyValuePadding));
+    EXPECT_LE(a.bit_offset + a.bits.total() * a.key_count, 8ull * (c.key_values.size() - kKeyValuePadding));
   }
   ASSERT_GE(c.key_values.size(), kKeyValuePadding);
   for (size_t i = c.key_values.size() - kKeyValuePadding; i < c.key_values.size(); ++i) EXPECT_EQ(c.key_values[i], 0);
@@ -400,7 +403,7 @@ TEST_F(PabWalk, RoundTripsThroughTheWriterAndTheVerifier) {
     const fb::AnimatedChannel& a = *fc.animated()->Get(static_cast<flatbuffers::uoffset_t>(i));
     EXPECT_EQ(a.joint(), c.animated[i].joint);
     EXPECT_EQ(static_cast<uint8_t>(a.channel()), c.animated[i].channel);
-    EXPECT_EQ(a.bits(), c.animated[i].bits);
+    EXPECT_EQ(widths_of(a), c.animated[i].bits);
     EXPECT_EQ(a.dropped(), c.animated[i].dropped);
     EXPECT_EQ(a.first_key(), c.animated[i].first_key);
     EXPECT_EQ(a.key_count(), c.animated[i].key_count);
@@ -501,8 +504,10 @@ TEST(ClipCompressSharing, ChannelsShareKeyListsWithinTheBoundAndInFewerBytes) {
     lists.insert(a.first_key);
     if (a.key_count < c->grid.frame_count) ++reduced;
   }
-  // 56 channels, all with keys removed; each on its own list they took 31,763 bytes.
-  EXPECT_EQ(reduced, c->animated.size());
+  // 56 channels, all but one or two with keys removed (a channel whose quiet components take a few
+  // bits may keep every frame, which needs no list of its own); each on its own list they took
+  // 31,763 bytes.
+  EXPECT_GE(reduced + 2, c->animated.size());
   EXPECT_GE(c->animated.size(), 50u);
   EXPECT_LE(lists.size(), c->animated.size() / 2) << c->animated.size() << " channels";
   EXPECT_LT(c->cooked_bytes, 31763u);
@@ -590,7 +595,7 @@ TEST(ClipCompress, LosslessModeReproducesEveryFrame) {
   EXPECT_TRUE(c->constants.empty());
   ASSERT_EQ(c->animated.size(), 12u);
   for (const CompressedAnimated& a : c->animated) {
-    EXPECT_EQ(a.bits, kRawFloatBits);
+    EXPECT_TRUE(a.bits.raw());
     ASSERT_EQ(a.key_count, frames);
     const SourceTrack& tr = clip.tracks[a.joint];
     for (uint32_t k = 0; k < frames; ++k) {
@@ -651,13 +656,46 @@ TEST(ClipCompress, AHalfTurnCompressesWithoutTheRawFloatEscape) {
   const CompressedAnimated* r = find_animated(*c, 1, kR);
   ASSERT_NE(r, nullptr);
   EXPECT_EQ(r->dropped, 0u) << "x stays largest over the channel";
-  EXPECT_GE(r->bits, 1u);
-  EXPECT_LE(r->bits, kMaxQuantBits) << "no raw-float escape";
+  EXPECT_FALSE(r->bits.raw()) << "no raw-float escape";
   EXPECT_LT(r->key_count, frames) << "a steady turn needs few keys";
   EXPECT_LE(c->max_error, c->tolerance);
   const Measured m = measure(clip, *c, sk);
   EXPECT_LE(m.max, c->tolerance * (1.0 + 1e-3));
   EXPECT_NEAR(m.max, c->max_error, 1e-3 * c->tolerance);
+}
+
+TEST(ClipCompress, AHingeStoresItsQuietComponentsInFewerBits) {
+  // Joint 1 swings up to 80 degrees about x like a knee, its axis wobbling 1 degree towards y and
+  // never towards z, carrying 2 m of chain. Stored with w dropped, x spans ~0.6, y ~0.03 and z
+  // nothing: at the step x needs, y needs 4-5 bits fewer and z one bit (format v12: a width per
+  // component).
+  const SourceSkeleton sk = chain();
+  const uint32_t frames = 61;
+  auto knee = [](uint32_t f) {
+    const float t = static_cast<float>(f) / 60.0f;
+    const glm::vec3 axis = glm::normalize(glm::vec3(1.0f, 0.02f * std::sin(9.0f * t), 0.0f));
+    return glm::angleAxis(glm::radians(40.0f) * (1.0f - std::cos(5.0f * t)), axis);
+  };
+  std::vector<SourceTrack> tracks{keyed(
+      1, frames, [](uint32_t) { return glm::vec3(0.0f, 1.0f, 0.0f); }, knee, [](uint32_t) { return glm::vec3(1.0f); })};
+  const SourceClip clip = clip_of("Knee", frames, tracks);
+  auto c = compress_clip(clip, sk, 1.0f, {});
+  ASSERT_TRUE(c.ok()) << c.error().message;
+  expect_well_formed(*c);
+  const CompressedAnimated* r = find_animated(*c, 1, kR);
+  ASSERT_NE(r, nullptr);
+  ASSERT_EQ(r->dropped, 3u) << "w stays largest over the channel";
+  ASSERT_FALSE(r->bits.raw());
+  const KeyWidths& w = r->bits;
+  EXPECT_GE(w.c[0], 8u) << "the swing needs a fine step";
+  EXPECT_LE(w.c[1] + 4, w.c[0]) << "the wobble: a smaller range at the same step";
+  EXPECT_GT(w.c[1], 1u);
+  EXPECT_EQ(w.c[2], 1u) << "no motion about z";
+  // The bound holds with the narrower components, between frames too (float rounding on the 2 m
+  // chain, which the cooker plays between frames in float, is ~1e-7 m).
+  const Measured m = measure(clip, *c, sk);
+  EXPECT_LE(m.max, c->tolerance * (1.0 + 1e-3));
+  EXPECT_NEAR(m.max, c->max_error, 3e-3 * c->tolerance);
 }
 
 TEST(ClipCompress, RotationsThatNoComponentAvoidsKeepTheirPrecision) {
@@ -818,7 +856,7 @@ TEST(ClipCompress, TheBoundHoldsBetweenFramesWhereTheSourceTurnsFast) {
   const CompressedAnimated* r = find_animated(*c, 1, kR);
   ASSERT_NE(r, nullptr);
   EXPECT_EQ(r->key_count, frames) << "no frame can go";
-  EXPECT_LE(r->bits, kMaxQuantBits) << "no raw-float escape";
+  EXPECT_FALSE(r->bits.raw()) << "no raw-float escape";
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -3,6 +3,7 @@
 // file and breaks exactly one, and must be rejected with a message naming the file and what is wrong.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -152,6 +153,16 @@ TEST(Clip, BitsInvalid) {
     SyntheticSpec spec;
     spec.clips[0].animated[1].bits = bits;
     EXPECT_TRUE(rejects(spec, with(kClip, {"bits"}))) << int(bits);
+  }
+  // Per component (format v12): one bad width among good ones, and raw floats mixed with
+  // quantized components (a raw key is three floats or nothing).
+  for (const std::array<uint8_t, 3> widths :
+       {std::array<uint8_t, 3>{12, 0, 12}, std::array<uint8_t, 3>{12, 12, 20}, std::array<uint8_t, 3>{32, 12, 12},
+        std::array<uint8_t, 3>{12, 32, 32}, std::array<uint8_t, 3>{32, 32, 19}}) {
+    SyntheticSpec spec;
+    spec.clips[0].animated[1].widths = widths;
+    EXPECT_TRUE(rejects(spec, with(kClip, {"bits for its components"})))
+        << int(widths[0]) << " " << int(widths[1]) << " " << int(widths[2]);
   }
 }
 

@@ -202,7 +202,7 @@ TEST(RuntimeView, ClipAndMaterialViewsReturnWhatWasWritten) {
     const test::SyntheticAnimated& w = want.animated[i];
     EXPECT_EQ(a.joint(), w.joint);
     EXPECT_EQ(a.channel(), w.channel);
-    EXPECT_EQ(a.bits(), w.bits);
+    EXPECT_EQ(widths_of(a), KeyWidths::uniform(w.bits));
     EXPECT_EQ(a.first_key(), frames);
     ASSERT_EQ(a.key_count(), w.frames.size());
     for (size_t k = 0; k < w.frames.size(); ++k) EXPECT_EQ(c.key_frames()[a.first_key() + k], w.frames[k]);
@@ -211,9 +211,11 @@ TEST(RuntimeView, ClipAndMaterialViewsReturnWhatWasWritten) {
     const float ex[3] = {a.range_extent().x(), a.range_extent().y(), a.range_extent().z()};
     for (uint32_t k = 0; k < a.key_count(); ++k) {
       float v[3];
-      decode_key(c.key_values().data(), a.bit_offset(), a.bits(), lo, ex, k, v);
-      const float step = a.bits() == kRawFloatBits ? 0.0f : 0.5f / static_cast<float>(quant_max(a.bits()));
-      for (int j = 0; j < 3; ++j) EXPECT_NEAR(v[j], w.values[k][j], step * ex[j] + 1e-7f) << i << " " << k << " " << j;
+      decode_key(c.key_values().data(), a.bit_offset(), widths_of(a), lo, ex, k, v);
+      for (int j = 0; j < 3; ++j) {
+        const float step = w.bits == kRawFloatBits ? 0.0f : 0.5f / static_cast<float>(quant_max(w.bits));
+        EXPECT_NEAR(v[j], w.values[k][j], step * ex[j] + 1e-7f) << i << " " << k << " " << j;
+      }
     }
     keys += w.frames.size();
     frames += w.frames.size();

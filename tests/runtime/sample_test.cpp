@@ -54,7 +54,7 @@ std::array<double, 4> decoded_key(const ClipView& clip, const fb::AnimatedChanne
   const float lo[3] = {a.range_min().x(), a.range_min().y(), a.range_min().z()};
   const float ex[3] = {a.range_extent().x(), a.range_extent().y(), a.range_extent().z()};
   float v[3];
-  decode_key(clip.key_values().data(), a.bit_offset(), a.bits(), lo, ex, k, v);
+  decode_key(clip.key_values().data(), a.bit_offset(), widths_of(a), lo, ex, k, v);
   if (a.channel() != fb::Channel::Rotation) return {v[0], v[1], v[2], 0.0};
   // The dropped component, rebuilt by the format's own float expression (the cooker tunes the
   // stored values to it, so a double-precision rebuild would disagree near half turns).
@@ -256,7 +256,7 @@ TEST(Sample, KeyFramesGiveTheFormatsDecodedTranslationsAndScalesBitForBit) {
         const uint16_t frame = clip.key_frames()[a.first_key() + k];
         sample(clip, static_cast<float>(frame) / clip.sample_rate(), SampleOptions{.loop = false}, cache, pose);
         float v[3];
-        decode_key(clip.key_values().data(), a.bit_offset(), a.bits(), lo, ex, k, v);
+        decode_key(clip.key_values().data(), a.bit_offset(), widths_of(a), lo, ex, k, v);
         for (uint32_t c = 0; c < 3; ++c) {
           const float got = pose.span()[static_cast<PoseComponent>(first_component(a.channel()) + c)][a.joint()];
           ASSERT_EQ(std::memcmp(&got, &v[c], sizeof got), 0)

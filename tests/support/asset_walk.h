@@ -321,12 +321,15 @@ class AssetWalker {
         return fail(at, "keys do not run from frame 0 to the last frame");
       for (uint64_t i = first + 1; i < first + n; ++i)
         if (!(frames[i] > frames[i - 1])) return fail(at, "key frames not strictly increasing");
-      const uint32_t b = ch.bits();
-      if (!((b >= 1 && b <= 19) || b == 32)) return fail(at, "bits not in 1..19 or 32");
+      const uint32_t w[3] = {ch.bits()->Get(0), ch.bits()->Get(1), ch.bits()->Get(2)};
+      const bool raw = w[0] == 32;
+      for (const uint32_t x : w)
+        if (raw ? x != 32 : !(x >= 1 && x <= 19)) return fail(at, "bits not each in 1..19, or all 32");
+      const uint32_t b = raw ? 32 : 0;  // 32 marks raw floats below
       if (ch.channel() == fb::Channel::Rotation && ch.dropped() > 3)
         return fail(at, "rotation drops no component 0..3");
       if (values.size() < 8) return fail(at, "key values shorter than their padding");
-      const uint64_t end = ch.bit_offset() + 3ull * b * n;
+      const uint64_t end = ch.bit_offset() + (uint64_t{w[0]} + w[1] + w[2]) * n;
       if (end > 8ull * (values.size() - 8)) return fail(at, "keys past key_values (before padding)");
       if (b == 32) {
         if (ch.bit_offset() % 8 != 0) return fail(at, "raw keys not byte-aligned");

@@ -67,7 +67,7 @@ CompressedClip read_clip(const fb::Clip& c) {
     CompressedAnimated a;
     a.joint = k->joint();
     a.channel = static_cast<uint8_t>(k->channel());
-    a.bits = k->bits();
+    a.bits = widths_of(*k);
     a.dropped = k->dropped();
     a.first_key = k->first_key();
     a.key_count = k->key_count();

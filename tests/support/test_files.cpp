@@ -248,15 +248,18 @@ flatbuffers::Offset<fb::Clip> write_clip(flatbuffers::FlatBufferBuilder& fbb, co
     const float rext[3] = {range_extent.x(), range_extent.y(), range_extent.z()};
     const auto first_key = static_cast<uint32_t>(key_frames.size());
     key_frames.insert(key_frames.end(), a.frames.begin(), a.frames.end());
-    if (a.bits == kRawFloatBits) writer.align_byte();
+    const std::array<uint8_t, 3> widths = a.widths.value_or(std::array<uint8_t, 3>{a.bits, a.bits, a.bits});
+    if (widths[0] == kRawFloatBits) writer.align_byte();
     const auto bit_offset = static_cast<uint32_t>(writer.bit_size());
     for (const auto& v : a.values) {
       for (int i = 0; i < 3; ++i) {
-        if (a.bits == kRawFloatBits) writer.write_float(v[i]);
-        else if (a.bits >= 1 && a.bits <= kMaxQuantBits) writer.write(quantize(v[i], rmin[i], rext[i], a.bits), a.bits);
+        if (widths[i] == kRawFloatBits) writer.write_float(v[i]);
+        else if (widths[i] >= 1 && widths[i] <= kMaxQuantBits)
+          writer.write(quantize(v[i], rmin[i], rext[i], widths[i]), widths[i]);
       }
     }
-    animated.emplace_back(a.joint, a.channel, a.bits, a.dropped.value_or(a.channel == fb::Channel::Rotation ? 3 : 0),
+    animated.emplace_back(a.joint, a.channel, flatbuffers::span<const uint8_t, 3>(widths),
+                          a.dropped.value_or(a.channel == fb::Channel::Rotation ? 3 : 0),
                           a.first_key.value_or(first_key), a.key_count.value_or(static_cast<uint32_t>(a.frames.size())),
                           a.bit_offset.value_or(bit_offset), range_min, range_extent);
   }
@@ -603,6 +606,13 @@ std::vector<std::pair<std::string, SyntheticSpec>> valid_variants() {
   spec.clips[0].animated[0].bits = 19;
   spec.clips[0].animated[0].values = {{0, 0, 1}, {0, 0, 0.92387953f}, {0, 0, 1}};
   out.emplace_back("drop-y", spec);
+
+  spec = {};
+  // A width per component (format v12): wide, narrow and 1-bit components in one key, and keys
+  // that straddle byte boundaries at every offset.
+  spec.clips[0].animated[0].widths = std::array<uint8_t, 3>{19, 2, 11};
+  spec.clips[0].animated[1].widths = std::array<uint8_t, 3>{1, 17, 6};
+  out.emplace_back("mixed-widths", spec);
 
   spec = {};
   spec.meshes.push_back(spec.meshes[0]);

@@ -129,7 +129,8 @@ struct SyntheticConstant {
 struct SyntheticAnimated {
   uint16_t joint = 0;
   fb::Channel channel = fb::Channel::Translation;
-  uint8_t bits = 16;  // 1..19, or 32 (raw floats)
+  uint8_t bits = 16;                             // 1..19, or 32 (raw floats): every component's width
+  std::optional<std::array<uint8_t, 3>> widths;  // per stored component instead of `bits`
   /// Rotations: the component not stored (0..3 = x, y, z, w). Default: 3 (w) for rotations, 0
   /// for other channels (which store 0).
   std::optional<uint8_t> dropped;
@@ -277,9 +278,9 @@ std::vector<uint8_t> make_valid_file(const SyntheticSpec& spec = {});
 /// Valid files of different shapes, by name: default, uint32-indices, float32-layout (16-bit joint
 /// slots), static-mesh (no skeleton), clip-only, empty-channels (plus a clip without channels),
 /// single-frame (a 1-frame clip of constants), root-motion, low-bits (1- and 3-bit keys), drop-y
-/// (a rotation storing x, z, w in 19 bits), two-meshes, graph (an animation graph with a montage, and clip events),
-/// morph (a mesh with two morph targets and a clip driving them). For suites that must not over-fit the default, and
-/// for seeding fuzz corpora.
+/// (a rotation storing x, z, w in 19 bits), mixed-widths (a width per key component), two-meshes, graph (an animation
+/// graph with a montage, and clip events), morph (a mesh with two morph targets and a clip driving them). For suites
+/// that must not over-fit the default, and for seeding fuzz corpora.
 std::vector<std::pair<std::string, SyntheticSpec>> valid_variants();
 
 /// A 16-byte aligned copy of some bytes: what verify_buffer expects, and what a std::vector

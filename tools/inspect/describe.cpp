@@ -160,14 +160,18 @@ json describe_channels(const ClipView& clip, const SkeletonView& skeleton) {
     size_t kind;
     bool animated;
     uint32_t keys;
-    uint32_t bits;
+    uint32_t bits[3];  // per stored component
   };
   std::vector<Row> rows;
   // Validation proved every channel enum is 0..2.
   for (const fb::ConstantChannel& c : clip.constants())
-    rows.push_back({c.joint(), static_cast<size_t>(c.channel()), false, 1, 32});
+    rows.push_back({c.joint(), static_cast<size_t>(c.channel()), false, 1, {32, 32, 32}});
   for (const fb::AnimatedChannel& a : clip.animated())
-    rows.push_back({a.joint(), static_cast<size_t>(a.channel()), true, a.key_count(), a.bits()});
+    rows.push_back({a.joint(),
+                    static_cast<size_t>(a.channel()),
+                    true,
+                    a.key_count(),
+                    {a.bits()->Get(0), a.bits()->Get(1), a.bits()->Get(2)}});
   std::sort(rows.begin(), rows.end(),
             [](const Row& x, const Row& y) { return x.joint != y.joint ? x.joint < y.joint : x.kind < y.kind; });
   // Joint names only when this file's skeleton is the clip's rig (as for worst_joint_name).
@@ -181,7 +185,7 @@ json describe_channels(const ClipView& clip, const SkeletonView& skeleton) {
              {"channel", kKinds[r.kind]},
              {"storage", r.animated ? "animated" : "constant"},
              {"key_count", r.keys},
-             {"bits", r.bits}});
+             {"bits", json::array({r.bits[0], r.bits[1], r.bits[2]})}});
   return out;
 }
 
@@ -580,7 +584,9 @@ std::string describe_text(const json& d) {
         const bool animated = ch["storage"] == "animated";
         line("    joint " + text(ch["joint"]) + (ch["joint_name"].is_string() ? quoted_name(ch["joint_name"]) : "") +
              " " + text(ch["channel"]) + ": " +
-             (animated ? text(ch["key_count"]) + " keys at " + text(ch["bits"]) + " bits" : std::string("constant")));
+             (animated ? text(ch["key_count"]) + " keys at " + text(ch["bits"][0]) + "+" + text(ch["bits"][1]) + "+" +
+                             text(ch["bits"][2]) + " bits"
+                       : std::string("constant")));
       }
     }
   }

@@ -1,12 +1,15 @@
 // clip_codec.h — the key encoding of compressed clips (format/ossa.fbs, AnimatedChannel), one
 // definition for the cooker that packs keys and the runtime that unpacks them.
 //
-// Keys are three components of `bits` bits each (1..19), packed LSB-first into a byte stream,
-// each component range-reduced to its channel's [min, min + extent]. Rotations drop one component
+// Keys are three components of 1..19 bits each (a width per component: KeyWidths), packed
+// LSB-first into a byte stream, each component range-reduced to its channel's [min, min + extent].
+// A width per component rather than one per channel: a rotation that turns mostly about one axis
+// (a knee, an elbow) spans a wide range in one stored component and almost none in the others,
+// which then need a few bits for the same step instead of all of them. Rotations drop one component
 // per channel (stored with that component >= 0): like ACL's drop-w format, range reduction then
 // buys 3-5 bits per component over smallest-three's fixed range and no per-key selector bits are
 // needed; unlike always dropping w, choosing the component that stays largest over the channel
-// keeps the rebuilt component precise near half turns. bits == 32 stores raw floats: the escape
+// keeps the rebuilt component precise near half turns. Widths of 32 store raw floats: the escape
 // for channels no quantization can hold within tolerance (and for lossless cooks).
 //
 // Decoding reads 64 bits at a time: the stream must be followed by at least 8 readable bytes
@@ -27,8 +30,24 @@ inline constexpr uint32_t kMaxQuantBits = 19;
 /// Largest quantized value for a bit count in 1..kMaxQuantBits.
 constexpr uint32_t quant_max(uint32_t bits) { return (1u << bits) - 1u; }
 
-/// Bits one key of a channel takes.
-constexpr uint64_t key_bits(uint32_t bits) { return 3ull * bits; }
+/// The widths of a key's three stored components (AnimatedChannel.bits): each 1..kMaxQuantBits,
+/// or all three kRawFloatBits.
+struct KeyWidths {
+  uint32_t c[3] = {0, 0, 0};
+  bool raw() const { return c[0] == kRawFloatBits; }
+  /// Bits one key takes.
+  uint64_t total() const { return uint64_t{c[0]} + c[1] + c[2]; }
+  /// Bit position of component i within a key.
+  uint32_t shift(uint32_t i) const { return i == 0 ? 0 : (i == 1 ? c[0] : c[0] + c[1]); }
+  static KeyWidths uniform(uint32_t bits) { return KeyWidths{{bits, bits, bits}}; }
+  bool operator==(const KeyWidths&) const = default;
+};
+
+/// The widths of a channel record (fb::AnimatedChannel or anything with its bits() array).
+template <class Channel>
+KeyWidths widths_of(const Channel& ch) {
+  return KeyWidths{{ch.bits()->Get(0), ch.bits()->Get(1), ch.bits()->Get(2)}};
+}
 
 /// Quantizes v in [lo, lo + extent] to bits (1..kMaxQuantBits), rounding to nearest, clamped.
 inline uint32_t quantize(float v, float lo, float extent, uint32_t bits) {
@@ -50,16 +69,17 @@ inline uint64_t read_bits(const uint8_t* stream, uint64_t bit, uint32_t count) {
 
 /// Decodes key `key` of a channel: three floats (rotation: x, y, z with w >= 0 implied).
 /// O(1), no branches but the raw-float escape.
-inline void decode_key(const uint8_t* stream, uint64_t bit_offset, uint32_t bits, const float range_min[3],
+inline void decode_key(const uint8_t* stream, uint64_t bit_offset, const KeyWidths& bits, const float range_min[3],
                        const float range_extent[3], uint32_t key, float out[3]) {
-  if (bits == kRawFloatBits) {
+  if (bits.raw()) {
     std::memcpy(out, stream + ((bit_offset + 96ull * key) >> 3), 12);
     return;
   }
-  const uint64_t packed = read_bits(stream, bit_offset + key_bits(bits) * key, 3 * bits);
-  const uint32_t mask = quant_max(bits);
-  for (uint32_t c = 0; c < 3; ++c)
-    out[c] = dequantize(static_cast<uint32_t>(packed >> (c * bits)) & mask, range_min[c], range_extent[c], bits);
+  const uint64_t packed = read_bits(stream, bit_offset + bits.total() * key, static_cast<uint32_t>(bits.total()));
+  for (uint32_t c = 0; c < 3; ++c) {
+    const auto q = static_cast<uint32_t>(packed >> bits.shift(c)) & quant_max(bits.c[c]);
+    out[c] = dequantize(q, range_min[c], range_extent[c], bits.c[c]);
+  }
 }
 
 /// The dropped component of a unit quaternion from the three stored ones (it was >= 0). The
