@@ -12,7 +12,7 @@
 //      and then one test and one cursor serve them all), one compare of the frame position
 //      against the range its cached key pair covers; only a run that left its range moves its
 //      cursor (forward by one: keep k1 as the new k0 and decode one key per channel; otherwise a
-//      dense run's pair is the frame itself, and a sparse one walks at most 15 keys from its seek
+//      dense run's pair is the frame itself, and a sparse one walks at most 7 keys from its seek
 //      index, so a seek costs the same in a long clip) and decodes (ossa/format/clip_codec.h);
 //   2. one loop over all joints (SoA, 8-lane blocks): lerp T and S, nlerp R with the shortest-arc
 //      sign fix, write the pose (anim/sample_interpolate.cpp: vector code, on x86-64 compiled
@@ -34,7 +34,7 @@
 // (check_clip_binding), so no check is repeated per sample.
 //
 // Cost: make_sampling_cache O(joints + animated channels + keys of sparse runs), a few allocations
-// (a seek index of 2 bytes per 16 frames per sparse run, shared with a prototype); sample O(joints
+// (a seek index of 2 bytes per 8 frames per sparse run, shared with a prototype); sample O(joints
 // + runs) + O(keys passed, at most 15 per run on a seek), no allocation; reset O(runs).
 // advance_time is advance_time.cpp.
 #include <ossa/anim/sample.h>
@@ -107,8 +107,9 @@ struct Track {
   uint32_t weight_index = 0;          // kind * stride + joint, into start / inv_length
 };
 
-/// Frames per entry of a sparse run's seek index (Run::seek): 16, so a seek walks at most 15 keys.
-constexpr uint32_t kSeekShift = 4;
+/// Frames per entry of a sparse run's seek index (Run::seek): 8, so a seek walks at most 7 keys (with
+/// 16, a walk of up to 15 cost Pab's atlas and crossarms 5-10 % and 4 % more per seek, Zen 5).
+constexpr uint32_t kSeekShift = 3;
 
 /// Animated channels sharing one key-frame list, and the cursor they share: the pair (cursor,
 /// cursor + 1) is valid while enter <= frame < leave (leave is +inf for the last pair, which also
@@ -353,7 +354,7 @@ inline float inverse_gap(uint32_t f0, uint32_t f1) {
 /// frames[k + 1], or the last pair at the last frame (or the first before a first key past 0). A
 /// dense run's pair is the frame's whole part. A sparse run takes the next pair when playback moved
 /// forward into it (the common case: one compare, the index untouched); otherwise it walks forward
-/// from its seek index's entry for the frame's 16-frame block: at most 15 keys whatever the clip's
+/// from its seek index's entry for the frame's 8-frame block: at most 7 keys whatever the clip's
 /// length, where a binary search over a long clip's keys would cost a dozen mispredicted branches.
 inline uint32_t find_pair(const Run& r, float frame) {
   const uint32_t n = r.key_count;
@@ -372,9 +373,9 @@ inline uint32_t find_pair(const Run& r, float frame) {
   return k > n - 2 ? n - 2 : k;
 }
 
-/// Appends a sparse run's seek index to `index`: for each 16-frame block b of the clip's
+/// Appends a sparse run's seek index to `index`: for each 8-frame block b of the clip's
 /// `frame_count` frames, the pair around frame b << kSeekShift (as find_pair defines it). O(keys +
-/// blocks); 2 bytes per 16 frames.
+/// blocks); 2 bytes per 8 frames.
 void make_seek_index(const uint16_t* frames, uint32_t key_count, uint32_t frame_count, std::vector<uint16_t>& index) {
   uint32_t k = 0;
   for (uint32_t b = 0; b <= (frame_count - 1) >> kSeekShift; ++b) {

@@ -328,9 +328,9 @@ SyntheticSpec hemisphere_spec(uint8_t bits) {
 }
 
 TEST(Sample, SeeksFindTheKeyPairInALongClipWithSparseAndDenseRuns) {
-  // 200 frames, so a sparse run's seek index has 13 blocks of 16 frames: keys on block starts and
+  // 200 frames, so a sparse run's seek index has 25 blocks of 8 frames: keys on block starts and
   // just past them, a 42-frame gap over empty blocks, a run that ends its keys early, a dense run
-  // (a key on every frame), one that misses a single frame (a seek walks 15 keys) and a raw-float
+  // (a key on every frame), one that misses a single frame (a seek walks 7 keys) and a raw-float
   // one. Every frame, every half frame, each block's edges,
   // and random times, sampled in an order that jumps back and forth through one cache, must give
   // the pose of the key pair found by a plain walk over the keys (reference_pose).
@@ -353,13 +353,13 @@ TEST(Sample, SeeksFindTheKeyPairInALongClipWithSparseAndDenseRuns) {
   };
   std::vector<uint16_t> every(200);
   for (uint16_t k = 0; k < 200; ++k) every[k] = k;
-  std::vector<uint16_t> almost_every = every;  // sparse, yet 15 keys past some block starts
+  std::vector<uint16_t> almost_every = every;  // sparse, yet 7 keys past some block starts
   almost_every.erase(almost_every.begin() + 100);
   c.animated = {channel(0, fb::Channel::Translation, 10, {0, 2, 4, 6, 8, 10, 12, 14, 16, 18, 20, 22, 24, 199}),
                 channel(1, fb::Channel::Rotation, 14, every),
                 channel(2, fb::Channel::Rotation, 12, {0, 5, 31, 100, 120, 121, 122, 199}),
                 channel(2, fb::Channel::Scale, 16, almost_every),
-                channel(3, fb::Channel::Translation, 16, {0, 1, 15, 16, 17, 32, 33, 47, 48, 90, 91, 150, 199}),
+                channel(3, fb::Channel::Translation, 16, {0, 1, 7, 8, 9, 15, 16, 17, 32, 33, 47, 48, 90, 91, 150, 199}),
                 channel(3, fb::Channel::Scale, 32, {0, 64, 65, 199})};
   const Loaded f = load(spec);
   const ClipView clip = f.clip();
@@ -367,7 +367,7 @@ TEST(Sample, SeeksFindTheKeyPairInALongClipWithSparseAndDenseRuns) {
   Pose pose(static_cast<uint32_t>(f.skeleton().joint_count()));
   std::vector<double> frames;
   for (int k = 0; k < 200; ++k) frames.insert(frames.end(), {double(k), k + 0.5, k + 0.99});
-  for (int b = 16; b < 200; b += 16) frames.insert(frames.end(), {b - 0.01, double(b), b + 0.01});
+  for (int b = 8; b < 200; b += 8) frames.insert(frames.end(), {b - 0.01, double(b), b + 0.01});
   std::mt19937 rng(17);
   std::uniform_real_distribution<double> u(0.0, 199.0);
   for (int i = 0; i < 400; ++i) frames.push_back(u(rng));
