@@ -326,12 +326,12 @@ ChannelPlan animate_lossless(uint32_t channel, const glm::vec4* ref, uint32_t n)
 
 KeyWidths key_widths(uint32_t bits, const float extent[3]) {
   if (bits == kRawFloatBits) return KeyWidths::uniform(kRawFloatBits);
-  const double widest = std::max({double{extent[0]}, double{extent[1]}, double{extent[2]}});
-  const double step = widest / quant_max(bits);
+  const auto range = [&](int c) { return static_cast<double>(extent[c]); };
+  const double step = std::max({range(0), range(1), range(2)}) / quant_max(bits);
   KeyWidths w;
   for (int c = 0; c < 3; ++c) {
     uint32_t b = 1;
-    while (b<bits&& double{extent[c]} / quant_max(b)> step) ++b;
+    while (b < bits && range(c) / quant_max(b) > step) ++b;
     w.c[c] = b;
   }
   return w;

@@ -35,7 +35,7 @@
 //
 // Cost: make_sampling_cache O(joints + animated channels + keys of sparse runs), a few allocations
 // (a seek index of 2 bytes per 8 frames per sparse run, shared with a prototype); sample O(joints
-// + runs) + O(keys passed, at most 15 per run on a seek), no allocation; reset O(runs).
+// + runs) + O(keys passed, at most 7 per run on a seek), no allocation; reset O(runs).
 // advance_time is advance_time.cpp.
 #include <ossa/anim/sample.h>
 
