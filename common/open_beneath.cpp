@@ -350,6 +350,27 @@ OpenedFile open_beneath(const ReadRoots* roots, const fs::path& path, bool for_r
   return f;
 }
 
+bool sole_name_now(int fd) {
+  // First wait out a rename in progress in the name's folder: looking up a name nobody has used
+  // takes the folder's lock (shared), which a rename holds (exclusive) until it has unlinked the
+  // name it replaced. The lookup's answer (none) is not used.
+  char proc[32];
+  std::snprintf(proc, sizeof proc, "/proc/self/fd/%d", fd);
+  char target[4096];
+  const ssize_t n = ::readlink(proc, target, sizeof target - 64);
+  if (n > 0) {
+    std::string folder(target, static_cast<size_t>(n));
+    folder.resize(folder.rfind('/') == std::string::npos ? 0 : folder.rfind('/'));
+    static std::atomic<uint64_t> probes{0};
+    const std::string probe = folder + "/.ossa-lock-probe-" + std::to_string(::getpid()) + "-" +
+                              std::to_string(probes.fetch_add(1, std::memory_order_relaxed));
+    struct stat ignored {};
+    (void)::stat(probe.c_str(), &ignored);
+  }
+  struct stat st {};
+  return ::fstat(fd, &st) == 0 && st.st_nlink <= 1 && !name_unlinked(fd);
+}
+
 const char* file_kind(const struct stat& st) {
   if (S_ISDIR(st.st_mode)) return "a directory";
   if (S_ISFIFO(st.st_mode)) return "a FIFO";

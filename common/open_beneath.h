@@ -77,6 +77,13 @@ struct OpenedFile {
 OpenedFile open_beneath(const ReadRoots* roots, const std::filesystem::path& path, bool for_reading,
                         bool allow_hard_links);
 
+/// The hard-link rule again, on a file open_beneath opened and the caller has read: true when it
+/// still has one link and the name it was opened by is still linked. A rename over a hard link
+/// drops the link count before it unlinks the name, so open_beneath's one look can fall between
+/// the two and see one link and a live name; once the rename is done the name reads as unlinked
+/// for good. Reading first and looking again after makes that window the whole read. O(1).
+bool sole_name_now(int fd);
+
 /// "a directory", "a FIFO", "a device", "a socket", "not a regular file": what `st` is, for messages.
 const char* file_kind(const struct stat& st);
 

@@ -130,6 +130,7 @@ std::string hard_link_message(const struct stat& st) {
 struct OpenedInput {
   int fd = -1;
   uint64_t size = 0;
+  bool sole_name = false;  // the hard-link rule applies: look again after reading (sole_name_now)
 };
 
 /// The sandbox's one door: resolved and opened in one step beneath the allowed folders
@@ -157,7 +158,7 @@ Result<OpenedInput> open_input(const fs::path& path, uint64_t max_bytes, std::st
     return Error{detail::printable(path.string(), 400) + ": is " + std::to_string(f.st.st_size) +
                  " bytes, over the limit of " + std::to_string(max_bytes)};
   }
-  return OpenedInput{f.fd, static_cast<uint64_t>(f.st.st_size)};
+  return OpenedInput{f.fd, static_cast<uint64_t>(f.st.st_size), sandbox && !sandbox->allow_hard_links};
 }
 
 }  // namespace
@@ -176,8 +177,9 @@ Result<std::vector<uint8_t>> read_input(const fs::path& path, uint64_t max_bytes
   }
   uint8_t extra = 0;
   const ssize_t more = done == bytes.size() ? ::read(fd, &extra, 1) : 0;
+  const bool linked_elsewhere = opened->sole_name && !sole_name_now(fd);
   ::close(fd);
-  if (done != bytes.size() || more != 0)
+  if (done != bytes.size() || more != 0 || linked_elsewhere)
     return Error{detail::printable(path.string(), 400) + ": changed while being read"};
   if (InputLog* log = current_input_log()) log->add(path, bytes);
   return bytes;
@@ -206,8 +208,10 @@ Status hash_input(const fs::path& path, std::string_view reference) {
   }
   const uint64_t hash = XXH3_64bits_digest(state);
   XXH3_freeState(state);
+  const bool linked_elsewhere = opened->sole_name && !sole_name_now(opened->fd);
   ::close(opened->fd);
-  if (done != opened->size) return Error{detail::printable(path.string(), 400) + ": changed while being read"};
+  if (done != opened->size || linked_elsewhere)
+    return Error{detail::printable(path.string(), 400) + ": changed while being read"};
   if (InputLog* log = current_input_log()) log->add_hashed(path, hash, done);
   return {};
 }
