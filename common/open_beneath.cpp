@@ -266,15 +266,20 @@ OpenedFile via_system(const fs::path& path, bool for_reading) {
 /// linked after that look had no other name at the look; without this, a link made into the tree,
 /// opened, then removed again would show one link: the outside name's. Unknown (no /proc) counts
 /// as not unlinked: the link count is then the only check.
-bool name_unlinked(int fd) {
+/// The path the kernel shows for `fd` (/proc/self/fd), or "" when it cannot tell.
+std::string fd_path(int fd) {
   char proc[32];
   std::snprintf(proc, sizeof proc, "/proc/self/fd/%d", fd);
   char target[4096];
   const ssize_t n = ::readlink(proc, target, sizeof target);
+  if (n <= 0 || static_cast<size_t>(n) >= sizeof target) return {};
+  return std::string(target, static_cast<size_t>(n));
+}
+
+bool name_unlinked(int fd) {
   constexpr std::string_view kDeleted = " (deleted)";
-  if (n <= 0 || static_cast<size_t>(n) >= sizeof target) return false;
-  const std::string_view link(target, static_cast<size_t>(n));
-  return link.size() >= kDeleted.size() && link.substr(link.size() - kDeleted.size()) == kDeleted;
+  const std::string link = fd_path(fd);
+  return link.size() >= kDeleted.size() && std::string_view(link).substr(link.size() - kDeleted.size()) == kDeleted;
 }
 
 }  // namespace
@@ -354,15 +359,11 @@ bool sole_name_now(int fd) {
   // First wait out a rename in progress in the name's folder: looking up a name nobody has used
   // takes the folder's lock (shared), which a rename holds (exclusive) until it has unlinked the
   // name it replaced. The lookup's answer (none) is not used.
-  char proc[32];
-  std::snprintf(proc, sizeof proc, "/proc/self/fd/%d", fd);
-  char target[4096];
-  const ssize_t n = ::readlink(proc, target, sizeof target - 64);
-  if (n > 0) {
-    std::string folder(target, static_cast<size_t>(n));
-    folder.resize(folder.rfind('/') == std::string::npos ? 0 : folder.rfind('/'));
+  const std::string path = fd_path(fd);
+  const size_t slash = path.rfind('/');
+  if (slash != std::string::npos) {
     static std::atomic<uint64_t> probes{0};
-    const std::string probe = folder + "/.ossa-lock-probe-" + std::to_string(::getpid()) + "-" +
+    const std::string probe = path.substr(0, slash) + "/.ossa-lock-probe-" + std::to_string(::getpid()) + "-" +
                               std::to_string(probes.fetch_add(1, std::memory_order_relaxed));
     struct stat ignored {};
     (void)::stat(probe.c_str(), &ignored);
