@@ -76,7 +76,7 @@ void print_breakdown(const CompressedClip& c) {
   const uint32_t frames = c.grid.frame_count;
   size_t every_channels = 0, reduced_channels = 0;
   uint64_t every_keys = 0, reduced_keys = 0, every_bits = 0, reduced_bits = 0;
-  std::set<uint32_t> every_runs, reduced_runs;  // first_key of the key-frame runs each group reads
+  std::set<uint32_t> reduced_runs;  // first_key of the key-frame runs the reduced channels read
   uint64_t reduced_run_frames = 0;
   std::map<uint32_t, uint32_t> bits_used[3];  // per channel kind: bits per key -> channels
   for (const CompressedAnimated& a : c.animated) {
@@ -84,7 +84,6 @@ void print_breakdown(const CompressedClip& c) {
       ++every_channels;
       every_keys += a.key_count;
       every_bits += value_bits(a);
-      every_runs.insert(a.first_key);
     } else {
       ++reduced_channels;
       reduced_keys += a.key_count;
@@ -94,11 +93,11 @@ void print_breakdown(const CompressedClip& c) {
     if (a.channel < 3) ++bits_used[a.channel][static_cast<uint32_t>(a.bits.total())];
   }
   std::printf(
-      "# %s: keyed at every frame: %zu channels, %llu keys, %.0f B of values, %zu run(s) of %u frames;"
+      "# %s: keyed at every frame: %zu channels, %llu keys, %.0f B of values (no key frames stored, %u frames);"
       " keys removed: %zu channels, %llu of %llu frames kept, %.0f B of values, %llu B of key frames"
       " (%zu runs)\n",
-      name, every_channels, static_cast<unsigned long long>(every_keys), static_cast<double>(every_bits) / 8.0,
-      every_runs.size(), frames, reduced_channels, static_cast<unsigned long long>(reduced_keys),
+      name, every_channels, static_cast<unsigned long long>(every_keys), static_cast<double>(every_bits) / 8.0, frames,
+      reduced_channels, static_cast<unsigned long long>(reduced_keys),
       static_cast<unsigned long long>(reduced_channels) * frames, static_cast<double>(reduced_bits) / 8.0,
       static_cast<unsigned long long>(reduced_run_frames * sizeof(uint16_t)), reduced_runs.size());
   static const char* const kKinds[3] = {"translation", "rotation", "scale"};

@@ -6,6 +6,7 @@
 #include <cstdio>
 
 #include <imgui.h>
+#include <ossa/format/clip_codec.h>
 
 #include "viewer/montage_panel.h"
 
@@ -40,8 +41,13 @@ std::vector<KeyMark> clip_key_marks(const ClipView& clip) {
   const uint32_t frames = std::max<uint32_t>(clip.frame_count(), 1);
   const float rate = clip.sample_rate() > 0.0f ? clip.sample_rate() : 30.0f;
   std::vector<uint32_t> per_frame(frames, 0);
-  for (const uint16_t f : clip.key_frames())
-    if (f < frames) ++per_frame[f];
+  const std::span<const uint16_t> key_frames = clip.key_frames();
+  for (const fb::AnimatedChannel& a : clip.animated()) {
+    for (uint32_t k = 0; k < a.key_count(); ++k) {
+      const uint32_t f = key_frame(key_frames.data(), a.first_key(), a.key_count(), clip.frame_count(), k);
+      if (f < frames) ++per_frame[f];
+    }
+  }
   for (uint32_t f = 0; f < frames; ++f) {
     if (per_frame[f] == 0) continue;
     out.push_back({std::min(static_cast<float>(f) / rate, clip.duration()), per_frame[f]});

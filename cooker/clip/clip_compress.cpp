@@ -91,9 +91,9 @@
 //
 // Layout: constants and animated channels sorted by (joint, channel); each animated channel's keys
 // are contiguous in key_values and its key frames contiguous in key_frames, in frame order, so
-// forward playback reads both in memory order. Channels whose key frames are identical point at one
-// shared run of key_frames (first_key), which the format allows and which saves two bytes per key
-// for every channel keyed at every frame (mocap, lossless cooks) and for every list step 7 shares.
+// forward playback reads both in memory order. A channel keyed at every frame (mocap, lossless
+// cooks) stores no key frames; channels whose other lists are identical point at one shared run of
+// key_frames (first_key), which saves two bytes per key for every list step 7 shares.
 //
 // Files: step 2 is in clip_compress_levers.cpp, steps 4-5 for one channel in
 // clip_compress_channel.cpp, step 7's grouping in clip_compress_share.cpp, what they share in
@@ -281,10 +281,8 @@ Status pack(const ClipLayout& layout, uint32_t joints, uint32_t frames, Compress
   out.animated.clear();
   out.key_frames.clear();
   KeyWriter writer;
-  // Identical key frame lists share one run. Every-frame lists, the common case, are matched by
-  // size alone; the rest through an ordered map (deterministic).
+  // Identical key frame lists share one run, found through an ordered map (deterministic).
   std::map<std::vector<uint16_t>, uint32_t> shared_frames;
-  int64_t every_frame_run = -1;
   for (uint32_t j = 0; j < joints; ++j) {
     for (uint32_t ch = 0; ch < kChannelsPerJoint; ++ch) {
       const ChannelPlan& p = layout.plans[j * 3 + ch];
@@ -294,7 +292,15 @@ Status pack(const ClipLayout& layout, uint32_t joints, uint32_t frames, Compress
         c.joint = static_cast<uint16_t>(j);
         c.channel = static_cast<uint8_t>(ch);
         for (int i = 0; i < 4; ++i) c.value[i] = p.constant[i];
-        if (ch != kRotation) c.value[3] = 0.0f;
+        if (ch != kRotation) {
+          c.value[3] = 0.0f;
+        } else {  // stored as three components: the value is what a reader rebuilds
+          for (uint32_t i = 1; i < 4; ++i)
+            if (std::fabs(c.value[i]) > std::fabs(c.value[c.dropped])) c.dropped = static_cast<uint8_t>(i);
+          float stored[3];
+          rotation_to_stored(c.value, c.dropped, stored);
+          rotation_from_stored(stored, c.dropped, c.value);
+        }
         out.constants.push_back(c);
         continue;
       }
@@ -304,13 +310,10 @@ Status pack(const ClipLayout& layout, uint32_t joints, uint32_t frames, Compress
       a.bits = p.widths;
       a.dropped = static_cast<uint8_t>(ch == kRotation ? p.dropped : 0);  // 0 for other channels
       a.key_count = static_cast<uint32_t>(p.frames.size());
-      if (p.frames.size() == frames && every_frame_run >= 0) {
-        a.first_key = static_cast<uint32_t>(every_frame_run);
-      } else {
+      if (!keyed_every_frame(a.key_count, frames)) {  // an every-frame channel stores no frames
         const auto [it, inserted] = shared_frames.emplace(p.frames, static_cast<uint32_t>(out.key_frames.size()));
         if (inserted) out.key_frames.insert(out.key_frames.end(), p.frames.begin(), p.frames.end());
         a.first_key = it->second;
-        if (p.frames.size() == frames) every_frame_run = it->second;
       }
       if (p.widths.raw()) writer.align_byte();
       if (writer.bit_size() > std::numeric_limits<uint32_t>::max()) {

@@ -24,8 +24,9 @@ namespace ossa::cook {
 
 struct CompressedConstant {
   uint16_t joint = 0;
-  uint8_t channel = 0;  // fb::Channel
-  float value[4] = {0, 0, 0, 0};
+  uint8_t channel = 0;            // fb::Channel
+  uint8_t dropped = 0;            // rotations: the component not stored (fb::ConstantChannel)
+  float value[4] = {0, 0, 0, 0};  // as a reader decodes it (a rotation rebuilt from the three stored)
 };
 
 struct CompressedAnimated {
@@ -46,8 +47,8 @@ struct CompressedClip {
   FrameGrid grid;
   std::vector<CompressedConstant> constants;  // sorted by (joint, channel)
   std::vector<CompressedAnimated> animated;   // sorted by (joint, channel)
-  std::vector<uint16_t> key_frames;
-  std::vector<uint8_t> key_values;  // padded (ossa/format/clip_codec.h)
+  std::vector<uint16_t> key_frames;           // none for channels keyed at every frame
+  std::vector<uint8_t> key_values;            // padded (ossa/format/clip_codec.h)
   // What was measured, in source units.
   float tolerance = 0.0f, probe_distance = 0.0f, max_error = 0.0f, mean_error = 0.0f;
   uint16_t worst_joint = 0;

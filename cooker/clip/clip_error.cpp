@@ -52,14 +52,16 @@ void decode_clip(const CompressedClip& clip, const SourceSkeleton& skeleton, Cli
   for (const CompressedAnimated& a : clip.animated) {
     if (a.joint >= joints || a.channel >= kChannelsPerJoint || a.key_count < 2) continue;
     glm::vec4* dst = out.channel(a.joint, a.channel);
-    const uint16_t* key_frames = clip.key_frames.data() + a.first_key;
+    const auto frame_of = [&](uint32_t k) {
+      return key_frame(clip.key_frames.data(), a.first_key, a.key_count, frames, k);
+    };
     float xyz[3];
     decode_key(clip.key_values.data(), a.bit_offset, a.bits, a.range_min, a.range_extent, 0, xyz);
     glm::vec4 prev = key_sample(a.channel, a.dropped, xyz);
     for (uint32_t k = 1; k < a.key_count; ++k) {
       decode_key(clip.key_values.data(), a.bit_offset, a.bits, a.range_min, a.range_extent, k, xyz);
       const glm::vec4 next = key_sample(a.channel, a.dropped, xyz);
-      const uint32_t f0 = key_frames[k - 1], f1 = key_frames[k];
+      const uint32_t f0 = frame_of(k - 1), f1 = frame_of(k);
       const float inv_length = 1.0f / static_cast<float>(f1 - f0);
       for (uint32_t p = f0 * n; p <= f1 * n && p < positions; ++p) {
         const float x = static_cast<float>(p / n) + static_cast<float>(p % n) * step;

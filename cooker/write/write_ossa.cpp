@@ -141,8 +141,11 @@ Offset<fb::Clip> write_clip(FlatBufferBuilder& fbb, const CompressedClip& clip, 
   std::vector<fb::ConstantChannel> constants;
   constants.reserve(clip.constants.size());
   for (const CompressedConstant& c : clip.constants) {
-    constants.emplace_back(c.joint, static_cast<fb::Channel>(c.channel),
-                           fb::Quat(c.value[0], c.value[1], c.value[2], c.value[3]));
+    float stored[3] = {c.value[0], c.value[1], c.value[2]};
+    const bool rotation = c.channel == static_cast<uint8_t>(fb::Channel::Rotation);
+    if (rotation) rotation_to_stored(c.value, c.dropped & 3u, stored);
+    constants.emplace_back(c.joint, static_cast<fb::Channel>(c.channel), rotation ? c.dropped : uint8_t{0},
+                           fb::Vec3(stored[0], stored[1], stored[2]));
   }
   std::vector<fb::AnimatedChannel> animated;
   animated.reserve(clip.animated.size());

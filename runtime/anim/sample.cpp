@@ -115,7 +115,7 @@ constexpr uint32_t kSeekShift = 3;
 /// cursor + 1) is valid while enter <= frame < leave (leave is +inf for the last pair, which also
 /// covers the last frame).
 struct Run {
-  const uint16_t* frames = nullptr;
+  const uint16_t* frames = nullptr;  // null for a dense run (the file stores no frames for it)
   // Sparse runs: seek[b] is the pair around frame b << kSeekShift (make_seek_index). Null for a
   // dense run, a key on every frame (key_count == frame_count), whose pair is the frame itself.
   const uint16_t* seek = nullptr;
@@ -394,8 +394,10 @@ void move_run(State& s, Run& r, float frame) {
   const uint8_t* stream = s.stream;
   float* k0 = s.k0;
   float* k1 = s.k1;
-  const auto f0 = static_cast<float>(r.frames[k]);
-  const float inv = inverse_gap(r.frames[k], r.frames[k + 1]);
+  // A dense run stores no frames: its key k is at frame k.
+  const uint32_t frame0 = r.frames ? r.frames[k] : k, frame1 = r.frames ? r.frames[k + 1] : k + 1;
+  const auto f0 = static_cast<float>(frame0);
+  const float inv = inverse_gap(frame0, frame1);
   if (r.cursor != kNoCursor && k == r.cursor + 1) {
     const auto shift = [&](const Track& x) {  // k1 becomes k0
       k0[x.offset[0]] = k1[x.offset[0]];
@@ -423,7 +425,7 @@ void move_run(State& s, Run& r, float frame) {
   }
   r.cursor = k;
   r.enter = f0;
-  r.leave = k + 2 == r.key_count ? kInf : static_cast<float>(r.frames[k + 1]);
+  r.leave = k + 2 == r.key_count ? kInf : static_cast<float>(frame1);
 }
 
 }  // namespace
@@ -465,7 +467,7 @@ Result<SamplingCache> make_sampling_cache(const ClipView& clip, const SkeletonVi
         run_of.emplace(std::make_pair(a.first_key(), a.key_count()), static_cast<uint32_t>(runs.size()));
     if (added) {
       Run r;
-      r.frames = clip.key_frames().data() + a.first_key();
+      if (!keyed_every_frame(a.key_count(), clip.frame_count())) r.frames = clip.key_frames().data() + a.first_key();
       r.key_count = a.key_count();
       runs.push_back(r);
     }
@@ -498,7 +500,8 @@ Result<SamplingCache> make_sampling_cache(const ClipView& clip, const SkeletonVi
     set_fixed(*s, j, 2, sc);
   }
   for (const fb::ConstantChannel& c : clip.constants()) {
-    float v[4] = {c.value().x(), c.value().y(), c.value().z(), c.value().w()};
+    float v[4];
+    constant_value(c, v);
     const auto kind = static_cast<uint32_t>(c.channel());
     if (kind == 1) normalize4(v);  // validation proved rotation constants normalizable
     set_fixed(*s, c.joint(), kind, v);

@@ -21,8 +21,8 @@ namespace ossa::validate_detail {
 // ---- clips ----
 //
 // Everything the sampler (runtime/anim/sample.cpp) and root_motion.cpp dereference is proven here,
-// before any of them runs: channel joints < joint_count, each animated channel's key range
-// inside key_frames and its bit range inside key_values minus the 8 padding bytes the decoder's
+// before any of them runs: channel joints < joint_count, each animated channel keyed at every
+// frame or its key range inside key_frames, and its bit range inside key_values minus the 8 padding bytes the decoder's
 // 64-bit reads may touch, frames strictly increasing from 0 to frame_count - 1 (so a cursor or a
 // binary search always finds a bracketing pair), ranges finite (so decoded values are), raw-float
 // keys finite, rotations bounded (so normalizing never divides by zero or infinity).
@@ -80,8 +80,16 @@ Status Validator::check_clip(const fb::Clip& c, size_t clip_index) {
                                          k - 1));
     }
     if (ch.channel() == fb::Channel::Rotation) {
-      if (!normalizable(ch.value())) return fail(where, cl() + ": value is not a finite, non-zero quaternion");
-    } else if (!bounded(ch.value().x()) || !bounded(ch.value().y()) || !bounded(ch.value().z())) {
+      // Three stored components in [-1, 1] rebuild a quaternion the sampler can normalize (all
+      // zero rebuilds w = 1; otherwise the norm is that of a non-zero vector of unit-bounded values).
+      if (ch.dropped() > 3)
+        return fail(where, cl() + format(" has dropped component %u; must be 0..3 (x, y, z, w)", ch.dropped()));
+      const fb::Vec3& v = ch.value();
+      for (const float x : {v.x(), v.y(), v.z()})
+        if (!(std::fabs(x) <= kRotationComponentLimit))
+          return fail(where, cl() + format(": rotation value %s is not three finite quaternion components in [-1, 1]",
+                                           vec3_text(v).c_str()));
+    } else if (!bounded3(ch.value())) {
       return fail(where, cl() + ": value is not finite (or beyond 1e7)");
     }
   }
@@ -123,25 +131,35 @@ Status Validator::check_clip(const fb::Clip& c, size_t clip_index) {
       ++next_constant;
     }
 
-    // Keys: range inside key_frames, frames strictly increasing from 0 to the last frame.
+    // Keys: a key on every frame (no key frames stored, first_key 0), or a range inside
+    // key_frames, frames strictly increasing from 0 to the last frame.
     const uint32_t n = ch.key_count();
     if (n < 2) return fail(where, cl() + format(" has %u keys; an animated channel has at least 2", n));
+    if (n > frame_count)
+      return fail(where, cl() + format(" has %u keys, more than the clip's %u frames", n, frame_count));
     const uint64_t first = ch.first_key();
-    if (first + n > frame_total)
-      return fail(where, cl() + format(" uses keys [%llu, %llu), past the %zu key frames",
-                                       static_cast<unsigned long long>(first),
-                                       static_cast<unsigned long long>(first + n), frame_total));
-    if (!spend(static_cast<uint64_t>(n) * sizeof(uint16_t))) return over_budget(where);
-    const uint16_t* f = frames + first;
-    if (f[0] != 0) return fail(where, cl() + format(": first key is at frame %u, must be 0", f[0]));
-    for (uint32_t i = 1; i < n; ++i)
-      if (!(f[i] > f[i - 1]))
-        return fail(where, cl() + format(": key %u at frame %u is not after key %u at frame %u (frames must strictly "
-                                         "increase)",
-                                         i, f[i], i - 1, f[i - 1]));
-    if (f[n - 1] != frame_count - 1)
-      return fail(where,
-                  cl() + format(": last key is at frame %u, must be the last frame %u", f[n - 1], frame_count - 1));
+    if (keyed_every_frame(n, frame_count)) {
+      if (first != 0)
+        return fail(where, cl() + format(" has a key on every frame and first_key %llu; it stores no key frames, so "
+                                         "first_key must be 0",
+                                         static_cast<unsigned long long>(first)));
+    } else {
+      if (first + n > frame_total)
+        return fail(where, cl() + format(" uses keys [%llu, %llu), past the %zu key frames",
+                                         static_cast<unsigned long long>(first),
+                                         static_cast<unsigned long long>(first + n), frame_total));
+      if (!spend(static_cast<uint64_t>(n) * sizeof(uint16_t))) return over_budget(where);
+      const uint16_t* f = frames + first;
+      if (f[0] != 0) return fail(where, cl() + format(": first key is at frame %u, must be 0", f[0]));
+      for (uint32_t i = 1; i < n; ++i)
+        if (!(f[i] > f[i - 1]))
+          return fail(where, cl() + format(": key %u at frame %u is not after key %u at frame %u (frames must "
+                                           "strictly increase)",
+                                           i, f[i], i - 1, f[i - 1]));
+      if (f[n - 1] != frame_count - 1)
+        return fail(where,
+                    cl() + format(": last key is at frame %u, must be the last frame %u", f[n - 1], frame_count - 1));
+    }
 
     // Bits: a width per component, each 1..19, or raw floats (all three 32); inside key_values,
     // minus the padding.

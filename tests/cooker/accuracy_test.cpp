@@ -592,7 +592,7 @@ TEST_P(Accuracy, NoTinyValueIsCooked) {
   for (size_t c = 0; c < asset_->clip_count(); ++c) {
     const ossa::ClipView clip = asset_->clip(c);
     for (const ossa::fb::ConstantChannel& k : clip.constants())
-      for (float v : {k.value().x(), k.value().y(), k.value().z(), k.value().w()}) check(v, "constant of clip", c, 0);
+      for (float v : {k.value().x(), k.value().y(), k.value().z()}) check(v, "constant of clip", c, 0);
   }
   EXPECT_GT(checked, 0u);
 }

@@ -168,8 +168,11 @@ std::vector<std::vector<Trs>> cooked_poses(const CompressedClip& c, const Source
     uint32_t k = 0;
     for (uint32_t p = 0; p < positions; ++p) {
       const double x = static_cast<double>(p) / kSteps;
-      while (k + 2 < a.key_count && c.key_frames[a.first_key + k + 1] <= x) ++k;
-      const double f0 = c.key_frames[a.first_key + k], f1 = c.key_frames[a.first_key + k + 1];
+      const auto frame = [&](uint32_t i) {
+        return key_frame(c.key_frames.data(), a.first_key, a.key_count, c.grid.frame_count, i);
+      };
+      while (k + 2 < a.key_count && frame(k + 1) <= x) ++k;
+      const double f0 = frame(k), f1 = frame(k + 1);
       // Shortest arc: keys are stored with their dropped component >= 0, so neighbours may sit
       // on opposite hemispheres (blend takes care of it).
       const Trs v = blend(key(k), key(k + 1), (x - f0) / (f1 - f0));
@@ -244,11 +247,16 @@ void expect_well_formed(const CompressedClip& c) {
     const int times = ++seen[std::make_pair(int{a.joint}, int{a.channel})];
     EXPECT_EQ(times, 1) << "joint " << a.joint << " channel " << int{a.channel} << " twice";
     ASSERT_GE(a.key_count, 2u);
-    ASSERT_LE(a.first_key + a.key_count, c.key_frames.size());
-    EXPECT_EQ(c.key_frames[a.first_key], 0u);
-    EXPECT_EQ(c.key_frames[a.first_key + a.key_count - 1], c.grid.frame_count - 1);
-    for (uint32_t k = 1; k < a.key_count; ++k)
-      EXPECT_LT(c.key_frames[a.first_key + k - 1], c.key_frames[a.first_key + k]);
+    ASSERT_LE(a.key_count, c.grid.frame_count);
+    if (keyed_every_frame(a.key_count, c.grid.frame_count)) {
+      EXPECT_EQ(a.first_key, 0u) << "a channel keyed at every frame stores no key frames";
+    } else {
+      ASSERT_LE(a.first_key + a.key_count, c.key_frames.size());
+      EXPECT_EQ(c.key_frames[a.first_key], 0u);
+      EXPECT_EQ(c.key_frames[a.first_key + a.key_count - 1], c.grid.frame_count - 1);
+      for (uint32_t k = 1; k < a.key_count; ++k)
+        EXPECT_LT(c.key_frames[a.first_key + k - 1], c.key_frames[a.first_key + k]);
+    }
     for (const uint32_t w : a.bits.c) {
       EXPECT_TRUE(a.bits.raw() ? w == kRawFloatBits : w >= 1 && w <= kMaxQuantBits)
           << a.bits.c[0] << " " << a.bits.c[1] << " " << a.bits.c[2];
@@ -501,8 +509,10 @@ TEST(ClipCompressSharing, ChannelsShareKeyListsWithinTheBoundAndInFewerBytes) {
   std::set<uint32_t> lists;
   uint32_t reduced = 0;
   for (const CompressedAnimated& a : c->animated) {
-    lists.insert(a.first_key);
-    if (a.key_count < c->grid.frame_count) ++reduced;
+    if (a.key_count < c->grid.frame_count) {
+      ++reduced;
+      lists.insert(a.first_key);
+    }
   }
   // 56 channels, all but one or two with keys removed (a channel whose quiet components take a few
   // bits may keep every frame, which needs no list of its own); each on its own list they took
@@ -599,7 +609,7 @@ TEST(ClipCompress, LosslessModeReproducesEveryFrame) {
     ASSERT_EQ(a.key_count, frames);
     const SourceTrack& tr = clip.tracks[a.joint];
     for (uint32_t k = 0; k < frames; ++k) {
-      EXPECT_EQ(c->key_frames[a.first_key + k], k);
+      EXPECT_EQ(key_frame(c->key_frames.data(), a.first_key, a.key_count, frames, k), k);
       float v[3];
       decode_key(c->key_values.data(), a.bit_offset, a.bits, a.range_min, a.range_extent, k, v);
       if (a.channel == kT) {

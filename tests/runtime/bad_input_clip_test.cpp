@@ -122,7 +122,7 @@ TEST(Clip, KeysPastKeyFrames) {
   EXPECT_TRUE(rejects(wraps, with(kClip, {"key frames"})));
   SyntheticSpec huge;
   huge.clips[0].animated[1].key_count = 0xFFFFFFF0u;
-  EXPECT_TRUE(rejects(huge, with(kClip, {"key frames"})));
+  EXPECT_TRUE(rejects(huge, with(kClip, {"keys, more than the clip's 31 frames"})));
 }
 
 TEST(Clip, KeyFramesNotIncreasing) {
@@ -256,12 +256,36 @@ TEST(Clip, ConstantNotFinite) {
   EXPECT_TRUE(accepts(make_valid_file(unused_w)));
 }
 
-TEST(Clip, RotationConstantZero) {
-  for (const fb::Quat& q : {fb::Quat(0, 0, 0, 0), fb::Quat(1e-30f, 0, 0, 0), fb::Quat(3e38f, 3e38f, 0, 0)}) {
+TEST(Clip, RotationConstantOutOfRange) {
+  // A rotation constant stores three components of a unit quaternion: each must lie in [-1, 1]
+  // (then the rebuilt quaternion is normalizable; huge ones would overflow its norm).
+  for (const fb::Vec3& v : {fb::Vec3(2, 0, 0), fb::Vec3(0, -1.5f, 0), fb::Vec3(3e38f, 3e38f, 0)}) {
     SyntheticSpec spec;
-    spec.clips[0].constants[1].value = q;
-    EXPECT_TRUE(rejects(spec, with(kClip, {"quaternion"}))) << q.x();
+    spec.clips[0].constants[1].stored = v;
+    EXPECT_TRUE(rejects(spec, with(kClip, {"quaternion"}))) << v.x() << " " << v.y();
   }
+  SyntheticSpec dropped;
+  dropped.clips[0].constants[1].dropped = 4;
+  EXPECT_TRUE(rejects(dropped, with(kClip, {"dropped component 4"})));
+  // All three zero is the identity's w rebuilt: valid, and sampled as the identity.
+  SyntheticSpec zero;
+  zero.clips[0].constants[1].stored = fb::Vec3(0, 0, 0);
+  EXPECT_TRUE(accepts(make_valid_file(zero)));
+}
+
+TEST(Clip, EveryFrameChannelWithKeyFrames) {
+  // A channel with a key on every frame stores no key frames: its first_key must be 0.
+  SyntheticSpec spec;
+  test::SyntheticAnimated& a = spec.clips[0].animated[0];
+  a.frames.clear();
+  a.values.clear();
+  for (uint16_t f = 0; f < spec.clips[0].frame_count; ++f) {
+    a.frames.push_back(f);
+    a.values.push_back({0.01f * f, 0.0f, 1.0f});
+  }
+  EXPECT_TRUE(accepts(make_valid_file(spec)));
+  a.first_key = 1;
+  EXPECT_TRUE(rejects(spec, with(kClip, {"first_key must be 0"})));
 }
 
 SyntheticRootMotion valid_root_motion(uint32_t frames) {

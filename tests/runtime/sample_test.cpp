@@ -82,14 +82,17 @@ std::vector<RefJoint> reference_pose(const ClipView& clip, const SkeletonView& s
   }
   for (const fb::ConstantChannel& c : clip.constants()) {
     const uint32_t base = first_component(c.channel());
-    const double q[4] = {c.value().x(), c.value().y(), c.value().z(), c.value().w()};
+    float q[4];
+    constant_value(c, q);
     for (uint32_t i = 0; i < (c.channel() == fb::Channel::Rotation ? 4u : 3u); ++i) out[c.joint()].v[base + i] = q[i];
   }
   for (const fb::AnimatedChannel& a : clip.animated()) {
-    const uint16_t* frames = clip.key_frames().data() + a.first_key();
+    const auto frames = [&](uint32_t k) {
+      return key_frame(clip.key_frames().data(), a.first_key(), a.key_count(), clip.frame_count(), k);
+    };
     uint32_t k = 0;
-    while (k + 2 < a.key_count() && frames[k + 1] <= frame) ++k;
-    const double f0 = frames[k], f1 = frames[k + 1];
+    while (k + 2 < a.key_count() && frames(k + 1) <= frame) ++k;
+    const double f0 = frames(k), f1 = frames(k + 1);
     const double w = std::clamp((frame - f0) / (f1 - f0), 0.0, 1.0);
     const auto ka = decoded_key(clip, a, k), kb0 = decoded_key(clip, a, k + 1);
     auto kb = kb0;
@@ -211,7 +214,7 @@ TEST(Sample, FrameTimesReproduceDecodedKeys) {
   Pose pose(static_cast<uint32_t>(f.skeleton().joint_count()));
   for (const fb::AnimatedChannel& a : clip.animated()) {
     for (uint32_t k = 0; k < a.key_count(); ++k) {
-      const uint16_t frame = clip.key_frames()[a.first_key() + k];
+      const uint32_t frame = key_frame(clip.key_frames().data(), a.first_key(), a.key_count(), clip.frame_count(), k);
       sample(clip, static_cast<float>(frame) / clip.sample_rate(), SampleOptions{.loop = false}, cache, pose);
       const auto key = decoded_key(clip, a, k);
       const uint32_t base = first_component(a.channel());
@@ -253,7 +256,7 @@ TEST(Sample, KeyFramesGiveTheFormatsDecodedTranslationsAndScalesBitForBit) {
       const float lo[3] = {a.range_min().x(), a.range_min().y(), a.range_min().z()};
       const float ex[3] = {a.range_extent().x(), a.range_extent().y(), a.range_extent().z()};
       for (uint32_t k = 0; k < a.key_count(); ++k) {
-        const uint16_t frame = clip.key_frames()[a.first_key() + k];
+        const uint32_t frame = key_frame(clip.key_frames().data(), a.first_key(), a.key_count(), clip.frame_count(), k);
         sample(clip, static_cast<float>(frame) / clip.sample_rate(), SampleOptions{.loop = false}, cache, pose);
         float v[3];
         decode_key(clip.key_values().data(), a.bit_offset(), widths_of(a), lo, ex, k, v);

@@ -26,6 +26,7 @@
 
 #include <flatbuffers/flatbuffers.h>
 
+#include <ossa/format/clip_codec.h>
 #include <ossa/format/hash.h>
 #include <ossa/format/vertex_format.h>
 #include <ossa/version.h>
@@ -293,12 +294,12 @@ class AssetWalker {
       if (!finite(fb::Vec3(ch.value().x(), ch.value().y(), ch.value().z())))
         return fail(where, "constant value not finite");
       if (ch.channel() == fb::Channel::Rotation) {
-        if (!std::isfinite(ch.value().w())) return fail(where, "rotation constant not finite");
-        // validate.h promises "normalizable": a squared norm, in float as the sampler computes it,
-        // that neither underflows below FLT_MIN nor overflows (a double sum > 1e-30 was stricter
-        // than that promise, and the fuzzer found constants between the two).
-        const float x = ch.value().x(), y = ch.value().y(), z = ch.value().z(), w = ch.value().w();
-        const float n2 = x * x + y * y + z * z + w * w;
+        if (ch.dropped() > 3) return fail(where, "rotation constant drops no component 0..3");
+        // validate.h promises "normalizable": the rebuilt quaternion's squared norm, in float as
+        // the sampler computes it, neither underflows below FLT_MIN nor overflows.
+        float q[4];
+        constant_value(ch, q);
+        const float n2 = q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3];
         if (!(n2 >= std::numeric_limits<float>::min() && n2 <= std::numeric_limits<float>::max()))
           return fail(where, "zero rotation constant");
       }
@@ -316,11 +317,16 @@ class AssetWalker {
       const uint64_t first = ch.first_key(), n = ch.key_count();
       keys += n;
       if (n < 2) return fail(at, "fewer than 2 keys");
-      if (first + n > frames.size()) return fail(at, "keys past key_frames");
-      if (frames[first] != 0 || frames[first + n - 1] != frame_count - 1)
-        return fail(at, "keys do not run from frame 0 to the last frame");
-      for (uint64_t i = first + 1; i < first + n; ++i)
-        if (!(frames[i] > frames[i - 1])) return fail(at, "key frames not strictly increasing");
+      if (n > frame_count) return fail(at, "more keys than frames");
+      if (n == frame_count) {  // keyed at every frame: no key frames stored
+        if (first != 0) return fail(at, "keyed at every frame with first_key != 0");
+      } else {
+        if (first + n > frames.size()) return fail(at, "keys past key_frames");
+        if (frames[first] != 0 || frames[first + n - 1] != frame_count - 1)
+          return fail(at, "keys do not run from frame 0 to the last frame");
+        for (uint64_t i = first + 1; i < first + n; ++i)
+          if (!(frames[i] > frames[i - 1])) return fail(at, "key frames not strictly increasing");
+      }
       const uint32_t w[3] = {ch.bits()->Get(0), ch.bits()->Get(1), ch.bits()->Get(2)};
       const bool raw = w[0] == 32;
       for (const uint32_t x : w)

@@ -9,6 +9,7 @@
 #include "cooker/write/write_ossa.h"
 #include "test_files.h"
 #include <ossa/anim/pose_ops.h>
+#include <ossa/format/clip_codec.h>
 
 namespace ossa::test {
 namespace fs = std::filesystem;
@@ -57,10 +58,8 @@ CompressedClip read_clip(const fb::Clip& c) {
     CompressedConstant cc;
     cc.joint = k->joint();
     cc.channel = static_cast<uint8_t>(k->channel());
-    cc.value[0] = k->value().x();
-    cc.value[1] = k->value().y();
-    cc.value[2] = k->value().z();
-    cc.value[3] = k->value().w();
+    cc.dropped = k->dropped();
+    constant_value(*k, cc.value);  // the writer stores it again as these three components
     out.constants.push_back(cc);
   }
   for (const fb::AnimatedChannel* k : *c.animated()) {

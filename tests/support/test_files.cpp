@@ -246,8 +246,11 @@ flatbuffers::Offset<fb::Clip> write_clip(flatbuffers::FlatBufferBuilder& fbb, co
     const fb::Vec3 range_extent = a.range_extent.value_or(fb::Vec3(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]));
     const float rmin[3] = {range_min.x(), range_min.y(), range_min.z()};
     const float rext[3] = {range_extent.x(), range_extent.y(), range_extent.z()};
-    const auto first_key = static_cast<uint32_t>(key_frames.size());
-    key_frames.insert(key_frames.end(), a.frames.begin(), a.frames.end());
+    // A channel keyed at every frame stores no key frames (first_key 0).
+    const uint32_t key_count = a.key_count.value_or(static_cast<uint32_t>(a.frames.size()));
+    const bool every_frame = keyed_every_frame(static_cast<uint32_t>(a.frames.size()), c.frame_count);
+    const auto first_key = every_frame ? 0u : static_cast<uint32_t>(key_frames.size());
+    if (!every_frame) key_frames.insert(key_frames.end(), a.frames.begin(), a.frames.end());
     const std::array<uint8_t, 3> widths = a.widths.value_or(std::array<uint8_t, 3>{a.bits, a.bits, a.bits});
     if (widths[0] == kRawFloatBits) writer.align_byte();
     const auto bit_offset = static_cast<uint32_t>(writer.bit_size());
@@ -260,8 +263,8 @@ flatbuffers::Offset<fb::Clip> write_clip(flatbuffers::FlatBufferBuilder& fbb, co
     }
     animated.emplace_back(a.joint, a.channel, flatbuffers::span<const uint8_t, 3>(widths),
                           a.dropped.value_or(a.channel == fb::Channel::Rotation ? 3 : 0),
-                          a.first_key.value_or(first_key), a.key_count.value_or(static_cast<uint32_t>(a.frames.size())),
-                          a.bit_offset.value_or(bit_offset), range_min, range_extent);
+                          a.first_key.value_or(first_key), key_count, a.bit_offset.value_or(bit_offset), range_min,
+                          range_extent);
   }
   std::vector<uint8_t> key_values = writer.finish();
   key_values.resize(key_values.size() - kKeyValuePadding + c.key_value_padding, 0);
@@ -269,7 +272,18 @@ flatbuffers::Offset<fb::Clip> write_clip(flatbuffers::FlatBufferBuilder& fbb, co
   if (c.key_values) key_values = *c.key_values;
 
   std::vector<fb::ConstantChannel> constants;
-  for (const SyntheticConstant& k : c.constants) constants.emplace_back(k.joint, k.channel, k.value);
+  for (const SyntheticConstant& k : c.constants) {
+    const float v[4] = {k.value.x(), k.value.y(), k.value.z(), k.value.w()};
+    float stored[3] = {v[0], v[1], v[2]};
+    uint8_t dropped = 0;
+    if (k.channel == fb::Channel::Rotation) {  // the largest component left out, as the cooker does
+      for (uint8_t i = 1; i < 4; ++i)
+        if (std::fabs(v[i]) > std::fabs(v[dropped])) dropped = i;
+      rotation_to_stored(v, dropped, stored);
+    }
+    const uint8_t d = k.dropped.value_or(dropped);
+    constants.emplace_back(k.joint, k.channel, d, k.stored.value_or(fb::Vec3(stored[0], stored[1], stored[2])));
+  }
 
   const bool e = c.write_empty_channels;
   const auto name = fbb.CreateString(c.name);
@@ -613,6 +627,21 @@ std::vector<std::pair<std::string, SyntheticSpec>> valid_variants() {
   spec.clips[0].animated[0].widths = std::array<uint8_t, 3>{19, 2, 11};
   spec.clips[0].animated[1].widths = std::array<uint8_t, 3>{1, 17, 6};
   out.emplace_back("mixed-widths", spec);
+
+  spec = {};
+  // A channel keyed at every frame (format v13: it stores no key frames) beside channels that are
+  // not, and a rotation constant whose largest component is x, the one left out.
+  {
+    SyntheticAnimated& a = spec.clips[0].animated[1];
+    a.frames.clear();
+    a.values.clear();
+    for (uint16_t f = 0; f < spec.clips[0].frame_count; ++f) {
+      a.frames.push_back(f);
+      a.values.push_back({0.5f + 0.01f * static_cast<float>(f), 0.5f - 0.005f * static_cast<float>(f), 0.0f});
+    }
+    spec.clips[0].constants[1].value = fb::Quat(0.96592583f, 0, 0.25881905f, 0);
+  }
+  out.emplace_back("every-frame", spec);
 
   spec = {};
   spec.meshes.push_back(spec.meshes[0]);

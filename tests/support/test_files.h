@@ -116,11 +116,17 @@ struct SyntheticMesh {
   static std::vector<SyntheticVertex> default_vertices();
 };
 
-/// A channel with one value (ossa.fbs ConstantChannel): xyz for translation/scale, xyzw rotation.
+/// A channel with one value (ossa.fbs ConstantChannel): xyz for translation/scale, xyzw rotation
+/// (written as its three components other than the largest). The optional fields override what
+/// is derived, which is how defects are written.
 struct SyntheticConstant {
+  SyntheticConstant() = default;
+  SyntheticConstant(uint16_t j, fb::Channel c, fb::Quat v) : joint(j), channel(c), value(v) {}
   uint16_t joint = 0;
   fb::Channel channel = fb::Channel::Translation;
   fb::Quat value{0, 0, 0, 0};
+  std::optional<uint8_t> dropped;  // default: rotations the largest component, else 0
+  std::optional<fb::Vec3> stored;  // default: from value
 };
 
 /// An animated channel given by its key frames and decoded-to-be values; make_valid_file packs
@@ -134,7 +140,7 @@ struct SyntheticAnimated {
   /// Rotations: the component not stored (0..3 = x, y, z, w). Default: 3 (w) for rotations, 0
   /// for other channels (which store 0).
   std::optional<uint8_t> dropped;
-  std::vector<uint16_t> frames;  // one per key
+  std::vector<uint16_t> frames;  // one per key (not written when there is one per frame)
   /// One per key, as stored: rotations give the three components other than `dropped` (in x, y,
   /// z, w order) of the unit quaternion taken with its dropped component >= 0.
   std::vector<std::array<float, 3>> values;

@@ -105,6 +105,33 @@ inline void rotation_to_stored(const float xyzw[4], uint32_t dropped, float stor
     if (c != dropped) stored[j++] = sign * xyzw[c];
 }
 
+/// Whether an animated channel of `key_count` keys in a clip of `frame_count` frames has a key on
+/// every frame: then it stores no key frames (its key k is at frame k) and its first_key is 0.
+constexpr bool keyed_every_frame(uint32_t key_count, uint32_t frame_count) { return key_count == frame_count; }
+
+/// Frame of key `k` of an animated channel (first_key, key_count) of a clip of `frame_count`
+/// frames whose key-frame vector is `key_frames`. O(1).
+inline uint32_t key_frame(const uint16_t* key_frames, uint32_t first_key, uint32_t key_count, uint32_t frame_count,
+                          uint32_t k) {
+  return keyed_every_frame(key_count, frame_count) ? k : key_frames[first_key + k];
+}
+
+/// A constant channel's value (fb::ConstantChannel, or anything with channel(), dropped() and
+/// value()) as x, y, z, w: w 0 for translation and scale; a rotation rebuilt from its three stored
+/// components as rotation_from_stored does. O(1).
+template <class Constant>
+void constant_value(const Constant& c, float out[4]) {
+  const float stored[3] = {c.value().x(), c.value().y(), c.value().z()};
+  if (static_cast<uint32_t>(c.channel()) == 1u) {  // fb::Channel::Rotation
+    rotation_from_stored(stored, c.dropped() & 3u, out);
+  } else {
+    out[0] = stored[0];
+    out[1] = stored[1];
+    out[2] = stored[2];
+    out[3] = 0.0f;
+  }
+}
+
 /// Appends bit fields LSB-first; pad() finishes the stream with kKeyValuePadding zero bytes.
 class BitWriter {
  public:

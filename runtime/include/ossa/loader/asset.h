@@ -75,11 +75,14 @@ struct ClipView {
   uint32_t frame_count() const;
   uint64_t skeleton_hash() const;
   uint32_t joint_count() const;
-  /// Channels holding one value, sorted by (joint, channel).
+  /// Channels holding one value, sorted by (joint, channel); ossa::constant_value
+  /// (<ossa/format/clip_codec.h>) decodes one.
   std::span<const fb::ConstantChannel> constants() const;
   /// Channels with keys, sorted by (joint, channel), disjoint from constants().
   std::span<const fb::AnimatedChannel> animated() const;
-  /// Key frames of every animated channel; channel c owns [first_key, first_key + key_count).
+  /// Key frames of the animated channels that are not keyed at every frame (those store none);
+  /// channel c owns [first_key, first_key + key_count). ossa::key_frame (<ossa/format/clip_codec.h>)
+  /// gives any channel's key frame.
   std::span<const uint16_t> key_frames() const;
   /// Packed key values (ossa/format/clip_codec.h), followed by kKeyValuePadding zero bytes.
   std::span<const uint8_t> key_values() const;
