@@ -12,8 +12,9 @@
 //      and then one test and one cursor serve them all), one compare of the frame position
 //      against the range its cached key pair covers; only a run that left its range moves its
 //      cursor (forward by one: keep k1 as the new k0 and decode one key per channel; otherwise a
-//      dense run's pair is the frame itself, and a sparse one walks at most 7 keys from its seek
-//      index, so a seek costs the same in a long clip) and decodes (ossa/format/clip_codec.h);
+//      dense run's pair is the frame itself, and a sparse one counts the keys up to the frame in
+//      its seek index's bitmap, so a seek costs the same in a long clip) and decodes
+//      (ossa/format/clip_codec.h);
 //   2. one loop over all joints (SoA, 8-lane blocks): lerp T and S, nlerp R with the shortest-arc
 //      sign fix, write the pose (anim/sample_interpolate.cpp: vector code, on x86-64 compiled
 //      for AVX2 and the SSE2 baseline, picked per call, so the default build runs on any x86-64).
@@ -34,8 +35,8 @@
 // (check_clip_binding), so no check is repeated per sample.
 //
 // Cost: make_sampling_cache O(joints + animated channels + keys of sparse runs), a few allocations
-// (a seek index of 2 bytes per 8 frames per sparse run, shared with a prototype); sample O(joints
-// + runs) + O(keys passed, at most 7 per run on a seek), no allocation; reset O(runs).
+// (a seek index of 16 bytes per 64 frames per sparse run, shared with a prototype); sample
+// O(joints + runs), no branch per key passed, no allocation; reset O(runs).
 // advance_time is advance_time.cpp.
 #include <ossa/anim/sample.h>
 
@@ -107,18 +108,33 @@ struct Track {
   uint32_t weight_index = 0;          // kind * stride + joint, into start / inv_length
 };
 
-/// Frames per entry of a sparse run's seek index (Run::seek): 8, so a seek walks at most 7 keys (with
-/// 16, a walk of up to 15 cost Pab's atlas and crossarms 5-10 % and 4 % more per seek, Zen 5).
-constexpr uint32_t kSeekShift = 3;
+/// 64 frames of a sparse run's seek index (Run::seek): bit i of `keys` is set when the run has a
+/// key at frame 64 b + i, and `before` counts its keys before frame 64 b. The pair around a frame
+/// is then `before` plus the keys set up to it, minus one: a population count, with no branch per
+/// key, where walking the keys from an entry per 8 frames (at most 7) mispredicted at each walk's
+/// end (Pab's atlas, 40 runs: ~20 % of a random seek, Zen 5). 2 bits per frame, as that index.
+struct SeekBlock {
+  uint64_t keys = 0;
+  uint32_t before = 0;
+  uint32_t unused = 0;
+};
+
+/// Set bits of x (SWAR: the SSE2 baseline has no POPCNT, and std::popcount there calls libgcc).
+inline uint32_t popcount64(uint64_t x) {
+  x = x - ((x >> 1) & 0x5555555555555555ull);
+  x = (x & 0x3333333333333333ull) + ((x >> 2) & 0x3333333333333333ull);
+  x = (x + (x >> 4)) & 0x0f0f0f0f0f0f0f0full;
+  return static_cast<uint32_t>((x * 0x0101010101010101ull) >> 56);
+}
 
 /// Animated channels sharing one key-frame list, and the cursor they share: the pair (cursor,
 /// cursor + 1) is valid while enter <= frame < leave (leave is +inf for the last pair, which also
 /// covers the last frame).
 struct Run {
   const uint16_t* frames = nullptr;  // null for a dense run (the file stores no frames for it)
-  // Sparse runs: seek[b] is the pair around frame b << kSeekShift (make_seek_index). Null for a
-  // dense run, a key on every frame (key_count == frame_count), whose pair is the frame itself.
-  const uint16_t* seek = nullptr;
+  // Sparse runs: the keys of frames 64 b .. 64 b + 63 (make_seek_index). Null for a dense run, a
+  // key on every frame (key_count == frame_count), whose pair is the frame itself.
+  const SeekBlock* seek = nullptr;
   uint32_t key_count = 0;
   uint32_t cursor = kNoCursor;
   float enter = kInf;
@@ -162,7 +178,7 @@ struct SamplingCache::State {
   // What move_run reads: tracks, or a prototype's (identical: they depend on the clip, rig and filter only).
   const Track* track_data = nullptr;
   // The sparse runs' seek indexes, one after another (Run::seek points into this or a prototype's).
-  std::vector<uint16_t> seek_index;
+  std::vector<SeekBlock> seek_index;
   // The joint filter the cache was made with (empty: every joint), compared with a prototype's.
   std::span<const uint8_t> filter;
 };
@@ -353,9 +369,10 @@ inline float inverse_gap(uint32_t f0, uint32_t f1) {
 /// The key pair of a run around `frame` (in [0, last frame]): k with frames[k] <= frame <
 /// frames[k + 1], or the last pair at the last frame (or the first before a first key past 0). A
 /// dense run's pair is the frame's whole part. A sparse run takes the next pair when playback moved
-/// forward into it (the common case: one compare, the index untouched); otherwise it walks forward
-/// from its seek index's entry for the frame's 8-frame block: at most 7 keys whatever the clip's
-/// length, where a binary search over a long clip's keys would cost a dozen mispredicted branches.
+/// forward into it (the common case: one compare, the index untouched); otherwise its seek index
+/// gives the last key at or before the frame's whole part (frames are whole, so that key's pair
+/// holds the frame) in O(1) whatever the clip's length, where a binary search over a long clip's
+/// keys would cost a dozen mispredicted branches.
 inline uint32_t find_pair(const Run& r, float frame) {
   const uint32_t n = r.key_count;
   const auto whole = static_cast<uint32_t>(frame);
@@ -363,25 +380,27 @@ inline uint32_t find_pair(const Run& r, float frame) {
   if (!r.seek) {
     k = whole;  // frames[k] == k
   } else {
-    const uint16_t* frames = r.frames;
     k = r.cursor != kNoCursor && frame >= r.leave ? r.cursor + 1 : 0;
-    if (k + 2 < n && frame >= static_cast<float>(frames[k + 1])) {  // past that pair: from the index
-      k = std::max<uint32_t>(k, r.seek[whole >> kSeekShift]);
-      while (k + 2 < n && frame >= static_cast<float>(frames[k + 1])) ++k;
+    if (k + 2 < n && frame >= static_cast<float>(r.frames[k + 1])) {  // past that pair: from the index
+      const SeekBlock& b = r.seek[whole >> 6];
+      // Keys at frames 64 b .. whole; frames[0] == 0, so the count is at least one.
+      k = b.before + popcount64(b.keys & (~0ull >> (63 - (whole & 63)))) - 1;
     }
   }
   return k > n - 2 ? n - 2 : k;
 }
 
-/// Appends a sparse run's seek index to `index`: for each 8-frame block b of the clip's
-/// `frame_count` frames, the pair around frame b << kSeekShift (as find_pair defines it). O(keys +
-/// blocks); 2 bytes per 8 frames.
-void make_seek_index(const uint16_t* frames, uint32_t key_count, uint32_t frame_count, std::vector<uint16_t>& index) {
-  uint32_t k = 0;
-  for (uint32_t b = 0; b <= (frame_count - 1) >> kSeekShift; ++b) {
-    const uint32_t f = b << kSeekShift;
-    while (k + 2 < key_count && f >= frames[k + 1]) ++k;
-    index.push_back(static_cast<uint16_t>(k));
+/// Appends a sparse run's seek index to `index`: for each 64-frame block of the clip's
+/// `frame_count` frames, its keys as bits and the keys before it. O(keys + blocks); 16 bytes per 64
+/// frames.
+void make_seek_index(const uint16_t* frames, uint32_t key_count, uint32_t frame_count, std::vector<SeekBlock>& index) {
+  const size_t first = index.size();
+  index.resize(first + ((frame_count + 63) >> 6));
+  for (uint32_t k = 0; k < key_count; ++k) index[first + (frames[k] >> 6)].keys |= 1ull << (frames[k] & 63);
+  uint32_t before = 0;
+  for (size_t b = first; b < index.size(); ++b) {
+    index[b].before = before;
+    before += popcount64(index[b].keys);
   }
 }
 

@@ -331,10 +331,10 @@ SyntheticSpec hemisphere_spec(uint8_t bits) {
 }
 
 TEST(Sample, SeeksFindTheKeyPairInALongClipWithSparseAndDenseRuns) {
-  // 200 frames, so a sparse run's seek index has 25 blocks of 8 frames: keys on block starts and
-  // just past them, a 42-frame gap over empty blocks, a run that ends its keys early, a dense run
-  // (a key on every frame), one that misses a single frame (a seek walks 7 keys) and a raw-float
-  // one. Every frame, every half frame, each block's edges,
+  // 200 frames, so a sparse run's seek index has 4 blocks of 64 frames (every frame below samples
+  // the bitmaps' word edges): keys on 8-frame starts and just past them, a 42-frame gap, a run that
+  // ends its keys early, a dense run (a key on every frame), one that misses a single frame and a
+  // raw-float one. Every frame, every half frame, each 8-frame block's edges,
   // and random times, sampled in an order that jumps back and forth through one cache, must give
   // the pose of the key pair found by a plain walk over the keys (reference_pose).
   test::SyntheticSpec spec;
