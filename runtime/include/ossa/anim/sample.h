@@ -5,9 +5,9 @@
 // playback then only decodes a key when time passes it, and each channel's keys are read in
 // memory order; a seek, a loop or reverse play moves the cursor (to the frame itself where a
 // channel has a key on every frame, else a count of the keys up to the frame in a seek index of
-// one 64-bit key bitmap per 64 frames) and stays exact. Per frame the work left is one interpolation per joint over
-// SoA arrays: constants and bind-pose channels sit in the cache as key pairs that never change, so
-// the interpolation loop has no per-channel branches.
+// one 64-bit key bitmap per 64 frames) and stays exact. Per frame the work left is one
+// interpolation per joint over SoA arrays: constants and bind-pose channels sit in the cache as
+// key pairs that never change, so the interpolation loop has no per-channel branches.
 //
 // sample() never allocates and touches only the cache and the output; one cache per (clip,
 // playing instance). Caches are made for one clip + skeleton and checked against the clip's
@@ -54,7 +54,7 @@ class SamplingCache {
 /// outlive this one; what never changes (constant and bind channels, and each animated channel's
 /// decode record) is then read from it, so many characters playing one clip share it in cache and
 /// each cache keeps only its cursors and decoded key pairs (and the seek index: 16 bytes per 64
-/// frames of each run of channels with fewer keys than frames). O(joints + animated channels + their keys).
+/// frames per run of channels with fewer keys than frames). O(joints + animated channels + keys).
 /// `joints` (optional, one entry per joint): decode only the animated channels of the joints with
 /// a non-zero entry (a masked slot, which shows some joints of a clip, pays for their keys only).
 /// Every kept joint samples bit for bit as without the filter. sample() leaves the output's lanes
