@@ -93,12 +93,14 @@
 // are contiguous in key_values and its key frames contiguous in key_frames, in frame order, so
 // forward playback reads both in memory order. A channel keyed at every frame (mocap, lossless
 // cooks) stores no key frames; channels whose other lists are identical point at one shared run of
-// key_frames (first_key), which saves two bytes per key for every list step 7 shares.
+// key_frames (first_key), which saves two bytes per key for every list step 7 shares. A channel
+// keyed at every frame is stored in segments of 16 keys where that takes fewer bits (format v14).
 //
 // Files: step 2 is in clip_compress_levers.cpp, steps 4-5 for one channel in
-// clip_compress_channel.cpp, step 7's grouping in clip_compress_share.cpp, what they share in
-// clip_compress_internal.h; this file runs the whole clip (classification order, compensation,
-// packing, verification, step 7's refit). Step 1 is clip_reference.h's.
+// clip_compress_channel.cpp, step 7's grouping in clip_compress_share.cpp, packing in
+// clip_compress_pack.cpp, what they share in clip_compress_internal.h; this file runs the whole
+// clip (classification order, compensation, verification, step 7's refit). Step 1 is
+// clip_reference.h's.
 #include "cooker/clip/clip_compress.h"
 
 #include <algorithm>
@@ -251,94 +253,6 @@ void compensated_target(const SourceSkeleton& skeleton, const ClipSamples& ref, 
 struct ClipLayout {
   std::vector<ChannelPlan> plans;  // [joint * 3 + channel]
 };
-
-/// ossa/format/clip_codec.h's BitWriter, byte for byte (LSB-first fields, byte alignment, padding),
-/// writing whole fields instead of single bits: packing runs once per verification round.
-class KeyWriter {
- public:
-  uint64_t bit_size() const { return bits_; }
-  void write(uint32_t value, uint32_t count) {  // count <= 32
-    const uint64_t v = (static_cast<uint64_t>(value) & ((1ull << count) - 1ull)) << (bits_ & 7u);
-    const size_t first = static_cast<size_t>(bits_ >> 3);
-    bits_ += count;
-    bytes_.resize(static_cast<size_t>((bits_ + 7) >> 3), 0);
-    for (size_t i = first; i < bytes_.size(); ++i) bytes_[i] |= static_cast<uint8_t>(v >> (8 * (i - first)));
-  }
-  void align_byte() { bits_ = (bits_ + 7) & ~7ull; }
-  std::vector<uint8_t> finish() {
-    std::vector<uint8_t> out = std::move(bytes_);
-    out.resize(static_cast<size_t>((bits_ + 7) >> 3) + kKeyValuePadding, 0);
-    return out;
-  }
-
- private:
-  std::vector<uint8_t> bytes_;
-  uint64_t bits_ = 0;
-};
-
-Status pack(const ClipLayout& layout, uint32_t joints, uint32_t frames, CompressedClip& out) {
-  out.constants.clear();
-  out.animated.clear();
-  out.key_frames.clear();
-  KeyWriter writer;
-  // Identical key frame lists share one run, found through an ordered map (deterministic).
-  std::map<std::vector<uint16_t>, uint32_t> shared_frames;
-  for (uint32_t j = 0; j < joints; ++j) {
-    for (uint32_t ch = 0; ch < kChannelsPerJoint; ++ch) {
-      const ChannelPlan& p = layout.plans[j * 3 + ch];
-      if (p.kind == Kind::Bind) continue;
-      if (p.kind == Kind::Constant) {
-        CompressedConstant c;
-        c.joint = static_cast<uint16_t>(j);
-        c.channel = static_cast<uint8_t>(ch);
-        for (int i = 0; i < 4; ++i) c.value[i] = p.constant[i];
-        if (ch != kRotation) {
-          c.value[3] = 0.0f;
-        } else {  // stored as three components: the value is what a reader rebuilds
-          for (uint32_t i = 1; i < 4; ++i)
-            if (std::fabs(c.value[i]) > std::fabs(c.value[c.dropped])) c.dropped = static_cast<uint8_t>(i);
-          float stored[3];
-          rotation_to_stored(c.value, c.dropped, stored);
-          rotation_from_stored(stored, c.dropped, c.value);
-        }
-        out.constants.push_back(c);
-        continue;
-      }
-      CompressedAnimated a;
-      a.joint = static_cast<uint16_t>(j);
-      a.channel = static_cast<uint8_t>(ch);
-      a.bits = p.widths;
-      a.dropped = static_cast<uint8_t>(ch == kRotation ? p.dropped : 0);  // 0 for other channels
-      a.key_count = static_cast<uint32_t>(p.frames.size());
-      if (!keyed_every_frame(a.key_count, frames)) {  // an every-frame channel stores no frames
-        const auto [it, inserted] = shared_frames.emplace(p.frames, static_cast<uint32_t>(out.key_frames.size()));
-        if (inserted) out.key_frames.insert(out.key_frames.end(), p.frames.begin(), p.frames.end());
-        a.first_key = it->second;
-      }
-      if (p.widths.raw()) writer.align_byte();
-      if (writer.bit_size() > std::numeric_limits<uint32_t>::max()) {
-        return Error{"clip '" + out.name + "': compressed keys exceed 4 Gbit"};
-      }
-      a.bit_offset = static_cast<uint32_t>(writer.bit_size());
-      for (int c = 0; c < 3; ++c) {
-        a.range_min[c] = p.widths.raw() ? 0.0f : p.range_min[c];
-        a.range_extent[c] = p.widths.raw() ? 0.0f : p.range_extent[c];
-      }
-      for (const uint16_t f : p.frames)
-        for (int c = 0; c < 3; ++c) writer.write(p.codes[f][c], p.widths.c[c]);
-      out.animated.push_back(a);
-    }
-  }
-  if (writer.bit_size() > std::numeric_limits<uint32_t>::max()) {
-    return Error{"clip '" + out.name + "': compressed keys exceed 4 Gbit"};
-  }
-  out.key_values = writer.finish();
-  out.cooked_bytes = static_cast<uint32_t>(out.constants.size() * sizeof(fb::ConstantChannel) +
-                                           out.animated.size() * sizeof(fb::AnimatedChannel) +
-                                           out.key_frames.size() * sizeof(uint16_t) + out.key_values.size());
-  return {};
-}
-
 }  // namespace
 
 Result<CompressedClip> compress_clip(const SourceClip& clip, const SourceSkeleton& skeleton, float metres_per_unit,
@@ -399,7 +313,7 @@ Result<CompressedClip> compress_clip(const SourceClip& clip, const SourceSkeleto
     for (uint32_t j = 0; j < joints; ++j)
       for (uint32_t ch = 0; ch < kChannelsPerJoint; ++ch)
         layout.plans[j * 3 + ch] = plan_lossless(ch, ref.channel(j, ch), frames, bind_value(skeleton.joints[j], ch));
-    if (Status st = pack(layout, joints, frames, out); !st) return st.error();
+    if (Status st = pack(layout.plans, joints, frames, out); !st) return st.error();
     decode_clip(out, skeleton, decoded, kErrorSubdivisions);
     finish(measure_clip_error(skeleton, between_frames(ref), decoded, probe, nullptr, kErrorSubdivisions));
     return out;
@@ -503,7 +417,7 @@ Result<CompressedClip> compress_clip(const SourceClip& clip, const SourceSkeleto
       }
       models.joint_planned(j);
     }
-    if (Status st = pack(layout, joints, frames, out); !st) return st.error();
+    if (Status st = pack(layout.plans, joints, frames, out); !st) return st.error();
     decode_clip(out, skeleton, decoded, kErrorSubdivisions);
     error = measure_clip_error(skeleton, ref_positions, decoded, probe,
                                ref_position_models.empty() ? nullptr : &ref_position_models, kErrorSubdivisions);
@@ -560,7 +474,7 @@ Result<CompressedClip> compress_clip(const SourceClip& clip, const SourceSkeleto
         }
         models.joint_planned(j);
       }
-      if (Status st = pack(layout, joints, frames, out); !st) return st.error();
+      if (Status st = pack(layout.plans, joints, frames, out); !st) return st.error();
       decode_clip(out, skeleton, decoded, kErrorSubdivisions);
       const ClipError shared =
           measure_clip_error(skeleton, ref_positions, decoded, probe,
@@ -578,7 +492,7 @@ Result<CompressedClip> compress_clip(const SourceClip& clip, const SourceSkeleto
     }
     if (!kept) {
       layout.plans = own;
-      if (Status st = pack(layout, joints, frames, out); !st) return st.error();
+      if (Status st = pack(layout.plans, joints, frames, out); !st) return st.error();
     }
   }
   finish(error);

@@ -32,8 +32,9 @@ struct CompressedConstant {
 struct CompressedAnimated {
   uint16_t joint = 0;
   uint8_t channel = 0;
-  KeyWidths bits;       // per stored component: 1..kMaxQuantBits (19) each, or all 32
-  uint8_t dropped = 3;  // rotations: the component not stored (ossa/format/clip_codec.h)
+  KeyWidths bits;                   // per stored component: 1..kMaxQuantBits (19) each, or all 32
+  uint8_t dropped = 3;              // rotations: the component not stored (ossa/format/clip_codec.h)
+  uint8_t segment_offset_bits = 0;  // 0: plain keys; 1..32: segmented (ossa/format/clip_codec.h)
   uint32_t first_key = 0;
   uint32_t key_count = 0;
   uint32_t bit_offset = 0;

@@ -1,8 +1,9 @@
-// clip_compress_internal.h — what the three files of the clip compressor share (internal to
+// clip_compress_internal.h — what the files of the clip compressor share (internal to
 // cooker/clip/): the channel plan, the error metric and levers, and the stage functions that
-// clip_compress.cpp (classification order, compensation, packing, verification) calls in
-// clip_compress_levers.cpp (step 2: levers) and clip_compress_channel.cpp (steps 4-5 for one
-// channel: classification, keys and bits). The design is in clip_compress.cpp's header; the stages
+// clip_compress.cpp (classification order, compensation, verification) calls in
+// clip_compress_levers.cpp (step 2: levers), clip_compress_channel.cpp (steps 4-5 for one
+// channel: classification, keys and bits), clip_compress_share.cpp (step 7) and
+// clip_compress_pack.cpp (the bytes). The design is in clip_compress.cpp's header; the stages
 // are files of their own so each stays readable on its own.
 #pragma once
 
@@ -112,5 +113,14 @@ struct ShareInput {
 /// to their group's list and returns, per plan, whether it now shares its list with another.
 /// Deterministic. O(groups^2) key removals over the groups' channels; more than 512 groups: none.
 std::vector<bool> share_key_lists(std::vector<ChannelPlan>& plans, std::span<const ShareInput> inputs, uint32_t frames);
+
+// ---------------------------------------------------------------------------------------------
+// Packing (clip_compress_pack.cpp)
+
+/// The plans (plans[joint * 3 + channel]) as the bytes a file holds, into out's constants,
+/// animated channels, key frames and key values (cooked_bytes set): identical key-frame lists
+/// share one run, channels keyed at every frame store none, and each of those is segmented where
+/// that takes fewer bits (ossa/format/clip_codec.h). An error past 4 Gbit of keys. O(keys).
+Status pack(const std::vector<ChannelPlan>& plans, uint32_t joints, uint32_t frames, CompressedClip& out);
 
 }  // namespace ossa::cook::compress_detail

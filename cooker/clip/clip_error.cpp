@@ -56,10 +56,12 @@ void decode_clip(const CompressedClip& clip, const SourceSkeleton& skeleton, Cli
       return key_frame(clip.key_frames.data(), a.first_key, a.key_count, frames, k);
     };
     float xyz[3];
-    decode_key(clip.key_values.data(), a.bit_offset, a.bits, a.range_min, a.range_extent, 0, xyz);
+    decode_key(clip.key_values.data(), a.bit_offset, a.bits, a.segment_offset_bits, a.range_min, a.range_extent, 0,
+               xyz);
     glm::vec4 prev = key_sample(a.channel, a.dropped, xyz);
     for (uint32_t k = 1; k < a.key_count; ++k) {
-      decode_key(clip.key_values.data(), a.bit_offset, a.bits, a.range_min, a.range_extent, k, xyz);
+      decode_key(clip.key_values.data(), a.bit_offset, a.bits, a.segment_offset_bits, a.range_min, a.range_extent, k,
+                 xyz);
       const glm::vec4 next = key_sample(a.channel, a.dropped, xyz);
       const uint32_t f0 = frame_of(k - 1), f1 = frame_of(k);
       const float inv_length = 1.0f / static_cast<float>(f1 - f0);

@@ -153,7 +153,7 @@ Offset<fb::Clip> write_clip(FlatBufferBuilder& fbb, const CompressedClip& clip, 
     const uint8_t bits[3] = {static_cast<uint8_t>(a.bits.c[0]), static_cast<uint8_t>(a.bits.c[1]),
                              static_cast<uint8_t>(a.bits.c[2])};
     animated.emplace_back(a.joint, static_cast<fb::Channel>(a.channel), flatbuffers::span<const uint8_t, 3>(bits),
-                          a.dropped, a.first_key, a.key_count, a.bit_offset,
+                          a.dropped, a.segment_offset_bits, a.first_key, a.key_count, a.bit_offset,
                           fb::Vec3(a.range_min[0], a.range_min[1], a.range_min[2]),
                           fb::Vec3(a.range_extent[0], a.range_extent[1], a.range_extent[2]));
   }

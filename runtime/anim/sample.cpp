@@ -14,7 +14,8 @@
 //      cursor (forward by one: keep k1 as the new k0 and decode one key per channel; otherwise a
 //      dense run's pair is the frame itself, and a sparse one counts the keys up to the frame in
 //      its seek index's bitmap, so a seek costs the same in a long clip) and decodes
-//      (ossa/format/clip_codec.h);
+//      (anim/sample_decode.h: clip_codec.h's decoding specialized; a run's segmented channels
+//      decode after its plain ones, in a loop of their own, each key after its segment's header);
 //   2. one loop over all joints (SoA, 8-lane blocks): lerp T and S, nlerp R with the shortest-arc
 //      sign fix, write the pose (anim/sample_interpolate.cpp: vector code, on x86-64 compiled
 //      for AVX2 and the SSE2 baseline, picked per call, so the default build runs on any x86-64).
@@ -58,6 +59,7 @@
 #endif
 
 #include <ossa/format/clip_codec.h>
+#include "anim/sample_decode.h"
 #include "internal/float_env.h"
 #include "internal/memory.h"
 #include "internal/sample_lanes.h"
@@ -67,6 +69,12 @@ namespace {
 
 using detail::kSkipped;
 using detail::normalize4;
+using sample_detail::decode;
+using sample_detail::decode_pair;
+using sample_detail::decode_two;
+using sample_detail::KeySource;
+using sample_detail::SegmentCursor;
+using sample_detail::Track;
 
 constexpr uint32_t kNoCursor = std::numeric_limits<uint32_t>::max();
 constexpr float kInf = std::numeric_limits<float>::infinity();
@@ -90,22 +98,6 @@ struct AlignedFloats {
   }
   AlignedFloats(const AlignedFloats&) = delete;
   ~AlignedFloats() { detail::deallocate(data, count * sizeof(float), 32); }
-};
-
-/// How to decode one animated channel and where its values go, gathered from the FlatBuffer at
-/// cache creation so the hot path reads one flat record.
-struct Track {
-  uint64_t bit_offset = 0;
-  uint32_t key_bits = 0;         // bits per key: the three widths summed (96: raw floats)
-  bool raw = false;              // raw floats
-  uint8_t shift[3] = {0, 0, 0};  // each component's bit position in a key
-  uint32_t mask[3] = {0, 0, 0};  // 2^width - 1
-  float qmax[4] = {1, 1, 1, 1};  // the same as floats, 4 wide for one SSE load
-  float lo[4] = {0, 0, 0, 0};    // 4 wide (the 4th unused) for one SSE load
-  float extent[4] = {0, 0, 0, 0};
-  bool rotation = false;
-  uint32_t offset[4] = {0, 0, 0, 0};  // where components go in k0 / k1 (offset[3]: a rotation's rebuilt one)
-  uint32_t weight_index = 0;          // kind * stride + joint, into start / inv_length
 };
 
 /// 64 frames of a sparse run's seek index (Run::seek): bit i of `keys` is set when the run has a
@@ -141,6 +133,7 @@ struct Run {
   float leave = -kInf;
   uint32_t first_track = 0;  // its channels are tracks[first_track, first_track + track_count)
   uint32_t track_count = 0;
+  uint32_t segmented = 0;  // its last `segmented` tracks are segmented channels, the others plain
 };
 
 }  // namespace
@@ -177,6 +170,8 @@ struct SamplingCache::State {
   std::vector<Track> tracks;  // grouped by run
   // What move_run reads: tracks, or a prototype's (identical: they depend on the clip, rig and filter only).
   const Track* track_data = nullptr;
+  // Per track (track_data's order), the segment it last decoded; empty when no track is segmented.
+  std::vector<SegmentCursor> segments;
   // The sparse runs' seek indexes, one after another (Run::seek points into this or a prototype's).
   std::vector<SeekBlock> seek_index;
   // The joint filter the cache was made with (empty: every joint), compared with a prototype's.
@@ -221,6 +216,9 @@ Track make_track(const fb::AnimatedChannel& ch, uint32_t stride) {
   const KeyWidths w = widths_of(ch);
   t.key_bits = static_cast<uint32_t>(w.total());
   t.raw = w.raw();
+  t.offset_bits = ch.segment_offset_bits();  // validation proved it 0 for raw keys
+  t.widths = w;
+  t.header_bits = t.raw ? 0u : static_cast<uint32_t>(segment_header_bits(w, t.offset_bits));
   for (uint32_t c = 0; c < 3 && !t.raw; ++c) {
     t.shift[c] = static_cast<uint8_t>(w.shift(c));
     t.mask[c] = quant_max(w.c[c]);
@@ -241,117 +239,6 @@ Track make_track(const fb::AnimatedChannel& ch, uint32_t stride) {
   t.weight_index = kind * stride + ch.joint();
   return t;
 }
-
-// Key decodes: ossa/format/clip_codec.h's decode_key and rotation_from_stored, specialized to the
-// precomputed record, with the same bits: on x86-64 the three components are dequantized in one
-// SSE register (one division instead of three), each lane performing the scalar code's IEEE
-// operations (lo + extent * (q / qmax)) in its order.
-#if defined(__SSE2__)
-/// Key `key` of a quantized track as (x, y, z, 0): its three stored components, dequantized.
-inline __m128 dequantized(const Track& t, const uint8_t* stream, uint32_t key) {
-  const uint64_t packed = read_bits(stream, t.bit_offset + uint64_t{t.key_bits} * key, t.key_bits);
-  // q < 2^19 fits a signed 32-bit lane, so the signed conversion is exact.
-  const auto q0 = static_cast<int>(static_cast<uint32_t>(packed) & t.mask[0]);
-  const auto q1 = static_cast<int>(static_cast<uint32_t>(packed >> t.shift[1]) & t.mask[1]);
-  const auto q2 = static_cast<int>(static_cast<uint32_t>(packed >> t.shift[2]) & t.mask[2]);
-  const __m128 f = _mm_div_ps(_mm_cvtepi32_ps(_mm_setr_epi32(q0, q1, q2, 0)), _mm_loadu_ps(t.qmax));
-  return _mm_add_ps(_mm_loadu_ps(t.lo), _mm_mul_ps(_mm_loadu_ps(t.extent), f));
-}
-
-/// Key `key` of any track as (x, y, z, 0): its three stored components. A raw key is read as 16
-/// bytes (validation keeps 8 padding bytes after the last key, so the read stays inside the stream)
-/// and the bytes after it are cleared, so no arithmetic on lane 3 can raise a floating-point flag.
-inline __m128 stored(const Track& t, const uint8_t* stream, uint32_t key) {
-  if (t.raw)
-    return _mm_and_ps(_mm_loadu_ps(reinterpret_cast<const float*>(stream + (t.bit_offset >> 3) + 12ull * key)),
-                      _mm_castsi128_ps(_mm_setr_epi32(-1, -1, -1, 0)));
-  return dequantized(t, stream, key);
-}
-
-/// Writes the three stored components where the record says they go (through memory: a 16-byte
-/// store forwards to the 4-byte loads, cheaper than shuffling each lane out).
-inline void put(const Track& t, __m128 v, float* keys) {
-  float x[4];
-  _mm_storeu_ps(x, v);
-  keys[t.offset[0]] = x[0];
-  keys[t.offset[1]] = x[1];
-  keys[t.offset[2]] = x[2];
-}
-
-/// Decodes key `key` of a track into the k0 or k1 array.
-inline void decode(const Track& t, const uint8_t* stream, uint32_t key, float* keys) {
-  float v[4];
-  if (t.raw) std::memcpy(v, stream + (t.bit_offset >> 3) + 12ull * key, 12);
-  else _mm_storeu_ps(v, dequantized(t, stream, key));
-  keys[t.offset[0]] = v[0];
-  keys[t.offset[1]] = v[1];
-  keys[t.offset[2]] = v[2];
-  if (t.rotation) keys[t.offset[3]] = rotation_w(v);
-}
-
-/// rotation_w of two stored keys at once (lanes 0 and 1): its operations, lane for lane, in its
-/// order, with one square root for both.
-inline __m128 rotation_w2(__m128 a, __m128 b) {
-  const __m128 xy = _mm_unpacklo_ps(a, b);  // xa xb ya yb
-  const __m128 z = _mm_unpackhi_ps(a, b);   // za zb 0 0
-  const __m128 sq = _mm_mul_ps(xy, xy);
-  const __m128 w2 = _mm_sub_ps(_mm_sub_ps(_mm_sub_ps(_mm_set1_ps(1.0f), sq), _mm_movehl_ps(sq, sq)), _mm_mul_ps(z, z));
-  // w2 <= 0 gives 0, as rotation_w's test does; clamping first keeps a negative (or another lane's
-  // unused value) out of the square root, which would raise invalid-operation.
-  return _mm_sqrt_ps(_mm_max_ps(w2, _mm_setzero_ps()));
-}
-
-/// Keys `key` and `key + 1` of a track into k0 and k1 (a seek).
-inline void decode_pair(const Track& t, const uint8_t* stream, uint32_t key, float* k0, float* k1) {
-  const __m128 a = stored(t, stream, key), b = stored(t, stream, key + 1);
-  put(t, a, k0);
-  put(t, b, k1);
-  if (!t.rotation) return;
-  float w[4];
-  _mm_storeu_ps(w, rotation_w2(a, b));
-  k0[t.offset[3]] = w[0];
-  k1[t.offset[3]] = w[1];
-}
-
-/// Key `key` of two tracks into `keys` (forward playback).
-inline void decode_two(const Track& ta, const Track& tb, const uint8_t* stream, uint32_t key, float* keys) {
-  const __m128 a = stored(ta, stream, key), b = stored(tb, stream, key);
-  put(ta, a, keys);
-  put(tb, b, keys);
-  if (!(ta.rotation || tb.rotation)) return;
-  float w[4];
-  _mm_storeu_ps(w, rotation_w2(a, b));
-  if (ta.rotation) keys[ta.offset[3]] = w[0];
-  if (tb.rotation) keys[tb.offset[3]] = w[1];
-}
-#else
-inline void decode(const Track& t, const uint8_t* stream, uint32_t key, float* keys) {
-  float v[3];
-  if (t.raw) {
-    std::memcpy(v, stream + (t.bit_offset >> 3) + 12ull * key, 12);
-  } else {
-    const uint64_t packed = read_bits(stream, t.bit_offset + uint64_t{t.key_bits} * key, t.key_bits);
-    for (uint32_t c = 0; c < 3; ++c) {
-      const uint32_t q = static_cast<uint32_t>(packed >> t.shift[c]) & t.mask[c];
-      v[c] = t.lo[c] + t.extent[c] * (static_cast<float>(q) / t.qmax[c]);
-    }
-  }
-  keys[t.offset[0]] = v[0];
-  keys[t.offset[1]] = v[1];
-  keys[t.offset[2]] = v[2];
-  if (t.rotation) keys[t.offset[3]] = rotation_w(v);
-}
-
-inline void decode_pair(const Track& t, const uint8_t* stream, uint32_t key, float* k0, float* k1) {
-  decode(t, stream, key, k0);
-  decode(t, stream, key + 1, k1);
-}
-
-inline void decode_two(const Track& ta, const Track& tb, const uint8_t* stream, uint32_t key, float* keys) {
-  decode(ta, stream, key, keys);
-  decode(tb, stream, key, keys);
-}
-#endif
 
 /// 1 / gap for the key gaps real clips have (a few frames), so moving a cursor costs no division.
 struct Reciprocals {
@@ -404,20 +291,14 @@ void make_seek_index(const uint16_t* frames, uint32_t key_count, uint32_t frame_
   }
 }
 
-/// Moves a run that left its key pair to the pair around `frame`, decoding what changed: one key
-/// per channel when it moved forward by one (k1 becomes k0), both keys otherwise.
-void move_run(State& s, Run& r, float frame) {
-  const uint32_t k = find_pair(r, frame);
-  const Track* t = s.track_data + r.first_track;
-  const Track* end = t + r.track_count;
-  const uint8_t* stream = s.stream;
+/// Decodes tracks [t, end) of a run that moved to pair k (frames f0 and f0 + 1 / inv): one key
+/// each when `forward` (k1 becomes k0), both keys otherwise. kSegments: the tracks are segmented.
+template <bool kSegments>
+void move_tracks(State& s, const Track* t, const Track* end, uint32_t k, bool forward, float f0, float inv) {
+  const KeySource src{s.stream, s.track_data, s.segments.data()};
   float* k0 = s.k0;
   float* k1 = s.k1;
-  // A dense run stores no frames: its key k is at frame k.
-  const uint32_t frame0 = r.frames ? r.frames[k] : k, frame1 = r.frames ? r.frames[k + 1] : k + 1;
-  const auto f0 = static_cast<float>(frame0);
-  const float inv = inverse_gap(frame0, frame1);
-  if (r.cursor != kNoCursor && k == r.cursor + 1) {
+  if (forward) {
     const auto shift = [&](const Track& x) {  // k1 becomes k0
       k0[x.offset[0]] = k1[x.offset[0]];
       k0[x.offset[1]] = k1[x.offset[1]];
@@ -429,18 +310,37 @@ void move_run(State& s, Run& r, float frame) {
     for (; end - t >= 2; t += 2) {
       shift(t[0]);
       shift(t[1]);
-      decode_two(t[0], t[1], stream, k + 1, k1);
+      decode_two<kSegments>(t[0], t[1], src, k + 1, k1);
     }
     if (t != end) {
       shift(*t);
-      decode(*t, stream, k + 1, k1);
+      decode<kSegments>(*t, src, k + 1, k1);
     }
-  } else if (k != r.cursor) {
-    for (; t != end; ++t) {
-      decode_pair(*t, stream, k, k0, k1);
-      s.start[t->weight_index] = f0;
-      s.inv_length[t->weight_index] = inv;
-    }
+    return;
+  }
+  for (; t != end; ++t) {
+    decode_pair<kSegments>(*t, src, k, k0, k1);
+    s.start[t->weight_index] = f0;
+    s.inv_length[t->weight_index] = inv;
+  }
+}
+
+/// Moves a run that left its key pair to the pair around `frame`, decoding what changed: one key
+/// per channel when it moved forward by one (k1 becomes k0), both keys otherwise. Its plain tracks
+/// and its segmented ones (after them) run in loops of their own, each compiled for one layout
+/// (measured: the segmented decode in the plain keys' loop slowed their seeks by a quarter).
+void move_run(State& s, Run& r, float frame) {
+  const uint32_t k = find_pair(r, frame);
+  const Track* t = s.track_data + r.first_track;
+  const Track* end = t + r.track_count;
+  // A dense run stores no frames: its key k is at frame k.
+  const uint32_t frame0 = r.frames ? r.frames[k] : k, frame1 = r.frames ? r.frames[k + 1] : k + 1;
+  const auto f0 = static_cast<float>(frame0);
+  const float inv = inverse_gap(frame0, frame1);
+  if (k != r.cursor) {
+    const bool forward = r.cursor != kNoCursor && k == r.cursor + 1;
+    move_tracks<false>(s, t, end - r.segmented, k, forward, f0, inv);
+    if (r.segmented != 0) move_tracks<true>(s, end - r.segmented, end, k, forward, f0, inv);
   }
   r.cursor = k;
   r.enter = f0;
@@ -492,6 +392,7 @@ Result<SamplingCache> make_sampling_cache(const ClipView& clip, const SkeletonVi
     }
     run_index[i] = it->second;
     ++runs[it->second].track_count;
+    if (a.segment_offset_bits() != 0) ++runs[it->second].segmented;
   }
   // Floats first (a multiple of 8 floats: the runs start 32-byte aligned), then the runs.
   const size_t floats = (2 * kPoseComponents + 6) * stride;
@@ -555,11 +456,18 @@ Result<SamplingCache> make_sampling_cache(const ClipView& clip, const SkeletonVi
   s->run_count = static_cast<uint32_t>(runs.size());
   if (!runs.empty()) std::memcpy(static_cast<void*>(s->runs), runs.data(), runs.size() * sizeof(Run));
   s->tracks.resize(animated.size());
-  std::vector<uint32_t> filled(runs.size(), 0);
+  // Within a run, plain tracks first, then the segmented ones (move_run's two loops).
+  std::vector<uint32_t> plain(runs.size(), 0), segmented(runs.size(), 0);
   for (size_t i = 0; i < animated.size(); ++i) {
     const Run& r = runs[run_index[i]];
-    s->tracks[r.first_track + filled[run_index[i]]++] = make_track(*animated[i], s->stride);
+    const uint32_t at = animated[i]->segment_offset_bits() != 0
+                            ? r.track_count - r.segmented + segmented[run_index[i]]++
+                            : plain[run_index[i]]++;
+    s->tracks[r.first_track + at] = make_track(*animated[i], s->stride);
   }
+  if (std::any_of(animated.begin(), animated.end(),
+                  [](const fb::AnimatedChannel* a) { return a->segment_offset_bits() != 0; }))
+    s->segments.resize(animated.size());
   forget_cursors(*s);
   s->fixed = s->k0;
   s->track_data = s->tracks.data();

@@ -27,6 +27,38 @@ namespace ossa::validate_detail {
 // binary search always finds a bracketing pair), ranges finite (so decoded values are), raw-float
 // keys finite, rotations bounded (so normalizing never divides by zero or infinity).
 
+namespace {
+
+/// Where a segmented channel's keys end (a bit position of key_values), its headers read in
+/// order: each segment's keys start where the previous segment's end (the first right after the
+/// headers), and each width w and minimum m leave m + 2^w - 1 inside the channel's codes, so
+/// every key decodes to a code the plain layout could hold. Empty, or what is wrong. O(segments).
+std::string segments_end(const uint8_t* values, uint64_t value_bits, uint64_t offset, const KeyWidths& bits,
+                         uint32_t offset_bits, uint32_t n, uint64_t& end) {
+  const uint32_t segments = segment_count(n);
+  const uint64_t headers = segment_header_bits(bits, offset_bits) * segments;
+  if (offset + headers > value_bits)
+    return format(": its %u segment headers need key value bits [%llu, %llu), the clip has %llu (before padding)",
+                  segments, static_cast<unsigned long long>(offset), static_cast<unsigned long long>(offset + headers),
+                  static_cast<unsigned long long>(value_bits));
+  uint64_t data = headers;
+  for (uint32_t s = 0; s < segments; ++s) {
+    const SegmentHeader h = read_segment(values, offset, bits, offset_bits, s);
+    if (h.data != data)
+      return format(": segment %u's keys start at bit %llu of the channel, not %llu where the previous end", s,
+                    static_cast<unsigned long long>(h.data), static_cast<unsigned long long>(data));
+    for (uint32_t c = 0; c < 3; ++c)
+      if (h.widths.c[c] > bits.c[c] || uint64_t{h.min[c]} + quant_max(h.widths.c[c]) > quant_max(bits.c[c]))
+        return format(": segment %u's component %u (minimum %u, %u bits) leaves the channel's %u-bit codes", s, c,
+                      h.min[c], h.widths.c[c], bits.c[c]);
+    data += h.widths.total() * std::min(kSegmentKeys, n - s * kSegmentKeys);
+  }
+  end = offset + data;
+  return {};
+}
+
+}  // namespace
+
 /// "animated channel 3 (joint 5 'Hips' rotation)".
 std::string Validator::channel_label(const char* kind, size_t index, size_t joint, unsigned channel,
                                      bool binds_here) const {
@@ -180,7 +212,17 @@ Status Validator::check_clip(const fb::Clip& c, size_t clip_index) {
     if (raw && offset % 8 != 0)
       return fail(where, cl() + format(": raw-float keys start at bit %llu, not on a byte boundary",
                                        static_cast<unsigned long long>(offset)));
-    const uint64_t end = offset + widths.total() * n;
+    const uint32_t offset_bits = ch.segment_offset_bits();
+    uint64_t end = offset + widths.total() * n;
+    if (offset_bits != 0) {
+      if (raw || offset_bits > kMaxSegmentOffsetBits || !keyed_every_frame(n, frame_count))
+        return fail(where, cl() + format(" has segment_offset_bits %u; segments need 1..%u, quantized keys and a "
+                                         "key on every frame",
+                                         offset_bits, kMaxSegmentOffsetBits));
+      if (!spend(uint64_t{segment_count(n)} * 16)) return over_budget(where);
+      if (std::string why = segments_end(values, value_bits, offset, widths, offset_bits, n, end); !why.empty())
+        return fail(where, cl() + why);
+    }
     if (end > value_bits)
       return fail(where, cl() + format(" needs key value bits [%llu, %llu), the clip has %llu (before padding)",
                                        static_cast<unsigned long long>(offset), static_cast<unsigned long long>(end),

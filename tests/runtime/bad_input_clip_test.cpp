@@ -13,6 +13,7 @@
 #include <flatbuffers/flatbuffers.h>
 
 #include "bad_input.h"
+#include <ossa/format/clip_codec.h>
 #include <ossa/format/hash.h>
 #include <ossa/loader/asset.h>
 #include <ossa/loader/texture.h>
@@ -286,6 +287,66 @@ TEST(Clip, EveryFrameChannelWithKeyFrames) {
   EXPECT_TRUE(accepts(make_valid_file(spec)));
   a.first_key = 1;
   EXPECT_TRUE(rejects(spec, with(kClip, {"first_key must be 0"})));
+}
+
+/// The default clip with one animated channel, the arm's translation keyed at every frame in 4
+/// bits per component and segmented with 8-bit data offsets (format v14), its key values written
+/// here bit by bit: 31 keys are two segments, headers of 15 + 8 + 12 bits (widths, where the keys
+/// start, minima); segment 0 has component 0 at minimum `min0` in `width0` bits (every field 0)
+/// and its keys start at bit 70 + `skew`; segment 1 holds still (widths 0).
+SyntheticSpec segmented_spec(uint32_t min0, uint32_t width0, uint32_t skew) {
+  SyntheticSpec spec;
+  test::SyntheticAnimated a = spec.clips[0].animated[1];
+  a.frames.clear();
+  a.values.clear();
+  for (uint16_t f = 0; f < spec.clips[0].frame_count; ++f) {
+    a.frames.push_back(f);
+    a.values.push_back({0.01f * f, 0.0f, 1.0f});
+  }
+  a.bits = 4;
+  a.segment_offset_bits = 8;
+  a.bit_offset = 0;
+  spec.clips[0].animated = {a};
+  BitWriter w;
+  const uint32_t headers = 2 * (8 + 12 + 15);
+  w.write(width0, 5), w.write(0, 5), w.write(0, 5);
+  w.write(headers + skew, 8);
+  w.write(min0, 4), w.write(0, 4), w.write(0, 4);
+  w.write(0, 15);
+  w.write(headers + 16 * width0, 8);
+  w.write(0, 12);
+  w.write(0, 16 * width0);
+  spec.clips[0].key_values = w.finish();
+  return spec;
+}
+
+TEST(Clip, SegmentedKeysInvalid) {
+  EXPECT_TRUE(accepts(make_valid_file(segmented_spec(3, 2, 0))));
+  EXPECT_TRUE(accepts(make_valid_file(segmented_spec(12, 2, 0)))) << "12 + 3 is the largest 4-bit code";
+  EXPECT_TRUE(rejects(segmented_spec(14, 2, 0), with(kClip, {"segment 0's component 0", "4-bit codes"})));
+  EXPECT_TRUE(rejects(segmented_spec(0, 5, 0), with(kClip, {"segment 0's component 0 (minimum 0, 5 bits)"})));
+  EXPECT_TRUE(rejects(segmented_spec(0, 2, 1), with(kClip, {"segment 0's keys start at bit 71"})));
+  // Segment 0 has 32 bits of keys, the first written: its keys cannot also start where segment 1's do.
+  SyntheticSpec late = segmented_spec(0, 2, 0);
+  (*late.clips[0].key_values)[6] ^= 0x08;  // segment 1's offset (bits 50..57): its bit 1 flipped
+  EXPECT_TRUE(rejects(late, with(kClip, {"segment 1's keys start"})));
+  // Headers past the key values, and layouts that cannot be segmented.
+  SyntheticSpec past = segmented_spec(0, 2, 0);
+  past.clips[0].animated[0].bit_offset = 200;
+  EXPECT_TRUE(rejects(past, with(kClip, {"segment headers need key value bits"})));
+  SyntheticSpec wide = segmented_spec(0, 2, 0);
+  wide.clips[0].animated[0].segment_offset_bits = 33;
+  EXPECT_TRUE(rejects(wide, with(kClip, {"segment_offset_bits 33"})));
+  SyntheticSpec sparse;  // the spine rotation keeps frames 0 15 30
+  sparse.clips[0].animated[0].segment_offset_bits = 8;
+  EXPECT_TRUE(rejects(sparse, with(kClip, {"segment_offset_bits 8", "a key on every frame"})));
+  SyntheticSpec raw = segmented_spec(0, 2, 0);  // raw floats carry no codes to segment
+  raw.clips[0].animated[0].bits = 32;
+  raw.clips[0].key_values.reset();
+  raw.clips[0].animated[0].segment_offset_bits = 0;
+  ASSERT_TRUE(accepts(make_valid_file(raw)));
+  raw.clips[0].animated[0].segment_offset_bits = 8;
+  EXPECT_TRUE(rejects(raw, with(kClip, {"segment_offset_bits 8", "quantized keys"})));
 }
 
 SyntheticRootMotion valid_root_motion(uint32_t frames) {

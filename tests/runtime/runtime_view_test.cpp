@@ -219,7 +219,7 @@ TEST(RuntimeView, ClipAndMaterialViewsReturnWhatWasWritten) {
     const float ex[3] = {a.range_extent().x(), a.range_extent().y(), a.range_extent().z()};
     for (uint32_t k = 0; k < a.key_count(); ++k) {
       float v[3];
-      decode_key(c.key_values().data(), a.bit_offset(), widths_of(a), lo, ex, k, v);
+      decode_key(c.key_values().data(), a.bit_offset(), widths_of(a), a.segment_offset_bits(), lo, ex, k, v);
       for (int j = 0; j < 3; ++j) {
         const float step = w.bits == kRawFloatBits ? 0.0f : 0.5f / static_cast<float>(quant_max(w.bits));
         EXPECT_NEAR(v[j], w.values[k][j], step * ex[j] + 1e-7f) << i << " " << k << " " << j;

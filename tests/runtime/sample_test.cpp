@@ -54,7 +54,7 @@ std::array<double, 4> decoded_key(const ClipView& clip, const fb::AnimatedChanne
   const float lo[3] = {a.range_min().x(), a.range_min().y(), a.range_min().z()};
   const float ex[3] = {a.range_extent().x(), a.range_extent().y(), a.range_extent().z()};
   float v[3];
-  decode_key(clip.key_values().data(), a.bit_offset(), widths_of(a), lo, ex, k, v);
+  decode_key(clip.key_values().data(), a.bit_offset(), widths_of(a), a.segment_offset_bits(), lo, ex, k, v);
   if (a.channel() != fb::Channel::Rotation) return {v[0], v[1], v[2], 0.0};
   // The dropped component, rebuilt by the format's own float expression (the cooker tunes the
   // stored values to it, so a double-precision rebuild would disagree near half turns).
@@ -259,7 +259,7 @@ TEST(Sample, KeyFramesGiveTheFormatsDecodedTranslationsAndScalesBitForBit) {
         const uint32_t frame = key_frame(clip.key_frames().data(), a.first_key(), a.key_count(), clip.frame_count(), k);
         sample(clip, static_cast<float>(frame) / clip.sample_rate(), SampleOptions{.loop = false}, cache, pose);
         float v[3];
-        decode_key(clip.key_values().data(), a.bit_offset(), widths_of(a), lo, ex, k, v);
+        decode_key(clip.key_values().data(), a.bit_offset(), widths_of(a), a.segment_offset_bits(), lo, ex, k, v);
         for (uint32_t c = 0; c < 3; ++c) {
           const float got = pose.span()[static_cast<PoseComponent>(first_component(a.channel()) + c)][a.joint()];
           ASSERT_EQ(std::memcmp(&got, &v[c], sizeof got), 0)
@@ -396,6 +396,66 @@ TEST(Sample, SeeksFindTheKeyPairInALongClipWithSparseAndDenseRuns) {
     sample(clip, t, SampleOptions{.loop = false}, *shared, pose);
     sample(clip, t, SampleOptions{.loop = false}, own, other);
     ASSERT_TRUE(same_bits(pose, other)) << "frame " << frame;
+  }
+}
+
+TEST(Sample, SegmentedKeysSampleAsTheirPlainKeysBitForBit) {
+  // Format v14: a channel keyed at every frame may store its codes in segments of 16 keys, each
+  // with its own minimum and width per component. The same codes segmented or plain must sample to
+  // the same bits at every time, forward and by seeks: here 200 frames (13 segments, the last of 8
+  // keys), components that move slowly, jump once (a segment spanning the channel's whole range),
+  // or hold still for a segment (width 0), in rotation, translation and scale channels of
+  // different widths, with data offsets of 14 bits (the fewest that hold them all) and 32, and
+  // with one channel segmented beside plain ones (the sampler decodes those in a loop of its own).
+  const auto spec_of = [](std::array<uint8_t, 3> offset_bits) {
+    test::SyntheticSpec spec;
+    test::SyntheticClip& c = spec.clips[0];
+    c.frame_count = 200;
+    c.constants.clear();
+    const auto channel = [&](uint16_t joint, fb::Channel ch, std::array<uint8_t, 3> widths, float phase) {
+      test::SyntheticAnimated a;
+      a.joint = joint;
+      a.channel = ch;
+      a.widths = widths;
+      a.segment_offset_bits = offset_bits[joint];
+      for (uint16_t f = 0; f < 200; ++f) {
+        const float x = 0.3f * std::sin(0.05f * static_cast<float>(f) + phase) + (f >= 120 ? 0.4f : 0.0f);
+        const float still = f >= 32 && f < 48 ? 0.25f : 0.1f * std::cos(0.11f * static_cast<float>(f));
+        a.frames.push_back(f);
+        a.values.push_back(ch == fb::Channel::Rotation ? std::array<float, 3>{0.5f * x, still, 0.1f}
+                                                       : std::array<float, 3>{x, still, 1.0f + 0.5f * x});
+      }
+      return a;
+    };
+    c.animated = {channel(0, fb::Channel::Translation, {10, 6, 3}, 0.0f),
+                  channel(1, fb::Channel::Rotation, {14, 12, 1}, 1.0f),
+                  channel(2, fb::Channel::Scale, {19, 19, 19}, 2.0f)};
+    return spec;
+  };
+  const Loaded plain = load(spec_of({0, 0, 0}));
+  const std::vector<uint8_t> plain_bytes = make_valid_file(spec_of({0, 0, 0}));
+  using Layout = std::array<uint8_t, 3>;
+  for (const Layout offset_bits : {Layout{14, 14, 14}, Layout{32, 32, 32}, Layout{0, 14, 0}, Layout{32, 0, 14}}) {
+    const test::SyntheticSpec spec = spec_of(offset_bits);
+    EXPECT_LT(make_valid_file(spec).size(), plain_bytes.size()) << "segments take fewer bits here";
+    const Loaded segmented = load(spec);
+    SamplingCache a = cache_for(plain.clip(), plain.skeleton());
+    SamplingCache b = cache_for(segmented.clip(), segmented.skeleton());
+    Pose pa(static_cast<uint32_t>(plain.skeleton().joint_count()));
+    Pose pb(static_cast<uint32_t>(segmented.skeleton().joint_count()));
+    std::vector<double> frames;
+    for (int k = 0; k < 200; ++k) frames.insert(frames.end(), {double(k), k + 0.25, k + 0.75});
+    std::mt19937 rng(23);
+    std::uniform_real_distribution<double> u(0.0, 199.0);
+    for (int i = 0; i < 300; ++i) frames.push_back(u(rng));
+    std::shuffle(frames.begin() + 600, frames.end(), rng);  // forward playback first, then seeks
+    for (const double frame : frames) {
+      const float t = static_cast<float>(frame / plain.clip().sample_rate());
+      sample(plain.clip(), t, SampleOptions{.loop = false}, a, pa);
+      sample(segmented.clip(), t, SampleOptions{.loop = false}, b, pb);
+      ASSERT_TRUE(same_bits(pa, pb)) << "offset bits " << int{offset_bits[0]} << " " << int{offset_bits[1]} << " "
+                                     << int{offset_bits[2]} << ", frame " << frame;
+    }
   }
 }
 

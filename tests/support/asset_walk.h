@@ -335,7 +335,24 @@ class AssetWalker {
       if (ch.channel() == fb::Channel::Rotation && ch.dropped() > 3)
         return fail(at, "rotation drops no component 0..3");
       if (values.size() < 8) return fail(at, "key values shorter than their padding");
-      const uint64_t end = ch.bit_offset() + (uint64_t{w[0]} + w[1] + w[2]) * n;
+      uint64_t end = ch.bit_offset() + (uint64_t{w[0]} + w[1] + w[2]) * n;
+      if (const uint32_t o = ch.segment_offset_bits(); o != 0) {  // segmented: walk the headers
+        if (raw || o > 32 || n != frame_count) return fail(at, "segmented, but raw, past 32 bits or not every frame");
+        const KeyWidths kw{{w[0], w[1], w[2]}};
+        const uint64_t segments = (n + 15) / 16, header = o + kw.total() + 15;
+        if (ch.bit_offset() + segments * header > 8ull * (values.size() - 8))
+          return fail(at, "segment headers past key_values");
+        uint64_t data = segments * header;
+        for (uint64_t s = 0; s < segments; ++s) {
+          const SegmentHeader h = read_segment(values.data(), ch.bit_offset(), kw, o, static_cast<uint32_t>(s));
+          if (h.data != data) return fail(at, "segment keys not where the previous segment ends");
+          for (uint32_t i = 0; i < 3; ++i)
+            if (h.widths.c[i] > w[i] || uint64_t{h.min[i]} + ((1ull << h.widths.c[i]) - 1) > (1ull << w[i]) - 1)
+              return fail(at, "segment width or minimum outside the channel's codes");
+          data += h.widths.total() * std::min<uint64_t>(16, n - 16 * s);
+        }
+        end = ch.bit_offset() + data;
+      }
       if (end > 8ull * (values.size() - 8)) return fail(at, "keys past key_values (before padding)");
       if (b == 32) {
         if (ch.bit_offset() % 8 != 0) return fail(at, "raw keys not byte-aligned");

@@ -68,6 +68,7 @@ CompressedClip read_clip(const fb::Clip& c) {
     a.channel = static_cast<uint8_t>(k->channel());
     a.bits = widths_of(*k);
     a.dropped = k->dropped();
+    a.segment_offset_bits = k->segment_offset_bits();
     a.first_key = k->first_key();
     a.key_count = k->key_count();
     a.bit_offset = k->bit_offset();

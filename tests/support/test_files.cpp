@@ -229,6 +229,35 @@ flatbuffers::Offset<fb::Mesh> write_mesh(flatbuffers::FlatBufferBuilder& fbb, co
                         &lo, &hi, &offset, &scale, joints, inverse_bind, target_vector, cloth);
 }
 
+/// Writes quantized codes q (one per key) of a channel of widths w segmented (clip_codec.h), with
+/// data offsets of `offset_bits` bits (truncated to them when too narrow).
+void write_segmented(BitWriter& writer, const std::vector<std::array<uint32_t, 3>>& q, const KeyWidths& w,
+                     uint32_t offset_bits) {
+  const auto n = static_cast<uint32_t>(q.size());
+  const uint32_t count = segment_count(n);
+  std::vector<std::array<uint32_t, 3>> lo(count), width(count);
+  for (uint32_t s = 0; s < count; ++s) {
+    for (uint32_t c = 0; c < 3; ++c) {
+      uint32_t a = quant_max(w.c[c]), b = 0;
+      for (uint32_t k = s * kSegmentKeys; k < std::min(n, (s + 1) * kSegmentKeys); ++k) {
+        a = std::min(a, q[k][c]);
+        b = std::max(b, q[k][c]);
+      }
+      while (((b - a) >> width[s][c]) != 0) ++width[s][c];
+      lo[s][c] = std::min(a, quant_max(w.c[c]) - quant_max(width[s][c]));
+    }
+  }
+  uint64_t data = segment_header_bits(w, offset_bits) * count;
+  for (uint32_t s = 0; s < count; ++s) {
+    for (uint32_t c = 0; c < 3; ++c) writer.write(width[s][c], kSegmentWidthBits);
+    writer.write(data, offset_bits);
+    for (uint32_t c = 0; c < 3; ++c) writer.write(lo[s][c], w.c[c]);
+    data += (uint64_t{width[s][0]} + width[s][1] + width[s][2]) * std::min(kSegmentKeys, n - s * kSegmentKeys);
+  }
+  for (uint32_t k = 0; k < n; ++k)
+    for (uint32_t c = 0; c < 3; ++c) writer.write(q[k][c] - lo[k / kSegmentKeys][c], width[k / kSegmentKeys][c]);
+}
+
 flatbuffers::Offset<fb::Clip> write_clip(flatbuffers::FlatBufferBuilder& fbb, const SyntheticClip& c,
                                          uint64_t skeleton_hash, uint16_t joint_count) {
   // Pack every animated channel in order: frames appended to key_frames, keys to one bit stream.
@@ -254,15 +283,25 @@ flatbuffers::Offset<fb::Clip> write_clip(flatbuffers::FlatBufferBuilder& fbb, co
     const std::array<uint8_t, 3> widths = a.widths.value_or(std::array<uint8_t, 3>{a.bits, a.bits, a.bits});
     if (widths[0] == kRawFloatBits) writer.align_byte();
     const auto bit_offset = static_cast<uint32_t>(writer.bit_size());
-    for (const auto& v : a.values) {
-      for (int i = 0; i < 3; ++i) {
-        if (widths[i] == kRawFloatBits) writer.write_float(v[i]);
-        else if (widths[i] >= 1 && widths[i] <= kMaxQuantBits)
-          writer.write(quantize(v[i], rmin[i], rext[i], widths[i]), widths[i]);
+    const KeyWidths kw{{widths[0], widths[1], widths[2]}};
+    const bool quantized = std::all_of(kw.c, kw.c + 3, [](uint32_t w) { return w >= 1 && w <= kMaxQuantBits; });
+    if (a.segment_offset_bits != 0 && quantized) {
+      std::vector<std::array<uint32_t, 3>> q;
+      for (const auto& v : a.values)
+        q.push_back({quantize(v[0], rmin[0], rext[0], kw.c[0]), quantize(v[1], rmin[1], rext[1], kw.c[1]),
+                     quantize(v[2], rmin[2], rext[2], kw.c[2])});
+      write_segmented(writer, q, kw, a.segment_offset_bits);
+    } else {
+      for (const auto& v : a.values) {
+        for (int i = 0; i < 3; ++i) {
+          if (widths[i] == kRawFloatBits) writer.write_float(v[i]);
+          else if (widths[i] >= 1 && widths[i] <= kMaxQuantBits)
+            writer.write(quantize(v[i], rmin[i], rext[i], widths[i]), widths[i]);
+        }
       }
     }
     animated.emplace_back(a.joint, a.channel, flatbuffers::span<const uint8_t, 3>(widths),
-                          a.dropped.value_or(a.channel == fb::Channel::Rotation ? 3 : 0),
+                          a.dropped.value_or(a.channel == fb::Channel::Rotation ? 3 : 0), a.segment_offset_bits,
                           a.first_key.value_or(first_key), key_count, a.bit_offset.value_or(bit_offset), range_min,
                           range_extent);
   }

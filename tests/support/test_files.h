@@ -149,6 +149,9 @@ struct SyntheticAnimated {
   std::optional<uint32_t> first_key;     // default: where its frames were appended
   std::optional<uint32_t> key_count;     // default: frames.size()
   std::optional<uint32_t> bit_offset;    // default: where its keys were packed
+  /// Non-zero: the keys are written segmented (format v14, ossa/format/clip_codec.h) with data
+  /// offsets of this many bits, each segment's minimum and widths the tightest for its codes.
+  uint8_t segment_offset_bits = 0;
 };
 
 struct SyntheticRootMotion {

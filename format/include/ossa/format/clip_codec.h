@@ -12,6 +12,19 @@
 // keeps the rebuilt component precise near half turns. Widths of 32 store raw floats: the escape
 // for channels no quantization can hold within tolerance (and for lossless cooks).
 //
+// A channel keyed at every frame may be segmented (AnimatedChannel.segment_offset_bits > 0): its
+// keys go in segments of kSegmentKeys, each with its own minimum code and width per component, so
+// a long clip pays for the range each 16-frame stretch covers rather than the whole clip's (ACL's
+// segments; on CMU mocap ~20% fewer key bits, headers included). The codes are the channel's own
+// (a lossless re-packing of the plain layout), so range, dequantization and error are unchanged.
+// Layout at bit_offset: the segments' headers, then their keys. Header s is segment_header_bits
+// long, at bit_offset + s * that: the three widths (kSegmentWidthBits each, 0..bits[c]), the bit
+// position of its first key relative to bit_offset (segment_offset_bits bits), the three minimum
+// codes (bits[c] bits each); key i of the segment follows at that position + i * (the three
+// widths summed), component c decoding to minimum + field. Random access stays O(1): a header
+// read, then the key. Widths and position come first so that one 64-bit read gives the key's
+// address, and the minima's read runs beside the key's.
+//
 // Decoding reads 64 bits at a time: the stream must be followed by at least 8 readable bytes
 // (kKeyValuePadding), which the writer appends and the loader checks.
 #pragma once
@@ -34,11 +47,11 @@ constexpr uint32_t quant_max(uint32_t bits) { return (1u << bits) - 1u; }
 /// or all three kRawFloatBits.
 struct KeyWidths {
   uint32_t c[3] = {0, 0, 0};
-  bool raw() const { return c[0] == kRawFloatBits; }
+  constexpr bool raw() const { return c[0] == kRawFloatBits; }
   /// Bits one key takes.
-  uint64_t total() const { return uint64_t{c[0]} + c[1] + c[2]; }
+  constexpr uint64_t total() const { return uint64_t{c[0]} + c[1] + c[2]; }
   /// Bit position of component i within a key.
-  uint32_t shift(uint32_t i) const { return i == 0 ? 0 : (i == 1 ? c[0] : c[0] + c[1]); }
+  constexpr uint32_t shift(uint32_t i) const { return i == 0 ? 0 : (i == 1 ? c[0] : c[0] + c[1]); }
   static KeyWidths uniform(uint32_t bits) { return KeyWidths{{bits, bits, bits}}; }
   bool operator==(const KeyWidths&) const = default;
 };
@@ -67,19 +80,69 @@ inline uint64_t read_bits(const uint8_t* stream, uint64_t bit, uint32_t count) {
   return (word >> (bit & 7u)) & ((count >= 64 ? 0 : (1ull << count)) - 1ull);
 }
 
+inline constexpr uint32_t kSegmentKeys = 16;
+inline constexpr uint32_t kSegmentWidthBits = 5;
+/// Widest segment data offset (AnimatedChannel.segment_offset_bits: 1..this, 0 for plain keys).
+inline constexpr uint32_t kMaxSegmentOffsetBits = 32;
+
+/// Segments of a segmented channel of `key_count` keys.
+constexpr uint32_t segment_count(uint32_t key_count) { return (key_count + kSegmentKeys - 1) / kSegmentKeys; }
+/// Bits of one segment header of a channel of widths `bits` and data offsets of `offset_bits`.
+constexpr uint64_t segment_header_bits(const KeyWidths& bits, uint32_t offset_bits) {
+  return offset_bits + bits.total() + 3 * kSegmentWidthBits;
+}
+
+/// One segment's header: where its keys start (from the channel's bit_offset), each component's
+/// minimum code and width (0..the channel's).
+struct SegmentHeader {
+  uint64_t data = 0;
+  uint32_t min[3] = {0, 0, 0};
+  KeyWidths widths;
+};
+
+/// Header of segment `segment` of a segmented channel. O(1): three reads.
+inline SegmentHeader read_segment(const uint8_t* stream, uint64_t bit_offset, const KeyWidths& bits,
+                                  uint32_t offset_bits, uint32_t segment) {
+  SegmentHeader h;
+  const uint64_t at = bit_offset + segment_header_bits(bits, offset_bits) * segment;
+  const uint64_t widths = read_bits(stream, at, 3 * kSegmentWidthBits);
+  h.data = read_bits(stream, at + 3 * kSegmentWidthBits, offset_bits);
+  const uint64_t mins =
+      read_bits(stream, at + 3 * kSegmentWidthBits + offset_bits, static_cast<uint32_t>(bits.total()));
+  for (uint32_t c = 0; c < 3; ++c) {
+    h.min[c] = static_cast<uint32_t>(mins >> bits.shift(c)) & quant_max(bits.c[c]);
+    h.widths.c[c] = static_cast<uint32_t>(widths >> (kSegmentWidthBits * c)) & quant_max(kSegmentWidthBits);
+  }
+  return h;
+}
+
+/// The three codes of key `key` of a quantized channel, plain (offset_bits 0) or segmented. O(1).
+inline void key_codes(const uint8_t* stream, uint64_t bit_offset, const KeyWidths& bits, uint32_t offset_bits,
+                      uint32_t key, uint32_t q[3]) {
+  if (offset_bits == 0) {
+    const uint64_t packed = read_bits(stream, bit_offset + bits.total() * key, static_cast<uint32_t>(bits.total()));
+    for (uint32_t c = 0; c < 3; ++c) q[c] = static_cast<uint32_t>(packed >> bits.shift(c)) & quant_max(bits.c[c]);
+    return;
+  }
+  const SegmentHeader h = read_segment(stream, bit_offset, bits, offset_bits, key / kSegmentKeys);
+  const uint64_t packed = read_bits(stream, bit_offset + h.data + h.widths.total() * (key % kSegmentKeys),
+                                    static_cast<uint32_t>(h.widths.total()));
+  for (uint32_t c = 0; c < 3; ++c)
+    q[c] = h.min[c] + (static_cast<uint32_t>(packed >> h.widths.shift(c)) & quant_max(h.widths.c[c]));
+}
+
 /// Decodes key `key` of a channel: three floats (rotation: x, y, z with w >= 0 implied).
-/// O(1), no branches but the raw-float escape.
-inline void decode_key(const uint8_t* stream, uint64_t bit_offset, const KeyWidths& bits, const float range_min[3],
-                       const float range_extent[3], uint32_t key, float out[3]) {
+/// `offset_bits`: the channel's segment_offset_bits (0: plain keys). O(1), no branches but the
+/// raw-float escape and the layout.
+inline void decode_key(const uint8_t* stream, uint64_t bit_offset, const KeyWidths& bits, uint32_t offset_bits,
+                       const float range_min[3], const float range_extent[3], uint32_t key, float out[3]) {
   if (bits.raw()) {
     std::memcpy(out, stream + ((bit_offset + 96ull * key) >> 3), 12);
     return;
   }
-  const uint64_t packed = read_bits(stream, bit_offset + bits.total() * key, static_cast<uint32_t>(bits.total()));
-  for (uint32_t c = 0; c < 3; ++c) {
-    const auto q = static_cast<uint32_t>(packed >> bits.shift(c)) & quant_max(bits.c[c]);
-    out[c] = dequantize(q, range_min[c], range_extent[c], bits.c[c]);
-  }
+  uint32_t q[3];
+  key_codes(stream, bit_offset, bits, offset_bits, key, q);
+  for (uint32_t c = 0; c < 3; ++c) out[c] = dequantize(q[c], range_min[c], range_extent[c], bits.c[c]);
 }
 
 /// The dropped component of a unit quaternion from the three stored ones (it was >= 0). The
