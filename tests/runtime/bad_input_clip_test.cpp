@@ -315,7 +315,7 @@ SyntheticSpec segmented_spec(uint32_t min0, uint32_t width0, uint32_t skew) {
   w.write(0, 15);
   w.write(headers + 16 * width0, 8);
   w.write(0, 12);
-  w.write(0, 16 * width0);
+  for (uint32_t k = 0; k < 16; ++k) w.write(0, width0);  // segment 0's keys
   spec.clips[0].key_values = w.finish();
   return spec;
 }
