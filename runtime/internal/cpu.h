@@ -30,5 +30,9 @@ bool cpu_has_avx2();
 bool cpu_has_avx2_fma();
 /// cpu_has_avx2_fma() and AVX-512 F/VL/BW/DQ, with OS support for the ZMM state.
 bool cpu_has_avx512();
+/// cpu_has_avx512() on a CPU that runs a 512-bit operation as two 256-bit halves (AMD Zen 4): a
+/// kernel that only widens its arithmetic from 256 to 512 bits gains nothing there, and pays
+/// for the extra extracts.
+bool cpu_avx512_split();
 
 }  // namespace ossa::detail

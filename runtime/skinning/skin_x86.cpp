@@ -31,8 +31,9 @@
 // 512-bit operation as two 256-bit halves, a 16-wide per-vertex kernel measured ~25% slower (more
 // cross-lane shuffles for the same arithmetic). The range loops' AVX-512 copy blends a vertex's
 // matrix in one 512-bit register (one FMA per influence instead of two): positions alone ~8%
-// faster on Zen 5, whose 512-bit units are full width. The classification is where AVX-512 pays
-// most. Scalar word loads rather than gathers in steps 1 and 2: measured faster on Zen 4.
+// faster on Zen 5, whose 512-bit units are full width, and used only where they are full width
+// (not on Zen 4: cpu_avx512_split). The classification is where AVX-512 pays most. Scalar word
+// loads rather than gathers in steps 1 and 2: measured faster on Zen 4.
 // Palette matrices are 64 bytes read as 32- or 64-byte loads; skin_quantized copies a palette
 // that is not 64-byte aligned (a std::vector<glm::mat4> is aligned to 16) to one that is, since a
 // load across two cache lines costs two (~7-10% of a call on arnaud, Zen 5, for a 3.4 KB copy).
@@ -361,6 +362,10 @@ OSSA_TARGET_AVX2 void skin_fast(const float* palette, const FastMesh& m, Outputs
   }
   Batch b;
   uint32_t begin = 0;
+  // The per-vertex range loops' 512-bit blend only where 512-bit operations run at full width: on
+  // Zen 4, which splits them in two, it is the same work plus an extract per vertex (positions
+  // alone measured 8-14% slower than the 256-bit blend there, Pab's arnaud).
+  const bool blend512 = avx512 && !detail::cpu_avx512_split();
   const auto run = [&](auto k) -> bool {
     constexpr int K = decltype(k)::value;
     const uint32_t end = K == kClasses - 1 ? m.count : class_end(m, begin, K);
@@ -377,7 +382,7 @@ OSSA_TARGET_AVX2 void skin_fast(const float* palette, const FastMesh& m, Outputs
     for (b.first = begin; b.first < end; b.first += kBatch) {
       b.n = std::min(kBatch, end - b.first);
       if constexpr (kNormals || kTangents) decode_directions<kTangents>(m, b);
-      const uint32_t outside = avx512
+      const uint32_t outside = blend512
                                    ? skin_range_avx512<K, kSlots, kPositions, kNormals, kTangents>(palette, m, b, out)
                                    : skin_range<K, kSlots, kPositions, kNormals, kTangents>(palette, m, b, out);
       if (outside != 0) {
