@@ -28,6 +28,19 @@ struct Streams {
   std::vector<MorphStreams> targets;  // merged by name over the members; zeros where a member lacks one
 };
 
+/// Renumbers a weld's remap (old vertex -> new, the new ones numbered in first use order, ~0u for
+/// a vertex no triangle uses) so that the kept vertices keep their order: each merged set is
+/// numbered where its first member stands. O(vertices).
+void keep_vertex_order(std::vector<unsigned>& remap, size_t unique) {
+  std::vector<unsigned> renumbered(unique, ~0u);
+  unsigned next = 0;
+  for (unsigned& r : remap) {
+    if (r == ~0u) continue;
+    if (renumbered[r] == ~0u) renumbered[r] = next++;
+    r = renumbered[r];
+  }
+}
+
 struct PaletteEntry {
   uint16_t joint = 0;
   glm::mat4 inverse_bind{1.0f};
@@ -393,10 +406,11 @@ Result<CookedMesh> build_group(const SourceScene& scene, const std::vector<Clean
   }
 
   // Vertices the quantized layout made identical (source vertices a rounding error apart, which
-  // Assimp used to merge by epsilon) are one vertex: equal bytes draw exactly alike. The remap
-  // numbers vertices in first use order, which the fetch optimizer already gave them, so the
-  // fetch order is kept. With morph targets, the targets' quantized deltas are part of the key:
-  // two vertices merge only when every target moves them alike.
+  // Assimp used to merge by epsilon) are one vertex: equal bytes draw exactly alike. The merged
+  // vertex takes its first member's place and the others keep their order (keep_vertex_order),
+  // so a skinned mesh stays ordered by influence class (merged vertices have equal weights) and
+  // every class range keeps its fetch order. With morph targets, the targets' quantized deltas are
+  // part of the key: two vertices merge only when every target moves them alike.
   if (quantized && vertex_count > 0) {
     std::vector<unsigned> remap(vertex_count);
     size_t unique = 0;
@@ -415,6 +429,7 @@ Result<CookedMesh> build_group(const SourceScene& scene, const std::vector<Clean
       });
     }
     if (unique < vertex_count) {
+      keep_vertex_order(remap, unique);
       for (DenseMorph& d : dense) remap_morph(d, remap, unique);
       compact(s.cloth, remap, unique);
       std::vector<uint8_t> merged(unique * layout.stride);

@@ -11,12 +11,15 @@
 
 #include <algorithm>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
+#include <ossa/format/vertex_codec.h>
+#include <ossa/loader/asset.h>
 #include "test_files.h"
 
 namespace fs = std::filesystem;
@@ -81,6 +84,32 @@ bool cook_shared_assets(const fs::path& out, int jobs) {
               j);
 }
 
+/// The cooker's promise to skin_cpu's range loops, on every skinned mesh cooked: influence classes
+/// never decrease along the vertex buffer (one contiguous range per class). Meshes whose
+/// quantized vertices merge (most of ../shared/assets) are where it once broke.
+void expect_class_order(const fs::path& cooked) {
+  size_t skinned = 0;
+  for (const fs::path& rel : cooked_files(cooked)) {
+    auto asset = ossa::Asset::open((cooked / rel).string());
+    ASSERT_TRUE(asset.ok()) << rel << ": " << asset.error().message;
+    for (size_t i = 0; i < asset->mesh_count(); ++i) {
+      const ossa::MeshView mesh = asset->mesh(i);
+      const ossa::fb::VertexAttribute* w = mesh.attribute(ossa::fb::VertexSemantic::Weights);
+      if (w == nullptr || w->format() != ossa::fb::VertexFormat::Unorm8x4) continue;
+      ++skinned;
+      int last = 0;
+      for (uint32_t v = 0; v < mesh.vertex_count(); ++v) {
+        uint32_t word;
+        std::memcpy(&word, mesh.vertex_bytes().data() + size_t{v} * mesh.vertex_stride() + w->offset(), 4);
+        const int c = ossa::influence_class(word);
+        ASSERT_GE(c, last) << rel << " mesh " << i << ": vertex " << v << " is of a lower influence class";
+        last = c;
+      }
+    }
+  }
+  EXPECT_GT(skinned, 0u) << cooked;
+}
+
 void expect_goldens(const fs::path& cooked, const fs::path& golden_dir) {
   const auto files = cooked_files(cooked);
   ASSERT_FALSE(files.empty());
@@ -134,6 +163,7 @@ TEST(Golden, RepoAssetsMatchGoldensAndCookDeterministically) {
                  c = ossa::test::make_temp_dir("det-c");
   ASSERT_TRUE(cook_repo_assets(a, 2));
   expect_goldens(a, ossa::test::source_dir() / "tests" / "golden" / "assets");
+  expect_class_order(a);
   ASSERT_TRUE(cook_repo_assets(b, 1));
   ASSERT_TRUE(cook_repo_assets(c, 2));
   expect_same_bytes(a, b);  // --jobs 2 vs --jobs 1
@@ -146,6 +176,7 @@ TEST(Golden, SharedAssetsMatchGoldensAndCookDeterministically) {
   const fs::path a = ossa::test::make_temp_dir("golden-shared-a"), b = ossa::test::make_temp_dir("golden-shared-b");
   ASSERT_TRUE(cook_shared_assets(a, 2));
   expect_goldens(a, ossa::test::source_dir() / "tests" / "golden" / "shared");
+  expect_class_order(a);
   ASSERT_TRUE(cook_shared_assets(b, 1));
   expect_same_bytes(a, b);
 }
