@@ -419,7 +419,7 @@ TEST(Skinning, RangeLoopsReadEveryWeightByteAsTheClassifiedLoopsDo) {
   // A class-ordered mesh runs one loop per class range, anything else classified batches; both
   // read the joint slots and weights their own way. Every byte value in every influence of every
   // class, skinned both ways (the same vertices class-ordered, and in reverse so that the order
-  // probe fails), must give the same positions and tangents, bit for bit.
+  // probe fails), must give the same positions, normals and tangents, bit for bit.
   ossa::test::SyntheticSpec spec;
   std::mt19937 gen(11);
   std::uniform_real_distribution<float> u(-1.0f, 1.0f);
@@ -468,10 +468,16 @@ TEST(Skinning, RangeLoopsReadEveryWeightByteAsTheClassifiedLoopsDo) {
     ossa::skin_cpu(dealt.asset->mesh(0), palette, ossa::SkinningMethod::Linear, {q, {}, {}});
     ossa::skin_cpu(ordered.asset->mesh(0), palette, ossa::SkinningMethod::Linear, {{}, {}, t});
     ossa::skin_cpu(dealt.asset->mesh(0), palette, ossa::SkinningMethod::Linear, {{}, {}, r});
+    // With normals and no tangents the class ranges run the eight-vertex kernel (soa_kernel.h).
+    std::vector<float> pn(3 * n), qn(3 * n), pp(3 * n), qp(3 * n);
+    ossa::skin_cpu(ordered.asset->mesh(0), palette, ossa::SkinningMethod::Linear, {pp, pn, {}});
+    ossa::skin_cpu(dealt.asset->mesh(0), palette, ossa::SkinningMethod::Linear, {qp, qn, {}});
     size_t differ = 0;
     for (size_t v = 0; v < n; ++v) {
       differ += std::memcmp(&p[3 * v], &q[3 * (n - 1 - v)], 12) != 0;
       differ += std::memcmp(&t[4 * v], &r[4 * (n - 1 - v)], 16) != 0;
+      differ += std::memcmp(&pp[3 * v], &qp[3 * (n - 1 - v)], 12) != 0;
+      differ += std::memcmp(&pn[3 * v], &qn[3 * (n - 1 - v)], 12) != 0;
     }
     EXPECT_EQ(differ, 0u) << isa_name(isa);
   }
