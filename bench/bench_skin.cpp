@@ -143,14 +143,16 @@ int main(int argc, char** argv) {
       for (int s = 0; s < cases[i].streams; ++s) time_streams(cases[i], s, reps[i]);
 
   std::printf("# ns per vertex, the minimum of %d interleaved rounds; order: how skin_cpu walks the mesh\n", rounds);
-  std::printf("%-48s %4s %8s  %-28s %9s %12s %12s\n", "file", "mesh", "vertices", "order", "positions", "+normals",
-              "+tangents");
+  int width = 4;
+  for (const Case& c : cases) width = std::max(width, static_cast<int>(c.file.size()));
+  std::printf("%-*s %4s %8s  %-28s %9s %12s %12s\n", width, "file", "mesh", "vertices", "order", "positions",
+              "+normals", "+tangents");
   for (const Case& c : cases) {
     char t[32] = "-";
     if (c.streams == 3) std::snprintf(t, sizeof t, "%.3f", c.best[2]);
     char n[32] = "-";
     if (c.streams >= 2) std::snprintf(n, sizeof n, "%.3f", c.best[1]);
-    std::printf("%-48s %4zu %8u  %-28s %9.3f %12s %12s\n", c.file.c_str(), c.mesh_index, c.mesh.vertex_count(),
+    std::printf("%-*s %4zu %8u  %-28s %9.3f %12s %12s\n", width, c.file.c_str(), c.mesh_index, c.mesh.vertex_count(),
                 c.order.c_str(), c.best[0], n, t);
   }
   return 0;
