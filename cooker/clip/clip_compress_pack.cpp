@@ -144,8 +144,7 @@ Status pack(const std::vector<ChannelPlan>& plans, uint32_t joints, uint32_t fra
         if (ch != kRotation) {
           c.value[3] = 0.0f;
         } else {  // stored as three components: the value is what a reader rebuilds
-          for (uint32_t i = 1; i < 4; ++i)
-            if (std::fabs(c.value[i]) > std::fabs(c.value[c.dropped])) c.dropped = static_cast<uint8_t>(i);
+          c.dropped = static_cast<uint8_t>(largest_component(c.value));
           float stored[3];
           rotation_to_stored(c.value, c.dropped, stored);
           rotation_from_stored(stored, c.dropped, c.value);

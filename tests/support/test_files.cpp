@@ -316,8 +316,7 @@ flatbuffers::Offset<fb::Clip> write_clip(flatbuffers::FlatBufferBuilder& fbb, co
     float stored[3] = {v[0], v[1], v[2]};
     uint8_t dropped = 0;
     if (k.channel == fb::Channel::Rotation) {  // the largest component left out, as the cooker does
-      for (uint8_t i = 1; i < 4; ++i)
-        if (std::fabs(v[i]) > std::fabs(v[dropped])) dropped = i;
+      dropped = static_cast<uint8_t>(largest_component(v));
       rotation_to_stored(v, dropped, stored);
     }
     const uint8_t d = k.dropped.value_or(dropped);

@@ -160,6 +160,15 @@ inline void rotation_from_stored(const float stored[3], uint32_t dropped, float 
   for (uint32_t c = 0; c < 4; ++c) out[c] = c == dropped ? rebuilt : stored[j++];
 }
 
+/// The component a rotation constant leaves out: the first of largest magnitude, so the one rebuilt
+/// (rotation_w) is the one least hurt by the square root's loss of precision near 0.
+inline uint32_t largest_component(const float xyzw[4]) {
+  uint32_t d = 0;
+  for (uint32_t c = 1; c < 4; ++c)
+    if (std::fabs(xyzw[c]) > std::fabs(xyzw[d])) d = c;
+  return d;
+}
+
 /// The three components of x, y, z, w stored for a rotation with `dropped` left out (in order).
 inline void rotation_to_stored(const float xyzw[4], uint32_t dropped, float stored[3]) {
   const float sign = xyzw[dropped] < 0.0f ? -1.0f : 1.0f;
