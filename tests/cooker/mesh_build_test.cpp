@@ -408,6 +408,53 @@ TEST(MeshBuild, SkinnedBoxRoundTripsThroughTheQuantizedLayout) {
   EXPECT_EQ(got, want);
 }
 
+TEST(MeshBuild, VerticesMergedByQuantizationKeepTheInfluenceClassOrder) {
+  // A skinned grid whose every interior vertex has a twin a rounding error away (1e-6 of a 15-unit
+  // grid, far inside one unorm16 step), used by every other triangle: the twins are different
+  // source vertices, so they survive the first weld and merge only in the last one, once quantized.
+  // That weld must keep the vertices ordered by influence class (skin_cpu's range loops).
+  const uint32_t cols = 16;
+  SourceScene scene = scene_with({grid(cols, cols)}, chain_skeleton(3));
+  SourceMesh& g = scene.meshes[0];
+  skin(g, kSkinPatterns, scene.skeleton);
+  const size_t n = g.positions.size();
+  std::vector<uint32_t> twin(n);
+  for (size_t v = 0; v < n; ++v) {
+    twin[v] = static_cast<uint32_t>(v);
+    const uint32_t x = static_cast<uint32_t>(v % cols), y = static_cast<uint32_t>(v / cols);
+    if (x == 0 || y == 0 || x + 1 == cols || y + 1 == cols) continue;  // the bounds stay as they are
+    twin[v] = static_cast<uint32_t>(g.positions.size());
+    g.positions.push_back(g.positions[v] + glm::vec3(1e-6f, 1e-6f, 0.0f));
+    g.normals.push_back(g.normals[v]);
+    g.joints.push_back(g.joints[v]);
+    g.weights.push_back(g.weights[v]);
+  }
+  for (size_t t = 0; t < g.indices.size() / 3; t += 2)
+    for (size_t c = 0; c < 3; ++c) g.indices[3 * t + c] = twin[g.indices[3 * t + c]];
+  const size_t triangles = g.indices.size() / 3;
+
+  MeshBuildStats stats;
+  const auto meshes = build_ok(scene, {}, &stats);
+  ASSERT_EQ(meshes.size(), 1u);
+  const CookedMesh& m = meshes[0];
+  EXPECT_EQ(stats.source_vertices, g.positions.size());
+  EXPECT_EQ(m.vertex_count, n) << "every twin merged with its vertex";
+  const Decoded d = decode(m);
+  ASSERT_EQ(d.weights_raw.size(), n);
+  ASSERT_EQ(d.indices.size(), 3 * triangles);
+  int last = 0;
+  std::array<size_t, 5> per_class{};
+  for (size_t v = 0; v < n; ++v) {
+    const auto& w = d.weights_raw[v];
+    const int c = influence_class(w[0] | w[1] << 8 | w[2] << 16 | w[3] << 24);
+    ASSERT_GE(c, last) << "vertex " << v;
+    ++per_class[static_cast<size_t>(c)];
+    last = c;
+  }
+  EXPECT_GT(per_class[0], 0u);
+  EXPECT_GT(per_class[4], 0u);
+}
+
 TEST(MeshBuild, WeightsSumTo255ByLargestRemainder) {
   SourceScene scene = scene_with({triangle_soup(40)}, chain_skeleton(4));
   SourceMesh& src = scene.meshes[0];
