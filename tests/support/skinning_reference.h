@@ -1,7 +1,7 @@
 // skinning_reference.h — the double-precision reference skin_cpu and skinning_matrices are tested
 // against, and the ways of running the code under test in every implementation the CPU has; shared
 // by tests/runtime/skinning_test.cpp (synthetic files) and tests/cooker/skinning_cooked_test.cpp
-// (cooked samples).
+// (cooked samples); tests/cooker/golden_test.cpp checks every cook's class order with it.
 //
 // The reference is written here from the definition, not from skinning.cpp: a vertex's position
 // is sum_k w_k * model[joint(slot_k)] * inverse_bind[slot_k] * (offset + scale * q), its normal
@@ -56,7 +56,6 @@ inline const char* isa_name(ossa::SkinningIsa isa) {
   return "?";
 }
 
-/// Selects an implementation for a scope, and puts the previous one back.
 /// The class the fast paths give these weight bytes: 0 one influence of weight 255, else 1 + the
 /// index of the last non-zero weight (all zero: 1). The cooker orders vertices by it.
 inline int influence_class(const std::array<uint8_t, 4>& w) {
@@ -66,6 +65,23 @@ inline int influence_class(const std::array<uint8_t, 4>& w) {
   return 1;
 }
 
+/// The first vertex of `mesh` whose influence class is lower than the one before it, or
+/// vertex_count() when classes never decrease: the order the cooker promises skin_cpu's class
+/// ranges. Reads the Weights attribute as Unorm8x4 (the caller checks its format).
+inline uint32_t first_class_drop(const ossa::MeshView& mesh) {
+  const ossa::fb::VertexAttribute* w = mesh.attribute(VertexSemantic::Weights);
+  int last = 0;
+  for (uint32_t v = 0; v < mesh.vertex_count(); ++v) {
+    std::array<uint8_t, 4> q;
+    std::memcpy(q.data(), mesh.vertex_bytes().data() + size_t{v} * mesh.vertex_stride() + w->offset(), 4);
+    const int c = influence_class(q);
+    if (c < last) return v;
+    last = c;
+  }
+  return mesh.vertex_count();
+}
+
+/// Selects an implementation for a scope, and puts the previous one back.
 class IsaScope {
  public:
   explicit IsaScope(ossa::SkinningIsa isa) : previous_(ossa::skinning_isa()) { ossa::set_skinning_isa(isa); }
