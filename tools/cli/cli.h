@@ -35,7 +35,7 @@ inline constexpr int kExitUsage = 2;
 
 enum class Verbosity { quiet, normal, verbose };
 
-/// "<tool> 0.6.0 (format 7)": what --version prints.
+/// "<tool> 0.6.1 (format 14)": what --version prints.
 std::string version_line(std::string_view tool);
 
 /// Levenshtein distance (insertions, deletions, substitutions each cost 1; common/edit_distance.h).
