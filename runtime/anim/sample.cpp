@@ -15,7 +15,10 @@
 //      dense run's pair is the frame itself, and a sparse one counts the keys up to the frame in
 //      its seek index's bitmap, so a seek costs the same in a long clip) and decodes
 //      (anim/sample_decode.h: clip_codec.h's decoding specialized; a run's segmented channels
-//      decode after its plain ones, in a loop of their own, each key after its segment's header);
+//      decode after its plain ones, in a loop of their own, each key after its segment's header).
+//      A frame more than kSeekFrames from the last sample's (a seek, a loop's wrap, the first
+//      sample) skips the range tests: every run takes its pair from its index and decodes both
+//      keys of each channel (seek_all), with no branch that depends on the frame;
 //   2. one loop over all joints (SoA, 8-lane blocks): lerp T and S, nlerp R with the shortest-arc
 //      sign fix, write the pose (anim/sample_interpolate.cpp: vector code, on x86-64 compiled
 //      for AVX2 and the SSE2 baseline, picked per call, so the default build runs on any x86-64).
@@ -136,6 +139,9 @@ struct Run {
   uint32_t segmented = 0;  // its last `segmented` tracks are segmented channels, the others plain
 };
 
+/// A sample more than this many frames from the last one is a seek (seek_all).
+constexpr float kSeekFrames = 2.0f;
+
 }  // namespace
 
 struct SamplingCache::State {
@@ -167,6 +173,7 @@ struct SamplingCache::State {
   // The intersection of every run's range (largest enter, smallest leave): a frame inside moves no
   // run, so pass 1 is one compare (a slow clip, updates faster than keys). Empty when forgotten.
   float all_enter = kInf, all_leave = -kInf;
+  float last = kInf;          // the frame position of the last sample (kInf when forgotten)
   std::vector<Track> tracks;  // grouped by run
   // What move_run reads: tracks, or a prototype's (identical: they depend on the clip, rig and filter only).
   const Track* track_data = nullptr;
@@ -197,6 +204,7 @@ void forget_cursors(State& s) {
   }
   s.all_enter = kInf;
   s.all_leave = -kInf;
+  s.last = kInf;
 }
 
 /// Writes a fixed value (bind or constant) into both keys of one joint's channel.
@@ -291,37 +299,47 @@ void make_seek_index(const uint16_t* frames, uint32_t key_count, uint32_t frame_
   }
 }
 
-/// Decodes tracks [t, end) of a run that moved to pair k (frames f0 and f0 + 1 / inv): one key
-/// each when `forward` (k1 becomes k0), both keys otherwise. kSegments: the tracks are segmented.
+/// Decodes both keys of pair k (frames f0 and f0 + 1 / inv) of tracks [t, end) of a run.
+/// kSegments: the tracks are segmented. Always inlined, as move_tracks: each caller's loop is then
+/// compiled for its case (a call per run cost Pab's three-clip frame a tenth, Zen 5).
 template <bool kSegments>
-void move_tracks(State& s, const Track* t, const Track* end, uint32_t k, bool forward, float f0, float inv) {
+[[gnu::always_inline]] inline void decode_pairs(State& s, const Track* t, const Track* end, uint32_t k, float f0,
+                                                float inv) {
   const KeySource src{s.stream, s.track_data, s.segments.data()};
   float* k0 = s.k0;
   float* k1 = s.k1;
-  if (forward) {
-    const auto shift = [&](const Track& x) {  // k1 becomes k0
-      k0[x.offset[0]] = k1[x.offset[0]];
-      k0[x.offset[1]] = k1[x.offset[1]];
-      k0[x.offset[2]] = k1[x.offset[2]];
-      if (x.rotation) k0[x.offset[3]] = k1[x.offset[3]];
-      s.start[x.weight_index] = f0;
-      s.inv_length[x.weight_index] = inv;
-    };
-    for (; end - t >= 2; t += 2) {
-      shift(t[0]);
-      shift(t[1]);
-      decode_two<kSegments>(t[0], t[1], src, k + 1, k1);
-    }
-    if (t != end) {
-      shift(*t);
-      decode<kSegments>(*t, src, k + 1, k1);
-    }
-    return;
-  }
   for (; t != end; ++t) {
     decode_pair<kSegments>(*t, src, k, k0, k1);
     s.start[t->weight_index] = f0;
     s.inv_length[t->weight_index] = inv;
+  }
+}
+
+/// Decodes tracks [t, end) of a run that moved to pair k (frames f0 and f0 + 1 / inv): one key
+/// each when `forward` (k1 becomes k0), both keys otherwise. kSegments: the tracks are segmented.
+template <bool kSegments>
+[[gnu::always_inline]] inline void move_tracks(State& s, const Track* t, const Track* end, uint32_t k, bool forward,
+                                               float f0, float inv) {
+  if (!forward) return decode_pairs<kSegments>(s, t, end, k, f0, inv);
+  const KeySource src{s.stream, s.track_data, s.segments.data()};
+  float* k0 = s.k0;
+  float* k1 = s.k1;
+  const auto shift = [&](const Track& x) {  // k1 becomes k0
+    k0[x.offset[0]] = k1[x.offset[0]];
+    k0[x.offset[1]] = k1[x.offset[1]];
+    k0[x.offset[2]] = k1[x.offset[2]];
+    if (x.rotation) k0[x.offset[3]] = k1[x.offset[3]];
+    s.start[x.weight_index] = f0;
+    s.inv_length[x.weight_index] = inv;
+  };
+  for (; end - t >= 2; t += 2) {
+    shift(t[0]);
+    shift(t[1]);
+    decode_two<kSegments>(t[0], t[1], src, k + 1, k1);
+  }
+  if (t != end) {
+    shift(*t);
+    decode<kSegments>(*t, src, k + 1, k1);
   }
 }
 
@@ -345,6 +363,38 @@ void move_run(State& s, Run& r, float frame) {
   r.cursor = k;
   r.enter = f0;
   r.leave = k + 2 == r.key_count ? kInf : static_cast<float>(frame1);
+}
+
+/// A seek: every run to the pair around `frame` (from its seek index, as find_pair would find it)
+/// and every track's pair decoded, whatever moved. A random seek moves nearly every run; testing
+/// each run's range first mispredicted, and its outcome then broke the prediction of the short
+/// track loops after it (a long clip has dozens of sparse runs of one to three tracks). Here every
+/// branch but the decoders' own takes the same way at every seek. O(runs + tracks).
+void seek_all(State& s, float frame) {
+  const auto whole = static_cast<uint32_t>(frame);
+  float all_enter = -kInf, all_leave = kInf;
+  for (Run& r : std::span<Run>(s.runs, s.run_count)) {
+    uint32_t k = whole;  // a dense run: frames[k] == k
+    if (r.seek) {
+      const SeekBlock& b = r.seek[whole >> 6];  // frames[0] == 0: at least one key counted
+      k = b.before + popcount64(b.keys & (~0ull >> (63 - (whole & 63)))) - 1;
+    }
+    k = k > r.key_count - 2 ? r.key_count - 2 : k;
+    const uint32_t frame0 = r.frames ? r.frames[k] : k, frame1 = r.frames ? r.frames[k + 1] : k + 1;
+    const auto f0 = static_cast<float>(frame0);
+    const float inv = inverse_gap(frame0, frame1);
+    const Track* t = s.track_data + r.first_track;
+    const Track* end = t + r.track_count;
+    decode_pairs<false>(s, t, end - r.segmented, k, f0, inv);
+    if (r.segmented != 0) decode_pairs<true>(s, end - r.segmented, end, k, f0, inv);
+    r.cursor = k;
+    r.enter = f0;
+    r.leave = k + 2 == r.key_count ? kInf : static_cast<float>(frame1);
+    all_enter = std::max(all_enter, r.enter);
+    all_leave = std::min(all_leave, r.leave);
+  }
+  s.all_enter = all_enter;
+  s.all_leave = all_leave;
 }
 
 }  // namespace
@@ -519,8 +569,14 @@ void sample(const ClipView& clip, float time, const SampleOptions& options, Samp
   const auto nearest = static_cast<float>(static_cast<int32_t>(frame + 0.5f));
   if (std::fabs(frame - nearest) <= 1e-5f * (1.0f + nearest)) frame = nearest;
 
-  // Pass 1: runs whose cached pair no longer covers the frame (none while inside every run's range).
-  if (!(frame >= s.all_enter && frame < s.all_leave)) {
+  // Pass 1: a seek (a frame more than kSeekFrames from the last sample's, or the first sample)
+  // decodes every track's pair; otherwise only runs whose cached pair no longer covers the frame
+  // move (none while inside every run's range).
+  const float last = s.last;
+  s.last = frame;
+  if (!(std::fabs(frame - last) <= kSeekFrames)) {
+    seek_all(s, frame);
+  } else if (!(frame >= s.all_enter && frame < s.all_leave)) {
     float all_enter = -kInf, all_leave = kInf;
     for (Run& r : std::span<Run>(s.runs, s.run_count)) {
       if (!(frame >= r.enter && frame < r.leave)) move_run(s, r, frame);

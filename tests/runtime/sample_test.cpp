@@ -606,6 +606,23 @@ std::vector<float> random_times(const ClipView& clip, int n, uint32_t seed) {
   return times;
 }
 
+/// Times that step back and forth by up to 5 frames, many of them near the sampler's seek
+/// threshold (2 frames: a longer step decodes every channel's pair, a shorter one moves only the
+/// runs that left their pair), so one cache goes through both paths in turn.
+std::vector<float> jumps(const ClipView& clip, int n, uint32_t seed) {
+  std::mt19937 rng(seed);
+  const float steps[] = {0.4f, 1.0f, 1.99f, 2.0f, 2.01f, 2.5f, 3.0f, 5.0f};
+  std::uniform_int_distribution<int> pick(0, 7), sign(0, 2);
+  std::vector<float> times;
+  float t = 0.37f * clip.duration();
+  for (int i = 0; i < n; ++i) {
+    times.push_back(t);
+    const float frames = steps[pick(rng)] * (sign(rng) == 0 ? -1.0f : 1.0f);
+    t = advance_time(t, frames / clip.sample_rate(), 1.0f, clip.duration(), true);
+  }
+  return times;
+}
+
 #if defined(__SSE2__)
 TEST(Sample, RebuildingARotationRaisesNoInvalidOperation) {
   // Quantized rotation keys whose three stored components square to just over 1 (w2 < 0: the
@@ -664,6 +681,7 @@ TEST(Sample, CacheIsInvisibleOnSyntheticClips) {
       expect_cache_invisible(f.clip(), f.skeleton(), playback(f.clip(), 1.0f, 200, loop), o, "forward");
       expect_cache_invisible(f.clip(), f.skeleton(), playback(f.clip(), -1.3f, 200, loop, 0.9f), o, "reverse");
       expect_cache_invisible(f.clip(), f.skeleton(), random_times(f.clip(), 200, 3), o, "seek");
+      expect_cache_invisible(f.clip(), f.skeleton(), jumps(f.clip(), 200, 4), o, "steps and jumps");
     }
   }
 }
@@ -767,6 +785,7 @@ TEST(SamplePab, CacheIsInvisible) {
   expect_cache_invisible(clip, skeleton, playback(clip, 0.05f, 400, true, 0.4f), loop, "very slow");
   expect_cache_invisible(clip, skeleton, playback(clip, -0.05f, 400, true, 0.4f), loop, "very slow, reverse");
   expect_cache_invisible(clip, skeleton, random_times(clip, 400, 5), loop, "random seeks");
+  expect_cache_invisible(clip, skeleton, jumps(clip, 400, 8), loop, "steps and jumps");
   expect_cache_invisible(clip, skeleton, random_times(clip, 100, 6),
                          SampleOptions{.loop = true, .rotation = RotationInterpolation::Slerp}, "slerp seeks");
 }
@@ -785,6 +804,8 @@ TEST(SamplePab, CacheIsInvisibleOnEveryClipAtEveryRate) {
         for (bool looping : {true, false})
           expect_cache_invisible(a->clip(c), skeleton, playback(a->clip(c), rate, 300, looping, 0.2f),
                                  SampleOptions{.loop = looping}, name);
+    for (size_t c = 0; c < a->clip_count(); ++c)
+      expect_cache_invisible(a->clip(c), skeleton, jumps(a->clip(c), 300, 9), SampleOptions{}, name);
   }
 }
 
