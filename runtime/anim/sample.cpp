@@ -18,7 +18,8 @@
 //      decode after its plain ones, in a loop of their own, each key after its segment's header).
 //      A frame more than kSeekFrames from the last sample's (a seek, a loop's wrap, the first
 //      sample) skips the range tests: every run takes its pair from its index and decodes both
-//      keys of each channel (seek_all), with no branch that depends on the frame;
+//      keys of each channel (seek_all), its branches taking the same way run after run. Outside
+//      a seek, a run moved to one of its keys' own frames decodes only that key (settle);
 //   2. one loop over all joints (SoA, 8-lane blocks): lerp T and S, nlerp R with the shortest-arc
 //      sign fix, write the pose (anim/sample_interpolate.cpp: vector code, on x86-64 compiled
 //      for AVX2 and the SSE2 baseline, picked per call, so the default build runs on any x86-64).
@@ -137,6 +138,9 @@ struct Run {
   uint32_t first_track = 0;  // its channels are tracks[first_track, first_track + track_count)
   uint32_t track_count = 0;
   uint32_t segmented = 0;  // its last `segmented` tracks are segmented channels, the others plain
+  // Only the pair's first key is decoded (k1 holds older keys): moved to at that key's own frame,
+  // where the second key's weight is 0. The range is then that frame alone (leave == enter).
+  uint32_t half = 0;
 };
 
 /// A sample more than this many frames from the last one is a seek (seek_all).
@@ -201,6 +205,7 @@ void forget_cursors(State& s) {
     r.cursor = kNoCursor;
     r.enter = kInf;
     r.leave = -kInf;
+    r.half = 0;
   }
   s.all_enter = kInf;
   s.all_leave = -kInf;
@@ -232,7 +237,7 @@ Track make_track(const fb::AnimatedChannel& ch, uint32_t stride) {
     t.mask[c] = quant_max(w.c[c]);
     t.qmax[c] = static_cast<float>(t.mask[c]);
   }
-  t.lo[0] = ch.range_min().x(), t.lo[1] = ch.range_min().y(), t.lo[2] = ch.range_min().z();
+  t.lo[0] = ch.range_min().x() + 0.0f, t.lo[1] = ch.range_min().y() + 0.0f, t.lo[2] = ch.range_min().z() + 0.0f;
   t.extent[0] = ch.range_extent().x(), t.extent[1] = ch.range_extent().y(), t.extent[2] = ch.range_extent().z();
   const auto kind = static_cast<uint32_t>(ch.channel());
   t.rotation = kind == 1;
@@ -267,7 +272,8 @@ inline float inverse_gap(uint32_t f0, uint32_t f1) {
 /// forward into it (the common case: one compare, the index untouched); otherwise its seek index
 /// gives the last key at or before the frame's whole part (frames are whole, so that key's pair
 /// holds the frame) in O(1) whatever the clip's length, where a binary search over a long clip's
-/// keys would cost a dozen mispredicted branches.
+/// keys would cost a dozen mispredicted branches. (A half pair's leave is its enter, not its second
+/// key's frame: it always asks the index.)
 inline uint32_t find_pair(const Run& r, float frame) {
   const uint32_t n = r.key_count;
   const auto whole = static_cast<uint32_t>(frame);
@@ -275,7 +281,7 @@ inline uint32_t find_pair(const Run& r, float frame) {
   if (!r.seek) {
     k = whole;  // frames[k] == k
   } else {
-    k = r.cursor != kNoCursor && frame >= r.leave ? r.cursor + 1 : 0;
+    k = r.cursor != kNoCursor && !r.half && frame >= r.leave ? r.cursor + 1 : 0;
     if (k + 2 < n && frame >= static_cast<float>(r.frames[k + 1])) {  // past that pair: from the index
       const SeekBlock& b = r.seek[whole >> 6];
       // Keys at frames 64 b .. whole; frames[0] == 0, so the count is at least one.
@@ -300,8 +306,8 @@ void make_seek_index(const uint16_t* frames, uint32_t key_count, uint32_t frame_
 }
 
 /// Decodes both keys of pair k (frames f0 and f0 + 1 / inv) of tracks [t, end) of a run.
-/// kSegments: the tracks are segmented. Always inlined, as move_tracks: each caller's loop is then
-/// compiled for its case (a call per run cost Pab's three-clip frame a tenth, Zen 5).
+/// kSegments: the tracks are segmented. The helpers here are always inlined: each caller's loop is
+/// then compiled for its case (a call per run cost Pab's three-clip frame a tenth, Zen 5).
 template <bool kSegments>
 [[gnu::always_inline]] inline void decode_pairs(State& s, const Track* t, const Track* end, uint32_t k, float f0,
                                                 float inv) {
@@ -315,12 +321,20 @@ template <bool kSegments>
   }
 }
 
-/// Decodes tracks [t, end) of a run that moved to pair k (frames f0 and f0 + 1 / inv): one key
-/// each when `forward` (k1 becomes k0), both keys otherwise. kSegments: the tracks are segmented.
+/// Decodes key `key` of tracks [t, end) into `keys` (k0 or k1), two tracks at a time (one square
+/// root for two rotations).
 template <bool kSegments>
-[[gnu::always_inline]] inline void move_tracks(State& s, const Track* t, const Track* end, uint32_t k, bool forward,
-                                               float f0, float inv) {
-  if (!forward) return decode_pairs<kSegments>(s, t, end, k, f0, inv);
+[[gnu::always_inline]] inline void decode_keys(State& s, const Track* t, const Track* end, uint32_t key, float* keys) {
+  const KeySource src{s.stream, s.track_data, s.segments.data()};
+  for (; end - t >= 2; t += 2) decode_two<kSegments>(t[0], t[1], src, key, keys);
+  if (t != end) decode<kSegments>(*t, src, key, keys);
+}
+
+/// Playback moved forward by one pair (to k): each track's k1 becomes its k0 and key k + 1 is
+/// decoded into k1.
+template <bool kSegments>
+[[gnu::always_inline]] inline void shift_tracks(State& s, const Track* t, const Track* end, uint32_t k, float f0,
+                                                float inv) {
   const KeySource src{s.stream, s.track_data, s.segments.data()};
   float* k0 = s.k0;
   float* k1 = s.k1;
@@ -343,33 +357,65 @@ template <bool kSegments>
   }
 }
 
-/// Moves a run that left its key pair to the pair around `frame`, decoding what changed: one key
-/// per channel when it moved forward by one (k1 becomes k0), both keys otherwise. Its plain tracks
-/// and its segmented ones (after them) run in loops of their own, each compiled for one layout
-/// (measured: the segmented decode in the plain keys' loop slowed their seeks by a quarter).
-void move_run(State& s, Run& r, float frame) {
-  const uint32_t k = find_pair(r, frame);
+/// Brings run r's tracks to pair k (frames f0 and f0 + 1 / inv) for a sample at `frame`, decoding
+/// only what they lack, and sets its cursor and range. Its plain tracks and its segmented ones
+/// (after them) run in loops of their own, each compiled for one layout (measured: the segmented
+/// decode in the plain keys' loop slowed their seeks by a quarter):
+///   - the next pair: shift (one key per track);
+///   - the same pair: nothing, or its second keys if only the first were decoded and the frame
+///     left the first key's;
+///   - at key k's own frame: its first keys only (half). The second key's weight is 0 there, and
+///     no key decodes to -0 (clip_codec.h), so the lerps and nlerps give the first key whatever k1
+///     holds: bit for bit the pose of the whole pair, for one key per track instead of two
+///     (mocap at 120 frames per second played at 60 Hz steps two keys, every sample at a key);
+///   - otherwise both keys.
+[[gnu::always_inline]] inline void settle(State& s, Run& r, uint32_t k, float frame, uint32_t frame0, uint32_t frame1) {
   const Track* t = s.track_data + r.first_track;
   const Track* end = t + r.track_count;
-  // A dense run stores no frames: its key k is at frame k.
-  const uint32_t frame0 = r.frames ? r.frames[k] : k, frame1 = r.frames ? r.frames[k + 1] : k + 1;
+  const Track* seg = end - r.segmented;
   const auto f0 = static_cast<float>(frame0);
   const float inv = inverse_gap(frame0, frame1);
-  if (k != r.cursor) {
-    const bool forward = r.cursor != kNoCursor && k == r.cursor + 1;
-    move_tracks<false>(s, t, end - r.segmented, k, forward, f0, inv);
-    if (r.segmented != 0) move_tracks<true>(s, end - r.segmented, end, k, forward, f0, inv);
+  if (k == r.cursor + 1 && r.cursor != kNoCursor && !r.half) {
+    shift_tracks<false>(s, t, seg, k, f0, inv);
+    if (seg != end) shift_tracks<true>(s, seg, end, k, f0, inv);
+  } else if (k == r.cursor) {
+    if (r.half && frame != f0) {
+      decode_keys<false>(s, t, seg, k + 1, s.k1);
+      if (seg != end) decode_keys<true>(s, seg, end, k + 1, s.k1);
+      r.half = 0;
+    }
+  } else if (frame == f0) {
+    decode_keys<false>(s, t, seg, k, s.k0);
+    if (seg != end) decode_keys<true>(s, seg, end, k, s.k0);
+    for (const Track* x = t; x != end; ++x) {
+      s.start[x->weight_index] = f0;
+      s.inv_length[x->weight_index] = inv;
+    }
+    r.half = 1;
+  } else {
+    decode_pairs<false>(s, t, seg, k, f0, inv);
+    if (seg != end) decode_pairs<true>(s, seg, end, k, f0, inv);
+    r.half = 0;
   }
   r.cursor = k;
   r.enter = f0;
-  r.leave = k + 2 == r.key_count ? kInf : static_cast<float>(frame1);
+  r.leave = r.half ? f0 : k + 2 == r.key_count ? kInf : static_cast<float>(frame1);
 }
 
-/// A seek: every run to the pair around `frame` (from its seek index, as find_pair would find it)
-/// and every track's pair decoded, whatever moved. A random seek moves nearly every run; testing
-/// each run's range first mispredicted, and its outcome then broke the prediction of the short
-/// track loops after it (a long clip has dozens of sparse runs of one to three tracks). Here every
-/// branch but the decoders' own takes the same way at every seek. O(runs + tracks).
+/// Moves a run that left its key pair to the pair around `frame` (settle).
+void move_run(State& s, Run& r, float frame) {
+  const uint32_t k = find_pair(r, frame);
+  // A dense run stores no frames: its key k is at frame k.
+  const uint32_t frame0 = r.frames ? r.frames[k] : k, frame1 = r.frames ? r.frames[k + 1] : k + 1;
+  settle(s, r, k, frame, frame0, frame1);
+}
+
+/// A seek: every run to the pair around `frame`, from its seek index (the pair find_pair would
+/// find), both keys decoded unless the run already holds that whole pair. A random seek moves
+/// nearly every run; testing each run's range first mispredicted, and its outcome then broke the
+/// prediction of the short track loops after it (a long clip has dozens of sparse runs of one to
+/// three tracks). Here the branches take the same way run after run, so settle's cases stay out
+/// (they cost Pab's atlas 5% of a seek, Zen 5). O(runs + tracks).
 void seek_all(State& s, float frame) {
   const auto whole = static_cast<uint32_t>(frame);
   float all_enter = -kInf, all_leave = kInf;
@@ -382,11 +428,14 @@ void seek_all(State& s, float frame) {
     k = k > r.key_count - 2 ? r.key_count - 2 : k;
     const uint32_t frame0 = r.frames ? r.frames[k] : k, frame1 = r.frames ? r.frames[k + 1] : k + 1;
     const auto f0 = static_cast<float>(frame0);
-    const float inv = inverse_gap(frame0, frame1);
-    const Track* t = s.track_data + r.first_track;
-    const Track* end = t + r.track_count;
-    decode_pairs<false>(s, t, end - r.segmented, k, f0, inv);
-    if (r.segmented != 0) decode_pairs<true>(s, end - r.segmented, end, k, f0, inv);
+    if (k != r.cursor || r.half) {
+      const Track* t = s.track_data + r.first_track;
+      const Track* end = t + r.track_count;
+      const float inv = inverse_gap(frame0, frame1);
+      decode_pairs<false>(s, t, end - r.segmented, k, f0, inv);
+      if (r.segmented != 0) decode_pairs<true>(s, end - r.segmented, end, k, f0, inv);
+    }
+    r.half = 0;
     r.cursor = k;
     r.enter = f0;
     r.leave = k + 2 == r.key_count ? kInf : static_cast<float>(frame1);

@@ -31,7 +31,7 @@ struct Track {
   uint8_t shift[3] = {0, 0, 0};  // each component's bit position in a key
   uint32_t mask[3] = {0, 0, 0};  // 2^width - 1
   float qmax[4] = {1, 1, 1, 1};  // the same as floats, 4 wide for one SSE load
-  float lo[4] = {0, 0, 0, 0};    // 4 wide (the 4th unused) for one SSE load
+  float lo[4] = {0, 0, 0, 0};    // 4 wide (the 4th unused) for one SSE load; never -0 (dequantize's lo + 0)
   float extent[4] = {0, 0, 0, 0};
   bool rotation = false;
   uint32_t offset[4] = {0, 0, 0, 0};  // where components go in k0 / k1 (offset[3]: a rotation's rebuilt one)
@@ -123,12 +123,15 @@ inline __m128 dequantized(const Track& t, const KeySource& src, uint32_t key) {
 
 /// Key `key` of any track as (x, y, z, 0): its three stored components. A raw key is read as 16
 /// bytes (validation keeps 8 padding bytes after the last key, so the read stays inside the stream)
-/// and the bytes after it are cleared, so no arithmetic on lane 3 can raise a floating-point flag.
+/// and the bytes after it are cleared, so no arithmetic on lane 3 can raise a floating-point flag;
+/// + 0 turns a -0 into +0, as decode_key does.
 template <bool kSegments>
 inline __m128 stored(const Track& t, const KeySource& src, uint32_t key) {
   if (t.raw)
-    return _mm_and_ps(_mm_loadu_ps(reinterpret_cast<const float*>(src.stream + (t.bit_offset >> 3) + 12ull * key)),
-                      _mm_castsi128_ps(_mm_setr_epi32(-1, -1, -1, 0)));
+    return _mm_add_ps(
+        _mm_and_ps(_mm_loadu_ps(reinterpret_cast<const float*>(src.stream + (t.bit_offset >> 3) + 12ull * key)),
+                   _mm_castsi128_ps(_mm_setr_epi32(-1, -1, -1, 0))),
+        _mm_setzero_ps());
   return dequantized<kSegments>(t, src, key);
 }
 
@@ -144,10 +147,9 @@ inline void put(const Track& t, __m128 v, float* keys) {
 
 /// Decodes key `key` of a track into the k0 or k1 array.
 template <bool kSegments>
-inline void decode(const Track& t, const KeySource& src, uint32_t key, float* keys) {
+[[gnu::always_inline]] inline void decode(const Track& t, const KeySource& src, uint32_t key, float* keys) {
   float v[4];
-  if (t.raw) std::memcpy(v, src.stream + (t.bit_offset >> 3) + 12ull * key, 12);
-  else _mm_storeu_ps(v, dequantized<kSegments>(t, src, key));
+  _mm_storeu_ps(v, stored<kSegments>(t, src, key));
   keys[t.offset[0]] = v[0];
   keys[t.offset[1]] = v[1];
   keys[t.offset[2]] = v[2];
@@ -222,9 +224,11 @@ inline void decode_pair(const Track& t, const KeySource& src, uint32_t key, floa
   k1[t.offset[3]] = w[1];
 }
 
-/// Key `key` of two tracks into `keys` (forward playback).
+/// Key `key` of two tracks into `keys` (forward playback). Always inlined, as decode is: sample.cpp
+/// calls them from several per-track loops, and GCC would otherwise call them once per track.
 template <bool kSegments>
-inline void decode_two(const Track& ta, const Track& tb, const KeySource& src, uint32_t key, float* keys) {
+[[gnu::always_inline]] inline void decode_two(const Track& ta, const Track& tb, const KeySource& src, uint32_t key,
+                                              float* keys) {
   const __m128 a = stored<kSegments>(ta, src, key), b = stored<kSegments>(tb, src, key);
   put(ta, a, keys);
   put(tb, b, keys);
@@ -240,6 +244,7 @@ inline void decode(const Track& t, const KeySource& src, uint32_t key, float* ke
   float v[3];
   if (t.raw) {
     std::memcpy(v, src.stream + (t.bit_offset >> 3) + 12ull * key, 12);
+    for (float& x : v) x += 0.0f;  // -0 reads as +0 (decode_key)
   } else {
     uint32_t q[3];
     if (kSegments) segment_codes(t, src, key, q);

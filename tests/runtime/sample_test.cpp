@@ -17,6 +17,7 @@
 #include <cstring>
 #include <filesystem>
 #include <memory>
+#include <map>
 #include <optional>
 #include <random>
 #include <string>
@@ -378,6 +379,9 @@ TEST(Sample, SeeksFindTheKeyPairInALongClipWithSparseAndDenseRuns) {
   const size_t half = frames.size() / 2;
   frames.insert(frames.end(), frames.begin(), frames.begin() + static_cast<std::ptrdiff_t>(half));
   std::sort(frames.begin() + static_cast<std::ptrdiff_t>(half), frames.end());  // forward playback too
+  // Steps that skip a key and land on the next one (a run then holds only its pair's first key),
+  // then a jump inside that pair's long gap, which must decode the second key.
+  frames.insert(frames.end(), {63.5, 65.0, 100.0, 119.5, 121.0, 121.5, 63.5, 65.0, 64.5, 30.0, 31.0, 80.0});
   for (const double frame : frames) {
     const float t = static_cast<float>(frame / clip.sample_rate());
     sample(clip, t, SampleOptions{.loop = false}, cache, pose);
@@ -396,6 +400,68 @@ TEST(Sample, SeeksFindTheKeyPairInALongClipWithSparseAndDenseRuns) {
     sample(clip, t, SampleOptions{.loop = false}, *shared, pose);
     sample(clip, t, SampleOptions{.loop = false}, own, other);
     ASSERT_TRUE(same_bits(pose, other)) << "frame " << frame;
+  }
+}
+
+TEST(Sample, AKeysOwnFrameGivesTheSameBitsWhateverTheNextKeyHolds) {
+  // At a key's own frame the sampler may decode only the pair's first key (sample.cpp, settle):
+  // the second key's weight is 0 there, and no key decodes to -0 (clip_codec.h), so the pose may
+  // not depend on the second key. Keys holding -0 (raw floats; a quantized channel whose range
+  // minimum and extent are -0) beside keys of either sign, sampled at their frames after a jump
+  // (first keys only), a step forward onto the key and a step back inside the pair after it (whole
+  // pairs), must give the same bits, nlerp and slerp, with +0 where a key holds -0. At weight 0
+  // slerp is nlerp (both the normalized first key), which is what keeps it off the second key.
+  test::SyntheticSpec spec;
+  test::SyntheticClip& c = spec.clips[0];
+  c.frame_count = 8;
+  c.constants.clear();
+  const float z = -0.0f;
+  test::SyntheticAnimated raw_t;
+  raw_t.joint = 0;
+  raw_t.channel = fb::Channel::Translation;
+  raw_t.bits = 32;
+  raw_t.values = {{z, z, 0.5f}, {1.0f, -1.0f, 0.5f},  {z, 2.0f, z}, {-1.0f, 1.0f, 1.0f},
+                  {z, z, z},    {2.0f, -2.0f, 0.25f}, {z, 0.0f, z}, {-3.0f, 3.0f, -1.0f}};
+  test::SyntheticAnimated raw_r;
+  raw_r.joint = 1;
+  raw_r.channel = fb::Channel::Rotation;
+  raw_r.bits = 32;
+  raw_r.values = {{z, 0.0f, 0.6f}, {0.3f, -0.2f, 0.1f}, {z, z, z},        {-0.4f, 0.5f, -0.3f},
+                  {z, 0.2f, z},    {0.1f, 0.1f, -0.6f}, {0.0f, z, -0.1f}, {-0.5f, -0.5f, 0.5f}};
+  test::SyntheticAnimated flat;  // quantized; every code decodes to min + extent * q / max = -0 + -0
+  flat.joint = 2;
+  flat.channel = fb::Channel::Translation;
+  flat.bits = 8;
+  flat.values.assign(8, {0.0f, 1.0f, 0.0f});
+  flat.range_min = fb::Vec3(z, 1.0f, z);
+  flat.range_extent = fb::Vec3(z, 0.0f, z);
+  for (test::SyntheticAnimated* a : {&raw_t, &raw_r, &flat}) a->frames = {0, 1, 2, 3, 4, 5, 6, 7};
+  c.animated = {raw_t, raw_r, flat};
+  const Loaded f = load(spec);
+  const ClipView clip = f.clip();
+  const auto joints = static_cast<uint32_t>(f.skeleton().joint_count());
+  std::map<int, Pose> nlerped;
+  for (const RotationInterpolation mode : {RotationInterpolation::Nlerp, RotationInterpolation::Slerp}) {
+    const SampleOptions o{.loop = false, .rotation = mode};
+    for (const int key : {0, 2, 4, 6}) {
+      // How each cache comes to the key's frame: the frames sampled before it.
+      const std::vector<std::vector<double>> ways = {{},    {key - 0.5}, {key + 0.5}, {key + 0.25, key + 0.75},
+                                                     {7.0}, {key + 3.0}, {key - 3.0}};
+      std::optional<Pose> first;
+      for (const auto& before : ways) {
+        SamplingCache cache = cache_for(clip, f.skeleton());
+        Pose pose(joints);
+        for (const double frame : before)
+          if (frame >= 0.0 && frame <= 7.0) sample(clip, static_cast<float>(frame / 30.0), o, cache, pose);
+        sample(clip, static_cast<float>(key / 30.0), o, cache, pose);
+        EXPECT_FALSE(std::signbit(pose.span()[kTx][0])) << "key " << key << ": raw -0 reads as +0";
+        EXPECT_FALSE(std::signbit(pose.span()[kTx][2])) << "key " << key << ": -0 + -0 decodes as +0";
+        if (!first) first = std::move(pose);
+        else ASSERT_TRUE(same_bits(*first, pose)) << "key " << key << " after " << before.size() << " samples";
+      }
+      if (mode == RotationInterpolation::Nlerp) nlerped.emplace(key, std::move(*first));
+      else EXPECT_TRUE(same_bits(nlerped.at(key), *first)) << "key " << key << ": slerp at weight 0 is nlerp";
+    }
   }
 }
 
@@ -609,16 +675,21 @@ std::vector<float> random_times(const ClipView& clip, int n, uint32_t seed) {
 /// Times that step back and forth by up to 5 frames, many of them near the sampler's seek
 /// threshold (2 frames: a longer step decodes every channel's pair, a shorter one moves only the
 /// runs that left their pair), so one cache goes through both paths in turn.
-std::vector<float> jumps(const ClipView& clip, int n, uint32_t seed) {
+/// `whole`: from a key's frame, in steps of whole and half frames, so many samples land on keys'
+/// own frames (where the sampler decodes a pair's first key only) reached in every way: by a jump,
+/// a step forward or back, from the same pair.
+std::vector<float> jumps(const ClipView& clip, int n, uint32_t seed, bool whole = false) {
   std::mt19937 rng(seed);
   const float steps[] = {0.4f, 1.0f, 1.99f, 2.0f, 2.01f, 2.5f, 3.0f, 5.0f};
+  const float whole_steps[] = {0.5f, 1.0f, 1.5f, 2.0f, 2.0f, 3.0f, 4.0f, 7.0f};
   std::uniform_int_distribution<int> pick(0, 7), sign(0, 2);
   std::vector<float> times;
-  float t = 0.37f * clip.duration();
+  const double frames = std::floor(0.37 * (clip.frame_count() - 1));
+  float t = whole ? static_cast<float>(frames / clip.sample_rate()) : 0.37f * clip.duration();
   for (int i = 0; i < n; ++i) {
     times.push_back(t);
-    const float frames = steps[pick(rng)] * (sign(rng) == 0 ? -1.0f : 1.0f);
-    t = advance_time(t, frames / clip.sample_rate(), 1.0f, clip.duration(), true);
+    const float step = (whole ? whole_steps : steps)[pick(rng)] * (sign(rng) == 0 ? -1.0f : 1.0f);
+    t = advance_time(t, step / clip.sample_rate(), 1.0f, clip.duration(), true);
   }
   return times;
 }
@@ -682,6 +753,7 @@ TEST(Sample, CacheIsInvisibleOnSyntheticClips) {
       expect_cache_invisible(f.clip(), f.skeleton(), playback(f.clip(), -1.3f, 200, loop, 0.9f), o, "reverse");
       expect_cache_invisible(f.clip(), f.skeleton(), random_times(f.clip(), 200, 3), o, "seek");
       expect_cache_invisible(f.clip(), f.skeleton(), jumps(f.clip(), 200, 4), o, "steps and jumps");
+      expect_cache_invisible(f.clip(), f.skeleton(), jumps(f.clip(), 200, 5, true), o, "keys' frames");
     }
   }
 }
@@ -786,6 +858,7 @@ TEST(SamplePab, CacheIsInvisible) {
   expect_cache_invisible(clip, skeleton, playback(clip, -0.05f, 400, true, 0.4f), loop, "very slow, reverse");
   expect_cache_invisible(clip, skeleton, random_times(clip, 400, 5), loop, "random seeks");
   expect_cache_invisible(clip, skeleton, jumps(clip, 400, 8), loop, "steps and jumps");
+  expect_cache_invisible(clip, skeleton, jumps(clip, 400, 10, true), loop, "keys' frames");
   expect_cache_invisible(clip, skeleton, random_times(clip, 100, 6),
                          SampleOptions{.loop = true, .rotation = RotationInterpolation::Slerp}, "slerp seeks");
 }
@@ -804,8 +877,10 @@ TEST(SamplePab, CacheIsInvisibleOnEveryClipAtEveryRate) {
         for (bool looping : {true, false})
           expect_cache_invisible(a->clip(c), skeleton, playback(a->clip(c), rate, 300, looping, 0.2f),
                                  SampleOptions{.loop = looping}, name);
-    for (size_t c = 0; c < a->clip_count(); ++c)
+    for (size_t c = 0; c < a->clip_count(); ++c) {
       expect_cache_invisible(a->clip(c), skeleton, jumps(a->clip(c), 300, 9), SampleOptions{}, name);
+      expect_cache_invisible(a->clip(c), skeleton, jumps(a->clip(c), 300, 11, true), SampleOptions{}, name);
+    }
   }
 }
 

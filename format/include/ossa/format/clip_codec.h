@@ -69,8 +69,10 @@ inline uint32_t quantize(float v, float lo, float extent, uint32_t bits) {
   u = u < 0.0f ? 0.0f : (u > 1.0f ? 1.0f : u);
   return static_cast<uint32_t>(std::lround(u * static_cast<float>(quant_max(bits))));
 }
+/// The value of code q. Never -0 (see decode_key): lo + 0 turns a lo of -0 into +0, and a sum
+/// whose first term is not -0 is not -0.
 inline float dequantize(uint32_t q, float lo, float extent, uint32_t bits) {
-  return lo + extent * (static_cast<float>(q) / static_cast<float>(quant_max(bits)));
+  return (lo + 0.0f) + extent * (static_cast<float>(q) / static_cast<float>(quant_max(bits)));
 }
 
 /// Reads `count` (<= 57) bits at bit position `bit` of a padded stream.
@@ -133,11 +135,14 @@ inline void key_codes(const uint8_t* stream, uint64_t bit_offset, const KeyWidth
 
 /// Decodes key `key` of a channel: three floats (rotation: x, y, z with w >= 0 implied).
 /// `offset_bits`: the channel's segment_offset_bits (0: plain keys). O(1), no branches but the
-/// raw-float escape and the layout.
+/// raw-float escape and the layout. No component decodes to -0 (a raw -0 reads as +0, as a
+/// quantized zero does): a lerp or nlerp at weight 0 then gives the first key whatever the second
+/// holds, so ossa::sample may leave the second undecoded at a key's own frame.
 inline void decode_key(const uint8_t* stream, uint64_t bit_offset, const KeyWidths& bits, uint32_t offset_bits,
                        const float range_min[3], const float range_extent[3], uint32_t key, float out[3]) {
   if (bits.raw()) {
     std::memcpy(out, stream + ((bit_offset + 96ull * key) >> 3), 12);
+    for (uint32_t c = 0; c < 3; ++c) out[c] += 0.0f;
     return;
   }
   uint32_t q[3];
