@@ -179,7 +179,7 @@ struct SamplingCache::State {
   float all_enter = kInf, all_leave = -kInf;
   float last = kInf;          // the frame position of the last sample (kInf when forgotten)
   std::vector<Track> tracks;  // grouped by run
-  // What move_run reads: tracks, or a prototype's (identical: they depend on the clip, rig and filter only).
+  // What settle and seek_all read: tracks, or a prototype's (identical: they depend on the clip, rig and filter only).
   const Track* track_data = nullptr;
   // Per track (track_data's order), the segment it last decoded; empty when no track is segmented.
   std::vector<SegmentCursor> segments;
@@ -266,6 +266,21 @@ inline float inverse_gap(uint32_t f0, uint32_t f1) {
   return gap < 64 ? kReciprocals.r[gap] : 1.0f / static_cast<float>(gap);
 }
 
+/// Where a sparse run's keys are: the last key at or before frame `whole` (its seek index's keys
+/// up to it, counted; frames[0] == 0, so at least one), not yet clamped to the last pair.
+inline uint32_t indexed_key(const Run& r, uint32_t whole) {
+  const SeekBlock& b = r.seek[whole >> 6];
+  return b.before + popcount64(b.keys & (~0ull >> (63 - (whole & 63)))) - 1;
+}
+
+/// The frames of pair k's two keys (a dense run stores none: its key k is at frame k).
+struct PairFrames {
+  uint32_t first, second;
+};
+inline PairFrames pair_frames(const Run& r, uint32_t k) {
+  return r.frames ? PairFrames{r.frames[k], r.frames[k + 1]} : PairFrames{k, k + 1};
+}
+
 /// The key pair of a run around `frame` (in [0, last frame]): k with frames[k] <= frame <
 /// frames[k + 1], or the last pair at the last frame (or the first before a first key past 0). A
 /// dense run's pair is the frame's whole part. A sparse run takes the next pair when playback moved
@@ -282,11 +297,7 @@ inline uint32_t find_pair(const Run& r, float frame) {
     k = whole;  // frames[k] == k
   } else {
     k = r.cursor != kNoCursor && !r.half && frame >= r.leave ? r.cursor + 1 : 0;
-    if (k + 2 < n && frame >= static_cast<float>(r.frames[k + 1])) {  // past that pair: from the index
-      const SeekBlock& b = r.seek[whole >> 6];
-      // Keys at frames 64 b .. whole; frames[0] == 0, so the count is at least one.
-      k = b.before + popcount64(b.keys & (~0ull >> (63 - (whole & 63)))) - 1;
-    }
+    if (k + 2 < n && frame >= static_cast<float>(r.frames[k + 1])) k = indexed_key(r, whole);  // past that pair
   }
   return k > n - 2 ? n - 2 : k;
 }
@@ -319,6 +330,16 @@ template <bool kSegments>
     s.start[t->weight_index] = f0;
     s.inv_length[t->weight_index] = inv;
   }
+}
+
+/// Both keys of pair k of every track of run r: its plain tracks, then its segmented ones (after
+/// them), each in a loop compiled for its layout (measured: the segmented decode in the plain
+/// keys' loop slowed their seeks by a quarter).
+[[gnu::always_inline]] inline void decode_run_pairs(State& s, const Run& r, uint32_t k, float f0, float inv) {
+  const Track* t = s.track_data + r.first_track;
+  const Track* end = t + r.track_count;
+  decode_pairs<false>(s, t, end - r.segmented, k, f0, inv);
+  if (r.segmented != 0) decode_pairs<true>(s, end - r.segmented, end, k, f0, inv);
 }
 
 /// Decodes key `key` of tracks [t, end) into `keys` (k0 or k1), two tracks at a time (one square
@@ -357,10 +378,9 @@ template <bool kSegments>
   }
 }
 
-/// Brings run r's tracks to pair k (frames f0 and f0 + 1 / inv) for a sample at `frame`, decoding
-/// only what they lack, and sets its cursor and range. Its plain tracks and its segmented ones
-/// (after them) run in loops of their own, each compiled for one layout (measured: the segmented
-/// decode in the plain keys' loop slowed their seeks by a quarter):
+/// Brings run r's tracks to pair k for a sample at `frame`, decoding only what they lack, and
+/// sets its cursor and range. Plain and segmented tracks in loops of their own, as in
+/// decode_run_pairs:
 ///   - the next pair: shift (one key per track);
 ///   - the same pair: nothing, or its second keys if only the first were decoded and the frame
 ///     left the first key's;
@@ -369,12 +389,13 @@ template <bool kSegments>
 ///     holds: bit for bit the pose of the whole pair, for one key per track instead of two
 ///     (mocap at 120 frames per second played at 60 Hz steps two keys, every sample at a key);
 ///   - otherwise both keys.
-[[gnu::always_inline]] inline void settle(State& s, Run& r, uint32_t k, float frame, uint32_t frame0, uint32_t frame1) {
+void settle(State& s, Run& r, uint32_t k, float frame) {
   const Track* t = s.track_data + r.first_track;
   const Track* end = t + r.track_count;
   const Track* seg = end - r.segmented;
-  const auto f0 = static_cast<float>(frame0);
-  const float inv = inverse_gap(frame0, frame1);
+  const PairFrames frames = pair_frames(r, k);
+  const auto f0 = static_cast<float>(frames.first);
+  const float inv = inverse_gap(frames.first, frames.second);
   if (k == r.cursor + 1 && r.cursor != kNoCursor && !r.half) {
     shift_tracks<false>(s, t, seg, k, f0, inv);
     if (seg != end) shift_tracks<true>(s, seg, end, k, f0, inv);
@@ -393,21 +414,12 @@ template <bool kSegments>
     }
     r.half = 1;
   } else {
-    decode_pairs<false>(s, t, seg, k, f0, inv);
-    if (seg != end) decode_pairs<true>(s, seg, end, k, f0, inv);
+    decode_run_pairs(s, r, k, f0, inv);
     r.half = 0;
   }
   r.cursor = k;
   r.enter = f0;
-  r.leave = r.half ? f0 : k + 2 == r.key_count ? kInf : static_cast<float>(frame1);
-}
-
-/// Moves a run that left its key pair to the pair around `frame` (settle).
-void move_run(State& s, Run& r, float frame) {
-  const uint32_t k = find_pair(r, frame);
-  // A dense run stores no frames: its key k is at frame k.
-  const uint32_t frame0 = r.frames ? r.frames[k] : k, frame1 = r.frames ? r.frames[k + 1] : k + 1;
-  settle(s, r, k, frame, frame0, frame1);
+  r.leave = r.half ? f0 : k + 2 == r.key_count ? kInf : static_cast<float>(frames.second);
 }
 
 /// A seek: every run to the pair around `frame`, from its seek index (the pair find_pair would
@@ -420,25 +432,15 @@ void seek_all(State& s, float frame) {
   const auto whole = static_cast<uint32_t>(frame);
   float all_enter = -kInf, all_leave = kInf;
   for (Run& r : std::span<Run>(s.runs, s.run_count)) {
-    uint32_t k = whole;  // a dense run: frames[k] == k
-    if (r.seek) {
-      const SeekBlock& b = r.seek[whole >> 6];  // frames[0] == 0: at least one key counted
-      k = b.before + popcount64(b.keys & (~0ull >> (63 - (whole & 63)))) - 1;
-    }
+    uint32_t k = r.seek ? indexed_key(r, whole) : whole;  // a dense run: frames[k] == k
     k = k > r.key_count - 2 ? r.key_count - 2 : k;
-    const uint32_t frame0 = r.frames ? r.frames[k] : k, frame1 = r.frames ? r.frames[k + 1] : k + 1;
-    const auto f0 = static_cast<float>(frame0);
-    if (k != r.cursor || r.half) {
-      const Track* t = s.track_data + r.first_track;
-      const Track* end = t + r.track_count;
-      const float inv = inverse_gap(frame0, frame1);
-      decode_pairs<false>(s, t, end - r.segmented, k, f0, inv);
-      if (r.segmented != 0) decode_pairs<true>(s, end - r.segmented, end, k, f0, inv);
-    }
+    const PairFrames frames = pair_frames(r, k);
+    const auto f0 = static_cast<float>(frames.first);
+    if (k != r.cursor || r.half) decode_run_pairs(s, r, k, f0, inverse_gap(frames.first, frames.second));
     r.half = 0;
     r.cursor = k;
     r.enter = f0;
-    r.leave = k + 2 == r.key_count ? kInf : static_cast<float>(frame1);
+    r.leave = k + 2 == r.key_count ? kInf : static_cast<float>(frames.second);
     all_enter = std::max(all_enter, r.enter);
     all_leave = std::min(all_leave, r.leave);
   }
@@ -555,7 +557,7 @@ Result<SamplingCache> make_sampling_cache(const ClipView& clip, const SkeletonVi
   s->run_count = static_cast<uint32_t>(runs.size());
   if (!runs.empty()) std::memcpy(static_cast<void*>(s->runs), runs.data(), runs.size() * sizeof(Run));
   s->tracks.resize(animated.size());
-  // Within a run, plain tracks first, then the segmented ones (move_run's two loops).
+  // Within a run, plain tracks first, then the segmented ones (decode_run_pairs's two loops).
   std::vector<uint32_t> plain(runs.size(), 0), segmented(runs.size(), 0);
   for (size_t i = 0; i < animated.size(); ++i) {
     const Run& r = runs[run_index[i]];
@@ -628,7 +630,7 @@ void sample(const ClipView& clip, float time, const SampleOptions& options, Samp
   } else if (!(frame >= s.all_enter && frame < s.all_leave)) {
     float all_enter = -kInf, all_leave = kInf;
     for (Run& r : std::span<Run>(s.runs, s.run_count)) {
-      if (!(frame >= r.enter && frame < r.leave)) move_run(s, r, frame);
+      if (!(frame >= r.enter && frame < r.leave)) settle(s, r, find_pair(r, frame), frame);
       all_enter = std::max(all_enter, r.enter);
       all_leave = std::min(all_leave, r.leave);
     }
