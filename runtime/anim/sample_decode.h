@@ -1,14 +1,15 @@
-// sample_decode.h — the sampler's key decoding (anim/sample.cpp), internal to runtime/anim.
+// sample_decode.h — the sampler's key decoding (anim/sample_keys.cpp), internal to runtime/anim.
 //
 // ossa/format/clip_codec.h defines how a channel's keys are stored; this is the same decoding
 // specialized for the hot path: each animated channel gathered into one flat record (Track) when
 // a sampling cache is made, keys read from it with the same bits as decode_key. Plain keys are one
 // read each; a segmented channel's keys (format v14) first need their segment's header, which a
 // per-cache cursor keeps unpacked, so forward playback reads a header once per 16 keys and a seek
-// one per pair. The decoders are templates on the layout: sample.cpp decodes a run's plain and
+// one per pair. The decoders are templates on the layout: sample_keys.cpp decodes a run's plain and
 // segmented channels in separate loops, each compiled without the other's branch. On x86-64 the
 // three components of a key are dequantized in one SSE register (one division instead of three),
-// each lane performing the scalar code's IEEE operations in its order.
+// each lane performing the scalar code's IEEE operations in its order. Every helper of the hot
+// path is OSSA_INLINE, so each of sample_keys.cpp's two compiled copies gets its own.
 #pragma once
 #include <cstdint>
 #include <cstring>
@@ -19,6 +20,7 @@
 #endif
 
 #include <ossa/format/clip_codec.h>
+#include "internal/vector_clones.h"
 
 namespace ossa::sample_detail {
 
@@ -61,6 +63,15 @@ struct KeySource {
   SegmentCursor* cursors;
 };
 
+/// The 64 bits from bit `bit` of the stream, of which the low 57 are the stream's: a key (3 x 19
+/// bits at most, validate_clip.cpp) or two that fit, with the bits after them left in, which
+/// the per-component masks drop (read_bits's own mask is 7 instructions of a seek's ~110 per key).
+inline uint64_t key_word(const uint8_t* stream, uint64_t bit) {
+  uint64_t word;
+  std::memcpy(&word, stream + (bit >> 3), 8);  // little-endian host assumed (as FlatBuffers does)
+  return word >> (bit & 7u);
+}
+
 /// Unpacks header `segment` of a segmented track into c: clip_codec.h's read_segment, specialized
 /// to the track's precomputed widths (the minima and widths in one read when they fit in 57 bits).
 inline void load_segment(const Track& t, const uint8_t* stream, uint32_t segment, SegmentCursor& c) {
@@ -69,7 +80,7 @@ inline void load_segment(const Track& t, const uint8_t* stream, uint32_t segment
   // Widths and data position in one read (15 + at most 32 bits), the minima in a second, beside it.
   const uint64_t widths = read_bits(stream, at, 3 * kSegmentWidthBits + t.offset_bits);
   c.data = t.bit_offset + (widths >> (3 * kSegmentWidthBits));
-  const uint64_t mins = read_bits(stream, at + 3 * kSegmentWidthBits + t.offset_bits, t.key_bits);
+  const uint64_t mins = key_word(stream, at + 3 * kSegmentWidthBits + t.offset_bits);
   const auto w0 = static_cast<uint32_t>(widths) & 31u, w1 = static_cast<uint32_t>(widths >> 5) & 31u,
              w2 = static_cast<uint32_t>(widths >> 10) & 31u;
   const uint32_t m0 = static_cast<uint32_t>(mins) & t.mask[0];
@@ -89,10 +100,10 @@ inline void load_segment(const Track& t, const uint8_t* stream, uint32_t segment
 }
 
 /// The three codes of key `key` of a segmented track, through its cursor. O(1).
-inline void segment_codes(const Track& t, const KeySource& src, uint32_t key, uint32_t q[3]) {
+OSSA_INLINE void segment_codes(const Track& t, const KeySource& src, uint32_t key, uint32_t q[3]) {
   SegmentCursor& c = src.cursors[&t - src.tracks];
   if (c.segment != key / kSegmentKeys) load_segment(t, src.stream, key / kSegmentKeys, c);
-  const uint64_t packed = read_bits(src.stream, c.data + uint64_t{c.key_bits} * (key % kSegmentKeys), c.key_bits);
+  const uint64_t packed = key_word(src.stream, c.data + uint64_t{c.key_bits} * (key % kSegmentKeys));
   for (uint32_t i = 0; i < 3; ++i) q[i] = c.min[i] + (static_cast<uint32_t>(packed >> c.shift[i]) & c.mask[i]);
 }
 
@@ -103,7 +114,7 @@ inline void segment_codes(const Track& t, const KeySource& src, uint32_t key, ui
 #if defined(__SSE2__)
 /// Key `key` of a quantized track as (x, y, z, 0): its three stored components, dequantized.
 template <bool kSegments>
-inline __m128 dequantized(const Track& t, const KeySource& src, uint32_t key) {
+OSSA_INLINE __m128 dequantized(const Track& t, const KeySource& src, uint32_t key) {
   // q < 2^19 fits a signed 32-bit lane, so the signed conversion is exact.
   __m128i q;
   if (kSegments) {
@@ -111,7 +122,7 @@ inline __m128 dequantized(const Track& t, const KeySource& src, uint32_t key) {
     segment_codes(t, src, key, c);
     q = _mm_setr_epi32(static_cast<int>(c[0]), static_cast<int>(c[1]), static_cast<int>(c[2]), 0);
   } else {
-    const uint64_t packed = read_bits(src.stream, t.bit_offset + uint64_t{t.key_bits} * key, t.key_bits);
+    const uint64_t packed = key_word(src.stream, t.bit_offset + uint64_t{t.key_bits} * key);
     const auto q0 = static_cast<int>(static_cast<uint32_t>(packed) & t.mask[0]);
     const auto q1 = static_cast<int>(static_cast<uint32_t>(packed >> t.shift[1]) & t.mask[1]);
     const auto q2 = static_cast<int>(static_cast<uint32_t>(packed >> t.shift[2]) & t.mask[2]);
@@ -126,7 +137,7 @@ inline __m128 dequantized(const Track& t, const KeySource& src, uint32_t key) {
 /// and the bytes after it are cleared, so no arithmetic on lane 3 can raise a floating-point flag;
 /// + 0 turns a -0 into +0, as decode_key does.
 template <bool kSegments>
-inline __m128 stored(const Track& t, const KeySource& src, uint32_t key) {
+OSSA_INLINE __m128 stored(const Track& t, const KeySource& src, uint32_t key) {
   if (t.raw)
     return _mm_add_ps(
         _mm_and_ps(_mm_loadu_ps(reinterpret_cast<const float*>(src.stream + (t.bit_offset >> 3) + 12ull * key)),
@@ -137,7 +148,7 @@ inline __m128 stored(const Track& t, const KeySource& src, uint32_t key) {
 
 /// Writes the three stored components where the record says they go (through memory: a 16-byte
 /// store forwards to the 4-byte loads, cheaper than shuffling each lane out).
-inline void put(const Track& t, __m128 v, float* keys) {
+OSSA_INLINE void put(const Track& t, __m128 v, float* keys) {
   float x[4];
   _mm_storeu_ps(x, v);
   keys[t.offset[0]] = x[0];
@@ -147,7 +158,7 @@ inline void put(const Track& t, __m128 v, float* keys) {
 
 /// Decodes key `key` of a track into the k0 or k1 array.
 template <bool kSegments>
-[[gnu::always_inline]] inline void decode(const Track& t, const KeySource& src, uint32_t key, float* keys) {
+OSSA_INLINE void decode(const Track& t, const KeySource& src, uint32_t key, float* keys) {
   float v[4];
   _mm_storeu_ps(v, stored<kSegments>(t, src, key));
   keys[t.offset[0]] = v[0];
@@ -158,7 +169,7 @@ template <bool kSegments>
 
 /// rotation_w of two stored keys at once (lanes 0 and 1): its operations, lane for lane, in its
 /// order, with one square root for both.
-inline __m128 rotation_w2(__m128 a, __m128 b) {
+OSSA_INLINE __m128 rotation_w2(__m128 a, __m128 b) {
   const __m128 xy = _mm_unpacklo_ps(a, b);  // xa xb ya yb
   const __m128 z = _mm_unpackhi_ps(a, b);   // za zb 0 0
   const __m128 sq = _mm_mul_ps(xy, xy);
@@ -169,7 +180,7 @@ inline __m128 rotation_w2(__m128 a, __m128 b) {
 }
 
 /// The codes of one key of a segment, `packed` its bits, as (q0, q1, q2, 0).
-inline __m128i cursor_codes(const SegmentCursor& c, uint64_t packed) {
+OSSA_INLINE __m128i cursor_codes(const SegmentCursor& c, uint64_t packed) {
   const auto q0 = static_cast<int>(static_cast<uint32_t>(packed) & c.mask[0]);
   const auto q1 = static_cast<int>(static_cast<uint32_t>(packed >> c.shift[1]) & c.mask[1]);
   const auto q2 = static_cast<int>(static_cast<uint32_t>(packed >> c.shift[2]) & c.mask[2]);
@@ -177,37 +188,37 @@ inline __m128i cursor_codes(const SegmentCursor& c, uint64_t packed) {
 }
 
 /// Codes as floats dequantized the way dequantized() does.
-inline __m128 dequantize_codes(const Track& t, __m128i q) {
+OSSA_INLINE __m128 dequantize_codes(const Track& t, __m128i q) {
   const __m128 f = _mm_div_ps(_mm_cvtepi32_ps(q), _mm_loadu_ps(t.qmax));
   return _mm_add_ps(_mm_loadu_ps(t.lo), _mm_mul_ps(_mm_loadu_ps(t.extent), f));
 }
 
 /// Keys `key` and `key + 1` of a segmented track: one header for both unless `key` ends its
 /// segment, and one read for both when they fit 57 bits (the cursor is left on key + 1's segment).
-inline void segment_pair(const Track& t, const KeySource& src, uint32_t key, __m128& a, __m128& b) {
+OSSA_INLINE void segment_pair(const Track& t, const KeySource& src, uint32_t key, __m128& a, __m128& b) {
   SegmentCursor& c = src.cursors[&t - src.tracks];
   const uint32_t segment = key / kSegmentKeys, i = key % kSegmentKeys;
   if (c.segment != segment) load_segment(t, src.stream, segment, c);
   const uint64_t at = c.data + uint64_t{c.key_bits} * i;
   if (i + 1 < kSegmentKeys) {
     if (2 * c.key_bits <= 57) {
-      const uint64_t both = read_bits(src.stream, at, 2 * c.key_bits);
+      const uint64_t both = key_word(src.stream, at);
       a = dequantize_codes(t, cursor_codes(c, both));
       b = dequantize_codes(t, cursor_codes(c, both >> c.key_bits));
     } else {
-      a = dequantize_codes(t, cursor_codes(c, read_bits(src.stream, at, c.key_bits)));
-      b = dequantize_codes(t, cursor_codes(c, read_bits(src.stream, at + c.key_bits, c.key_bits)));
+      a = dequantize_codes(t, cursor_codes(c, key_word(src.stream, at)));
+      b = dequantize_codes(t, cursor_codes(c, key_word(src.stream, at + c.key_bits)));
     }
     return;
   }
-  a = dequantize_codes(t, cursor_codes(c, read_bits(src.stream, at, c.key_bits)));
+  a = dequantize_codes(t, cursor_codes(c, key_word(src.stream, at)));
   load_segment(t, src.stream, segment + 1, c);
-  b = dequantize_codes(t, cursor_codes(c, read_bits(src.stream, c.data, c.key_bits)));
+  b = dequantize_codes(t, cursor_codes(c, key_word(src.stream, c.data)));
 }
 
 /// Keys `key` and `key + 1` of a track into k0 and k1 (a seek).
 template <bool kSegments>
-inline void decode_pair(const Track& t, const KeySource& src, uint32_t key, float* k0, float* k1) {
+OSSA_INLINE void decode_pair(const Track& t, const KeySource& src, uint32_t key, float* k0, float* k1) {
   __m128 a, b;
   if (kSegments) {
     segment_pair(t, src, key, a, b);
@@ -224,11 +235,10 @@ inline void decode_pair(const Track& t, const KeySource& src, uint32_t key, floa
   k1[t.offset[3]] = w[1];
 }
 
-/// Key `key` of two tracks into `keys` (forward playback). Always inlined, as decode is: sample.cpp
+/// Key `key` of two tracks into `keys` (forward playback). Always inlined, as decode is: sample_keys.cpp
 /// calls them from several per-track loops, and GCC would otherwise call them once per track.
 template <bool kSegments>
-[[gnu::always_inline]] inline void decode_two(const Track& ta, const Track& tb, const KeySource& src, uint32_t key,
-                                              float* keys) {
+OSSA_INLINE void decode_two(const Track& ta, const Track& tb, const KeySource& src, uint32_t key, float* keys) {
   const __m128 a = stored<kSegments>(ta, src, key), b = stored<kSegments>(tb, src, key);
   put(ta, a, keys);
   put(tb, b, keys);
@@ -258,7 +268,7 @@ inline void decode(const Track& t, const KeySource& src, uint32_t key, float* ke
 }
 
 template <bool kSegments>
-inline void decode_pair(const Track& t, const KeySource& src, uint32_t key, float* k0, float* k1) {
+OSSA_INLINE void decode_pair(const Track& t, const KeySource& src, uint32_t key, float* k0, float* k1) {
   decode<kSegments>(t, src, key, k0);
   decode<kSegments>(t, src, key + 1, k1);
 }

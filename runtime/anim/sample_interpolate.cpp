@@ -142,7 +142,7 @@ void interpolate_slerp(const SampleLanes& l, float frame) {
     float w = (frame - l.start[stride + j]) * l.inv_length[stride + j];
     w = w < 0.0f ? 0.0f : (w > 1.0f ? 1.0f : w);
     // At weight 0 the nlerp above gives the first key and reads nothing of the second, which the
-    // sampler may leave undecoded there (sample.cpp, settle); a slerp would read it.
+    // sampler may leave undecoded there (sample_keys.cpp, settle); a slerp would read it.
     if (w == 0.0f) continue;
     float a[4], b[4];
     for (uint32_t c = 0; c < 4; ++c) {

@@ -1,7 +1,7 @@
 // sample_lanes.h — pass 2 of ossa::sample (anim/sample.cpp): the per-joint interpolation between
 // a sampling cache's key pairs, kept in its own file (anim/sample_interpolate.cpp) because it is
-// the vector code, compiled twice (internal/vector_clones.h), while pass 1 (cursors, seeks, key
-// decodes) is scalar. Internal to runtime/.
+// 8-lane vector code over joints, where pass 1 (cursors, seeks, key decodes: anim/sample_keys.cpp)
+// works per run and channel. Both are compiled twice (internal/vector_clones.h). Internal to runtime/.
 #pragma once
 
 #include <cmath>

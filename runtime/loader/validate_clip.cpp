@@ -20,7 +20,7 @@ namespace ossa::validate_detail {
 
 // ---- clips ----
 //
-// Everything the sampler (runtime/anim/sample.cpp) and root_motion.cpp dereference is proven here,
+// Everything the sampler (runtime/anim/sample*.cpp) and root_motion.cpp dereference is proven here,
 // before any of them runs: channel joints < joint_count, each animated channel keyed at every
 // frame or its key range inside key_frames, and its bit range inside key_values minus the 8 padding bytes the decoder's
 // 64-bit reads may touch, frames strictly increasing from 0 to frame_count - 1 (so a cursor or a

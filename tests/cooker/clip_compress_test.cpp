@@ -511,7 +511,7 @@ const CompressedConstant* find_constant(const CompressedClip& c, uint16_t joint,
 }
 
 // Pab's crossarms: every animated channel drops keys, each on a list of its own unless step 7
-// shares them. A runtime tests one cursor per list at every sample (runtime/anim/sample.cpp).
+// shares them. A runtime tests one cursor per list at every sample (runtime/anim/sample_keys.cpp).
 TEST(ClipCompressSharing, ChannelsShareKeyListsWithinTheBoundAndInFewerBytes) {
   const fs::path dir = shared_assets() / "Pab";
   if (!fs::exists(dir / "crossarms.fbx") || !fs::exists(dir / "skeleton.fbx"))

@@ -206,6 +206,30 @@ const Pab* pab() {
   const ClipView clip = p->walk.clip(0);                                         \
   const SkeletonView skeleton = p->skeleton.skeleton()
 
+/// Samples `times` twice, once with each vector copy (vector_isa.h) and a cache of its own, and
+/// counts the poses compared; fails at the first that differs in a bit.
+int expect_copies_agree(const ClipView& clip, const SkeletonView& skeleton, const std::vector<float>& times,
+                        const std::string& what) {
+  const auto joints = static_cast<uint32_t>(skeleton.joint_count());
+  SamplingCache ca = cache_for(clip, skeleton), cb = cache_for(clip, skeleton);
+  Pose a(joints), b(joints);
+  int checked = 0;
+  for (const float t : times) {
+    for (const RotationInterpolation r : {RotationInterpolation::Nlerp, RotationInterpolation::Slerp}) {
+      const SampleOptions o{.loop = true, .rotation = r};
+      EXPECT_TRUE(ossa::set_vector_isa(ossa::VectorIsa::Avx2));
+      sample(clip, t, o, ca, a);
+      EXPECT_TRUE(ossa::set_vector_isa(ossa::VectorIsa::Baseline));
+      sample(clip, t, o, cb, b);
+      ossa::set_vector_isa(ossa::best_vector_isa());
+      EXPECT_TRUE(same_bits(a, b)) << what << " at t=" << t;
+      if (!same_bits(a, b)) return checked;
+      ++checked;
+    }
+  }
+  return checked;
+}
+
 // ---- synthetic clips -----------------------------------------------------------------------
 
 TEST(Sample, FrameTimesReproduceDecodedKeys) {
@@ -404,7 +428,7 @@ TEST(Sample, SeeksFindTheKeyPairInALongClipWithSparseAndDenseRuns) {
 }
 
 TEST(Sample, AKeysOwnFrameGivesTheSameBitsWhateverTheNextKeyHolds) {
-  // At a key's own frame the sampler may decode only the pair's first key (sample.cpp, settle):
+  // At a key's own frame the sampler may decode only the pair's first key (sample_keys.cpp, settle):
   // the second key's weight is 0 there, and no key decodes to -0 (clip_codec.h), so the pose may
   // not depend on the second key. Keys holding -0 (raw floats; a quantized channel whose range
   // minimum and extent are -0) beside keys of either sign, sampled at their frames after a jump
@@ -521,6 +545,12 @@ TEST(Sample, SegmentedKeysSampleAsTheirPlainKeysBitForBit) {
       sample(segmented.clip(), t, SampleOptions{.loop = false}, b, pb);
       ASSERT_TRUE(same_bits(pa, pb)) << "offset bits " << int{offset_bits[0]} << " " << int{offset_bits[1]} << " "
                                      << int{offset_bits[2]} << ", frame " << frame;
+    }
+    if (ossa::best_vector_isa() == ossa::VectorIsa::Avx2) {  // both key decodes (vector_isa.h) agree
+      std::vector<float> times;
+      for (const double frame : frames) times.push_back(static_cast<float>(frame / plain.clip().sample_rate()));
+      EXPECT_EQ(expect_copies_agree(segmented.clip(), segmented.skeleton(), times, "segmented"),
+                static_cast<int>(2 * times.size()));
     }
   }
 }
@@ -759,27 +789,30 @@ TEST(Sample, CacheIsInvisibleOnSyntheticClips) {
 }
 
 TEST(Sample, BothVectorCopiesGiveBitIdenticalPoses) {
-  // Sampling's interpolation kernel is compiled for AVX2 and the baseline (vector_isa.h); with no
-  // FMA in either, a pose must not depend on which copy ran.
+  // Both passes of a sample are compiled for AVX2 and the baseline (vector_isa.h): the key decode
+  // (seeks, steps, a key's own frame, segmented channels) and the interpolation. With no FMA in
+  // either, a pose must not depend on which copy ran.
   if (ossa::best_vector_isa() != ossa::VectorIsa::Avx2) GTEST_SKIP() << "no AVX2 copy on this CPU or build";
   int checked = 0;
   for (const auto& [name, spec] : test::valid_variants()) {
     if (spec.clips.empty() || !spec.skeleton || spec.clips[0].skeleton_hash) continue;
     const Loaded f = load(spec);
-    const auto joints = static_cast<uint32_t>(f.skeleton().joint_count());
-    SamplingCache ca = cache_for(f.clip(), f.skeleton()), cb = cache_for(f.clip(), f.skeleton());
-    Pose a(joints), b(joints);
-    for (const float t : playback(f.clip(), 1.0f, 120, true)) {
-      ASSERT_TRUE(ossa::set_vector_isa(ossa::VectorIsa::Avx2));
-      sample(f.clip(), t, {}, ca, a);
-      ASSERT_TRUE(ossa::set_vector_isa(ossa::VectorIsa::Baseline));
-      sample(f.clip(), t, {}, cb, b);
-      ASSERT_TRUE(same_bits(a, b)) << name << " at t=" << t;
-      ++checked;
-    }
+    checked += expect_copies_agree(f.clip(), f.skeleton(), playback(f.clip(), 1.0f, 120, true), name + " forward");
+    checked += expect_copies_agree(f.clip(), f.skeleton(), random_times(f.clip(), 60, 7), name + " seeks");
+    checked += expect_copies_agree(f.clip(), f.skeleton(), jumps(f.clip(), 60, 8, true), name + " keys' frames");
   }
-  ossa::set_vector_isa(ossa::best_vector_isa());
-  EXPECT_GT(checked, 0);
+  auto rig = Asset::open((test::fixtures_dir() / "Pab" / "skeleton.ossa").string());
+  ASSERT_TRUE(rig.ok()) << rig.error().message;
+  for (const char* name : {"walk", "crossarms"}) {  // dense runs; sparse runs in a 259-frame clip
+    auto a = Asset::open((test::fixtures_dir() / "Pab" / (std::string(name) + ".ossa")).string());
+    ASSERT_TRUE(a.ok()) << a.error().message;
+    const ClipView clip = a->clip(0);
+    const std::string what = std::string("Pab ") + name;
+    checked += expect_copies_agree(clip, rig->skeleton(), playback(clip, 1.0f, 120, true), what + " forward");
+    checked += expect_copies_agree(clip, rig->skeleton(), random_times(clip, 120, 9), what + " seeks");
+    checked += expect_copies_agree(clip, rig->skeleton(), jumps(clip, 120, 10), what + " steps and jumps");
+  }
+  EXPECT_GT(checked, 1000);
 }
 
 TEST(AdvanceTime, WrapsClampsAndCountsLoops) {
