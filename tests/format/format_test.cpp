@@ -7,8 +7,10 @@
 #include <random>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
+#include <ossa/format/clip_codec.h>
 #include <ossa/format/hash.h>
 #include <ossa/format/vertex_codec.h>
 #include <ossa/format/vertex_format.h>
@@ -72,6 +74,34 @@ TEST(Hash, SkeletonHashSeesEveryByteLengthOrderAndParent) {
   }
   std::sort(seen.begin(), seen.end());
   EXPECT_EQ(std::adjacent_find(seen.begin(), seen.end()), seen.end()) << "two name lengths collided";
+}
+
+TEST(ClipCodec, BitWriterFieldsReadBackAndBitsPastTheValueAreZeros) {
+  // Random fields of 1..57 bits (a key's widest) read back with read_bits where they were written,
+  // LSB-first; a field wider than 64 bits writes the value's 64 and zeros after them.
+  std::mt19937_64 rng(5);
+  ossa::BitWriter writer;
+  std::vector<std::pair<uint64_t, uint32_t>> fields;
+  for (int i = 0; i < 2000; ++i) {
+    const auto n = static_cast<uint32_t>(1 + rng() % 57);
+    const uint64_t value = rng();
+    fields.emplace_back(value & ((uint64_t{1} << n) - 1), n);
+    writer.write(value, n);  // the bits above n are not written
+  }
+  writer.write(~uint64_t{0}, 70);
+  writer.write(1, 1);
+  const std::vector<uint8_t> bytes = writer.finish();
+  uint64_t at = 0;
+  for (const auto& [value, n] : fields) {
+    ASSERT_EQ(ossa::read_bits(bytes.data(), at, n), value) << "field at bit " << at;
+    at += n;
+  }
+  EXPECT_EQ(ossa::read_bits(bytes.data(), at, 32), 0xffffffffu);
+  EXPECT_EQ(ossa::read_bits(bytes.data(), at + 32, 32), 0xffffffffu);
+  EXPECT_EQ(ossa::read_bits(bytes.data(), at + 64, 6), 0u);
+  EXPECT_EQ(ossa::read_bits(bytes.data(), at + 70, 1), 1u);
+  EXPECT_EQ(writer.bit_size(), at + 71);
+  EXPECT_EQ(bytes.size(), (at + 71 + 7) / 8 + ossa::kKeyValuePadding);
 }
 
 TEST(VertexCodec, OctahedralRoundTripWithinSnorm16Precision) {

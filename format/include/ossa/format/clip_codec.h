@@ -209,14 +209,15 @@ void constant_value(const Constant& c, float out[4]) {
   }
 }
 
-/// Appends bit fields LSB-first; pad() finishes the stream with kKeyValuePadding zero bytes.
+/// Appends bit fields LSB-first; finish() ends the stream with kKeyValuePadding zero bytes.
 class BitWriter {
  public:
   uint64_t bit_size() const { return bits_; }
+  /// Appends the low `count` bits of value; bits past its 64th are zeros. O(count).
   void write(uint64_t value, uint32_t count) {
     for (uint32_t i = 0; i < count; ++i, ++bits_) {
       if ((bits_ >> 3) >= bytes_.size()) bytes_.push_back(0);
-      if ((value >> i) & 1u) bytes_[bits_ >> 3] |= static_cast<uint8_t>(1u << (bits_ & 7u));
+      if (i < 64 && ((value >> i) & 1u)) bytes_[bits_ >> 3] |= static_cast<uint8_t>(1u << (bits_ & 7u));
     }
   }
   void write_float(float f) {
