@@ -26,7 +26,8 @@
 //      (rsqrt + one Newton step).
 // A class-ordered mesh skinned for normals without tangents takes soa_kernel.h instead of steps
 // 2-4: eight vertices at a time, structure-of-arrays after the blend (see "meshes ordered by
-// influence class" below).
+// influence class" below); one skinned for positions alone, where 512-bit operations run at full
+// width, takes skin_positions_quad: four vertices a step, their sums done two vertices per register.
 // The per-vertex transforms use 256-bit registers on both paths: on Zen 4, which executes a
 // 512-bit operation as two 256-bit halves, a 16-wide per-vertex kernel measured ~25% slower (more
 // cross-lane shuffles for the same arithmetic). The range loops' AVX-512 copy blends a vertex's
@@ -86,6 +87,24 @@ OSSA_TARGET_AVX2 inline void blend_matrix(const float* palette, const uint8_t* v
   }
 }
 
+/// Blended matrix (c0 | c1 | c2 | c3, one 512-bit register) of the class-K vertex whose joints are
+/// at j; `wb` receives its weight word.
+template <int K, Slots kSlots>
+[[gnu::always_inline]] OSSA_TARGET_AVX512 inline __m512 matrix512(const float* palette, const uint8_t* j,
+                                                                  ptrdiff_t off_weights, uint32_t& wb) {
+  const uint8_t* const w = kSlots == Slots::Packed ? j + 4 : j + off_weights;
+  const auto matrix = [&](int k) { return soa::slot_matrix<kSlots == Slots::Wide>(palette, j, k); };
+  wb = load_u32(w);
+  if constexpr (K == 0) {
+    return _mm512_loadu_ps(matrix(0));
+  } else {
+    __m512 m = _mm512_mul_ps(_mm512_set1_ps(kWeight[w[0]]), _mm512_loadu_ps(matrix(0)));
+#pragma GCC unroll 4
+    for (int k = 1; k < K; ++k) m = _mm512_fmadd_ps(_mm512_set1_ps(kWeight[w[k]]), _mm512_loadu_ps(matrix(k)), m);
+    return m;
+  }
+}
+
 /// blend_matrix for the AVX-512 copy of the range loops: the blend in one 512-bit register (one
 /// FMA per influence where the 256-bit form needs two), split into the same columns. Rounds as
 /// blend_matrix does (the same products and sums per element). Not always_inline (an AVX2
@@ -96,13 +115,7 @@ OSSA_TARGET_AVX512 inline void blend_matrix512(const float* palette, const uint8
   if constexpr (K == 0) {
     blend_matrix<K, kSlots, kNeedWeights>(palette, vx, off_joints, off_weights, a01, a23, wb);
   } else {
-    const uint8_t* const j = vx + off_joints;
-    const uint8_t* const w = kSlots == Slots::Packed ? j + 4 : vx + off_weights;
-    const auto matrix = [&](int k) { return soa::slot_matrix<kSlots == Slots::Wide>(palette, j, k); };
-    wb = load_u32(w);
-    __m512 m = _mm512_mul_ps(_mm512_set1_ps(kWeight[w[0]]), _mm512_loadu_ps(matrix(0)));
-#pragma GCC unroll 4
-    for (int k = 1; k < K; ++k) m = _mm512_fmadd_ps(_mm512_set1_ps(kWeight[w[k]]), _mm512_loadu_ps(matrix(k)), m);
+    const __m512 m = matrix512<K, kSlots>(palette, vx + off_joints, off_weights - off_joints, wb);
     a01 = _mm512_castps512_ps256(m);
     a23 = _mm512_extractf32x8_ps(m, 1);
   }
@@ -256,6 +269,78 @@ OSSA_TARGET_AVX512 OSSA_SOA_FLATTEN uint32_t skin_range_avx512(const float* pale
   return range_loop<K, kSlots, kPositions, kNormals, kTangents, true>(palette, mesh, b, out);
 }
 
+/// Two consecutive vertices' halves for skin_positions_quad: (a.lo | a.hi | b.lo | b.hi) with
+/// lo = fma(c2, z, c0 * x) and hi = fma(c3, 1, c1 * y), each vertex's position being lo + hi, the
+/// products and sums transform_dup rounds. The matrices' columns are regrouped by pairs of
+/// vertices, (a.c0 | a.c1 | b.c0 | b.c1) and (a.c2 | a.c3 | b.c2 | b.c3), and the two positions
+/// spread to match, so one multiply and one FMA serve both vertices.
+template <int K, Slots kSlots>
+[[gnu::always_inline]] OSSA_TARGET_AVX512 inline __m512 pair_halves(const float* palette, const uint8_t* j,
+                                                                    size_t stride, ptrdiff_t off_position,
+                                                                    ptrdiff_t off_weights, uint32_t& wa, uint32_t& wb) {
+  const __m512 ma = matrix512<K, kSlots>(palette, j, off_weights, wa);
+  const __m512 mb = matrix512<K, kSlots>(palette, j + stride, off_weights, wb);
+  const __m512 c01 = _mm512_shuffle_f32x4(ma, mb, 0x44), c23 = _mm512_shuffle_f32x4(ma, mb, 0xee);
+  // Both positions' unorm16 words, widened: (a.x a.y a.z a.w b.x b.y b.z b.w), scaled, w = 1.
+  const __m128i q = _mm_castpd_si128(
+      _mm_loadh_pd(_mm_castsi128_pd(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(j + off_position))),
+                   reinterpret_cast<const double*>(j + stride + off_position)));
+  const float s = 1.0f / 65535.0f;
+  const __m256 p = _mm256_fmadd_ps(_mm256_cvtepi32_ps(_mm256_cvtepu16_epi32(q)), _mm256_setr_ps(s, s, s, 0, s, s, s, 0),
+                                   _mm256_setr_ps(0, 0, 0, 1, 0, 0, 0, 1));
+  const __m512 xy = _mm512_permutexvar_ps(_mm512_setr_epi32(0, 0, 0, 0, 1, 1, 1, 1, 4, 4, 4, 4, 5, 5, 5, 5),
+                                          _mm512_castps256_ps512(p));
+  const __m512 zw = _mm512_permutexvar_ps(_mm512_setr_epi32(2, 2, 2, 2, 3, 3, 3, 3, 6, 6, 6, 6, 7, 7, 7, 7),
+                                          _mm512_castps256_ps512(p));
+  return _mm512_fmadd_ps(c23, zw, _mm512_mul_ps(c01, xy));
+}
+
+/// Class K's positions alone for the contiguous vertices [first, first + n) of a class-ordered mesh,
+/// four at a time (where 512-bit operations run at full width). Two pairs' halves (pair_halves)
+/// are added by one round of 128-bit lane shuffles into one register of four (x, y, z, 1), packed
+/// to 12 floats and written with one masked store: after the blends, ~7 operations a vertex
+/// (a quarter of them shuffles) where skin_vertex's position decode and transform_dup take 12
+/// (half of them shuffles). Positions alone ~7% faster on Pab's arnaud (Zen 5); a full 16-float
+/// store, its last 4 floats overwritten later, measured slower (it crosses a cache line 3 times in
+/// 4). The last n % 4 vertices take skin_vertex. Returns soa::outside_class<K> of the weight
+/// words' OR and AND.
+template <int K, Slots kSlots>
+OSSA_TARGET_AVX512 OSSA_SOA_FLATTEN uint32_t skin_positions_quad(const float* palette, const FastMesh& mesh,
+                                                                 uint32_t first, uint32_t n, float* positions) {
+  const size_t stride = mesh.stride;
+  const ptrdiff_t off_position = ptrdiff_t{mesh.off_position} - ptrdiff_t{mesh.off_joints},
+                  off_weights = ptrdiff_t{mesh.off_weights} - ptrdiff_t{mesh.off_joints};
+  const uint8_t* vx = mesh.base + first * stride + mesh.off_joints;
+  float* out = positions + 3 * static_cast<size_t>(first);
+  const __m512i pack = _mm512_setr_epi32(0, 1, 2, 4, 5, 6, 8, 9, 10, 12, 13, 14, 0, 0, 0, 0);
+  uint32_t any = 0, all = ~0u, i = 0;
+  for (; i + 4 <= n; i += 4) {
+    uint32_t w0, w1, w2, w3;
+    const __m512 h01 = pair_halves<K, kSlots>(palette, vx, stride, off_position, off_weights, w0, w1);
+    const __m512 h23 = pair_halves<K, kSlots>(palette, vx + 2 * stride, stride, off_position, off_weights, w2, w3);
+    any |= w0 | w1 | w2 | w3;
+    if constexpr (K == 0) all &= w0 & w1 & w2 & w3;
+    // (lo of vertices 0-3) + (hi of vertices 0-3): four (x, y, z, 1).
+    const __m512 r = _mm512_add_ps(_mm512_shuffle_f32x4(h01, h23, 0x88), _mm512_shuffle_f32x4(h01, h23, 0xdd));
+    _mm512_mask_storeu_ps(out, 0x0fff, _mm512_permutexvar_ps(pack, r));
+    vx += 4 * stride;
+    out += 12;
+  }
+  const VertexPointers none{};
+  for (; i < n; ++i) {
+    VertexPointers at = none;
+    at.vx = vx;
+    at.position_out = out;
+    const uint32_t wb =
+        skin_vertex<K, true, false, kSlots, true, false, false, true>(palette, at, off_position, 0, off_weights);
+    any |= wb;
+    if constexpr (K == 0) all &= wb;
+    vx += stride;
+    out += 3;
+  }
+  return soa::outside_class<K>(any, all);
+}
+
 /// Class K's loop over the contiguous vertices [first, first + n) of a class-ordered mesh, eight at
 /// a time (soa_kernel.h), positions and normals (renormalized as out asks) written directly.
 /// Returns n, or the index (from first) of the block where a vertex did not belong to the class:
@@ -378,6 +463,16 @@ OSSA_TARGET_AVX2 void skin_fast(const float* palette, const FastMesh& m, Outputs
       }
       begin = end;
       return true;
+    }
+    if constexpr (kPositions && !kNormals && !kTangents) {
+      if (blend512) {
+        if (skin_positions_quad<K, kSlots>(palette, m, begin, end - begin, out.positions) != 0) {
+          skin_classified<kSlots, kPositions, kNormals, kTangents>(palette, m, out, avx512, begin);
+          return false;
+        }
+        begin = end;
+        return true;
+      }
     }
     for (b.first = begin; b.first < end; b.first += kBatch) {
       b.n = std::min(kBatch, end - b.first);
