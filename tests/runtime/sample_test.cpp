@@ -597,6 +597,70 @@ TEST(Sample, SlerpHasConstantAngularVelocity) {
       << "nlerp and slerp should differ on a 160-degree key pair";
 }
 
+TEST(Sample, AtAKeysFrameSlerpAndNlerpGiveTheSameBits) {
+  // Three joints rotating 50-170 degrees between keys about changing axes, each with keys of its
+  // own: slerp takes its own branch between them. At a joint's key frame the key itself is the
+  // answer, whichever interpolation is asked for, so switching modes never moves a keyed pose
+  // (and the slerp reads nothing of a second key the sampler may not have decoded there).
+  const auto unit_xyz = [](double degrees, glm::dvec3 axis) {
+    const glm::dvec3 a = glm::normalize(axis) * std::sin(glm::radians(degrees) / 2);
+    return std::array<float, 3>{static_cast<float>(a.x), static_cast<float>(a.y), static_cast<float>(a.z)};
+  };
+  SyntheticSpec spec;
+  std::vector<test::SyntheticAnimated>& tracks = spec.clips[0].animated;
+  tracks[0].frames = {0, 7, 15, 22, 30};
+  tracks[0].values = {unit_xyz(0, {0, 1, 0}), unit_xyz(110, {0.3, 1, 0.2}), unit_xyz(60, {1, 0.2, 0}),
+                      unit_xyz(170, {0.1, 0.4, 1}), unit_xyz(50, {0.6, 0.6, 0.2})};
+  test::SyntheticAnimated more = tracks[0];
+  more.joint = 0;
+  more.frames = {0, 4, 11, 19, 26, 30};
+  more.values = {unit_xyz(20, {1, 0, 0}),  unit_xyz(150, {0.2, 0.1, 1}), unit_xyz(70, {0, 1, 0.5}),
+                 unit_xyz(160, {1, 1, 0}), unit_xyz(90, {0.2, 1, 0.9}),  unit_xyz(10, {0, 0, 1})};
+  tracks.insert(tracks.begin(), more);  // sorted by (joint, channel)
+  more.joint = 3;
+  more.bits = 32;
+  more.frames = {0, 10, 20, 30};
+  more.values = {unit_xyz(130, {0.5, 1, 0}), unit_xyz(40, {1, 0.3, 0.3}), unit_xyz(175, {0, 0.2, 1}),
+                 unit_xyz(80, {0.7, 0, 0.7})};
+  tracks.insert(tracks.begin() + 3, more);  // between joint 3's translation and scale
+  const std::map<int, std::vector<int>> keys = {
+      {1, {0, 7, 15, 22, 30}}, {0, {0, 4, 11, 19, 26, 30}}, {3, {0, 10, 20, 30}}};
+  const Loaded f = load(spec);
+  const SampleOptions n_opt{.loop = false, .rotation = RotationInterpolation::Nlerp};
+  const SampleOptions s_opt{.loop = false, .rotation = RotationInterpolation::Slerp};
+  const auto rotation = [](const Pose& p, int j) { return get_transform(p, static_cast<uint16_t>(j)).rotation; };
+  const auto same = [](glm::quat a, glm::quat b) { return std::memcmp(&a, &b, sizeof a) == 0; };
+  // Every frame played forward, then each joint's key frames alone (jumps past whole key pairs),
+  // and each frame from a fresh cache (a seek).
+  std::vector<std::vector<int>> orders(1);
+  for (int frame = 0; frame <= 30; ++frame) orders[0].push_back(frame);
+  for (const auto& [joint, frames] : keys) orders.push_back(frames);
+  int checked = 0, differing = 0;
+  for (const std::vector<int>& order : orders) {
+    SamplingCache by_nlerp = cache_for(f.clip(), f.skeleton()), by_slerp = cache_for(f.clip(), f.skeleton());
+    Pose nlerp(4), slerp(4), sought(4);
+    for (const int frame : order) {
+      const float t = static_cast<float>(frame) / 30.0f;
+      sample(f.clip(), t, n_opt, by_nlerp, nlerp);
+      sample(f.clip(), t, s_opt, by_slerp, slerp);
+      SamplingCache fresh = cache_for(f.clip(), f.skeleton());
+      sample(f.clip(), t, s_opt, fresh, sought);
+      for (const auto& [joint, frames] : keys) {
+        if (std::find(frames.begin(), frames.end(), frame) != frames.end()) {
+          EXPECT_TRUE(same(rotation(nlerp, joint), rotation(slerp, joint))) << "joint " << joint << " frame " << frame;
+          EXPECT_TRUE(same(rotation(nlerp, joint), rotation(sought, joint)))
+              << "joint " << joint << " frame " << frame << " after a seek";
+          ++checked;
+        } else if (!same(rotation(nlerp, joint), rotation(slerp, joint))) {
+          ++differing;
+        }
+      }
+    }
+  }
+  EXPECT_EQ(checked, 15 + 9 + 10 + 8);  // forward; then the key frames of joints 1, 0 and 3 (0 and 30: all three)
+  EXPECT_GT(differing, 50) << "slerp should differ from nlerp between these keys";
+}
+
 TEST(Sample, ClampAndLoopModes) {
   const Loaded f = load({});
   const ClipView clip = f.clip();
