@@ -5,6 +5,8 @@
 // The helper's pure functions (edit distance, closest name) are tested directly.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cstring>
 #include <filesystem>
 #include <regex>
 #include <string>
@@ -12,6 +14,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <ossa/loader/asset.h>
 #include <ossa/version.h>
 
 #include "tools/cli/cli.h"
@@ -172,6 +175,67 @@ TEST(ToolsCli, InspectQuietOnlyAnswersByStatusVerboseListsChannels) {
   const CommandResult missing = run_tool("ossa-inspect", q(dir / "missing.ossa"));
   EXPECT_EQ(missing.exit_code, 2);
   EXPECT_NE(missing.err.find("missing.ossa"), std::string::npos) << missing.err;
+}
+
+/// -v says how skin_cpu will walk each skinned mesh: its vertices per influence class and whether
+/// they run in class order (the cooker's order). The same mesh with its vertex records reversed
+/// has the same classes, out of order.
+TEST(ToolsCli, InspectVerboseSaysWhetherVerticesRunByInfluenceClass) {
+  const fs::path dir = ossa::test::make_temp_dir("tools-inspect-influences");
+  ASSERT_EQ(run_tool("ossa-cook", q(asset("Fox/Fox.glb")) + " -q -o " + q(dir)).exit_code, 0);
+  const fs::path fox = dir / "Fox.ossa";
+  const auto influences = [](const fs::path& file, size_t* vertices) {
+    const CommandResult r = run_tool("ossa-inspect", q(file) + " -v --json");
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    const nlohmann::json d = nlohmann::json::parse(r.out);
+    *vertices = d["meshes"][0]["vertex_count"].get<size_t>();
+    return d["meshes"][0].value("influences", nlohmann::json());
+  };
+  size_t n = 0;
+  const nlohmann::json cooked = influences(fox, &n);
+  ASSERT_TRUE(cooked.is_object()) << cooked;
+  const auto by_class = cooked["vertices_by_class"].get<std::vector<size_t>>();
+  ASSERT_EQ(by_class.size(), 5u);
+  size_t sum = 0, classes = 0;
+  for (const size_t c : by_class) {
+    sum += c;
+    classes += c > 0 ? 1 : 0;
+  }
+  EXPECT_EQ(sum, n);
+  ASSERT_GE(classes, 2u) << "Fox should mix influence classes";
+  EXPECT_TRUE(cooked["class_ordered"].get<bool>());
+  EXPECT_EQ(cooked["class_runs"].get<size_t>(), classes);
+  const CommandResult text = run_tool("ossa-inspect", q(fox) + " -v");
+  EXPECT_NE(text.out.find("vertex order   by influence class (" + std::to_string(classes) + " ranges"),
+            std::string::npos)
+      << text.out;
+  EXPECT_EQ(run_tool("ossa-inspect", q(fox) + " --json").out.find("influences"), std::string::npos);
+
+  // The vertex records reversed (the index buffer is not read here).
+  auto bytes = ossa::test::read_file(fox);
+  ASSERT_TRUE(bytes);
+  {
+    auto a = ossa::Asset::from_bytes(*bytes, "Fox.ossa");
+    ASSERT_TRUE(a) << a.error().message;
+    const ossa::MeshView mesh = a->mesh(0);
+    const size_t at = static_cast<size_t>(mesh.vertex_bytes().data() - a->bytes().data()),
+                 stride = mesh.vertex_stride();
+    std::vector<uint8_t> reversed(bytes->size());
+    std::copy(bytes->begin(), bytes->end(), reversed.begin());
+    for (size_t v = 0; v < n; ++v)
+      std::memcpy(reversed.data() + at + v * stride, bytes->data() + at + (n - 1 - v) * stride, stride);
+    *bytes = std::move(reversed);
+  }
+  ASSERT_TRUE(ossa::test::write_file(dir / "reversed.ossa", std::span<const uint8_t>(*bytes)));
+  size_t m = 0;
+  const nlohmann::json out_of_order = influences(dir / "reversed.ossa", &m);
+  ASSERT_TRUE(out_of_order.is_object()) << out_of_order;
+  EXPECT_EQ(out_of_order["vertices_by_class"], cooked["vertices_by_class"]);
+  EXPECT_FALSE(out_of_order["class_ordered"].get<bool>());
+  EXPECT_EQ(out_of_order["class_runs"].get<size_t>(), classes);
+  EXPECT_NE(
+      run_tool("ossa-inspect", q(dir / "reversed.ossa") + " -v").out.find("vertex order   not by influence class"),
+      std::string::npos);
 }
 
 /// Several files in one call: each described in turn, a bad one named without stopping the

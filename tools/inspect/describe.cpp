@@ -7,33 +7,26 @@
 #include "tools/inspect/describe.h"
 
 #include <algorithm>
+#include <array>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
+#include <span>
 #include <vector>
 
 #include <ossa/format/hash.h>
+#include <ossa/format/vertex_codec.h>
 #include "common/message.h"
+#include "tools/inspect/describe_parts.h"
 
 namespace ossa::inspect {
 namespace {
 
-/// A montage track's length on its timeline: the sum of (end - start) / rate over its segments
-/// (the loader has checked that every rate is positive).
-double track_length(const fb::MontageTrack& track) {
-  double length = 0.0;
-  if (track.segments() == nullptr) return length;
-  for (const fb::MontageSegment* s : *track.segments())
-    length += (static_cast<double>(s->end()) - static_cast<double>(s->start())) / static_cast<double>(s->rate());
-  return length;
-}
-
-using json = nlohmann::ordered_json;
 using detail::format;
-
-std::string hex16(uint64_t v) { return format("%016llx", static_cast<unsigned long long>(v)); }
-
-std::string str(const flatbuffers::String* s) { return s ? std::string(s->c_str(), s->size()) : std::string(); }
+using parts::hex16;
+using parts::json;
+using parts::str;
 
 template <class V>
 size_t count_of(const V* v) {
@@ -81,7 +74,33 @@ json describe_morph_targets(const MeshView& mesh, float metres_per_unit) {
   return list;
 }
 
-json describe_mesh(const MeshView& mesh, float metres_per_unit) {
+/// A skinned mesh's influence classes as skin_cpu sees them (ossa/format/vertex_codec.h's
+/// influence_class of each vertex's unorm8 weights): the vertices of each class, the runs of equal
+/// class in vertex order, and whether classes never decrease (the cooker's order, which lets
+/// skin_cpu skin each class as one range; a file in another order is classified batch by batch,
+/// slower, with the same result). Null for a mesh without unorm8 weights. O(vertices).
+json describe_influences(const MeshView& mesh) {
+  const fb::VertexAttribute* w = mesh.attribute(fb::VertexSemantic::Weights);
+  if (w == nullptr || w->format() != fb::VertexFormat::Unorm8x4) return nullptr;
+  const std::span<const uint8_t> bytes = mesh.vertex_bytes();
+  const size_t stride = mesh.vertex_stride();
+  std::array<size_t, 5> by_class{};
+  size_t runs = 0;
+  int last = -1;
+  bool ordered = true;
+  for (size_t v = 0; v < mesh.vertex_count(); ++v) {
+    uint32_t word;
+    std::memcpy(&word, bytes.data() + v * stride + w->offset(), 4);  // validation proved the bounds
+    const int c = influence_class(word);
+    ++by_class[static_cast<size_t>(c)];
+    runs += c != last ? 1 : 0;
+    ordered = ordered && c >= last;
+    last = c;
+  }
+  return json{{"vertices_by_class", by_class}, {"class_runs", runs}, {"class_ordered", ordered}};
+}
+
+json describe_mesh(const MeshView& mesh, float metres_per_unit, const DescribeOptions& options) {
   json layout = json::array();
   for (const fb::VertexAttribute& a : mesh.layout())
     layout.push_back(json{{"semantic", fb::EnumNameVertexSemantic(a.semantic())},
@@ -106,6 +125,9 @@ json describe_mesh(const MeshView& mesh, float metres_per_unit) {
            {"bounds", json{{"min", vec3(m.bounds_min())}, {"max", vec3(m.bounds_max())}}},
            {"position_offset", vec3(m.position_offset())},
            {"position_scale", vec3(m.position_scale())}};
+  if (options.influences) {
+    if (json influences = describe_influences(mesh); !influences.is_null()) out["influences"] = std::move(influences);
+  }
   // Only when present, so files without targets describe as they did before format v5.
   if (mesh.morph_target_count() > 0) out["morph_targets"] = describe_morph_targets(mesh, metres_per_unit);
   if (const fb::Cloth* c = m.cloth()) {  // format v10 (docs/CLOTH.md)
@@ -242,125 +264,6 @@ json describe_clip(const ClipView& clip, const SkeletonView& skeleton, float met
   return out;
 }
 
-/// A condition program back in infix form, for reading: "speed > 4.5 && !crossed".
-std::string condition_text(const fb::Graph& g, const fb::Transition& t) {
-  const auto* cond = t.condition();
-  if (!cond || cond->size() == 0) return "true";
-  std::vector<std::string> stack;
-  const auto param = [&](uint16_t p) { return str(g.parameters()->Get(p)->name()); };
-  static const char* const kOps[] = {"", "<", "<=", ">", ">=", "==", "!="};
-  for (const fb::ConditionInstr* c : *cond) {
-    const auto op = c->op();
-    if (op == fb::ConditionOp::True) {
-      stack.push_back("true");
-    } else if (op >= fb::ConditionOp::Less && op <= fb::ConditionOp::NotEqual) {
-      const fb::Parameter& p = *g.parameters()->Get(c->parameter());
-      std::string value = format("%g", static_cast<double>(c->value()));
-      if (p.type() == fb::ParameterType::Enum && p.enum_values() && c->value() >= 0.0f &&
-          c->value() < static_cast<float>(p.enum_values()->size()))
-        value = str(p.enum_values()->Get(static_cast<flatbuffers::uoffset_t>(c->value())));
-      stack.push_back(param(c->parameter()) + " " + kOps[static_cast<int>(op)] + " " + value);
-    } else if (op == fb::ConditionOp::Bool || op == fb::ConditionOp::Trigger) {
-      stack.push_back(param(c->parameter()));
-    } else if (op == fb::ConditionOp::Not && !stack.empty()) {
-      stack.back() = "!(" + stack.back() + ")";
-    } else if (stack.size() >= 2) {
-      const std::string b = stack.back();
-      stack.pop_back();
-      stack.back() = "(" + stack.back() + (op == fb::ConditionOp::And ? " && " : " || ") + b + ")";
-    }
-  }
-  return stack.empty() ? "?" : stack.back();
-}
-
-json describe_graph(const fb::Graph& g) {
-  json params = json::array(), machines = json::array();
-  for (const fb::Parameter* p : *g.parameters()) {
-    json item{{"name", str(p->name())},
-              {"type", fb::EnumNameParameterType(p->type())},
-              {"default", round6(p->default_value())}};
-    if (p->type() == fb::ParameterType::Vector) {
-      const fb::Vec3* v = p->default_vector();
-      item["default"] = v ? json::array({round6(v->x()), round6(v->y()), round6(v->z())}) : json::array({0, 0, 0});
-      item["space"] = fb::EnumNameParameterSpace(p->space());
-    }
-    if (p->enum_values()) {
-      json values = json::array();
-      for (const flatbuffers::String* v : *p->enum_values()) values.push_back(str(v));
-      item["values"] = std::move(values);
-    }
-    params.push_back(std::move(item));
-  }
-  json kinds = json::object();
-  for (const fb::Node* n : *g.nodes()) {
-    const std::string kind = fb::EnumNameNodeData(n->data_type());
-    kinds[kind] = kinds.value(kind, 0) + 1;
-  }
-  if (const auto* ms = g.machines()) {
-    for (const fb::StateMachine* m : *ms) {
-      json states = json::array(), transitions = json::array();
-      for (const fb::State* st : *m->states()) states.push_back(str(st->name()));
-      if (const auto* ts = m->transitions()) {
-        for (const fb::Transition* t : *ts) {
-          const auto state = [&](int i) { return i < 0 ? std::string("any") : str(m->states()->Get(i)->name()); };
-          json item{{"from", state(t->from())},
-                    {"to", state(t->to())},
-                    {"when", condition_text(g, *t)},
-                    {"duration", round6(t->duration())},
-                    {"mode", fb::EnumNameTransitionMode(t->mode())}};
-          if (t->exit_time() >= 0.0f) item["exit_time"] = round6(t->exit_time());
-          transitions.push_back(std::move(item));
-        }
-      }
-      machines.push_back(json{{"name", str(m->name())},
-                              {"entry", str(m->states()->Get(m->entry())->name())},
-                              {"states", std::move(states)},
-                              {"transitions", std::move(transitions)}});
-    }
-  }
-  json clips = json::array();
-  for (const flatbuffers::String* c : *g.clips()) clips.push_back(str(c));
-  json out{{"name", str(g.name())},           {"skeleton_hash", hex16(g.skeleton_hash())},
-           {"parameters", std::move(params)}, {"clips", std::move(clips)},
-           {"node_count", g.nodes()->size()}, {"nodes", std::move(kinds)},
-           {"machines", std::move(machines)}};
-  if (const auto* ms = g.montages(); ms && ms->size() > 0) {  // format v9
-    json montages = json::array();
-    for (const fb::Montage* m : *ms) {
-      json tracks = json::array(), sections = json::array();
-      double length = 0.0;
-      for (const fb::MontageTrack* t : *m->tracks()) {
-        length = std::max(length, track_length(*t));
-        tracks.push_back(json{{"slot", str(t->slot())}, {"segments", t->segments()->size()}});
-      }
-      for (const fb::MontageSection* sec : *m->sections()) {
-        const int next = sec->next();
-        sections.push_back(
-            json{{"name", str(sec->name())},
-                 {"start", round6(sec->start())},
-                 {"next", next >= 0 && next < static_cast<int>(m->sections()->size())
-                              ? str(m->sections()->Get(static_cast<flatbuffers::uoffset_t>(next))->name())
-                              : std::string()}});
-      }
-      const auto blend = [](float t, fb::MontageCurve c) {
-        return format("%g s ", static_cast<double>(t)) + fb::EnumNameMontageCurve(c);
-      };
-      montages.push_back(json{{"name", str(m->name())},
-                              {"group", str(m->group())},
-                              {"length", round6(static_cast<float>(length))},
-                              {"tracks", std::move(tracks)},
-                              {"sections", std::move(sections)},
-                              {"notifies", m->notifies() ? m->notifies()->size() : 0u},
-                              {"blend_in", blend(m->blend_in(), m->blend_in_curve())},
-                              {"blend_out", blend(m->blend_out(), m->blend_out_curve())},
-                              {"rate", round6(m->rate())},
-                              {"root_motion", m->root_motion()}});
-    }
-    out["montages"] = std::move(montages);
-  }
-  return out;
-}
-
 json describe_material(const fb::Material& m) {
   json textures = json::array();
   if (m.textures()) {
@@ -443,7 +346,7 @@ json describe(const Asset& asset, std::string_view file_name, const DescribeOpti
   const SkeletonView skeleton = asset.skeleton();
   json meshes = json::array(), clips = json::array(), materials = json::array();
   for (size_t i = 0; i < asset.mesh_count(); ++i)
-    meshes.push_back(describe_mesh(asset.mesh(i), asset.file().metres_per_unit()));
+    meshes.push_back(describe_mesh(asset.mesh(i), asset.file().metres_per_unit(), options));
   for (size_t i = 0; i < asset.clip_count(); ++i)
     clips.push_back(describe_clip(asset.clip(i), skeleton, file.metres_per_unit(), options));
   for (size_t i = 0; i < asset.material_count(); ++i) materials.push_back(describe_material(asset.material(i)));
@@ -463,7 +366,7 @@ json describe(const Asset& asset, std::string_view file_name, const DescribeOpti
            {"materials", std::move(materials)}};
   if (const auto* graphs = file.graphs(); graphs && graphs->size() > 0) {
     json list = json::array();
-    for (const fb::Graph* g : *graphs) list.push_back(describe_graph(*g));
+    for (const fb::Graph* g : *graphs) list.push_back(parts::describe_graph(*g));
     out["graphs"] = std::move(list);
   }
   return out;
@@ -522,6 +425,17 @@ std::string describe_text(const json& d) {
                   text(s["index_count"]).c_str(), text(s["material"]).c_str()));
     line("  joint slots    " + text(m["joint_slots"]));
     line("  bounds         " + vec_text(m["bounds"]["min"]) + " .. " + vec_text(m["bounds"]["max"]));
+    if (m.contains("influences")) {
+      const json& in = m["influences"];
+      const json& c = in["vertices_by_class"];
+      const std::string runs = text(in["class_runs"]);
+      line("  influences     " + text(c[0]) + " one joint, " + text(c[1]) + " up to 1, " + text(c[2]) + " up to 2, " +
+           text(c[3]) + " up to 3, " + text(c[4]) + " up to 4 (vertices)");
+      line(in["class_ordered"].get<bool>()
+               ? "  vertex order   by influence class (" + runs + " ranges: skin_cpu skins each in one loop)"
+               : "  vertex order   not by influence class (" + runs +
+                     " runs: skin_cpu classifies it batch by batch; cooking it again orders it)");
+    }
     if (m.contains("cloth")) {
       const json& c = m["cloth"];
       line("  cloth          " + text(c["particles"]) + " particles (" + text(c["fixed"]) + " fixed) on " +

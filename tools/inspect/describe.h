@@ -11,7 +11,8 @@
 // "schema_version", which moves only on an incompatible change (an added optional field keeps it).
 //
 // Cost: describe is O(joints + meshes*layout + submeshes + clip channels + textures); nothing per vertex
-// or per key. describe_text is linear in the size of the description.
+// or per key unless DescribeOptions::influences asks (then O(vertices)). describe_text is linear in
+// the size of the description.
 #pragma once
 #include <string>
 #include <string_view>
@@ -29,6 +30,10 @@ struct DescribeOptions {
   /// Each clip also lists its channels ("channels": joint, channel, constant or animated, keys,
   /// bits): ossa-inspect -v. Still O(channels), so cheap, but long for big rigs.
   bool channels = false;
+  /// Each skinned mesh with unorm8 weights also reports its influence classes ("influences": the
+  /// vertices of each class and whether they run in class order, which skin_cpu's range loops
+  /// need): ossa-inspect -v. O(vertices).
+  bool influences = false;
 };
 
 /// Everything ossa-inspect reports about a verified asset. `file_name` is what "file" says

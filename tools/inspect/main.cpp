@@ -103,6 +103,7 @@ int main(int argc, char** argv) {
     const std::string file_name = std::filesystem::path(path).filename().string();
     ossa::inspect::DescribeOptions options;
     options.channels = command.verbose();
+    options.influences = command.verbose();
     auto description = ossa::inspect::describe(*asset, file_name, options);
     if (json) {
       all.push_back(std::move(description));
