@@ -1,29 +1,34 @@
 #!/usr/bin/env bash
 # measure-anchors.sh — the performance tables of one machine in one go, each a ratio taken in the
 # same minutes: ossa against ozz-animation (ossa-bench-vs-ozz) and ACL (ossa-bench-acl), the guard
-# (ossa-bench-guard), and this checkout's ossa-bench-anim against an earlier commit's, run turn
-# about. It exists so that a session that lands on a CPU not measured yet (an Intel machine, an
+# (ossa-bench-guard), this checkout's ossa-bench-anim against an earlier commit's, run turn about,
+# and the guard of this checkout with the denormal regression put back (it must fail). It exists so that a session that lands on a CPU not measured yet (an Intel machine, an
 # older AMD) spends its time reading tables, not assembling them.
 #
 # Usage (from the repository root):
 #   scripts/measure-anchors.sh [--ozz DIR] [--acl DIR [--rtm DIR]] [--ref COMMIT] [--rounds N]
-#                              [--out DIR] [--jobs N]
+#                              [--out DIR] [--jobs N] [--no-regressed]
 #   --ozz     an ozz-animation 0.16.0 checkout with its media/bin (docs/MEASURING.md says how)
 #   --acl     an ACL v2.1.0 checkout; --rtm its RTM (default: <acl>/external/rtm)
 #   --ref     the earlier commit built for the turn-about rows (default 613d7e9, the landing before
 #             the 2x sampling regression on Intel; "none" skips it)
 #   --rounds  turn-about rounds of the two ossa-bench-anim builds (default 3)
 #   --out     where the outputs go (default /tmp/ossa-anchors): cpu.txt, vs-ozz.txt, acl.txt,
-#             guard.txt, anim.txt (one line per build and round), summary.txt
+#             guard.txt, guard-regressed.txt, anim.txt (one line per build and round), summary.txt
+#   --no-regressed  skip the guard of the build with the regression put back: a worktree of this
+#             checkout's HEAD in which runtime/internal/float_env.h's FlushDenormals sets no bits and
+#             cooker/import/tiny_values.cpp flushes nothing (the two defences against the 2x
+#             sampling regression on Intel, issue 27), built for ossa-bench-guard alone
 # The anchors are built into build-anchors/ (configured with the checkouts given; never fetched),
 # the reference in a git worktree under the output folder. A step that cannot run (no checkout
 # given, a reference that does not build) is reported in summary.txt and the others go on.
-# Cost: a first run builds the project twice (~15-25 minutes on 2 cores, less with ccache), then
-# ~10 minutes of benches. Run it on a quiet machine: every table here is a ratio, but a neighbour's
+# Cost: a first run builds the project three times (this checkout with the anchors, the reference,
+# the regressed worktree's guard: ~20-35 minutes on 2 cores, less with ccache), then ~10 minutes of
+# benches. Run it on a quiet machine: every table here is a ratio, but a neighbour's
 # load still widens the spread between rounds.
 set -u
 repo=$(pwd)
-ozz="" acl="" rtm="" ref=613d7e9 rounds=3 out=/tmp/ossa-anchors jobs=$(nproc)
+ozz="" acl="" rtm="" ref=613d7e9 rounds=3 out=/tmp/ossa-anchors jobs=$(nproc) regressed=1
 while [ $# -gt 0 ]; do
   case "$1" in
     --ozz) ozz=$2; shift 2 ;;
@@ -33,6 +38,7 @@ while [ $# -gt 0 ]; do
     --rounds) rounds=$2; shift 2 ;;
     --out) out=$2; shift 2 ;;
     --jobs) jobs=$2; shift 2 ;;
+    --no-regressed) regressed=0; shift ;;
     *) echo "measure-anchors.sh: unknown argument '$1' (see the header of $0)" >&2; exit 2 ;;
   esac
 done
@@ -78,7 +84,9 @@ if [ "$ref" != none ]; then
   if [ -d "$wt" ]; then
     rargs=(-S "$wt" -B "$wt/build" -G Ninja)
     command -v ccache >/dev/null && rargs+=(-DCMAKE_C_COMPILER_LAUNCHER=ccache -DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
-    if cmake "${rargs[@]}" >>"$out/build.log" 2>&1 && cmake --build "$wt/build" -j"$jobs" --target ossa-bench-anim >>"$out/build.log" 2>&1; then
+    if cmake "${rargs[@]}" >>"$out/build.log" 2>&1 &&
+      CCACHE_BASEDIR=$wt CCACHE_NOHASHDIR=1 cmake --build "$wt/build" -j"$jobs" --target ossa-bench-anim \
+        >>"$out/build.log" 2>&1; then
       ref_bin=$wt/build/bin
     else
       say "reference $ref: ossa-bench-anim did not build (see $out/build.log); its rows are skipped"
@@ -135,5 +143,36 @@ if [ -n "$acl" ]; then
   grep -E '^(CMU_BVH|Pab/atlas|Pab/crossarms)' "$out/acl.txt" >>"$summary"
 else
   say "# ossa-bench-acl: skipped (no --acl)"
+fi
+# The guard must catch the regression it was written for: this checkout's HEAD with both
+# defences against subnormals taken out, each edit checked to have matched.
+if [ "$regressed" = 1 ]; then
+  wt=$out/regressed
+  [ -d "$wt" ] && git -C "$repo" worktree remove --force "$wt" >>"$out/build.log" 2>&1
+  if git -C "$repo" worktree add --force --detach "$wt" HEAD >>"$out/build.log" 2>&1 &&
+    sed -i 's/kBits = 0x8040;/kBits = 0x0;/' "$wt/runtime/internal/float_env.h" &&
+    grep -q 'kBits = 0x0;' "$wt/runtime/internal/float_env.h" &&
+    sed -i 's/^  Flusher flush;$/  Flusher flush;\n  if (flush.changed == 0) return 0;/' "$wt/cooker/import/tiny_values.cpp" &&
+    [ "$(grep -c 'if (flush.changed == 0) return 0;' "$wt/cooker/import/tiny_values.cpp")" = 2 ]; then
+    gargs=(-S "$wt" -B "$wt/build" -G Ninja)
+    command -v ccache >/dev/null && gargs+=(-DCMAKE_C_COMPILER_LAUNCHER=ccache -DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+    if cmake "${gargs[@]}" >>"$out/build.log" 2>&1 &&
+      CCACHE_BASEDIR=$wt CCACHE_NOHASHDIR=1 cmake --build "$wt/build" -j"$jobs" --target ossa-bench-guard \
+        >>"$out/build.log" 2>&1; then
+      "$wt/build/bin/ossa-bench-guard" >"$out/guard-regressed.txt" 2>&1
+      status=$?
+      rows=$(awk '$NF == "REGRESSED" {printf "%s%s", sep, $1; sep = ", "}' "$out/guard-regressed.txt")
+      if [ "$status" != 0 ] && [ -n "$rows" ]; then
+        say "# ossa-bench-guard with the regression put back: exit $status, REGRESSED: $rows (as it must)"
+      else
+        say "# ossa-bench-guard with the regression put back: exit $status, nothing regressed: THE GUARD MISSED IT"
+      fi
+      grep -E -w '^check|ok|REGRESSED' "$out/guard-regressed.txt" >>"$summary"
+    else
+      say "# regression put back: ossa-bench-guard did not build (see $out/build.log)"
+    fi
+  else
+    say "# regression put back: the worktree or its two edits failed (see $out/build.log)"
+  fi
 fi
 echo "measure-anchors.sh: tables in $summary"
