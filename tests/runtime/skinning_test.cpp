@@ -79,28 +79,9 @@ std::vector<uint8_t> with_tangents(ossa::test::SyntheticSpec spec) {
   return bytes;
 }
 
-/// Synthetic variants: the cooker's layout, floats with 16-bit slots, a quantized layout with
-/// 16-bit slots (the fast paths' wide variant), tangents, and a mesh of many vertices with every
-/// influence class (so batches, list tails and padding are exercised).
-std::vector<std::pair<std::string, std::vector<uint8_t>>> synthetic_files() {
-  using S = VertexSemantic;
-  using F = VertexFormat;
-  std::vector<std::pair<std::string, std::vector<uint8_t>>> out;
-  for (const auto& [name, spec] : ossa::test::valid_variants())
-    if (name == "default" || name == "float32-layout" || name == "static-mesh")
-      out.emplace_back(name, ossa::test::make_valid_file(spec));
-  ossa::test::SyntheticSpec wide;
-  wide.meshes[0].layout = {{S::Position, F::Unorm16x4, 0},
-                           {S::Normal, F::Snorm16x2, 8},
-                           {S::TexCoord0, F::Float16x2, 12},
-                           {S::Joints, F::Uint16x4, 16},
-                           {S::Weights, F::Unorm8x4, 24}};
-  wide.meshes[0].vertex_stride = 28;
-  out.emplace_back("quantized-wide-slots", ossa::test::make_valid_file(wide));
-  out.emplace_back("tangents", with_tangents({}));
-
-  // 1000 vertices (four batches and a tail) with every class: one full weight, weights summing to
-  // 255 over 1-4 influences in any order, zeros in between, all zero.
+/// 1000 vertices (four batches and a tail) with every class: one full weight, weights summing to
+/// 255 over 1-4 influences in any order, zeros in between, all zero.
+ossa::test::SyntheticSpec many_vertices() {
   ossa::test::SyntheticSpec many;
   std::mt19937 gen(3);
   std::uniform_real_distribution<float> u(-1.0f, 1.0f);
@@ -122,16 +103,45 @@ std::vector<std::pair<std::string, std::vector<uint8_t>>> synthetic_files() {
     }
     many.meshes[0].vertices.push_back(v);
   }
+  return many;
+}
+
+/// spec's vertices in influence-class order, as the cooker orders them (stable).
+ossa::test::SyntheticSpec ordered_by_class(ossa::test::SyntheticSpec spec) {
+  std::vector<ossa::test::SyntheticVertex>& v = spec.meshes[0].vertices;
+  std::stable_sort(v.begin(), v.end(), [](const auto& a, const auto& b) {
+    return influence_class(a.weights) < influence_class(b.weights);
+  });
+  return spec;
+}
+
+/// Synthetic variants: the cooker's layout, floats with 16-bit slots, a quantized layout with
+/// 16-bit slots (the fast paths' wide variant), tangents, and a mesh of many vertices with every
+/// influence class (so batches, list tails and padding are exercised).
+std::vector<std::pair<std::string, std::vector<uint8_t>>> synthetic_files() {
+  using S = VertexSemantic;
+  using F = VertexFormat;
+  std::vector<std::pair<std::string, std::vector<uint8_t>>> out;
+  for (const auto& [name, spec] : ossa::test::valid_variants())
+    if (name == "default" || name == "float32-layout" || name == "static-mesh")
+      out.emplace_back(name, ossa::test::make_valid_file(spec));
+  ossa::test::SyntheticSpec wide;
+  wide.meshes[0].layout = {{S::Position, F::Unorm16x4, 0},
+                           {S::Normal, F::Snorm16x2, 8},
+                           {S::TexCoord0, F::Float16x2, 12},
+                           {S::Joints, F::Uint16x4, 16},
+                           {S::Weights, F::Unorm8x4, 24}};
+  wide.meshes[0].vertex_stride = 28;
+  out.emplace_back("quantized-wide-slots", ossa::test::make_valid_file(wide));
+  out.emplace_back("tangents", with_tangents({}));
+
+  const ossa::test::SyntheticSpec many = many_vertices();
   out.emplace_back("many-vertices", ossa::test::make_valid_file(many));
   out.emplace_back("many-vertices-tangents", with_tangents(many));
 
   // The same vertices ordered by influence class, as the cooker orders them: the fast paths run
   // one loop per class range (no classification).
-  ossa::test::SyntheticSpec ordered = many;
-  std::vector<ossa::test::SyntheticVertex>& ov = ordered.meshes[0].vertices;
-  std::stable_sort(ov.begin(), ov.end(), [](const auto& a, const auto& b) {
-    return influence_class(a.weights) < influence_class(b.weights);
-  });
+  const ossa::test::SyntheticSpec ordered = ordered_by_class(many);
   out.emplace_back("ordered-by-class", ossa::test::make_valid_file(ordered));
   out.emplace_back("ordered-by-class-tangents", with_tangents(ordered));
   // Ordered as far as the order probe looks, then broken: a four-influence vertex inside the
@@ -413,6 +423,65 @@ TEST(Skinning, OnlyRequestedStreamsAreWritten) {
       }
     }
   }
+}
+
+TEST(Skinning, NothingIsWrittenPastTheOutputs) {
+  // The kernels store wider than a vertex where another follows (16 bytes for 12; four or eight
+  // vertices a step) and must not past the last. The mesh of every class, in class order and not,
+  // cut so that its last range ends 0-7 vertices past a multiple of 8; every stream selection,
+  // renormalized or not, in every implementation; each output followed by guard floats that must
+  // keep their bits, and every float of each requested output written.
+  constexpr uint32_t kGuard = 0x7fc0dead;  // a NaN no kernel computes
+  constexpr size_t kExtra = 16;
+  const auto bits = [](float f) {
+    uint32_t b;
+    std::memcpy(&b, &f, 4);
+    return b;
+  };
+  float guard;
+  std::memcpy(&guard, &kGuard, 4);
+  const ossa::test::SyntheticSpec many = many_vertices();
+  int checked = 0;
+  for (const bool ordered : {true, false}) {
+    for (size_t cut = 0; cut < 8; ++cut) {
+      for (const bool tangents : {false, true}) {
+        ossa::test::SyntheticSpec spec = ordered ? ordered_by_class(many) : many;
+        spec.meshes[0].vertices.resize(spec.meshes[0].vertices.size() - cut);
+        SyntheticAsset s = load(tangents ? with_tangents(spec) : ossa::test::make_valid_file(spec));
+        ASSERT_NE(s.asset, nullptr);
+        const ossa::MeshView mesh = s.asset->mesh(0);
+        const auto palette = palette_of(mesh, make_pose(s.asset->skeleton(), 0.6f, 5).model);
+        const size_t n = mesh.vertex_count();
+        for (ossa::SkinningIsa isa : available_isas()) {
+          IsaScope scope(isa);
+          for (int mask = 1; mask < 8; ++mask) {
+            if ((mask & 4) && !tangents) continue;
+            for (const bool unit : {true, false}) {
+              std::vector<float> p(3 * n + kExtra, guard), nn(3 * n + kExtra, guard), t(4 * n + kExtra, guard);
+              const auto part = [](std::vector<float>& v, size_t count, bool asked) {
+                return asked ? std::span<float>(v.data(), count) : std::span<float>();
+              };
+              ossa::skin_cpu(mesh, palette, ossa::SkinningMethod::Linear,
+                             {part(p, 3 * n, mask & 1), part(nn, 3 * n, mask & 2), part(t, 4 * n, mask & 4), unit});
+              const auto check = [&](const std::vector<float>& v, size_t count, bool asked, const char* stream) {
+                for (size_t i = 0; i < v.size(); ++i) {
+                  const bool inside = asked && i < count;
+                  ASSERT_EQ(bits(v[i]) != kGuard, inside)
+                      << stream << " float " << i << " of " << count << ", " << isa_name(isa) << ", mask " << mask
+                      << ", cut " << cut << (ordered ? ", ordered" : ", unordered") << (unit ? ", unit" : "");
+                }
+              };
+              check(p, 3 * n, mask & 1, "positions");
+              check(nn, 3 * n, mask & 2, "normals");
+              check(t, 4 * n, mask & 4, "tangents");
+              ++checked;
+            }
+          }
+        }
+      }
+    }
+  }
+  EXPECT_GE(checked, 2 * 8 * (3 + 7) * 2);  // at least the portable implementation's runs
 }
 
 TEST(Skinning, RangeLoopsReadEveryWeightByteAsTheClassifiedLoopsDo) {
