@@ -21,7 +21,6 @@
 #include <glm/glm.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 
-#include <ossa/format/vertex_codec.h>
 #include <ossa/loader/asset.h>
 #include <ossa/skinning/skinning.h>
 
@@ -45,21 +44,10 @@ struct Case {
 /// "by class (R ranges)" when influence classes never decrease along the vertex buffer, else
 /// "unordered (R class runs)": what decides between skin_cpu's range loops and classified batches.
 std::string order_of(const ossa::MeshView& mesh) {
-  const ossa::fb::VertexAttribute* w = mesh.attribute(ossa::fb::VertexSemantic::Weights);
-  if (w == nullptr || w->format() != ossa::fb::VertexFormat::Unorm8x4) return "not unorm8 weights";
-  int last = -1;
-  size_t runs = 0;
-  bool ordered = true;
-  for (uint32_t v = 0; v < mesh.vertex_count(); ++v) {
-    uint32_t word;
-    std::memcpy(&word, mesh.vertex_bytes().data() + size_t{v} * mesh.vertex_stride() + w->offset(), 4);
-    const int c = ossa::influence_class(word);
-    if (c != last) ++runs;
-    ordered = ordered && c >= last;
-    last = c;
-  }
-  return (ordered ? "by class (" + std::to_string(runs) + " ranges)"
-                  : "unordered (" + std::to_string(runs) + " class runs)");
+  const ossa::InfluenceOrder o = ossa::influence_order(mesh);
+  if (!o.unorm8_weights) return "not unorm8 weights";
+  return (o.class_ordered ? "by class (" + std::to_string(o.class_runs) + " ranges)"
+                          : "unordered (" + std::to_string(o.class_runs) + " class runs)");
 }
 
 /// Times `reps` calls of one stream selection and keeps the minimum per vertex.

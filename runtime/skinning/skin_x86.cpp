@@ -87,22 +87,13 @@ OSSA_TARGET_AVX2 inline void blend_matrix(const float* palette, const uint8_t* v
   }
 }
 
-/// Blended matrix (c0 | c1 | c2 | c3, one 512-bit register) of the class-K vertex whose joints are
-/// at j; `wb` receives its weight word.
+/// soa::blend512 of the class-K vertex whose joints are at j; `wb` receives its weight word.
 template <int K, Slots kSlots>
 [[gnu::always_inline]] OSSA_TARGET_AVX512 inline __m512 matrix512(const float* palette, const uint8_t* j,
                                                                   ptrdiff_t off_weights, uint32_t& wb) {
   const uint8_t* const w = kSlots == Slots::Packed ? j + 4 : j + off_weights;
-  const auto matrix = [&](int k) { return soa::slot_matrix<kSlots == Slots::Wide>(palette, j, k); };
   wb = load_u32(w);
-  if constexpr (K == 0) {
-    return _mm512_loadu_ps(matrix(0));
-  } else {
-    __m512 m = _mm512_mul_ps(_mm512_set1_ps(kWeight[w[0]]), _mm512_loadu_ps(matrix(0)));
-#pragma GCC unroll 4
-    for (int k = 1; k < K; ++k) m = _mm512_fmadd_ps(_mm512_set1_ps(kWeight[w[k]]), _mm512_loadu_ps(matrix(k)), m);
-    return m;
-  }
+  return soa::blend512<K, kSlots == Slots::Wide>(j, w, palette, kWeight.data());
 }
 
 /// blend_matrix for the AVX-512 copy of the range loops: the blend in one 512-bit register (one
@@ -326,11 +317,8 @@ OSSA_TARGET_AVX512 OSSA_SOA_FLATTEN uint32_t skin_positions_quad(const float* pa
     vx += 4 * stride;
     out += 12;
   }
-  const VertexPointers none{};
   for (; i < n; ++i) {
-    VertexPointers at = none;
-    at.vx = vx;
-    at.position_out = out;
+    const VertexPointers at{vx, nullptr, nullptr, out, nullptr, nullptr};
     const uint32_t wb =
         skin_vertex<K, true, false, kSlots, true, false, false, true>(palette, at, off_position, 0, off_weights);
     any |= wb;

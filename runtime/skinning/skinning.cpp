@@ -46,7 +46,9 @@
 #include <atomic>
 #include <cassert>
 #include <cstdint>
+#include <cstring>
 
+#include <ossa/format/vertex_codec.h>
 #include <ossa/format/vertex_format.h>
 
 #include "internal/cpu.h"
@@ -142,6 +144,26 @@ void skin_cpu(const MeshView& mesh, std::span<const glm::mat4> palette, Skinning
   if (which != SkinningIsa::Portable && skin_quantized(m, &palette[0][0][0], o, which == SkinningIsa::Avx512)) return;
 #endif
   skin_linear_portable(m, palette.data(), o);
+}
+
+InfluenceOrder influence_order(const MeshView& mesh) {
+  InfluenceOrder out;
+  const fb::VertexAttribute* w = mesh.attribute(fb::VertexSemantic::Weights);
+  if (w == nullptr || w->format() != fb::VertexFormat::Unorm8x4) return out;
+  out.unorm8_weights = true;
+  out.class_ordered = true;
+  const uint8_t* at = mesh.vertex_bytes().data() + w->offset();  // validation proved every read
+  int last = -1;
+  for (uint32_t v = 0; v < mesh.vertex_count(); ++v, at += mesh.vertex_stride()) {
+    uint32_t word;
+    std::memcpy(&word, at, 4);
+    const int c = influence_class(word);
+    ++out.vertices_by_class[static_cast<size_t>(c)];
+    out.class_runs += c != last ? 1 : 0;
+    out.class_ordered = out.class_ordered && c >= last;
+    last = c;
+  }
+  return out;
 }
 
 }  // namespace ossa

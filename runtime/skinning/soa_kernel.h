@@ -404,15 +404,20 @@ OSSA_SOA_TARGET OSSA_SOA_INLINE uint32_t block(Cursor<kPacked> at, uint32_t last
 // always_inline (an AVX2 function may not inline them): range_avx512 flattens its calls.
 #define OSSA_SOA_TARGET512 OSSA_TARGET("avx2,fma,bmi,bmi2,popcnt,avx512f,avx512vl,avx512bw,avx512dq")
 
+/// The blended matrix of the class-K vertex with slots j and weight bytes w, one 512-bit register
+/// (c0 | c1 | c2 | c3), the weights read through `weight` (kWeight). skin_x86.cpp's 512-bit range
+/// loops blend through it too.
 template <int K, bool kWideSlots>
-OSSA_SOA_TARGET512 inline void blend512(const uint8_t* j, const uint8_t* w, const Layout& l, __m512& m) {
-  const auto matrix = [&](int k) { return slot_matrix<kWideSlots>(l.palette, j, k); };
+OSSA_SOA_TARGET512 inline __m512 blend512(const uint8_t* j, const uint8_t* w, const float* palette,
+                                          const float* weight) {
+  const auto matrix = [&](int k) { return slot_matrix<kWideSlots>(palette, j, k); };
   if constexpr (K == 0) {
-    m = _mm512_loadu_ps(matrix(0));
+    return _mm512_loadu_ps(matrix(0));
   } else {
-    m = _mm512_mul_ps(_mm512_set1_ps(l.weight[w[0]]), _mm512_loadu_ps(matrix(0)));
+    __m512 m = _mm512_mul_ps(_mm512_set1_ps(weight[w[0]]), _mm512_loadu_ps(matrix(0)));
 #pragma GCC unroll 4
-    for (int k = 1; k < K; ++k) m = _mm512_fmadd_ps(_mm512_set1_ps(l.weight[w[k]]), _mm512_loadu_ps(matrix(k)), m);
+    for (int k = 1; k < K; ++k) m = _mm512_fmadd_ps(_mm512_set1_ps(weight[w[k]]), _mm512_loadu_ps(matrix(k)), m);
+    return m;
   }
 }
 
@@ -503,8 +508,8 @@ OSSA_SOA_TARGET512 inline uint32_t block512(Cursor<kPacked> at, uint32_t last, c
   for (uint32_t v = 0; v < 4; ++v) {
     size_t d4;
     const Cursor<kPacked> u = vertex_of<kPacked, kTail>(at, v, last, l.stride, d4);
-    blend512<K, kWideSlots>(u.joints, u.weights(), l, m[v]);
-    blend512<K, kWideSlots>(u.joints + d4, u.weights() + d4, l, m[v + 4]);
+    m[v] = blend512<K, kWideSlots>(u.joints, u.weights(), l.palette, l.weight);
+    m[v + 4] = blend512<K, kWideSlots>(u.joints + d4, u.weights() + d4, l.palette, l.weight);
     const __m128i lo = words_of<kNormals, kFused>(u.position, u.normal);
     const __m128i hi = words_of<kNormals, kFused>(u.position + d4, u.normal + d4);
     A[v] = _mm256_inserti128_si256(_mm256_castsi128_si256(lo), hi, 1);

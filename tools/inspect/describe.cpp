@@ -7,16 +7,13 @@
 #include "tools/inspect/describe.h"
 
 #include <algorithm>
-#include <array>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
-#include <cstring>
-#include <span>
 #include <vector>
 
 #include <ossa/format/hash.h>
-#include <ossa/format/vertex_codec.h>
+#include <ossa/skinning/skinning.h>
 #include "common/message.h"
 #include "tools/inspect/describe_parts.h"
 
@@ -74,32 +71,6 @@ json describe_morph_targets(const MeshView& mesh, float metres_per_unit) {
   return list;
 }
 
-/// A skinned mesh's influence classes as skin_cpu sees them (ossa/format/vertex_codec.h's
-/// influence_class of each vertex's unorm8 weights): the vertices of each class, the runs of equal
-/// class in vertex order, and whether classes never decrease (the cooker's order, which lets
-/// skin_cpu skin each class as one range; a file in another order is classified batch by batch,
-/// slower, with the same result). Null for a mesh without unorm8 weights. O(vertices).
-json describe_influences(const MeshView& mesh) {
-  const fb::VertexAttribute* w = mesh.attribute(fb::VertexSemantic::Weights);
-  if (w == nullptr || w->format() != fb::VertexFormat::Unorm8x4) return nullptr;
-  const std::span<const uint8_t> bytes = mesh.vertex_bytes();
-  const size_t stride = mesh.vertex_stride();
-  std::array<size_t, 5> by_class{};
-  size_t runs = 0;
-  int last = -1;
-  bool ordered = true;
-  for (size_t v = 0; v < mesh.vertex_count(); ++v) {
-    uint32_t word;
-    std::memcpy(&word, bytes.data() + v * stride + w->offset(), 4);  // validation proved the bounds
-    const int c = influence_class(word);
-    ++by_class[static_cast<size_t>(c)];
-    runs += c != last ? 1 : 0;
-    ordered = ordered && c >= last;
-    last = c;
-  }
-  return json{{"vertices_by_class", by_class}, {"class_runs", runs}, {"class_ordered", ordered}};
-}
-
 json describe_mesh(const MeshView& mesh, float metres_per_unit, const DescribeOptions& options) {
   json layout = json::array();
   for (const fb::VertexAttribute& a : mesh.layout())
@@ -126,7 +97,9 @@ json describe_mesh(const MeshView& mesh, float metres_per_unit, const DescribeOp
            {"position_offset", vec3(m.position_offset())},
            {"position_scale", vec3(m.position_scale())}};
   if (options.influences) {
-    if (json influences = describe_influences(mesh); !influences.is_null()) out["influences"] = std::move(influences);
+    if (const InfluenceOrder o = influence_order(mesh); o.unorm8_weights)
+      out["influences"] = json{
+          {"vertices_by_class", o.vertices_by_class}, {"class_runs", o.class_runs}, {"class_ordered", o.class_ordered}};
   }
   // Only when present, so files without targets describe as they did before format v5.
   if (mesh.morph_target_count() > 0) out["morph_targets"] = describe_morph_targets(mesh, metres_per_unit);

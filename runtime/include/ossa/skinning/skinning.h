@@ -5,6 +5,7 @@
 // shader and skin_cpu both multiply the raw normalized position by the palette matrix with no
 // special case for quantized meshes (the design's promise).
 #pragma once
+#include <array>
 #include <cstdint>
 #include <span>
 
@@ -70,5 +71,18 @@ void skin_cpu(const MeshView& mesh, std::span<const glm::mat4> palette, Skinning
 enum class SkinningIsa : uint8_t { Portable, Avx2, Avx512 };
 SkinningIsa skinning_isa();
 bool set_skinning_isa(SkinningIsa isa);
+
+/// How skin_cpu walks a mesh with unorm8 weights: its vertices per influence class
+/// (ossa/format/vertex_codec.h's influence_class: [0] one weight of 255, [c] up to c joints), the
+/// runs of one class in vertex order, and whether classes never decrease along the vertex buffer
+/// (the cooker's order: skin_cpu then skins each class as one range; otherwise it classifies the
+/// vertices batch by batch, slower, with the same result). For tools and benchmarks. O(vertices).
+struct InfluenceOrder {
+  bool unorm8_weights = false;  // false: no Unorm8x4 Weights attribute, and the rest is zero
+  std::array<uint32_t, 5> vertices_by_class{};
+  uint32_t class_runs = 0;
+  bool class_ordered = false;
+};
+InfluenceOrder influence_order(const MeshView& mesh);
 
 }  // namespace ossa
