@@ -14,7 +14,8 @@
 #             the 2x sampling regression on Intel; "none" skips it)
 #   --rounds  turn-about rounds of the two ossa-bench-anim builds (default 3)
 #   --out     where the outputs go (default /tmp/ossa-anchors): cpu.txt, vs-ozz.txt, acl.txt,
-#             guard.txt, guard-regressed.txt, anim.txt (one line per build and round), summary.txt
+#             guard.txt, guard-avx2.txt, guard-regressed.txt, guard-regressed-avx2.txt (the guard
+#             with --clone avx2 too), anim.txt (one line per build and round), summary.txt
 #   --no-regressed  skip the guard of the build with the regression put back: a worktree of this
 #             checkout's HEAD in which runtime/internal/float_env.h's FlushDenormals sets no bits and
 #             cooker/import/tiny_values.cpp flushes nothing (the two defences against the 2x
@@ -124,9 +125,14 @@ awk -v ref="$ref" '
     }
   }' "$out/anim.txt" | tee -a "$summary"
 
-"$bin/ossa-bench-guard" >"$out/guard.txt" 2>&1
-say "# ossa-bench-guard: exit $? ($(grep -c -w ok "$out/guard.txt") rows ok, $(grep -c -w REGRESSED "$out/guard.txt") regressed)"
-grep -E -w '^check|ok|REGRESSED' "$out/guard.txt" >>"$summary"
+# The guard as CTest runs it, then with --clone avx2 (the copies an AVX2-only CPU runs; exit 77 and
+# no rows where this CPU has no AVX2).
+for clone in "" avx2; do
+  f=$out/guard${clone:+-$clone}.txt
+  "$bin/ossa-bench-guard" ${clone:+--clone "$clone"} >"$f" 2>&1
+  say "# ossa-bench-guard${clone:+ --clone $clone}: exit $? ($(grep -c -w ok "$f") rows ok, $(grep -c -w REGRESSED "$f") regressed)"
+  grep -E -w '^check|ok|REGRESSED' "$f" >>"$summary"
+done
 
 if [ -n "$ozz" ]; then
   "$bin/ossa-bench-vs-ozz" --rounds 31 --media "$ozz/media/bin" >"$out/vs-ozz.txt" 2>&1
@@ -159,15 +165,21 @@ if [ "$regressed" = 1 ]; then
     if cmake "${gargs[@]}" >>"$out/build.log" 2>&1 &&
       CCACHE_BASEDIR=$wt CCACHE_NOHASHDIR=1 cmake --build "$wt/build" -j"$jobs" --target ossa-bench-guard \
         >>"$out/build.log" 2>&1; then
-      "$wt/build/bin/ossa-bench-guard" >"$out/guard-regressed.txt" 2>&1
-      status=$?
-      rows=$(awk '$NF == "REGRESSED" {printf "%s%s", sep, $1; sep = ", "}' "$out/guard-regressed.txt")
-      if [ "$status" != 0 ] && [ -n "$rows" ]; then
-        say "# ossa-bench-guard with the regression put back: exit $status, REGRESSED: $rows (as it must)"
-      else
-        say "# ossa-bench-guard with the regression put back: exit $status, nothing regressed: THE GUARD MISSED IT"
-      fi
-      grep -E -w '^check|ok|REGRESSED' "$out/guard-regressed.txt" >>"$summary"
+      for clone in "" avx2; do
+        f=$out/guard-regressed${clone:+-$clone}.txt
+        "$wt/build/bin/ossa-bench-guard" ${clone:+--clone "$clone"} >"$f" 2>&1
+        status=$?
+        rows=$(awk '$NF == "REGRESSED" {printf "%s%s", sep, $1; sep = ", "}' "$f")
+        what="ossa-bench-guard${clone:+ --clone $clone} with the regression put back"
+        if [ "$status" = 77 ]; then
+          say "# $what: skipped (this CPU cannot run that copy)"
+        elif [ "$status" != 0 ] && [ -n "$rows" ]; then
+          say "# $what: exit $status, REGRESSED: $rows (as it must)"
+        else
+          say "# $what: exit $status, nothing regressed: THE GUARD MISSED IT"
+        fi
+        grep -E -w '^check|ok|REGRESSED' "$f" >>"$summary"
+      done
     else
       say "# regression put back: ossa-bench-guard did not build (see $out/build.log)"
     fi
