@@ -16,10 +16,9 @@ namespace ossa::diff {
 namespace {
 
 using json = nlohmann::ordered_json;
+using inspect::hex16;
 using inspect::round6;
 using ossa::detail::format;
-
-std::string hex16(uint64_t v) { return format("%016llx", static_cast<unsigned long long>(v)); }
 
 json optional_number(const std::optional<double>& v) { return v ? json(round6(*v)) : json(nullptr); }
 

@@ -21,7 +21,6 @@ namespace ossa::inspect {
 namespace {
 
 using detail::format;
-using parts::hex16;
 using parts::json;
 using parts::str;
 
@@ -287,6 +286,8 @@ std::string quoted_name(const json& v) {
 }
 
 }  // namespace
+
+std::string hex16(uint64_t value) { return format("%016llx", static_cast<unsigned long long>(value)); }
 
 double round6(double value) {
   char buf[32];

@@ -14,6 +14,7 @@
 // or per key unless DescribeOptions::influences asks (then O(vertices)). describe_text is linear in
 // the size of the description.
 #pragma once
+#include <cstdint>
 #include <string>
 #include <string_view>
 
@@ -46,5 +47,8 @@ std::string describe_text(const nlohmann::ordered_json& description);
 
 /// A float as JSON: rounded to 6 significant digits, -0 as 0, so goldens are stable.
 double round6(double value);
+
+/// A 64-bit hash as the 16 lower-case hex digits every description and diff report prints.
+std::string hex16(uint64_t value);
 
 }  // namespace ossa::inspect

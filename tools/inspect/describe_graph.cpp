@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "common/message.h"
 #include "tools/inspect/describe.h"
 #include "tools/inspect/describe_parts.h"
 

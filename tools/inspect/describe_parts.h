@@ -1,6 +1,6 @@
 // describe_parts.h — what describe.cpp shares with the files that describe one part of an asset
-// each (describe_graph.cpp): the JSON type, two text helpers, and the part describers. Internal to
-// tools/inspect; describe.h is the interface.
+// each (describe_graph.cpp): the JSON type, its text helpers (hex16 is describe.h's, which
+// ossa-diff shares), and the part describers. Internal to tools/inspect; describe.h is the interface.
 #pragma once
 #include <cstdint>
 #include <string>
@@ -8,14 +8,13 @@
 #include <nlohmann/json.hpp>
 
 #include <ossa/loader/asset.h>
-#include "common/message.h"
+#include "tools/inspect/describe.h"
 
 namespace ossa::inspect::parts {
 
 using json = nlohmann::ordered_json;
 
-/// A 64-bit hash as the 16 hex digits every description prints.
-inline std::string hex16(uint64_t v) { return detail::format("%016llx", static_cast<unsigned long long>(v)); }
+using inspect::hex16;  // describe.h
 
 /// A flatbuffers string, or "" for an absent one.
 inline std::string str(const flatbuffers::String* s) { return s ? std::string(s->c_str(), s->size()) : std::string(); }
