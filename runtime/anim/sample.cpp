@@ -168,6 +168,8 @@ Result<SamplingCache> make_sampling_cache(const ClipView& clip, const SkeletonVi
   s->joint_count = static_cast<uint32_t>(skeleton.joint_count());
   s->stride = pose_stride(s->joint_count);
   s->last_frame = static_cast<float>(clip.frame_count() - 1);
+  s->duration = clip.duration();
+  s->sample_rate = clip.sample_rate();
   const size_t stride = s->stride;
   // Runs: channels that address the same key-frame range share one, in order of first use;
   // tracks are grouped by run. A filter drops the channels of the joints it leaves out (and runs
@@ -297,11 +299,12 @@ void sample(const ClipView& clip, float time, const SampleOptions& options, Samp
   State& s = *cache.state();
   assert(clip.fb == s.clip && "a SamplingCache plays the clip it was made for");
   assert(out.joint_count == s.joint_count && out.stride == s.stride);
+  (void)clip;
   (void)out;
 
   // Time -> frame position in [0, last_frame]. The common case (a time already inside the clip)
   // skips fmod, a library call.
-  const float duration = clip.duration();
+  const float duration = s.duration;
   float t = time;
   if (!(t >= 0.0f && t < duration)) {
     if (!std::isfinite(t)) t = 0.0f;
@@ -317,7 +320,7 @@ void sample(const ClipView& clip, float time, const SampleOptions& options, Samp
       t = t < 0.0f ? 0.0f : (t > duration ? duration : t);
     }
   }
-  float frame = t * clip.sample_rate();
+  float frame = t * s.sample_rate;
   frame = frame > s.last_frame ? s.last_frame : frame;
   // frame is in [0, 65535]: adding 0.5 and truncating rounds to nearest without a libm call.
   const auto nearest = static_cast<float>(static_cast<int32_t>(frame + 0.5f));

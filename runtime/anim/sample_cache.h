@@ -89,6 +89,8 @@ struct SamplingCache::State {
   uint32_t joint_count = 0;
   uint32_t stride = 0;      // pose_stride(joint_count)
   float last_frame = 0.0f;  // frame_count - 1
+  float duration = 0.0f;    // the clip's, read once here: sample() needs both on every call
+  float sample_rate = 0.0f;
 
   // One block: k0[10 * stride], k1[10 * stride], start[3 * stride], inv_length[3 * stride].
   sample_detail::AlignedFloats block;
