@@ -70,6 +70,10 @@ void reset(SamplingCache& cache);
 
 /// Samples `clip` at `time` seconds into `out` (out.joint_count == the skeleton's). Forward
 /// playback: O(joints) + O(keys passed); a seek: O(joints + animated channels). Allocation-free.
+/// Like every float kernel of the runtime it runs with x86's flush-to-zero and denormals-are-zero
+/// set and gives the caller its MXCSR back: two MXCSR writes a call (3-5 ns on a Zen 5, a tenth of
+/// a 10-joint clip's sample) unless the calling thread has both bits set already, as many engines
+/// do for their game threads; then it only reads it.
 void sample(const ClipView& clip, float time, const SampleOptions& options, SamplingCache& cache, PoseSpan out);
 
 /// Time after advancing by dt * rate (rate may be negative), wrapped into [0, duration) when
