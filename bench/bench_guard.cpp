@@ -37,15 +37,16 @@
 // regression fails — a lost fast path, an accidental O(n^2), a verify pass run twice — never a
 // noisy neighbour; another vendor gets the larger of the two. The Intel figures are from a Xeon
 // family 6 model 207 (a GPU machine's host, two of its CPUs by taskset, sessions of 2026-11-27);
-// "within the limit" where that run's table was not kept. A kernel's baseline copy (a CPU without
-// AVX2, or --clone baseline: bench/machine.h) keeps other ratios than its vector copies and has limits
-// of its own, set from its ratios on Zen 5 (--clone baseline) as the others are, except where the
-// regression below must still fail them (sample.plain, frame.plain: ~1.2x their ratio). --clone avx2 on an AVX-512
-// machine runs the copies an AVX2-only CPU (Zen 2/3, Intel's client parts) would, against the same limits: CTest's
-// bench_guard_avx2 does, so every CI machine that can run them guards both. Exit status: 0 all within limits, 1
-// otherwise, 77 for a
-// --clone this CPU cannot run; a build without NDEBUG (debug, sanitizers) prints the table and skips (77), since its
-// ratios mean nothing. Output: one tab-separated row per check, after the machine line.
+// "within the limit" where that run's table was not kept.
+// A kernel's baseline copy (a CPU without AVX2, or --clone baseline: bench/machine.h) keeps other
+// ratios than its vector copies and has limits of its own, set from its ratios on Zen 5 as the
+// others are, except where the denormal regression (issue 27) must still fail them (sample.plain,
+// frame.plain: ~1.2x their ratio). --clone avx2 on an AVX-512 machine runs the copies an AVX2-only
+// CPU (Zen 2/3, Intel's client parts) would, against the same limits; CTest's bench_guard_avx2
+// does, so every CI machine that can run them guards both copies.
+// Exit status: 0 all within limits, 1 otherwise, 77 for a --clone this CPU cannot run; a build
+// without NDEBUG (debug, sanitizers) prints the table and skips (77), since its ratios mean
+// nothing. Output: one tab-separated row per check, after the machine line.
 #include <fcntl.h>
 #if defined(__SSE__)
 #include <xmmintrin.h>
