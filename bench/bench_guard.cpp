@@ -300,16 +300,12 @@ bool plain_rows(int trials, const ossa::bench::BenchData& data, std::vector<Row>
 
 int main(int argc, char** argv) {
   int trials = 25;
-  std::string clone;  // --clone's value, if any
-  for (int i = 1; i < argc; ++i) {
-    if (std::strcmp(argv[i], "--clone") == 0 && i + 1 < argc) clone = argv[i + 1];
-    else if (std::strncmp(argv[i], "--clone=", 8) == 0) clone = argv[i] + 8;
-  }
   std::string clone_error;
-  if (!ossa::bench::apply_clone(argc, argv, &clone_error)) {
+  bool unavailable = false;
+  if (!ossa::bench::apply_clone(argc, argv, &clone_error, &unavailable)) {
     std::fprintf(stderr, "ossa-bench-guard: %s\n", clone_error.c_str());
     // A known copy this CPU cannot run is a skip (CTest's bench_guard_avx2 on a CPU without AVX2).
-    return clone == "baseline" || clone == "avx2" || clone == "avx512" ? 77 : 2;
+    return unavailable ? 77 : 2;
   }
   for (int i = 1; i < argc; ++i) {
     if (std::strcmp(argv[i], "--trials") == 0 && i + 1 < argc) {

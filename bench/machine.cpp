@@ -54,7 +54,8 @@ CpuVendor cpu_vendor() {
   return CpuVendor::Other;
 }
 
-bool apply_clone(int& argc, char** argv, std::string* error) {
+bool apply_clone(int& argc, char** argv, std::string* error, bool* unavailable) {
+  if (unavailable) *unavailable = false;
   for (int i = 1; i < argc; ++i) {
     std::string name;
     int taken = 0;
@@ -80,6 +81,7 @@ bool apply_clone(int& argc, char** argv, std::string* error) {
     }
     if (!ok) {
       *error = "--clone " + name + ": this CPU or build cannot run it";
+      if (unavailable) *unavailable = true;
       return false;
     }
     for (int j = i; j + taken < argc; ++j) argv[j] = argv[j + taken];

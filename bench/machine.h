@@ -23,7 +23,8 @@ CpuVendor cpu_vendor();
 /// Takes `--clone baseline|avx2|avx512` (or `--clone=...`) out of argv, if present, and forces
 /// that copy: baseline = the per-joint loops' baseline copy and portable skinning; avx2 = their
 /// AVX2 copies; avx512 = the AVX2 per-joint loops (they have no AVX-512 copy) and AVX-512 skinning.
-/// False with *error set for an unknown name or a copy this CPU or build cannot run.
-bool apply_clone(int& argc, char** argv, std::string* error);
+/// False with *error set for an unknown name or a copy this CPU or build cannot run; *unavailable
+/// (when given) then says which: true for a known copy this CPU or build cannot run.
+bool apply_clone(int& argc, char** argv, std::string* error, bool* unavailable = nullptr);
 
 }  // namespace ossa::bench
