@@ -125,14 +125,17 @@ std::vector<std::pair<std::string, std::vector<uint8_t>>> synthetic_files() {
   for (const auto& [name, spec] : ossa::test::valid_variants())
     if (name == "default" || name == "float32-layout" || name == "static-mesh")
       out.emplace_back(name, ossa::test::make_valid_file(spec));
-  ossa::test::SyntheticSpec wide;
-  wide.meshes[0].layout = {{S::Position, F::Unorm16x4, 0},
-                           {S::Normal, F::Snorm16x2, 8},
-                           {S::TexCoord0, F::Float16x2, 12},
-                           {S::Joints, F::Uint16x4, 16},
-                           {S::Weights, F::Unorm8x4, 24}};
-  wide.meshes[0].vertex_stride = 28;
-  out.emplace_back("quantized-wide-slots", ossa::test::make_valid_file(wide));
+  // The cooker's quantized layout with 16-bit joint slots.
+  const auto wide_slots = [](ossa::test::SyntheticSpec spec) {
+    spec.meshes[0].layout = {{S::Position, F::Unorm16x4, 0},
+                             {S::Normal, F::Snorm16x2, 8},
+                             {S::TexCoord0, F::Float16x2, 12},
+                             {S::Joints, F::Uint16x4, 16},
+                             {S::Weights, F::Unorm8x4, 24}};
+    spec.meshes[0].vertex_stride = 28;
+    return spec;
+  };
+  out.emplace_back("quantized-wide-slots", ossa::test::make_valid_file(wide_slots({})));
   out.emplace_back("tangents", with_tangents({}));
 
   const ossa::test::SyntheticSpec many = many_vertices();
@@ -159,14 +162,7 @@ std::vector<std::pair<std::string, std::vector<uint8_t>>> synthetic_files() {
   // The structure-of-arrays kernel (positions with normals, class-ordered) in the layouts it
   // reads differently from the cooker's: 16-bit slots, weights apart from the slots, and the normal
   // apart from the position (each read on its own); plus the broken order with it.
-  ossa::test::SyntheticSpec ordered_wide = ordered;
-  ordered_wide.meshes[0].layout = {{S::Position, F::Unorm16x4, 0},
-                                   {S::Normal, F::Snorm16x2, 8},
-                                   {S::TexCoord0, F::Float16x2, 12},
-                                   {S::Joints, F::Uint16x4, 16},
-                                   {S::Weights, F::Unorm8x4, 24}};
-  ordered_wide.meshes[0].vertex_stride = 28;
-  out.emplace_back("ordered-wide-slots", ossa::test::make_valid_file(ordered_wide));
+  out.emplace_back("ordered-wide-slots", ossa::test::make_valid_file(wide_slots(ordered)));
   ossa::test::SyntheticSpec ordered_apart = ordered;
   ordered_apart.meshes[0].layout = {{S::Position, F::Unorm16x4, 0},
                                     {S::TexCoord0, F::Float16x2, 8},
