@@ -225,10 +225,13 @@ struct GraphDefinition::Impl {
 namespace graph_detail {
 
 /// Per joint inertialization of one channel (translation or rotation): offset = direction * x(t),
-/// x the quintic through (x0, v0, a0) reaching 0 with zero velocity and acceleration at t1.
+/// x the quintic through (x0, v0, a0) reaching 0 with zero velocity and acceleration at t1. Its
+/// three leading coefficients (of t^5, t^4, t^3) are fixed when the offset is captured
+/// (init_channel), so that a frame evaluates the polynomial without the three divisions they take.
 struct InertialChannel {
   glm::vec3 direction{0.0f};
   float x0 = 0.0f, v0 = 0.0f, a0 = 0.0f, t1 = 0.0f;
+  float k5 = 0.0f, k4 = 0.0f, k3 = 0.0f;
 };
 
 /// A machine's scalars that its update changes: the state played, the transition, the clocks.
