@@ -225,13 +225,14 @@ struct GraphDefinition::Impl {
 namespace graph_detail {
 
 /// Per joint inertialization of one channel (translation or rotation): offset = direction * x(t),
-/// x the quintic through (x0, v0, a0) reaching 0 with zero velocity and acceleration at t1. Its
-/// three leading coefficients (of t^5, t^4, t^3) are fixed when the offset is captured
-/// (init_channel), so that a frame evaluates the polynomial without the three divisions they take.
+/// x the quintic through (x0, v0, a0) reaching 0 with zero velocity and acceleration at t1:
+/// x = k5 t^5 + k4 t^4 + k3 t^3 + k2 t^2 + v0 t + x0 (k2 = a0 / 2). The coefficients are fixed when
+/// the offset is captured (init_channel), so that a frame evaluates the polynomial without the
+/// three divisions they take.
 struct InertialChannel {
   glm::vec3 direction{0.0f};
-  float x0 = 0.0f, v0 = 0.0f, a0 = 0.0f, t1 = 0.0f;
-  float k5 = 0.0f, k4 = 0.0f, k3 = 0.0f;
+  float x0 = 0.0f, v0 = 0.0f, t1 = 0.0f;
+  float k5 = 0.0f, k4 = 0.0f, k3 = 0.0f, k2 = 0.0f;
 };
 
 /// A machine's scalars that its update changes: the state played, the transition, the clocks.

@@ -100,7 +100,7 @@ bool has_last(const State& s, const MachineState& m) {
 
 float quintic(const InertialChannel& c, float t) {
   if (t >= c.t1) return 0.0f;
-  return (((((c.k5 * t + c.k4) * t + c.k3) * t + 0.5f * c.a0) * t + c.v0) * t) + c.x0;
+  return (((((c.k5 * t + c.k4) * t + c.k3) * t + c.k2) * t + c.v0) * t) + c.x0;
 }
 
 void init_channel(InertialChannel& c, const glm::vec3& offset, const glm::vec3& velocity, float duration) {
@@ -119,12 +119,12 @@ void init_channel(InertialChannel& c, const glm::vec3& offset, const glm::vec3& 
     return;
   }
   const float t1 = c.t1;
-  c.a0 = std::max(0.0f, (-8.0f * c.v0 * t1 - 20.0f * x0) / (t1 * t1));
-  const float v0 = c.v0, a0 = c.a0;
+  const float v0 = c.v0, a0 = std::max(0.0f, (-8.0f * v0 * t1 - 20.0f * x0) / (t1 * t1));
   const float t1_2 = t1 * t1, t1_3 = t1_2 * t1;
   c.k5 = -(a0 * t1_2 + 6.0f * v0 * t1 + 12.0f * x0) / (2.0f * t1_3 * t1_2);
   c.k4 = (3.0f * a0 * t1_2 + 16.0f * v0 * t1 + 30.0f * x0) / (2.0f * t1_3 * t1);
   c.k3 = -(3.0f * a0 * t1_2 + 12.0f * v0 * t1 + 20.0f * x0) / (2.0f * t1_3);
+  c.k2 = 0.5f * a0;
 }
 
 /// The rotation vector (axis * angle) of q, on the shortest arc.
